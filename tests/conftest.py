@@ -1,0 +1,30 @@
+"""Shared test fixtures: the real recordings folder, skipped cleanly when absent."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+
+
+def shared_data_dir() -> Path:
+    return Path(os.environ.get("VO_DOPPLER_SHARED_DATA", REPO_ROOT.parent / "shared" / "data"))
+
+
+@pytest.fixture(scope="session")
+def shared_data() -> Path:
+    path = shared_data_dir()
+    if not path.is_dir():
+        pytest.skip(f"real recordings not found at {path} (set VO_DOPPLER_SHARED_DATA)")
+    return path
+
+
+def require_shared(relative: str) -> Path:
+    """Path of one recording inside the shared data folder, or skip the test."""
+    path = shared_data_dir() / relative
+    if not path.exists():
+        pytest.skip(f"real recording {relative} not found under {shared_data_dir()}")
+    return path

@@ -1,0 +1,4 @@
+"""One module per ``vo-doppler`` subcommand: each has ``register(subparsers)``.
+
+A subcommand parses its arguments, calls the library and writes outputs; no maths here.
+"""

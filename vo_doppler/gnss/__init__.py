@@ -1,0 +1,1 @@
+"""gnss stage of vo-doppler."""

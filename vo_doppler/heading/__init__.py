@@ -1,0 +1,1 @@
+"""heading stage of vo-doppler."""

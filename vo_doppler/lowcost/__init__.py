@@ -1,0 +1,1 @@
+"""lowcost stage of vo-doppler."""

@@ -1,0 +1,168 @@
+"""Timestamped 6-DoF trajectories and their TUM / KITTI file formats.
+
+A pose maps body coordinates to world coordinates: p_world = R @ p_body + t.
+TUM rows are ``t x y z qx qy qz qw``; KITTI rows are the 3×4 matrix [R | t] row-major
+(KITTI files carry no time, so times come from elsewhere or default to the row index).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from vo_doppler.errors import InputError
+
+
+@dataclass
+class Trajectory:
+    """Poses at times ``t`` (N,), positions (N, 3) and orientations as scipy Rotations (N)."""
+
+    t: np.ndarray
+    positions: np.ndarray
+    orientations: Rotation
+
+    def __post_init__(self) -> None:
+        self.t = np.asarray(self.t, dtype=float).reshape(-1)
+        self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 3)
+        n = len(self.t)
+        if len(self.positions) != n or len(self.orientations) != n:
+            raise ValueError(
+                f"trajectory arrays disagree: {n} times, {len(self.positions)} positions, "
+                f"{len(self.orientations)} orientations"
+            )
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    @classmethod
+    def from_matrices(cls, t: np.ndarray, poses: np.ndarray) -> Trajectory:
+        """Build from (N, 4, 4) or (N, 3, 4) pose matrices."""
+        poses = np.asarray(poses, dtype=float)
+        return cls(t, poses[:, :3, 3], Rotation.from_matrix(poses[:, :3, :3]))
+
+    @property
+    def matrices(self) -> np.ndarray:
+        """Poses as (N, 4, 4) homogeneous matrices."""
+        out = np.tile(np.eye(4), (len(self), 1, 1))
+        if len(self):
+            out[:, :3, :3] = self.orientations.as_matrix()
+        out[:, :3, 3] = self.positions
+        return out
+
+    @property
+    def path_length(self) -> float:
+        return float(np.sum(np.linalg.norm(np.diff(self.positions, axis=0), axis=1)))
+
+    def cumulative_distance(self) -> np.ndarray:
+        steps = np.linalg.norm(np.diff(self.positions, axis=0), axis=1)
+        return np.concatenate([[0.0], np.cumsum(steps)])
+
+    def transformed(self, rotation: np.ndarray, translation: np.ndarray, scale: float = 1.0):
+        """Apply the similarity x ↦ s·R·x + t to every pose (orientations are rotated by R)."""
+        rot = Rotation.from_matrix(np.asarray(rotation, dtype=float))
+        positions = scale * self.positions @ np.asarray(rotation).T + np.asarray(translation)
+        return Trajectory(self.t.copy(), positions, rot * self.orientations)
+
+    def subset(self, index) -> Trajectory:
+        return Trajectory(self.t[index], self.positions[index], self.orientations[index])
+
+
+def _read_numeric_rows(path: Path, n_columns: int, what: str) -> np.ndarray:
+    rows: list[list[float]] = []
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise InputError(f"cannot read {what} file: {exc.strerror or exc}", path) from exc
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        fields = stripped.replace(",", " ").split()
+        if len(fields) != n_columns:
+            raise InputError(
+                f"{what} row has {len(fields)} fields, expected {n_columns}", path, number
+            )
+        try:
+            values = [float(f) for f in fields]
+        except ValueError as exc:
+            raise InputError(f"{what} row has a non-numeric field ({exc})", path, number) from exc
+        if not np.all(np.isfinite(values)):
+            raise InputError(f"{what} row has a non-finite value", path, number)
+        rows.append(values)
+    return np.array(rows, dtype=float).reshape(-1, n_columns)
+
+
+def read_tum(path: str | Path) -> Trajectory:
+    """Read a TUM trajectory file (``t x y z qx qy qz qw``; ``#`` comments allowed)."""
+    path = Path(path)
+    data = _read_numeric_rows(path, 8, "TUM")
+    quats = data[:, 4:8]
+    norms = np.linalg.norm(quats, axis=1)
+    bad = np.flatnonzero(norms < 1e-9)
+    if bad.size:
+        raise InputError(f"TUM row {bad[0] + 1} has a zero quaternion", path)
+    return Trajectory(data[:, 0], data[:, 1:4], Rotation.from_quat(quats / norms[:, None]))
+
+
+def write_tum(path: str | Path, trajectory: Trajectory) -> None:
+    """Write a TUM trajectory file with full double precision."""
+    quats = trajectory.orientations.as_quat() if len(trajectory) else np.zeros((0, 4))
+    data = np.column_stack([trajectory.t, trajectory.positions, quats])
+    np.savetxt(path, data, fmt="%.9f", header="t x y z qx qy qz qw")
+
+
+def read_kitti(path: str | Path, times: np.ndarray | None = None) -> Trajectory:
+    """Read a KITTI pose file (3×4 row-major per line); times default to the row index."""
+    path = Path(path)
+    data = _read_numeric_rows(path, 12, "KITTI")
+    poses = data.reshape(-1, 3, 4)
+    if times is None:
+        times = np.arange(len(poses), dtype=float)
+    elif len(times) != len(poses):
+        raise InputError(f"{len(poses)} poses but {len(times)} timestamps", path)
+    rotations = poses[:, :, :3]
+    u, _, vt = np.linalg.svd(rotations)
+    fixed = u @ vt
+    return Trajectory(times, poses[:, :, 3], Rotation.from_matrix(fixed))
+
+
+def write_kitti(path: str | Path, trajectory: Trajectory) -> None:
+    """Write a KITTI pose file (no timestamps)."""
+    rows = trajectory.matrices[:, :3, :].reshape(-1, 12)
+    np.savetxt(path, rows, fmt="%.9e")
+
+
+def read_trajectory(path: str | Path, fmt: str = "auto", times=None) -> Trajectory:
+    """Read TUM or KITTI; ``auto`` picks by the number of columns of the first data row."""
+    path = Path(path)
+    if fmt == "auto":
+        fmt = _sniff_format(path)
+    if fmt == "tum":
+        return read_tum(path)
+    if fmt == "kitti":
+        return read_kitti(path, times)
+    raise ValueError(f"unknown trajectory format {fmt!r} (expected tum, kitti or auto)")
+
+
+def _sniff_format(path: Path) -> str:
+    try:
+        with path.open() as handle:
+            for line in handle:
+                stripped = line.strip()
+                if stripped and not stripped.startswith("#"):
+                    n = len(stripped.replace(",", " ").split())
+                    if n == 8:
+                        return "tum"
+                    if n == 12:
+                        return "kitti"
+                    raise InputError(
+                        f"cannot tell the trajectory format: first row has {n} fields "
+                        "(TUM has 8, KITTI 12)",
+                        path,
+                    )
+    except OSError as exc:
+        raise InputError(f"cannot read trajectory: {exc.strerror or exc}", path) from exc
+    raise InputError("trajectory file has no data rows", path)

@@ -1,0 +1,1 @@
+"""vo stage of vo-doppler."""
