@@ -116,7 +116,9 @@ def read_yaml_calib(path: str | Path) -> Camera:
         dist = np.zeros(5)
         coeffs = [float(v) for v in data.get("distortion", data.get("distortion_coeffs", []))]
         if len(coeffs) > 5:
-            raise InputError(f"{len(coeffs)} distortion coefficients; at most 5 (k1 k2 p1 p2 k3)", path)
+            raise InputError(
+                f"{len(coeffs)} distortion coefficients; at most 5 (k1 k2 p1 p2 k3)", path
+            )
         dist[: len(coeffs)] = coeffs
         if "T_vehicle_camera" in data:
             extrinsic = np.array(data["T_vehicle_camera"], dtype=float)

@@ -1,0 +1,83 @@
+"""Error metrics on trajectories with a known answer."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from vo_doppler.cli import main
+from vo_doppler.eval.alignment import umeyama
+from vo_doppler.eval.metrics import evaluate, segment_lengths_that_fit
+from vo_doppler.trajectory import Trajectory, write_kitti, write_tum
+
+
+def straight(n=301, step=1.0, yaw_rate=0.0):
+    t = np.arange(n, dtype=float)
+    yaw = yaw_rate * t
+    positions = np.column_stack(
+        [np.cumsum(step * np.cos(yaw)), np.cumsum(step * np.sin(yaw)), 0 * t]
+    )
+    positions -= positions[0]
+    return Trajectory(t, positions, Rotation.from_euler("z", yaw[:, None]))
+
+
+def test_constant_scale_error_gives_known_translation_error():
+    truth = straight()
+    estimate = Trajectory(truth.t, truth.positions * 1.02, truth.orientations)
+    errors = evaluate(estimate, truth, "none")
+    assert [s.length_m for s in errors.segments] == [100.0, 200.0]
+    for segment in errors.segments:
+        assert segment.translation_pct == pytest.approx(2.0, abs=1e-9)
+        assert segment.rotation_deg_per_100m == pytest.approx(0.0, abs=1e-9)
+    assert errors.final_drift_pct == pytest.approx(2.0, abs=1e-9)
+    assert errors.end_yaw_error_deg == pytest.approx(0.0, abs=1e-9)
+
+
+def test_heading_offset_gives_known_end_error_and_yaw():
+    truth = straight(n=101)
+    rot = Rotation.from_euler("z", 1.0, degrees=True)
+    estimate = truth.transformed(rot.as_matrix(), np.zeros(3))
+    errors = evaluate(estimate, truth, "none")
+    assert errors.end_yaw_error_deg == pytest.approx(1.0, abs=1e-9)
+    expected = 2 * 100.0 * np.sin(np.radians(0.5))
+    assert errors.final_position_error_m == pytest.approx(expected, rel=1e-9)
+    aligned = evaluate(estimate, truth, "se2")
+    assert aligned.ate_rmse_m < 1e-9 and abs(aligned.end_yaw_error_deg) < 1e-9
+
+
+def test_umeyama_recovers_similarity():
+    rng = np.random.default_rng(1)
+    source = rng.normal(size=(50, 3))
+    rot = Rotation.random(random_state=3).as_matrix()
+    target = 2.5 * source @ rot.T + np.array([1.0, -2.0, 3.0])
+    r, t, s = umeyama(source, target, True)
+    np.testing.assert_allclose(r, rot, atol=1e-10)
+    assert s == pytest.approx(2.5)
+    np.testing.assert_allclose(t, [1, -2, 3], atol=1e-10)
+
+
+def test_short_paths_use_short_segments():
+    assert segment_lengths_that_fit(60.0) == (10.0, 20.0, 30.0, 40.0, 50.0)
+    assert segment_lengths_that_fit(250.0) == (100.0, 200.0)
+    assert segment_lengths_that_fit(5.0) == (2.5,)
+
+
+def test_cli_eval_json(tmp_path, capsys):
+    truth = straight(n=120)
+    estimate = Trajectory(truth.t, truth.positions * 1.01, truth.orientations)
+    write_tum(tmp_path / "gt.tum", truth)
+    write_tum(tmp_path / "est.tum", estimate)
+    assert main(["eval", str(tmp_path / "est.tum"), str(tmp_path / "gt.tum"), "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert figures["final_drift_pct"] == pytest.approx(1.0, abs=1e-6)
+
+
+def test_cli_eval_kitti_row_mismatch_exit_1(tmp_path, capsys):
+    truth = straight(n=10)
+    write_kitti(tmp_path / "gt.txt", truth)
+    write_kitti(tmp_path / "est.txt", truth.subset(slice(0, 8)))
+    assert main(["eval", str(tmp_path / "est.txt"), str(tmp_path / "gt.txt")]) == 1
+    assert "8 estimated poses but 10" in capsys.readouterr().err

@@ -1,0 +1,87 @@
+"""``vo-doppler eval EST GT``: KITTI-style segment errors, drift, end yaw error and ATE."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from vo_doppler.errors import InputError
+from vo_doppler.eval.alignment import ALIGNMENTS
+from vo_doppler.eval.metrics import TrajectoryErrors, associate, evaluate
+from vo_doppler.trajectory import read_trajectory
+
+UP_AXES = {"z": (0.0, 0.0, 1.0), "-y": (0.0, -1.0, 0.0), "y": (0.0, 1.0, 0.0)}
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "eval",
+        help="trajectory errors against ground truth",
+        description="KITTI-devkit segment errors (translation %%, rotation deg/100 m), final "
+        "drift %% of path length, yaw error at the end and ATE RMSE.",
+    )
+    parser.add_argument("estimate", help="estimated trajectory (TUM or KITTI)")
+    parser.add_argument("ground_truth", help="ground-truth trajectory (TUM or KITTI)")
+    parser.add_argument("--format", choices=("auto", "tum", "kitti"), default="auto")
+    parser.add_argument("--align", choices=ALIGNMENTS, default="start")
+    parser.add_argument(
+        "--up",
+        choices=("auto", *UP_AXES),
+        default="auto",
+        help="world up axis for yaw and SE(2) alignment (auto: -y for KITTI camera poses, else z)",
+    )
+    parser.add_argument("--json", action="store_true", help="print the figures as JSON")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    estimate = read_trajectory(args.estimate, args.format)
+    truth = read_trajectory(args.ground_truth, args.format)
+    kitti_rows = args.format == "kitti" or (
+        np.array_equal(estimate.t, np.arange(len(estimate)))
+        and np.array_equal(truth.t, np.arange(len(truth)))
+    )
+    if kitti_rows:
+        if len(estimate) != len(truth):
+            raise InputError(
+                f"{len(estimate)} estimated poses but {len(truth)} ground-truth poses "
+                "(KITTI rows are matched one to one)",
+                args.estimate,
+            )
+    else:
+        estimate, truth = associate(estimate, truth)
+        if len(estimate) < 2:
+            raise InputError("fewer than two timestamps match the ground truth", args.estimate)
+    up_name = args.up if args.up != "auto" else ("-y" if kitti_rows else "z")
+    errors = evaluate(estimate, truth, args.align, np.array(UP_AXES[up_name]))
+    if args.json:
+        print(json.dumps(errors.to_dict(), indent=2))
+    else:
+        print_errors(errors)
+    return 0
+
+
+def print_errors(errors: TrajectoryErrors) -> None:
+    console = Console()
+    table = Table(title=f"Segment errors ({errors.alignment} alignment)")
+    table.add_column("length [m]", justify="right")
+    table.add_column("translation [%]", justify="right")
+    table.add_column("rotation [deg/100 m]", justify="right")
+    table.add_column("segments", justify="right")
+    for s in errors.segments:
+        table.add_row(
+            f"{s.length_m:.0f}",
+            f"{s.translation_pct:.3f}",
+            f"{s.rotation_deg_per_100m:.4f}",
+            str(s.count),
+        )
+    console.print(table)
+    console.print(
+        f"path {errors.path_length_m:.1f} m | final error {errors.final_position_error_m:.3f} m "
+        f"({errors.final_drift_pct:.3f} % of path) | end yaw error "
+        f"{errors.end_yaw_error_deg:.3f} deg | ATE RMSE {errors.ate_rmse_m:.3f} m"
+    )

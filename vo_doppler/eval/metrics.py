@@ -1,0 +1,138 @@
+"""Trajectory error metrics: KITTI-devkit segment errors, final drift, end yaw error, ATE RMSE.
+
+Segment errors follow the KITTI odometry devkit: for every start frame and segment length L,
+the end frame is the first whose ground-truth path distance from the start is ≥ L; the error is
+the relative pose ``inv(ΔT_gt) · ΔT_est``, translation in % of L and rotation in degrees per 100 m.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from vo_doppler.eval.alignment import align
+from vo_doppler.trajectory import Trajectory
+
+KITTI_SEGMENT_LENGTHS_M = (100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 700.0, 800.0)
+SHORT_SEGMENT_LENGTHS_M = (10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0)
+
+
+@dataclass
+class SegmentError:
+    length_m: float
+    translation_pct: float
+    rotation_deg_per_100m: float
+    count: int
+
+
+@dataclass
+class TrajectoryErrors:
+    path_length_m: float
+    alignment: str
+    segments: list[SegmentError] = field(default_factory=list)
+    mean_translation_pct: float = float("nan")
+    mean_rotation_deg_per_100m: float = float("nan")
+    final_position_error_m: float = float("nan")
+    final_drift_pct: float = float("nan")
+    end_yaw_error_deg: float = float("nan")
+    ate_rmse_m: float = float("nan")
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def segment_lengths_that_fit(path_length: float) -> tuple[float, ...]:
+    """KITTI's 100…800 m lengths shorter than the path; on short paths 10…80 m; else half the path."""
+    for lengths in (KITTI_SEGMENT_LENGTHS_M, SHORT_SEGMENT_LENGTHS_M):
+        fit = tuple(length for length in lengths if length < path_length)
+        if fit:
+            return fit
+    return (path_length / 2.0,) if path_length > 0 else ()
+
+
+def yaw_about(rotation: Rotation, up: np.ndarray) -> np.ndarray:
+    """Signed rotation angle (rad) about ``up`` of each rotation, from a horizontal reference axis."""
+    up = np.asarray(up, dtype=float) / np.linalg.norm(up)
+    reference = np.eye(3)[int(np.argmin(np.abs(up)))]
+    reference = reference - (reference @ up) * up
+    reference /= np.linalg.norm(reference)
+    rotated = rotation.apply(reference)
+    rotated = rotated - np.outer(rotated @ up, up)
+    sin = np.cross(np.broadcast_to(reference, rotated.shape), rotated) @ up
+    return np.arctan2(sin, rotated @ reference)
+
+
+def segment_errors(estimate: Trajectory, truth: Trajectory, lengths) -> list[SegmentError]:
+    """KITTI-devkit relative errors for each segment length (every start frame used)."""
+    distance = truth.cumulative_distance()
+    est, gt = estimate.matrices, truth.matrices
+    results = []
+    for length in lengths:
+        starts = np.arange(len(distance))
+        ends = np.searchsorted(distance, distance + length, side="left")
+        keep = ends < len(distance)
+        starts, ends = starts[keep], ends[keep]
+        if starts.size == 0:
+            continue
+        delta_gt = np.linalg.inv(gt[starts]) @ gt[ends]
+        delta_est = np.linalg.inv(est[starts]) @ est[ends]
+        error = np.linalg.inv(delta_gt) @ delta_est
+        t_err = np.linalg.norm(error[:, :3, 3], axis=1) / length
+        r_err = Rotation.from_matrix(error[:, :3, :3]).magnitude() / length
+        results.append(
+            SegmentError(
+                length_m=float(length),
+                translation_pct=float(100.0 * t_err.mean()),
+                rotation_deg_per_100m=float(np.degrees(r_err.mean()) * 100.0),
+                count=int(starts.size),
+            )
+        )
+    return results
+
+
+def evaluate(
+    estimate: Trajectory,
+    truth: Trajectory,
+    alignment: str = "start",
+    up: np.ndarray | None = None,
+) -> TrajectoryErrors:
+    """All error figures of ``estimate`` against ``truth`` (rows must already correspond)."""
+    if len(estimate) != len(truth):
+        raise ValueError(f"estimate has {len(estimate)} poses, ground truth {len(truth)}")
+    if len(truth) < 2:
+        raise ValueError("need at least two poses to evaluate")
+    up = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, dtype=float)
+    aligned = align(estimate, truth, alignment, up)
+    path_length = truth.path_length
+    segments = segment_errors(aligned, truth, segment_lengths_that_fit(path_length))
+    result = TrajectoryErrors(path_length_m=path_length, alignment=alignment, segments=segments)
+    if segments:
+        weights = np.array([s.count for s in segments], dtype=float)
+        result.mean_translation_pct = float(
+            np.average([s.translation_pct for s in segments], weights=weights)
+        )
+        result.mean_rotation_deg_per_100m = float(
+            np.average([s.rotation_deg_per_100m for s in segments], weights=weights)
+        )
+    final_error = float(np.linalg.norm(aligned.positions[-1] - truth.positions[-1]))
+    result.final_position_error_m = final_error
+    result.final_drift_pct = 100.0 * final_error / path_length if path_length > 0 else float("nan")
+    yaw_est = yaw_about(aligned.orientations[-1:], up)[0]
+    yaw_gt = yaw_about(truth.orientations[-1:], up)[0]
+    result.end_yaw_error_deg = float(np.degrees(np.angle(np.exp(1j * (yaw_est - yaw_gt)))))
+    residual = aligned.positions - truth.positions
+    result.ate_rmse_m = float(np.sqrt(np.mean(np.sum(residual**2, axis=1))))
+    return result
+
+
+def associate(estimate: Trajectory, truth: Trajectory, max_dt: float = 0.02) -> tuple:
+    """Match rows by nearest timestamp within ``max_dt``; returns the matched pair."""
+    index = np.clip(np.searchsorted(truth.t, estimate.t), 1, max(len(truth) - 1, 1))
+    left = np.maximum(index - 1, 0)
+    nearer = np.where(
+        np.abs(truth.t[left] - estimate.t) <= np.abs(truth.t[index] - estimate.t), left, index
+    )
+    ok = np.abs(truth.t[nearer] - estimate.t) <= max_dt
+    return estimate.subset(np.flatnonzero(ok)), truth.subset(nearer[ok])
