@@ -82,7 +82,7 @@ def wrap_angle(angle_rad):
 
 
 def yaw_to_course(yaw_rad):
-    """Yaw (counter-clockwise from east) to course (clockwise from north), both in radians, [0, 2π)."""
+    """Yaw (counter-clockwise from east) to course (clockwise from north), radians in [0, 2π)."""
     return np.mod(np.pi / 2.0 - np.asarray(yaw_rad), 2.0 * np.pi)
 
 

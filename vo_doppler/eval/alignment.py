@@ -10,7 +10,7 @@ ALIGNMENTS = ("none", "start", "se2", "sim3")
 
 
 def umeyama(source: np.ndarray, target: np.ndarray, with_scale: bool) -> tuple:
-    """Least-squares similarity (R, t, s) with target ≈ s·R·source + t (Umeyama, 1991, Eq. 40–42)."""
+    """Similarity (R, t, s) minimising |target − (s·R·source + t)|² (Umeyama 1991, Eq. 40–42)."""
     mu_s, mu_t = source.mean(axis=0), target.mean(axis=0)
     xs, xt = source - mu_s, target - mu_t
     cov = xt.T @ xs / len(source)

@@ -44,7 +44,7 @@ class TrajectoryErrors:
 
 
 def segment_lengths_that_fit(path_length: float) -> tuple[float, ...]:
-    """KITTI's 100…800 m lengths shorter than the path; on short paths 10…80 m; else half the path."""
+    """KITTI's 100…800 m lengths that fit the path; on short paths 10…80 m; else half the path."""
     for lengths in (KITTI_SEGMENT_LENGTHS_M, SHORT_SEGMENT_LENGTHS_M):
         fit = tuple(length for length in lengths if length < path_length)
         if fit:
@@ -53,7 +53,7 @@ def segment_lengths_that_fit(path_length: float) -> tuple[float, ...]:
 
 
 def yaw_about(rotation: Rotation, up: np.ndarray) -> np.ndarray:
-    """Signed rotation angle (rad) about ``up`` of each rotation, from a horizontal reference axis."""
+    """Signed angle (rad) about ``up`` of each rotation, from a horizontal reference axis."""
     up = np.asarray(up, dtype=float) / np.linalg.norm(up)
     reference = np.eye(3)[int(np.argmin(np.abs(up)))]
     reference = reference - (reference @ up) * up
