@@ -1,0 +1,73 @@
+"""Every observable, LLI and signal-strength value of the shared RINEX files equals georinex's.
+
+georinex (test-only dependency) is slow — about 20 s for the Septentrio file — so each file is
+read once per test session.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from tests.conftest import require_shared
+from vo_doppler.io.rinex_obs import read_obs
+
+FILES = ("septentrio_static/rover.obs", "yamatogawa_ublox_walk/yamatogawa_rover.obs")
+
+
+@pytest.fixture(scope="session", params=FILES)
+def both_readers(request):
+    georinex = pytest.importorskip("georinex")
+    path = require_shared(request.param)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        reference = georinex.load(path, useindicators=True)
+    return read_obs(path), reference
+
+
+def _gps_seconds(times: np.ndarray) -> np.ndarray:
+    return (times - np.datetime64("1980-01-06T00:00:00")) / np.timedelta64(1, "ns") * 1e-9
+
+
+def _ours_as_grid(obs, code, attribute, reference):
+    """Our values of one observable on georinex's (time, sv) grid; NaN where we have none."""
+    times = _gps_seconds(reference.time.values)
+    svs = [str(s) for s in reference.sv.values]
+    grid = np.full((times.size, len(svs)), np.nan)
+    rows = obs.mask(code=code)
+    sat = obs.satellites()[rows]
+    t_index = np.searchsorted(times, obs.time[rows])
+    assert np.all(np.abs(times[t_index] - obs.time[rows]) < 1e-6)
+    sv_index = np.array([svs.index(s) for s in sat])
+    values = getattr(obs, attribute)[rows].astype(float)
+    if attribute != "value":
+        values[values < 0] = np.nan
+    grid[t_index, sv_index] = values
+    return grid
+
+
+@pytest.mark.shared_data
+def test_same_epochs_and_satellites(both_readers):
+    obs, reference = both_readers
+    np.testing.assert_allclose(obs.epoch_time, _gps_seconds(reference.time.values), atol=1e-6)
+    assert set(np.unique(obs.satellites())) <= {str(s) for s in reference.sv.values}
+    assert obs.problems == ()
+
+
+@pytest.mark.shared_data
+def test_every_observable_equal(both_readers):
+    obs, reference = both_readers
+    compared = 0
+    for name in reference.data_vars:
+        name = str(name)
+        code, attribute = name, "value"
+        if name.endswith(("lli", "ssi")):
+            code, attribute = name[:-3], name[-3:]
+        ours = _ours_as_grid(obs, code, attribute, reference)
+        theirs = reference[name].values
+        np.testing.assert_array_equal(ours, theirs, err_msg=name)
+        compared += int(np.isfinite(theirs).sum())
+    assert compared > 1000
+    assert np.isfinite(obs.value).all()
