@@ -1,0 +1,340 @@
+"""Wheel-speed scale (sec. 3.3) and gyro yaw-rate bias (sec. 3.4) calibrated against Doppler.
+
+Models (yaw counter-clockwise from east, yaw rate counter-clockwise positive):
+
+* wheel scale k:  v_doppler(t) = k · v_wheel(t) + noise, so the calibrated speed is k · v_wheel;
+* gyro bias b:    ω_measured = ω_true + b, hence with Φ(t) = ∫ ω_measured dt
+  ψ_doppler(t) − Φ(t) = ψ₀ − b · (t − t_ref) + noise, and the calibrated rate is ω_measured − b.
+
+Doppler samples pass an outlier gate on their short-term variation first (:func:`variation_gate`):
+the change of the Doppler value between neighbouring samples must agree with the change the
+vehicle sensor saw, to within a rate limit; a sample is dropped when it disagrees with every
+neighbour. Course samples also need a minimum speed. Both fits are least squares over stored
+recent data, refreshed as samples arrive (:class:`WheelScaleCalibrator`,
+:class:`GyroBiasCalibrator`); Kalman filters with a random-walk state are the alternative
+(:class:`WheelScaleKalman`, :class:`GyroBiasKalman`). Each returns the estimate and its
+standard deviation.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.kalman import KalmanFilter
+
+from vo_doppler.geo import wrap_angle
+
+
+@dataclass(frozen=True)
+class GateConfig:
+    """Outlier gate and data requirements of the calibration."""
+
+    max_speed_jump_mps: float = 0.5
+    max_speed_drift_mps2: float = 0.5
+    max_yaw_jump_rad: float = np.radians(2.0)
+    max_yaw_drift_rad_s: float = np.radians(1.0)
+    min_speed_mps: float = 1.0
+    window_s: float = 60.0
+    min_samples: int = 10
+
+
+@dataclass(frozen=True)
+class CalibrationEstimate:
+    """An estimated quantity with its standard deviation; NaN when not estimable."""
+
+    value: float
+    sigma: float
+    n_used: int
+    n_rejected: int
+
+    @property
+    def valid(self) -> bool:
+        return bool(np.isfinite(self.value))
+
+
+UNAVAILABLE = CalibrationEstimate(np.nan, np.nan, 0, 0)
+
+
+def variation_gate(
+    t: np.ndarray,
+    discrepancy: np.ndarray,
+    max_jump: float,
+    max_drift: float,
+    usable: np.ndarray,
+) -> np.ndarray:
+    """Mask of samples whose short-term variation is acceptable.
+
+    ``discrepancy`` is the Doppler value minus the sensor's prediction; between two neighbouring
+    usable samples ``dt`` apart its change must stay within ``max_jump + max_drift · dt``.
+    A sample is kept when at least one of its neighbour links passes (a spike drops only itself).
+    """
+    t = np.asarray(t, dtype=float)
+    keep = np.asarray(usable, dtype=bool).copy()
+    index = np.flatnonzero(keep)
+    if len(index) < 2:
+        return np.zeros_like(keep)
+    link_ok = np.abs(np.diff(discrepancy[index])) <= max_jump + max_drift * np.diff(t[index])
+    ok_left = np.concatenate([[False], link_ok])
+    ok_right = np.concatenate([link_ok, [False]])
+    keep[index] = ok_left | ok_right
+    return keep
+
+
+def estimate_wheel_scale(
+    t: np.ndarray,
+    doppler_speed: np.ndarray,
+    wheel_speed: np.ndarray,
+    doppler_valid: np.ndarray | None = None,
+    config: GateConfig = GateConfig(),
+) -> CalibrationEstimate:
+    """Least-squares wheel scale k (sec. 3.3) with its standard deviation."""
+    t = np.asarray(t, dtype=float)
+    vd, vw = np.asarray(doppler_speed, dtype=float), np.asarray(wheel_speed, dtype=float)
+    usable = np.isfinite(vd) & np.isfinite(vw) & (vw >= config.min_speed_mps)
+    if doppler_valid is not None:
+        usable &= np.asarray(doppler_valid, dtype=bool)
+    keep = variation_gate(
+        t, vd - vw, config.max_speed_jump_mps, config.max_speed_drift_mps2, usable
+    )
+    n, rejected = int(keep.sum()), int(usable.sum() - keep.sum())
+    if n < max(config.min_samples, 2):
+        return CalibrationEstimate(np.nan, np.nan, n, rejected)
+    x, y = vw[keep], vd[keep]
+    sxx = float(x @ x)
+    k = float(x @ y) / sxx
+    residual = y - k * x
+    sigma = np.sqrt(float(residual @ residual) / (n - 1) / sxx)
+    return CalibrationEstimate(k, float(sigma), n, rejected)
+
+
+def estimate_gyro_bias(
+    t: np.ndarray,
+    doppler_yaw: np.ndarray,
+    integrated_yaw: np.ndarray,
+    doppler_speed: np.ndarray,
+    doppler_valid: np.ndarray | None = None,
+    config: GateConfig = GateConfig(),
+) -> CalibrationEstimate:
+    """Least-squares yaw-rate bias b (sec. 3.4, rad/s) with its standard deviation.
+
+    ``doppler_yaw`` is the Doppler course as yaw (rad, counter-clockwise from east),
+    ``integrated_yaw`` is Φ(t), the integral of the measured (counter-clockwise) yaw rate.
+    """
+    t = np.asarray(t, dtype=float)
+    speed = np.asarray(doppler_speed, dtype=float)
+    z = np.asarray(doppler_yaw, dtype=float) - np.asarray(integrated_yaw, dtype=float)
+    usable = np.isfinite(z) & np.isfinite(speed) & (speed >= config.min_speed_mps)
+    if doppler_valid is not None:
+        usable &= np.asarray(doppler_valid, dtype=bool)
+    z_unwrapped = np.full_like(z, np.nan)
+    z_unwrapped[usable] = np.unwrap(wrap_angle(z[usable]))
+    keep = variation_gate(
+        t, z_unwrapped, config.max_yaw_jump_rad, config.max_yaw_drift_rad_s, usable
+    )
+    n, rejected = int(keep.sum()), int(usable.sum() - keep.sum())
+    if n < max(config.min_samples, 3):
+        return CalibrationEstimate(np.nan, np.nan, n, rejected)
+    tau = t[keep] - t[keep].mean()
+    if np.ptp(tau) <= 0:
+        return CalibrationEstimate(np.nan, np.nan, n, rejected)
+    A = np.column_stack([np.ones(n), -tau])
+    y = z_unwrapped[keep]
+    (intercept, bias), *_ = np.linalg.lstsq(A, y, rcond=None)
+    residual = y - A @ np.array([intercept, bias])
+    variance = float(residual @ residual) / (n - 2)
+    sigma = np.sqrt(variance / float(tau @ tau))
+    return CalibrationEstimate(float(bias), float(sigma), n, rejected)
+
+
+class _RecentSamples:
+    """Samples of the last ``window_s`` seconds, as columns."""
+
+    def __init__(self, window_s: float, n_columns: int):
+        self.window_s = window_s
+        self.rows: deque[tuple[float, ...]] = deque()
+        self.n_columns = n_columns
+
+    def add(self, *row: float) -> np.ndarray:
+        self.rows.append(tuple(float(v) for v in row))
+        while self.rows and self.rows[-1][0] - self.rows[0][0] > self.window_s:
+            self.rows.popleft()
+        return np.array(self.rows, dtype=float).reshape(-1, self.n_columns).T
+
+
+class WheelScaleCalibrator:
+    """Streaming sec. 3.3: least squares over the stored recent samples, refreshed per sample."""
+
+    def __init__(self, config: GateConfig = GateConfig()):
+        self.config = config
+        self._samples = _RecentSamples(config.window_s, 4)
+        self.estimate = UNAVAILABLE
+
+    def add(
+        self, t: float, doppler_speed: float, wheel_speed: float, doppler_valid: bool = True
+    ) -> CalibrationEstimate:
+        tt, vd, vw, ok = self._samples.add(t, doppler_speed, wheel_speed, doppler_valid)
+        self.estimate = estimate_wheel_scale(tt, vd, vw, ok > 0.5, self.config)
+        return self.estimate
+
+
+class GyroBiasCalibrator:
+    """Streaming sec. 3.4: least squares over the stored recent samples, refreshed per sample."""
+
+    def __init__(self, config: GateConfig = GateConfig()):
+        self.config = config
+        self._samples = _RecentSamples(config.window_s, 5)
+        self.estimate = UNAVAILABLE
+
+    def add(
+        self,
+        t: float,
+        doppler_yaw: float,
+        integrated_yaw: float,
+        doppler_speed: float,
+        doppler_valid: bool = True,
+    ) -> CalibrationEstimate:
+        columns = self._samples.add(t, doppler_yaw, integrated_yaw, doppler_speed, doppler_valid)
+        tt, yaw, phi, speed, ok = columns
+        self.estimate = estimate_gyro_bias(tt, yaw, phi, speed, ok > 0.5, self.config)
+        return self.estimate
+
+
+class _StreamGate:
+    """Streaming form of the variation gate: compare with the last accepted sample.
+
+    After ``reset_after`` consecutive rejections the next sample is accepted, so that a
+    lasting change (not a spike) is followed instead of rejected forever.
+    """
+
+    def __init__(self, max_jump: float, max_drift: float, reset_after: int = 3):
+        self.max_jump = max_jump
+        self.max_drift = max_drift
+        self.reset_after = reset_after
+        self._last: tuple[float, float] | None = None
+        self._rejections = 0
+
+    def passes(self, t: float, discrepancy: float) -> bool:
+        if self._last is not None and self._rejections < self.reset_after:
+            allowed = self.max_jump + self.max_drift * (t - self._last[0])
+            if abs(discrepancy - self._last[1]) > allowed:
+                self._rejections += 1
+                return False
+        self._last = (t, discrepancy)
+        self._rejections = 0
+        return True
+
+
+class WheelScaleKalman:
+    """Kalman variant of sec. 3.3: state k, a random walk of ``q_per_sqrt_s`` per √s."""
+
+    def __init__(
+        self,
+        speed_sigma_mps: float = 0.1,
+        q_per_sqrt_s: float = 1e-4,
+        initial_sigma: float = 0.1,
+        config: GateConfig = GateConfig(),
+    ):
+        self.filter = KalmanFilter(dim_x=1, dim_z=1)
+        self.filter.x = np.array([[1.0]])
+        self.filter.P = np.array([[initial_sigma**2]])
+        self.filter.R = np.array([[speed_sigma_mps**2]])
+        self.q_per_sqrt_s = q_per_sqrt_s
+        self.config = config
+        self._gate = _StreamGate(config.max_speed_jump_mps, config.max_speed_drift_mps2)
+        self._t: float | None = None
+        self.n_used = 0
+        self.n_rejected = 0
+
+    def add(
+        self, t: float, doppler_speed: float, wheel_speed: float, doppler_valid: bool = True
+    ) -> CalibrationEstimate:
+        usable = (
+            doppler_valid
+            and np.isfinite(doppler_speed)
+            and np.isfinite(wheel_speed)
+            and wheel_speed >= self.config.min_speed_mps
+        )
+        if not usable:
+            return self.estimate
+        if not self._gate.passes(t, doppler_speed - float(self.filter.x[0, 0]) * wheel_speed):
+            self.n_rejected += 1
+            return self.estimate
+        if self._t is not None:
+            dt = max(t - self._t, 0.0)
+            self.filter.predict(Q=np.array([[self.q_per_sqrt_s**2 * dt]]))
+        self._t = t
+        self.filter.update(np.array([[doppler_speed]]), H=np.array([[wheel_speed]]))
+        self.n_used += 1
+        return self.estimate
+
+    @property
+    def estimate(self) -> CalibrationEstimate:
+        if self.n_used == 0:
+            return CalibrationEstimate(np.nan, np.nan, 0, self.n_rejected)
+        value, sigma = float(self.filter.x[0, 0]), float(np.sqrt(self.filter.P[0, 0]))
+        return CalibrationEstimate(value, sigma, self.n_used, self.n_rejected)
+
+
+class GyroBiasKalman:
+    """Kalman variant of sec. 3.4: state [e, b] with e = ψ_true − Φ, ė = −b, b a random walk.
+
+    The measurement is ψ_doppler − Φ = e + noise; it is unwrapped next to the predicted e.
+    The variation gate applies to the change of the innovation between accepted samples.
+    """
+
+    def __init__(
+        self,
+        yaw_sigma_rad: float = np.radians(0.5),
+        bias_walk_rad_s_per_sqrt_s: float = np.radians(0.001),
+        initial_bias_sigma_rad_s: float = np.radians(1.0),
+        config: GateConfig = GateConfig(),
+    ):
+        self.filter = KalmanFilter(dim_x=2, dim_z=1)
+        self.filter.H = np.array([[1.0, 0.0]])
+        self.filter.R = np.array([[yaw_sigma_rad**2]])
+        self.filter.P = np.diag([np.pi**2, initial_bias_sigma_rad_s**2])
+        self.bias_walk = bias_walk_rad_s_per_sqrt_s
+        self.config = config
+        self._gate = _StreamGate(config.max_yaw_jump_rad, config.max_yaw_drift_rad_s)
+        self._t: float | None = None
+        self.n_used = 0
+        self.n_rejected = 0
+
+    def add(
+        self,
+        t: float,
+        doppler_yaw: float,
+        integrated_yaw: float,
+        doppler_speed: float,
+        doppler_valid: bool = True,
+    ) -> CalibrationEstimate:
+        z = doppler_yaw - integrated_yaw
+        usable = doppler_valid and np.isfinite(z) and doppler_speed >= self.config.min_speed_mps
+        if not usable:
+            return self.estimate
+        if self._t is None:
+            self.filter.x = np.array([[float(wrap_angle(z))], [0.0]])
+            self.filter.P[0, 0] = self.filter.R[0, 0]
+        else:
+            dt = max(t - self._t, 0.0)
+            self.filter.predict(
+                F=np.array([[1.0, -dt], [0.0, 1.0]]), Q=np.diag([0.0, self.bias_walk**2 * dt])
+            )
+        self._t = t
+        predicted = float(self.filter.x[0, 0])
+        z_near = predicted + float(wrap_angle(z - predicted))
+        if not self._gate.passes(t, z_near - predicted):
+            self.n_rejected += 1
+            return self.estimate
+        self.filter.update(np.array([[z_near]]))
+        self.n_used += 1
+        return self.estimate
+
+    @property
+    def estimate(self) -> CalibrationEstimate:
+        if self.n_used < 2:
+            return CalibrationEstimate(np.nan, np.nan, self.n_used, self.n_rejected)
+        value, sigma = float(self.filter.x[1, 0]), float(np.sqrt(self.filter.P[1, 1]))
+        return CalibrationEstimate(value, sigma, self.n_used, self.n_rejected)
