@@ -163,13 +163,21 @@ class _RecentSamples:
         return np.array(self.rows, dtype=float).reshape(-1, self.n_columns).T
 
 
-class WheelScaleCalibrator:
-    """Streaming sec. 3.3: least squares over the stored recent samples, refreshed per sample."""
+class _StreamingFit:
+    """Stored recent samples plus the latest estimate, refreshed on every sample."""
+
+    n_columns = 0
 
     def __init__(self, config: GateConfig = GateConfig()):
         self.config = config
-        self._samples = _RecentSamples(config.window_s, 4)
+        self._samples = _RecentSamples(config.window_s, self.n_columns)
         self.estimate = UNAVAILABLE
+
+
+class WheelScaleCalibrator(_StreamingFit):
+    """Streaming sec. 3.3: least squares over the stored recent samples, refreshed per sample."""
+
+    n_columns = 4
 
     def add(
         self, t: float, doppler_speed: float, wheel_speed: float, doppler_valid: bool = True
@@ -179,13 +187,10 @@ class WheelScaleCalibrator:
         return self.estimate
 
 
-class GyroBiasCalibrator:
+class GyroBiasCalibrator(_StreamingFit):
     """Streaming sec. 3.4: least squares over the stored recent samples, refreshed per sample."""
 
-    def __init__(self, config: GateConfig = GateConfig()):
-        self.config = config
-        self._samples = _RecentSamples(config.window_s, 5)
-        self.estimate = UNAVAILABLE
+    n_columns = 5
 
     def add(
         self,
@@ -226,7 +231,29 @@ class _StreamGate:
         return True
 
 
-class WheelScaleKalman:
+class _KalmanFit:
+    """A filterpy filter whose state ``index`` is the calibrated quantity."""
+
+    index = 0
+    min_used = 1
+
+    def __init__(self, dim_x: int, config: GateConfig):
+        self.filter = KalmanFilter(dim_x=dim_x, dim_z=1)
+        self.config = config
+        self._t: float | None = None
+        self.n_used = 0
+        self.n_rejected = 0
+
+    @property
+    def estimate(self) -> CalibrationEstimate:
+        if self.n_used < self.min_used:
+            return CalibrationEstimate(np.nan, np.nan, self.n_used, self.n_rejected)
+        i = self.index
+        value, sigma = float(self.filter.x[i, 0]), float(np.sqrt(self.filter.P[i, i]))
+        return CalibrationEstimate(value, sigma, self.n_used, self.n_rejected)
+
+
+class WheelScaleKalman(_KalmanFit):
     """Kalman variant of sec. 3.3: state k, a random walk of ``q_per_sqrt_s`` per √s."""
 
     def __init__(
@@ -236,16 +263,12 @@ class WheelScaleKalman:
         initial_sigma: float = 0.1,
         config: GateConfig = GateConfig(),
     ):
-        self.filter = KalmanFilter(dim_x=1, dim_z=1)
+        super().__init__(1, config)
         self.filter.x = np.array([[1.0]])
         self.filter.P = np.array([[initial_sigma**2]])
         self.filter.R = np.array([[speed_sigma_mps**2]])
         self.q_per_sqrt_s = q_per_sqrt_s
-        self.config = config
         self._gate = _StreamGate(config.max_speed_jump_mps, config.max_speed_drift_mps2)
-        self._t: float | None = None
-        self.n_used = 0
-        self.n_rejected = 0
 
     def add(
         self, t: float, doppler_speed: float, wheel_speed: float, doppler_valid: bool = True
@@ -269,20 +292,16 @@ class WheelScaleKalman:
         self.n_used += 1
         return self.estimate
 
-    @property
-    def estimate(self) -> CalibrationEstimate:
-        if self.n_used == 0:
-            return CalibrationEstimate(np.nan, np.nan, 0, self.n_rejected)
-        value, sigma = float(self.filter.x[0, 0]), float(np.sqrt(self.filter.P[0, 0]))
-        return CalibrationEstimate(value, sigma, self.n_used, self.n_rejected)
 
-
-class GyroBiasKalman:
+class GyroBiasKalman(_KalmanFit):
     """Kalman variant of sec. 3.4: state [e, b] with e = ψ_true − Φ, ė = −b, b a random walk.
 
     The measurement is ψ_doppler − Φ = e + noise; it is unwrapped next to the predicted e.
     The variation gate applies to the change of the innovation between accepted samples.
     """
+
+    index = 1
+    min_used = 2
 
     def __init__(
         self,
@@ -291,16 +310,12 @@ class GyroBiasKalman:
         initial_bias_sigma_rad_s: float = np.radians(1.0),
         config: GateConfig = GateConfig(),
     ):
-        self.filter = KalmanFilter(dim_x=2, dim_z=1)
+        super().__init__(2, config)
         self.filter.H = np.array([[1.0, 0.0]])
         self.filter.R = np.array([[yaw_sigma_rad**2]])
         self.filter.P = np.diag([np.pi**2, initial_bias_sigma_rad_s**2])
         self.bias_walk = bias_walk_rad_s_per_sqrt_s
-        self.config = config
         self._gate = _StreamGate(config.max_yaw_jump_rad, config.max_yaw_drift_rad_s)
-        self._t: float | None = None
-        self.n_used = 0
-        self.n_rejected = 0
 
     def add(
         self,
@@ -331,10 +346,3 @@ class GyroBiasKalman:
         self.filter.update(np.array([[z_near]]))
         self.n_used += 1
         return self.estimate
-
-    @property
-    def estimate(self) -> CalibrationEstimate:
-        if self.n_used < 2:
-            return CalibrationEstimate(np.nan, np.nan, self.n_used, self.n_rejected)
-        value, sigma = float(self.filter.x[1, 0]), float(np.sqrt(self.filter.P[1, 1]))
-        return CalibrationEstimate(value, sigma, self.n_used, self.n_rejected)
