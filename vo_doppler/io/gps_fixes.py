@@ -1,0 +1,182 @@
+"""GPS fixes from a CSV file (``t,lat_deg,lon_deg[,speed_mps]``) or from NMEA 0183 sentences.
+
+NMEA: GGA and RMC sentences through pynmeagps. Fix times become GPS time in seconds since
+1980-01-06 (UTC + leap seconds) once an RMC sentence has given the date; a GGA-only file has no
+date, so its times stay UTC seconds of day (logged). Sentences with a bad checksum or no fix
+(GGA quality 0, RMC status V) are skipped and counted. When GGA and RMC report the same time,
+one fix is kept (GGA position, RMC speed over ground).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pynmeagps import NMEAMessageError, NMEAParseError, NMEAReader, NMEATypeError
+
+from vo_doppler.errors import InputError
+from vo_doppler.io.gyro_csv import read_numeric_csv
+
+log = logging.getLogger(__name__)
+
+GPS_EPOCH = dt.datetime(1980, 1, 6, tzinfo=dt.UTC)
+KNOT_MPS = 1852.0 / 3600.0
+# GPS − UTC (s) from each date on (IERS Bulletin C); dates before the first entry are refused.
+LEAP_SECONDS = (
+    (dt.date(1999, 1, 1), 13),
+    (dt.date(2006, 1, 1), 14),
+    (dt.date(2009, 1, 1), 15),
+    (dt.date(2012, 7, 1), 16),
+    (dt.date(2015, 7, 1), 17),
+    (dt.date(2017, 1, 1), 18),
+)
+
+
+@dataclass(frozen=True)
+class GpsFixes:
+    """Fixes: time (s), latitude and longitude (rad), speed over ground (m/s, NaN if unknown)."""
+
+    t: np.ndarray
+    lat: np.ndarray
+    lon: np.ndarray
+    speed: np.ndarray
+    path: Path
+    n_skipped: int = 0
+    time_system: str = "gps"
+
+    def as_tuple(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.t, self.lat, self.lon
+
+
+def utc_to_gps_seconds(moment: dt.datetime) -> float:
+    """UTC date-time (naive means UTC) to GPS seconds since 1980-01-06."""
+    if moment.tzinfo is None:
+        moment = moment.replace(tzinfo=dt.UTC)
+    leap = [s for day, s in LEAP_SECONDS if moment.date() >= day]
+    if not leap:
+        raise ValueError(f"no leap-second entry for {moment.date()} (table starts 1999)")
+    return (moment - GPS_EPOCH).total_seconds() + leap[-1]
+
+
+def read_gps_csv(path: str | Path) -> GpsFixes:
+    """Read a ``t,lat_deg,lon_deg`` CSV, optionally with a ``speed_mps`` column."""
+    columns, report = read_numeric_csv(path, ("t", "lat_deg", "lon_deg"), ("speed_mps",))
+    speed = columns.get("speed_mps", np.full(len(columns["t"]), np.nan))
+    bad = (np.abs(columns["lat_deg"]) > 90) | (np.abs(columns["lon_deg"]) > 180)
+    if np.any(bad):
+        log.warning("%s: skipped %d fixes outside lat ±90°, lon ±180°", path, int(np.sum(bad)))
+    good = ~bad
+    return GpsFixes(
+        columns["t"][good],
+        np.radians(columns["lat_deg"][good]),
+        np.radians(columns["lon_deg"][good]),
+        speed[good],
+        Path(path),
+        report.n_malformed + report.n_non_finite + int(np.sum(bad)),
+    )
+
+
+def write_gps_csv(path, t, lat_rad, lon_rad, speed_mps=None) -> None:
+    """Write fixes as ``t,lat_deg,lon_deg[,speed_mps]`` with full precision."""
+    columns = [np.asarray(t, float), np.degrees(lat_rad), np.degrees(lon_rad)]
+    header = "t,lat_deg,lon_deg"
+    if speed_mps is not None:
+        columns.append(np.asarray(speed_mps, float))
+        header += ",speed_mps"
+    np.savetxt(
+        path, np.column_stack(columns), delimiter=",", fmt="%.17g", header=header, comments=""
+    )
+
+
+def _seconds_of_day(value: dt.time) -> float:
+    return value.hour * 3600.0 + value.minute * 60.0 + value.second + value.microsecond * 1e-6
+
+
+def _parse_sentences(path: Path, lines: list[bytes]):
+    """Readable GGA/RMC messages with a fix, and the counts of the skipped ones."""
+    messages = []
+    n_bad = n_nofix = 0
+    for number, raw in enumerate(lines, start=1):
+        raw = raw.strip()
+        if not raw.startswith(b"$"):
+            continue
+        try:
+            message = NMEAReader.parse(raw)
+        except (NMEAParseError, NMEAMessageError, NMEATypeError, ValueError) as exc:
+            n_bad += 1
+            log.debug("%s:%d: %s", path, number, exc)
+            continue
+        if message is None or message.msgID not in ("GGA", "RMC"):
+            continue
+        gga = message.msgID == "GGA"
+        no_fix = message.quality in (0, "") if gga else message.status != "A"
+        if no_fix or "" in (message.lat, message.lon, message.time):
+            n_nofix += 1
+            continue
+        messages.append(message)
+    return messages, n_bad, n_nofix
+
+
+def read_nmea(path: str | Path) -> GpsFixes:
+    """Read GGA/RMC fixes from an NMEA 0183 log (midnight roll-overs follow the time of day)."""
+    path = Path(path)
+    try:
+        lines = path.read_bytes().splitlines()
+    except OSError as exc:
+        raise InputError(f"cannot read NMEA file: {exc.strerror or exc}", path) from exc
+    messages, n_bad, n_nofix = _parse_sentences(path, lines)
+    if n_bad or n_nofix:
+        log.warning(
+            "%s: skipped %d unreadable sentences and %d without a fix", path, n_bad, n_nofix
+        )
+    if not messages:
+        raise InputError("no GGA or RMC fix found in the NMEA file", path)
+    date = next((m.date for m in messages if m.msgID == "RMC" and m.date != ""), None)
+    if date is None:
+        log.warning("%s: no RMC date, fix times are UTC seconds of day", path)
+    fixes: dict[float, list[float]] = {}
+    previous = None
+    for message in messages:
+        if message.msgID == "RMC" and message.date != "":
+            date = message.date
+        elif (
+            previous is not None
+            and date is not None
+            and _seconds_of_day(message.time) < _seconds_of_day(previous) - 43200.0
+        ):
+            date += dt.timedelta(days=1)
+        previous = message.time
+        if date is None:
+            t = _seconds_of_day(message.time)
+        else:
+            t = utc_to_gps_seconds(dt.datetime.combine(date, message.time))
+        entry = fixes.setdefault(t, [np.nan, np.nan, np.nan])
+        if message.msgID == "GGA" or np.isnan(entry[0]):
+            entry[0], entry[1] = float(message.lat), float(message.lon)
+        if message.msgID == "RMC" and message.spd != "":
+            entry[2] = float(message.spd) * KNOT_MPS
+    times = np.array(list(fixes), dtype=float)
+    rows = np.array(list(fixes.values()), dtype=float)
+    return GpsFixes(
+        times,
+        np.radians(rows[:, 0]),
+        np.radians(rows[:, 1]),
+        rows[:, 2],
+        path,
+        n_bad + n_nofix,
+        "gps" if date is not None else "utc-seconds-of-day",
+    )
+
+
+def read_gps_fixes(path: str | Path) -> GpsFixes:
+    """Read fixes from a CSV or an NMEA file, told apart by the first non-blank character."""
+    path = Path(path)
+    try:
+        with path.open("rb") as handle:
+            head = handle.read(4096).lstrip()
+    except OSError as exc:
+        raise InputError(f"cannot read GPS file: {exc.strerror or exc}", path) from exc
+    return read_nmea(path) if head.startswith(b"$") else read_gps_csv(path)

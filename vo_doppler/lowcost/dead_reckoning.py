@@ -1,0 +1,83 @@
+"""Dead reckoning from step lengths and yaw-rate increments, Eq. (15)–(17).
+
+The seed writes the update in a clockwise heading θ measured from north:
+    x ← x + ΔL·sin(θ + Δθ/2)     (15)   east
+    y ← y + ΔL·cos(θ + Δθ/2)     (16)   north
+    θ ← θ + Δθ                   (17)
+The public functions take and return DESIGN.md's yaw ψ (counter-clockwise from east, positive
+yaw rate turns left); the conversion θ = π/2 − ψ, Δθ = −Δψ happens only at the boundary.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.errors import InputError
+from vo_doppler.geo import wrap_angle
+
+
+def integrate_yaw_rate(t: np.ndarray, rate: np.ndarray, yaw0: float = 0.0) -> np.ndarray:
+    """Yaw (rad, CCW, not wrapped) at each sample time by the trapezoidal rule."""
+    t = np.asarray(t, dtype=float)
+    rate = np.asarray(rate, dtype=float)
+    if len(t) != len(rate):
+        raise InputError(f"{len(t)} times but {len(rate)} rates")
+    increments = np.diff(t) * (rate[1:] + rate[:-1]) / 2.0
+    return yaw0 + np.concatenate([[0.0], np.cumsum(increments)])
+
+
+def yaw_increments(t_rate: np.ndarray, rate: np.ndarray, t_epochs: np.ndarray) -> np.ndarray:
+    """Δψ (rad, CCW) between consecutive epochs, from the integrated rate interpolated at the
+    epoch times; epochs outside the rate record see no rotation there. (N − 1,)."""
+    yaw = integrate_yaw_rate(t_rate, rate)
+    return np.diff(np.interp(np.asarray(t_epochs, dtype=float), t_rate, yaw))
+
+
+@dataclass(frozen=True)
+class DeadReckoning:
+    """Positions (m, ENU east/north) and yaw (rad, CCW from east, wrapped) per epoch."""
+
+    t: np.ndarray
+    east: np.ndarray
+    north: np.ndarray
+    yaw: np.ndarray
+
+    @property
+    def path_length(self) -> float:
+        return float(np.sum(np.hypot(np.diff(self.east), np.diff(self.north))))
+
+
+def dead_reckon(
+    t: np.ndarray,
+    step_length: np.ndarray,
+    delta_yaw: np.ndarray,
+    yaw0: float,
+    start: tuple[float, float] = (0.0, 0.0),
+) -> DeadReckoning:
+    """Eq. (15)–(17) over N epochs from N − 1 step lengths (m) and yaw increments (rad, CCW)."""
+    t = np.asarray(t, dtype=float)
+    step_length = np.asarray(step_length, dtype=float)
+    delta_yaw = np.asarray(delta_yaw, dtype=float)
+    if not (len(step_length) == len(delta_yaw) == len(t) - 1):
+        raise InputError(
+            f"{len(t)} epochs need {len(t) - 1} steps, got {len(step_length)} step lengths "
+            f"and {len(delta_yaw)} yaw increments"
+        )
+    theta0 = np.pi / 2.0 - yaw0
+    delta_theta = -delta_yaw
+    theta = theta0 + np.concatenate([[0.0], np.cumsum(delta_theta)])
+    mid = theta[:-1] + delta_theta / 2.0
+    east = start[0] + np.concatenate([[0.0], np.cumsum(step_length * np.sin(mid))])
+    north = start[1] + np.concatenate([[0.0], np.cumsum(step_length * np.cos(mid))])
+    return DeadReckoning(t, east, north, wrap_angle(np.pi / 2.0 - theta))
+
+
+def track_yaw(east: np.ndarray, north: np.ndarray, min_step_m: float = 1.0) -> np.ndarray:
+    """Direction of travel (rad, CCW from east) of a track at each point, from the step that
+    leaves it; points whose step is shorter than ``min_step_m`` get NaN (no direction)."""
+    de = np.diff(np.asarray(east, dtype=float))
+    dn = np.diff(np.asarray(north, dtype=float))
+    yaw = np.where(np.hypot(de, dn) >= min_step_m, np.arctan2(dn, de), np.nan)
+    return np.concatenate([yaw, [np.nan]])
