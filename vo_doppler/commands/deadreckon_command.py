@@ -1,0 +1,138 @@
+"""``vo-doppler deadreckon``: the low-cost IMU/GPS path mapping (two gyros + GPS) end to end."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from vo_doppler.io.deadreckon_outputs import drift_table_rows, write_outputs
+from vo_doppler.io.gps_fixes import read_gps_fixes
+from vo_doppler.io.gyro_csv import read_gyro_csv, read_numeric_csv
+from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon
+
+TABLE_HEADERS = ("variant", "drift °/min", "final error °", "gap m", "gap %", "length m")
+
+
+def _auto_or_float(text: str) -> float | None:
+    if text == "auto":
+        return None
+    try:
+        return float(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"expected 'auto' or a number, got {text!r}") from exc
+
+
+def _k_value(text: str) -> float | None:
+    value = _auto_or_float(text)
+    if value is not None and not 0.0 <= value <= 2.0:
+        raise argparse.ArgumentTypeError(f"k must lie in [0, 2], got {value}")
+    return value
+
+
+def _interval(text: str) -> tuple[float, float]:
+    try:
+        t0, t1 = (float(part) for part in text.split(","))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"expected T0,T1 in seconds, got {text!r}") from exc
+    if t1 <= t0:
+        raise argparse.ArgumentTypeError(f"the interval must end after it starts: {text!r}")
+    return t0, t1
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer ≥ 1, got {text!r}")
+    return value
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "deadreckon",
+        help="low-cost path mapping: two gyros + GPS dead reckoning and drift table",
+        description="Combine two yaw-rate sensors (Eq. 7), remove the static bias (Eq. 5-6), "
+        "optionally threshold (Eq. 9), thin and interpolate the GPS (Eq. 10-14), dead-reckon "
+        "(Eq. 15-17) and report the heading drift in deg/min per variant.",
+    )
+    parser.add_argument("--gyro1", required=True, help="CSV t,yaw_rate_rad_s (CCW positive)")
+    parser.add_argument("--gyro2", required=True, help="CSV t,yaw_rate_rad_s (CCW positive)")
+    parser.add_argument("--gps", required=True, help="CSV t,lat_deg,lon_deg[,speed_mps] or NMEA")
+    parser.add_argument(
+        "--k", type=_k_value, default=None, help="weight of gyro 2 in [0, 2], or auto (sweep)"
+    )
+    parser.add_argument(
+        "--tau", type=_auto_or_float, default=None, help="bias averaging time s, or auto (Allan)"
+    )
+    parser.add_argument(
+        "--standstill", type=_interval, help="standstill T0,T1 (s); default: found from speed"
+    )
+    parser.add_argument(
+        "--wheel-speed", help="CSV t,speed_mps used to find the standstill (optional)"
+    )
+    parser.add_argument(
+        "--threshold",
+        type=float,
+        help="threshold h (rad/s) of Eq. 9; default 3σ of the de-biased standstill rate",
+    )
+    parser.add_argument("--downsample", type=_positive_int, default=1, help="keep every M-th fix")
+    parser.add_argument(
+        "--cluster-m", type=float, default=3.0, help="drop fixes closer than this (m)"
+    )
+    parser.add_argument("-o", "--output", required=True, help="output folder")
+    parser.set_defaults(func=run)
+
+
+def _speed_source(args, fixes):
+    if args.wheel_speed:
+        columns, _ = read_numeric_csv(args.wheel_speed, ("t", "speed_mps"))
+        return columns["t"], columns["speed_mps"]
+    if np.mean(np.isfinite(fixes.speed)) > 0.9:
+        good = np.isfinite(fixes.speed)
+        return fixes.t[good], fixes.speed[good]
+    return None
+
+
+def run(args: argparse.Namespace) -> int:
+    gyro1 = read_gyro_csv(args.gyro1)
+    gyro2 = read_gyro_csv(args.gyro2)
+    fixes = read_gps_fixes(args.gps)
+    config = DeadReckonConfig(
+        k=args.k,
+        tau_s=args.tau,
+        standstill=args.standstill,
+        threshold=args.threshold,
+        downsample=args.downsample,
+        cluster_m=args.cluster_m,
+    )
+    result = run_deadreckon(
+        gyro1.as_tuple(), gyro2.as_tuple(), fixes.as_tuple(), config, _speed_source(args, fixes)
+    )
+    paths = write_outputs(args.output, result)
+
+    model = result.model
+    console = Console()
+    table = Table(title=f"Heading drift (reference: {result.reference_source})")
+    for header in TABLE_HEADERS:
+        table.add_column(header, justify="left" if header == "variant" else "right")
+    for row in drift_table_rows(result.rows):
+        table.add_row(*(str(v) for v in row))
+    console.print(table)
+    choices = ", ".join(f"{c.method} {c.k:.3f}" for c in model.k_choices.as_list())
+    console.print(
+        f"k used {model.k:.3f} ({choices}); τ {model.tau:.3g} s; "
+        f"ε0 combined {np.degrees(model.eps0['combined']):.4g} deg/s; "
+        f"h {np.degrees(model.h):.3g} deg/s; standstill "
+        f"{result.prepared.standstill[0]:.2f}–{result.prepared.standstill[1]:.2f} s"
+    )
+    skipped = gyro1.report.n_malformed + gyro1.report.n_non_finite
+    skipped += gyro2.report.n_malformed + gyro2.report.n_non_finite
+    console.print(
+        f"skipped input rows: gyros {skipped}, GPS {fixes.n_skipped}; GPS gaps "
+        f"{result.prepared.report.n_gaps}, duplicate GPS times "
+        f"{result.prepared.report.n_duplicate_times}"
+    )
+    console.print(f"wrote {', '.join(str(p) for p in paths.values())}")
+    return 0
