@@ -360,3 +360,19 @@ def project_points(camera: Camera, T_world_camera: np.ndarray, points: np.ndarra
     pixels = camera.project(camera_points)
     pixels[camera_points[:, 2] <= 0] = np.nan
     return pixels
+
+
+def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray = (0.0, 0.0, 1.0)) -> np.ndarray:
+    """Camera → world pose (4×4, OpenCV axes) at ``eye`` looking at ``target``, ``up`` up."""
+    eye = np.asarray(eye, dtype=float)
+    forward = np.asarray(target, dtype=float) - eye
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, np.asarray(up, dtype=float))
+    norm = np.linalg.norm(right)
+    if norm < 1e-9:
+        raise ValueError("viewing direction is parallel to the up vector")
+    right /= norm
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([right, np.cross(forward, right), forward])
+    T[:3, 3] = eye
+    return T
