@@ -172,11 +172,12 @@ def read_nmea(path: str | Path) -> GpsFixes:
 
 
 def read_gps_fixes(path: str | Path) -> GpsFixes:
-    """Read fixes from a CSV or an NMEA file, told apart by the first non-blank character."""
+    """Read fixes from a CSV or an NMEA file: NMEA when one of the first lines starts with $."""
     path = Path(path)
     try:
         with path.open("rb") as handle:
-            head = handle.read(4096).lstrip()
+            head = handle.read(8192).splitlines()[:20]
     except OSError as exc:
         raise InputError(f"cannot read GPS file: {exc.strerror or exc}", path) from exc
-    return read_nmea(path) if head.startswith(b"$") else read_gps_csv(path)
+    is_nmea = any(line.lstrip().startswith(b"$") for line in head)
+    return read_nmea(path) if is_nmea else read_gps_csv(path)

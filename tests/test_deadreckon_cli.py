@@ -1,0 +1,87 @@
+"""``vo-doppler deadreckon`` end to end on a generated record written in the real file formats."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from vo_doppler.cli import main
+from vo_doppler.lowcost.drift import VARIANTS
+from vo_doppler.sim.two_gyro import TwoGyroSpec, generate_two_gyro, write_two_gyro
+from vo_doppler.trajectory import read_tum
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("two_gyro")
+    record = generate_two_gyro(TwoGyroSpec())
+    return record, write_two_gyro(record, folder)
+
+
+def _args(paths, out, *extra):
+    return [
+        "deadreckon",
+        "--gyro1",
+        str(paths["gyro1"]),
+        "--gyro2",
+        str(paths["gyro2"]),
+        "--gps",
+        str(paths["gps"]),
+        "-o",
+        str(out),
+        *extra,
+    ]
+
+
+def test_cli_writes_every_output(inputs, tmp_path, capsys):
+    record, paths = inputs
+    t0, t1 = record.standstill
+    out = tmp_path / "out"
+    code = main(_args(paths, out, "--standstill", f"{t0},{t1}", "--k", "1.13", "--downsample", "2"))
+    assert code == 0
+    printed = capsys.readouterr().out
+    assert "combined + ε0" in printed and "k used 1.130" in printed
+
+    trajectory = read_tum(out / "trajectory.tum")
+    n_fixes = len(record.gps[0])
+    assert len(trajectory) == n_fixes
+    np.testing.assert_allclose(trajectory.positions[0], 0.0, atol=1e-6)
+    assert np.all(trajectory.positions[:, 2] == 0.0)
+
+    with (out / "drift_table.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert [row["variant"] for row in rows] == list(VARIANTS)
+    drift = {row["variant"]: abs(float(row["drift_deg_per_min"])) for row in rows}
+    assert drift["combined + ε0 removed"] < drift["sensor 1"] / 50.0
+
+    geo = json.loads((out / "trajectory.geojson").read_text())
+    names = [f["properties"]["name"] for f in geo["features"]]
+    assert names == ["dead reckoning", "reconstructed GPS track", "start", "end"]
+    line = np.array(geo["features"][0]["geometry"]["coordinates"])
+    assert line.shape == (n_fixes, 2)
+    np.testing.assert_allclose(
+        line[0], [record.spec.origin_lon_deg, record.spec.origin_lat_deg], atol=1e-4
+    )
+
+    summary = json.loads((out / "deadreckon_summary.json").read_text())
+    assert summary["k_used"] == pytest.approx(1.13)
+    assert summary["standstill"] == [t0, t1]
+    assert summary["gyro2"]["rate_hz"] == pytest.approx(50.0)
+    for figure in ("map.png", "allan_deviation.png"):
+        assert (out / figure).read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_bad_input_exit_codes(inputs, tmp_path, capsys):
+    _, paths = inputs
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time,rate\n0,1\n")
+    code = main(_args({**paths, "gyro1": bad}, tmp_path / "o1"))
+    assert code == 1
+    assert "lacks column" in capsys.readouterr().err
+    for extra in (["--k", "2.5"], ["--standstill", "5,1"], ["--downsample", "0"]):
+        with pytest.raises(SystemExit) as info:
+            main(_args(paths, tmp_path / "o2", *extra))
+        assert info.value.code == 2
