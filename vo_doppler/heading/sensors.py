@@ -26,3 +26,18 @@ def sample_at(t: np.ndarray, value: np.ndarray, t_query: np.ndarray) -> np.ndarr
     out = np.interp(t_query, t, value)
     out[(t_query < t[0]) | (t_query > t[-1])] = np.nan
     return out
+
+
+def calibrated_epoch_inputs(
+    t_epoch: np.ndarray,
+    speed_t: np.ndarray,
+    speed: np.ndarray,
+    yaw_rate_t: np.ndarray,
+    yaw_rate: np.ndarray,
+    wheel_scale: float = 1.0,
+    gyro_bias: float = 0.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Calibrated speed k·v and integrated calibrated yaw ∫(ω − b) at the epochs (sec. 3.3–3.4)."""
+    speed_at = wheel_scale * sample_at(speed_t, speed, t_epoch)
+    yaw_at = integrate_rate(yaw_rate_t, np.asarray(yaw_rate, dtype=float) - gyro_bias, t_epoch)
+    return speed_at, yaw_at

@@ -1,0 +1,352 @@
+"""Tightly coupled time-series heading from Doppler, gyro and wheel speed (sec. 3.5).
+
+For the window of epochs t ∈ (t_k − W, t_k] ending at epoch k, every Doppler row (see
+:mod:`vo_doppler.heading.rows`) gives one equation in three unknowns:
+
+    y = −G·v_t + ρ_t,    v_t = s_t · [cos θ_t, sin θ_t, 0],
+    θ_t = θ₀ + Φ_t − Φ_k,    ρ_t = ρ₀ − α · (t − t_k)
+
+with s_t the calibrated speed, Φ the integrated calibrated yaw rate (counter-clockwise
+positive, so Φ_t − Φ_k = −∫_t^{t_k} ω dτ: "θ₀ minus the integrated yaw rate since t"), θ the
+yaw counter-clockwise from east, ρ the receiver clock drift (m/s) and α its rate. Vertical
+velocity is taken as zero (land vehicle). θ₀ is the heading at the newest epoch.
+
+Given θ₀ the model is linear in (ρ₀, α), so they are projected out (variable projection): with
+z = [cos θ₀, sin θ₀, 1] the weighted residual sum of squares is zᵀQz for a 3×3 matrix Q per
+window — a trigonometric polynomial of degree 2 in θ₀ with at most two minima. A grid finds
+both, Gauss–Newton refines them, and iteratively re-weighted passes apply Huber weights. Two
+minima that fit equally well (e.g. two satellites on a straight road) make the window
+*ambiguous*: the one nearer the previous heading propagated by the gyro is kept, or the epoch
+is unavailable. The θ₀ variance is s²/(J_θᵀ P J_θ) (the marginal of the full covariance),
+s² the a-posteriori variance factor. Every window is solved at once with numpy.
+
+Reliability (sec. 3.5): the heading at epoch k is compared with the headings of the previous
+epochs of the last ``reliability_epochs`` propagated by the gyro; it is reliable when enough of
+them exist and all agree within the gate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.geo import wrap_angle, yaw_to_course
+from vo_doppler.heading.rows import DopplerRows
+
+
+@dataclass(frozen=True)
+class TightHeadingConfig:
+    """Solver settings; angles in radians."""
+
+    window_s: float = 2.0
+    min_obs: int = 3
+    min_speed_mps: float = 0.2
+    grid_size: int = 72
+    gauss_newton_iterations: int = 10
+    robust_passes: int = 3
+    huber_k: float = 1.345
+    sigma_floor_mps: float = 0.01
+    observability_ratio: float = 1e-6
+    ambiguity_chi2: float = 9.0
+    ambiguity_min_separation_rad: float = np.radians(5.0)
+    max_sigma_rad: float = np.radians(20.0)
+    prior_max_age_s: float = 10.0
+    reliability_epochs: int = 10
+    reliability_min_epochs: int = 5
+    reliability_gate_rad: float = np.radians(3.0)
+    epoch_match_s: float = 1e-3
+    chunk_windows: int = 2048
+
+
+@dataclass
+class TightHeadingResult:
+    """Per-epoch heading (yaw, counter-clockwise from east); NaN where unavailable."""
+
+    t: np.ndarray
+    yaw: np.ndarray
+    sigma: np.ndarray
+    n_obs: np.ndarray
+    n_sat_epoch: np.ndarray
+    available: np.ndarray
+    reliable: np.ndarray
+    ambiguous: np.ndarray
+    clock_drift: np.ndarray
+    clock_drift_rate: np.ndarray
+
+    @property
+    def course(self) -> np.ndarray:
+        """Heading as course, clockwise from north, radians in [0, 2π); NaN where unavailable."""
+        return np.where(self.available, yaw_to_course(self.yaw), np.nan)
+
+
+@dataclass
+class _WindowSolution:
+    theta: np.ndarray
+    theta_second: np.ndarray
+    cost: np.ndarray
+    cost_second: np.ndarray
+    info: np.ndarray
+    info_raw: np.ndarray
+    variance_factor: np.ndarray
+    rho0: np.ndarray
+    alpha: np.ndarray
+    n_obs: np.ndarray
+
+
+def _projected_normal_matrix(X, T, w):
+    """Q = XᵀWX − XᵀWT (TᵀWT)⁺ TᵀWX per window, with XᵀWX, XᵀWT, (TᵀWT)⁺ and rank(TᵀWT)."""
+    XtWX = np.einsum("kri,kr,krj->kij", X, w, X)
+    XtWT = np.einsum("kri,kr,krj->kij", X, w, T)
+    TtWT = np.einsum("kri,kr,krj->kij", T, w, T)
+    TtWT_pinv = np.linalg.pinv(TtWT, hermitian=True)
+    Q = XtWX - XtWT @ TtWT_pinv @ XtWT.transpose(0, 2, 1)
+    return Q, XtWX, XtWT, TtWT_pinv, np.linalg.matrix_rank(TtWT, hermitian=True)
+
+
+def _quadratic(Q, u, v):
+    """uᵀQv per window for vectors u, v of shape (K, 3)."""
+    return np.einsum("ki,kij,kj->k", u, Q, v)
+
+
+def _z(theta):
+    return np.stack([np.cos(theta), np.sin(theta), np.ones_like(theta)], axis=-1)
+
+
+def _dz(theta):
+    return np.stack([-np.sin(theta), np.cos(theta), np.zeros_like(theta)], axis=-1)
+
+
+def _gauss_newton(Q, theta, iterations):
+    for _ in range(iterations):
+        dz = _dz(theta)
+        hessian = _quadratic(Q, dz, dz)
+        step = np.where(
+            hessian > 0, _quadratic(Q, dz, _z(theta)) / np.where(hessian > 0, hessian, 1), 0
+        )
+        theta = theta - step
+    return wrap_angle(theta)
+
+
+def _grid_minima(Q, grid_size):
+    """Best and second-best local minima of zᵀQz on a circular grid (second NaN if none)."""
+    grid = np.linspace(-np.pi, np.pi, grid_size, endpoint=False)
+    Z = _z(grid)
+    cost = np.einsum("gi,kij,gj->kg", Z, Q, Z)
+    is_min = (cost <= np.roll(cost, 1, axis=1)) & (cost < np.roll(cost, -1, axis=1))
+    candidate = np.where(is_min, cost, np.inf)
+    first = np.argmin(np.where(is_min.any(axis=1, keepdims=True), candidate, cost), axis=1)
+    rows = np.arange(len(Q))
+    candidate[rows, first] = np.inf
+    second = np.argmin(candidate, axis=1)
+    has_second = np.isfinite(candidate[rows, second])
+    return grid[first], np.where(has_second, grid[second], np.nan)
+
+
+def solve_windows(y, a, b, tau, w, config: TightHeadingConfig = TightHeadingConfig()):
+    """Solve padded windows at once: arrays (K, R) of reduced observations ``y``, coefficients
+    ``a``, ``b`` (model a·cos θ₀ + b·sin θ₀ + ρ₀ − α·τ), row times ``tau`` relative to the
+    window end and weights ``w`` (0 on padding). Returns a :class:`_WindowSolution`."""
+    X = np.stack([-a, -b, y], axis=-1)
+    T = np.stack([np.ones_like(tau), -tau], axis=-1)
+    n_obs = np.count_nonzero(w > 0, axis=1)
+    weights = w.copy()
+    for _ in range(config.robust_passes):
+        Q, XtWX, XtWT, TtWT_pinv, rank_t = _projected_normal_matrix(X, T, weights)
+        theta = _gauss_newton(
+            Q, _grid_minima(Q, config.grid_size)[0], config.gauss_newton_iterations
+        )
+        z = _z(theta)
+        params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
+        residual = X @ z[:, :, None]
+        residual = residual[:, :, 0] - np.einsum("krj,kj->kr", T, params)
+        normalised = np.abs(residual) * np.sqrt(w)
+        scale = _robust_scale(normalised, w, config)
+        ratio = normalised / scale[:, None]
+        weights = w * np.minimum(1.0, config.huber_k / np.maximum(ratio, 1e-300))
+    Q, XtWX, XtWT, TtWT_pinv, rank_t = _projected_normal_matrix(X, T, weights)
+    first, second = _grid_minima(Q, config.grid_size)
+    theta = _gauss_newton(Q, first, config.gauss_newton_iterations)
+    has_second = np.isfinite(second)
+    theta2 = _gauss_newton(Q, np.where(has_second, second, theta), config.gauss_newton_iterations)
+    cost = _quadratic(Q, _z(theta), _z(theta))
+    cost2 = np.where(has_second, _quadratic(Q, _z(theta2), _z(theta2)), np.inf)
+    swap = cost2 < cost
+    theta, theta2 = np.where(swap, theta2, theta), np.where(swap, theta, theta2)
+    cost, cost2 = np.where(swap, cost2, cost), np.where(swap, cost, cost2)
+    z, dz = _z(theta), _dz(theta)
+    params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
+    n_params = 1 + rank_t
+    dof = n_obs - n_params
+    mean_w = np.sum(w, axis=1) / np.maximum(n_obs, 1)
+    floor = config.sigma_floor_mps**2 * mean_w
+    posterior = np.where(dof > 0, np.maximum(cost, 0) / np.maximum(dof, 1), 1.0)
+    return _WindowSolution(
+        theta=theta,
+        theta_second=np.where(np.isfinite(cost2), theta2, np.nan),
+        cost=cost,
+        cost_second=cost2,
+        info=_quadratic(Q, dz, dz),
+        info_raw=_quadratic(XtWX, dz, dz),
+        variance_factor=np.maximum(posterior, floor),
+        rho0=params[:, 0],
+        alpha=params[:, 1],
+        n_obs=n_obs,
+    )
+
+
+def _robust_scale(normalised, w, config):
+    """1.4826 × median |normalised residual| per window (floored), the Huber scale."""
+    masked = np.where(w > 0, normalised, np.nan)
+    with np.errstate(all="ignore"):
+        mad = 1.4826 * np.nanmedian(masked, axis=1)
+        mean_w = np.nanmean(np.where(w > 0, w, np.nan), axis=1)
+    floor = config.sigma_floor_mps * np.sqrt(np.nan_to_num(mean_w, nan=1.0))
+    return np.maximum(np.nan_to_num(mad, nan=1.0), np.maximum(floor, 1e-300))
+
+
+def _match_epochs(row_t, t_epoch, tolerance):
+    """Index of the epoch of each row (−1 when no epoch lies within ``tolerance``)."""
+    position = np.clip(np.searchsorted(t_epoch, row_t), 1, max(len(t_epoch) - 1, 1))
+    left = np.maximum(position - 1, 0)
+    right = np.minimum(position, len(t_epoch) - 1)
+    nearest = np.where(np.abs(t_epoch[left] - row_t) <= np.abs(t_epoch[right] - row_t), left, right)
+    return np.where(np.abs(t_epoch[nearest] - row_t) <= tolerance, nearest, -1)
+
+
+def tight_heading_series(
+    rows: DopplerRows,
+    t_epoch: np.ndarray,
+    speed: np.ndarray,
+    yaw_angle: np.ndarray,
+    config: TightHeadingConfig = TightHeadingConfig(),
+) -> TightHeadingResult:
+    """Heading at every epoch from the window of Doppler rows ending there (sec. 3.5).
+
+    ``speed`` (m/s) and ``yaw_angle`` Φ (rad, integral of the calibrated counter-clockwise yaw
+    rate) are given per epoch; rows are matched to epochs by time.
+    """
+    t_epoch = np.asarray(t_epoch, dtype=float)
+    speed = np.asarray(speed, dtype=float)
+    yaw_angle = np.asarray(yaw_angle, dtype=float)
+    m = len(t_epoch)
+    epoch_of_row = _match_epochs(rows.t, t_epoch, config.epoch_match_s) if m else np.zeros(0, int)
+    y_all = rows.reduced()
+    usable = (
+        (epoch_of_row >= 0)
+        & np.isfinite(y_all)
+        & np.all(np.isfinite(rows.los), axis=1)
+        & (rows.weight > 0)
+    )
+    epoch_safe = np.maximum(epoch_of_row, 0)
+    usable &= np.isfinite(speed[epoch_safe]) & np.isfinite(yaw_angle[epoch_safe])
+    index = np.flatnonzero(usable)
+    row_epoch = epoch_of_row[index]
+    n_sat_epoch = np.bincount(row_epoch, minlength=m)[:m]
+    lo = np.searchsorted(t_epoch[row_epoch], t_epoch - config.window_s, side="right")
+    hi = np.searchsorted(t_epoch[row_epoch], t_epoch, side="right")
+
+    solutions = []
+    for start in range(0, m, config.chunk_windows):
+        k = np.arange(start, min(start + config.chunk_windows, m))
+        solutions.append(
+            _solve_chunk(
+                rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_angle, config
+            )
+        )
+    solution = _concatenate(solutions, m)
+    return _decide(solution, t_epoch, speed, yaw_angle, n_sat_epoch, config)
+
+
+def _solve_chunk(rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_angle, config):
+    width = max(int(np.max(hi[k] - lo[k], initial=0)), 1)
+    slot = lo[k][:, None] + np.arange(width)[None, :]
+    inside = slot < hi[k][:, None]
+    slot = np.where(inside, slot, 0) if len(index) else np.zeros_like(slot)
+    row = index[slot] if len(index) else np.zeros_like(slot)
+    epoch = row_epoch[slot] if len(index) else np.zeros_like(slot)
+    delta = yaw_angle[epoch] - yaw_angle[k][:, None]
+    tau = t_epoch[epoch] - t_epoch[k][:, None]
+    s = speed[epoch]
+    ge, gn = rows.los[row, 0], rows.los[row, 1]
+    cos_d, sin_d = np.cos(delta), np.sin(delta)
+    a = -s * (ge * cos_d + gn * sin_d)
+    b = -s * (gn * cos_d - ge * sin_d)
+    w = np.where(inside & (len(index) > 0), rows.weight[row], 0.0)
+    y = np.where(w > 0, y_all[row], 0.0)
+    a, b, tau = np.where(w > 0, a, 0.0), np.where(w > 0, b, 0.0), np.where(w > 0, tau, 0.0)
+    return solve_windows(y, a, b, tau, w, config)
+
+
+def _concatenate(solutions, m):
+    if not solutions:
+        empty = np.zeros(0)
+        return _WindowSolution(*([empty] * 9), n_obs=np.zeros(0, dtype=int))
+    fields = _WindowSolution.__dataclass_fields__
+    return _WindowSolution(
+        **{f: np.concatenate([getattr(s, f) for s in solutions]) for f in fields}
+    )
+
+
+def _decide(sol, t_epoch, speed, yaw_angle, n_sat_epoch, config) -> TightHeadingResult:
+    m = len(t_epoch)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sigma = np.sqrt(sol.variance_factor / sol.info)
+        observable = (sol.info > 0) & (sol.info >= config.observability_ratio * sol.info_raw)
+        chi2_gap = (sol.cost_second - sol.cost) / sol.variance_factor
+    separated = (
+        np.abs(wrap_angle(sol.theta_second - sol.theta)) > config.ambiguity_min_separation_rad
+    )
+    ambiguous = separated & (chi2_gap < config.ambiguity_chi2)
+    candidate = (
+        (sol.n_obs >= config.min_obs)
+        & (speed >= config.min_speed_mps)
+        & observable
+        & np.isfinite(sol.theta)
+        & (sigma <= config.max_sigma_rad)
+    )
+    yaw = np.where(candidate & ~ambiguous, sol.theta, np.nan)
+    available = candidate & ~ambiguous
+    last = -1
+    for k in range(m):
+        recent = last >= 0 and t_epoch[k] - t_epoch[last] <= config.prior_max_age_s
+        if candidate[k] and ambiguous[k] and recent:
+            prior = yaw[last] + yaw_angle[k] - yaw_angle[last]
+            options = np.array([sol.theta[k], sol.theta_second[k]])
+            yaw[k] = options[np.argmin(np.abs(wrap_angle(options - prior)))]
+            available[k] = True
+        if available[k]:
+            last = k
+    reliable = _reliability(yaw, available, yaw_angle, config)
+    return TightHeadingResult(
+        t=t_epoch,
+        yaw=np.where(available, wrap_angle(yaw), np.nan),
+        sigma=np.where(available, sigma, np.nan),
+        n_obs=sol.n_obs.astype(int),
+        n_sat_epoch=n_sat_epoch.astype(int),
+        available=available,
+        reliable=reliable,
+        ambiguous=ambiguous & candidate,
+        clock_drift=np.where(available, sol.rho0, np.nan),
+        clock_drift_rate=np.where(available, sol.alpha, np.nan),
+    )
+
+
+def _reliability(yaw, available, yaw_angle, config):
+    """Gyro-consistency over the last ``reliability_epochs`` epochs (sec. 3.5)."""
+    m = len(yaw)
+    count = np.zeros(m, dtype=int)
+    worst = np.zeros(m)
+    for lag in range(1, config.reliability_epochs):
+        if lag >= m:
+            break
+        both = available[lag:] & available[:-lag]
+        predicted = yaw[:-lag] + yaw_angle[lag:] - yaw_angle[:-lag]
+        error = np.abs(wrap_angle(yaw[lag:] - predicted))
+        count[lag:] += both
+        worst[lag:] = np.maximum(worst[lag:], np.where(both, error, 0.0))
+    return (
+        available
+        & (count >= config.reliability_min_epochs)
+        & (worst <= config.reliability_gate_rad)
+    )
