@@ -1,0 +1,113 @@
+"""``vo-doppler vo IMAGES --calib CALIB``: monocular VO over an image folder."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+from rich.progress import Progress
+
+from vo_doppler.errors import InputError
+from vo_doppler.eval.metrics import associate, evaluate
+from vo_doppler.eval.plots import plot_top_view
+from vo_doppler.io.images import (
+    find_times_file,
+    list_images,
+    read_image,
+    read_times,
+    times_from_fps,
+)
+from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
+from vo_doppler.trajectory import read_trajectory, write_kitti, write_tum
+from vo_doppler.vo.batch import run_visual_odometry
+from vo_doppler.vo.camera import read_camera
+from vo_doppler.vo.config import VoConfig
+
+log = logging.getLogger(__name__)
+
+CAMERA_UP = np.array([0.0, -1.0, 0.0])
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "vo",
+        help="monocular visual odometry over an image folder",
+        description="Track corners, initialise from two views and refine poses and points by "
+        "Levenberg–Marquardt bundle adjustment over a sliding window. Writes camera poses in "
+        "the first camera's frame (OpenCV axes), one per image.",
+    )
+    parser.add_argument("images", type=Path, help="folder of PNG/JPG images (sorted by name)")
+    parser.add_argument("--calib", type=Path, required=True, help="KITTI calib.txt or YAML")
+    timing = parser.add_mutually_exclusive_group()
+    timing.add_argument("--times", type=Path, help="times.txt or CSV with a t column")
+    timing.add_argument("--fps", type=float, help="fixed frame rate (Hz)")
+    parser.add_argument("--speed", type=Path, help="CSV t,speed_mps for metric scale")
+    parser.add_argument("--window", type=int, default=30, help="bundle-adjustment window (frames)")
+    parser.add_argument("--gt", type=Path, help="ground truth (KITTI poses or TUM) to evaluate")
+    parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.window < 3:
+        raise InputError(f"--window must be at least 3 frames, got {args.window}")
+    files = list_images(args.images)
+    camera = read_camera(args.calib)
+    if args.fps is not None:
+        times = times_from_fps(args.fps, len(files))
+    else:
+        times_path = args.times or find_times_file(args.images)
+        if times_path is None:
+            raise InputError("no timestamps: give --times FILE or --fps F", args.images)
+        times = read_times(times_path, len(files))
+    speed = None
+    if args.speed is not None:
+        series = read_sensor_csv(args.speed, SPEED_COLUMN)
+        if len(series) < 2:
+            raise InputError("speed CSV needs at least two samples", args.speed)
+        speed = (series.t, series.value)
+    config = VoConfig(window_size=args.window)
+    with Progress(transient=True) as progress:
+        task = progress.add_task("visual odometry", total=len(files))
+        output = run_visual_odometry(
+            (read_image(f) for f in files),
+            times,
+            camera,
+            config,
+            speed,
+            on_frame=lambda _: progress.advance(task),
+        )
+    args.output.mkdir(parents=True, exist_ok=True)
+    write_tum(args.output / "trajectory.tum", output.trajectory)
+    write_kitti(args.output / "trajectory.kitti", output.trajectory)
+    stats = output.stats.to_dict()
+    stats["metric_scale"] = output.metric
+    stats["flagged_frames"] = [
+        {**flag, "file": files[flag["index"]].name} for flag in stats["flagged_frames"]
+    ]
+    curves = {"VO" if output.metric else "VO (arbitrary scale)": output.trajectory}
+    if args.gt is not None:
+        truth = read_trajectory(args.gt, times=times)
+        estimate, matched = associate(output.trajectory, truth)
+        if len(estimate) >= 2:
+            stats["evaluation"] = evaluate(estimate, matched, "start", CAMERA_UP).to_dict()
+        curves["ground truth"] = truth
+    (args.output / "vo_stats.json").write_text(json.dumps(stats, indent=2))
+    plot_top_view(curves, args.output / "trajectory.png", ("x", "z"), "Top view (camera frame)")
+    print(
+        f"{stats['frames']} frames, {stats['keyframes']} keyframes, {stats['fps']:.1f} fps, "
+        f"{len(stats['flagged_frames'])} flagged; "
+        + ("metric scale from speed" if output.metric else "scale is arbitrary (no --speed)")
+    )
+    if "evaluation" in stats:
+        figures = stats["evaluation"]
+        print(
+            f"final error {figures['final_position_error_m']:.3f} m "
+            f"({figures['final_drift_pct']:.2f} % of path), end yaw error "
+            f"{figures['end_yaw_error_deg']:.3f} deg, ATE {figures['ate_rmse_m']:.3f} m"
+        )
+    print(f"wrote {args.output}/trajectory.tum, trajectory.kitti, vo_stats.json, trajectory.png")
+    return 0

@@ -1,0 +1,107 @@
+"""Image-sequence input: a folder of PNG/JPG images sorted by name, and their timestamps
+from ``times.txt`` (one time per line, KITTI style), a CSV, or a fixed frame rate."""
+
+from __future__ import annotations
+
+import csv
+import logging
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from vo_doppler.errors import InputError
+
+log = logging.getLogger(__name__)
+
+IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm"}
+
+
+def list_images(folder: str | Path) -> list[Path]:
+    """Image files of a folder (or its ``image_0`` subfolder), sorted by name."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError("image folder does not exist", folder)
+    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+    if not files and (folder / "image_0").is_dir():
+        return list_images(folder / "image_0")
+    if not files:
+        raise InputError("no PNG/JPG images in folder", folder)
+    return files
+
+
+def read_image(path: Path) -> np.ndarray | None:
+    """Grey uint8 image, or ``None`` (with a warning) when the file cannot be decoded."""
+    image = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+    if image is None:
+        log.warning("%s: cannot decode image; the frame is flagged and bridged", path)
+    return image
+
+
+def read_times(path: str | Path, n_images: int) -> np.ndarray:
+    """Timestamps for ``n_images`` frames from ``times.txt`` or a CSV with a ``t`` column.
+
+    A CSV may have a header naming ``t`` (or ``timestamp``); a plain file has one number a line.
+    Times must increase strictly; the count must equal the number of images.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise InputError(f"cannot read timestamps: {exc.strerror or exc}", path) from exc
+    rows = [
+        (number, line.strip())
+        for number, line in enumerate(text.splitlines(), start=1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    column = 0
+    if rows and not _is_number(next(csv.reader([rows[0][1]]))[0]):
+        header = [h.strip().lower() for h in next(csv.reader([rows[0][1]]))]
+        for name in ("t", "timestamp", "time", "t_s"):
+            if name in header:
+                column = header.index(name)
+                break
+        else:
+            raise InputError(f"CSV header {header} has no 't' or 'timestamp' column", path, 1)
+        rows = rows[1:]
+    times = np.empty(len(rows))
+    for k, (number, line) in enumerate(rows):
+        fields = next(csv.reader([line])) if "," in line else line.split()
+        try:
+            times[k] = float(fields[column])
+        except (ValueError, IndexError) as exc:
+            raise InputError(f"timestamp is not a number: {line!r}", path, number) from exc
+    if len(times) != n_images:
+        raise InputError(f"{len(times)} timestamps for {n_images} images", path)
+    steps = np.diff(times)
+    if np.any(~np.isfinite(times)) or np.any(steps <= 0):
+        bad = int(np.flatnonzero(~(steps > 0))[0]) + 1 if np.any(~(steps > 0)) else 0
+        raise InputError(
+            f"timestamps must increase strictly (row {bad + 1} of the data is not after the one "
+            "before)",
+            path,
+            rows[bad][0] if rows else None,
+        )
+    return times
+
+
+def times_from_fps(fps: float, n_images: int) -> np.ndarray:
+    if not fps > 0:
+        raise InputError(f"frame rate must be positive, got {fps}")
+    return np.arange(n_images) / fps
+
+
+def find_times_file(images_folder: Path) -> Path | None:
+    """``times.txt`` inside the image folder or beside it (KITTI layout), if present."""
+    for candidate in (images_folder / "times.txt", images_folder.parent / "times.txt"):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True

@@ -1,0 +1,46 @@
+"""Settings of the monocular visual odometry, with defaults tuned on KITTI and the simulator."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass
+class VoConfig:
+    """Front-end, geometry and bundle-adjustment settings.
+
+    Pixel thresholds are for images of roughly 1000 px width; they are used as given.
+    """
+
+    window_size: int = 30
+    """Frames kept in the sliding bundle-adjustment window."""
+    max_features: int = 600
+    grid_rows: int = 4
+    grid_cols: int = 8
+    min_corner_distance_px: int = 12
+    corner_quality: float = 0.005
+    replenish_below: float = 0.8
+    """Detect new corners when fewer than this fraction of ``max_features`` are tracked."""
+    klt_window_px: int = 15
+    klt_levels: int = 3
+    klt_epsilon: float = 0.01
+    forward_backward_max_px: float = 0.7
+    ransac_threshold_px: float = 1.0
+    init_min_parallax_deg: float = 1.0
+    init_min_points: int = 60
+    triangulation_min_parallax_deg: float = 1.0
+    max_reprojection_px: float = 2.0
+    pnp_min_inliers: int = 25
+    standstill_flow_px: float = 0.3
+    """Median feature motion below this (px) means the camera did not move."""
+    keyframe_flow_px: float = 25.0
+    """A frame becomes a keyframe when the median flow since the last keyframe exceeds this."""
+    keyframe_max_gap: int = 5
+    ba_max_iterations: int = 4
+    ba_function_tolerance: float = 1e-5
+    ba_threads: int = 1
+    ba_loss_scale_px: float = 1.5
+    ba_fixed_oldest: int = 2
+    """Oldest window poses held constant: the gauge (and, with two, the scale) of the window."""
+    min_texture_std: float = 3.0
+    """Images whose grey-level standard deviation is below this are treated as blank."""
