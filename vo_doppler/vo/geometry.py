@@ -145,7 +145,7 @@ def solve_pnp(
     threshold_px: float,
     min_inliers: int,
 ) -> PnpResult | None:
-    """PnP RANSAC (optionally from a guess) followed by Levenberg–Marquardt refinement on inliers."""
+    """PnP RANSAC (optionally from a guess), then Levenberg–Marquardt refinement on the inliers."""
     if len(uv) < max(min_inliers, 6):
         return None
     obj = points_world.astype(np.float64).reshape(-1, 1, 3)

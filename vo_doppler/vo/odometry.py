@@ -354,11 +354,10 @@ class VisualOdometry:
         for older in self._window:
             if not older.measured or older.index >= frame.index or not len(wanted):
                 continue
-            ids, ia, ib = np.intersect1d(older.features.ids, wanted, return_indices=True)
+            ids, ia, _ = np.intersect1d(older.features.ids, wanted, return_indices=True)
             if not len(ids):
                 continue
-            jb = np.searchsorted(frame.features.ids, ids, sorter=np.argsort(frame.features.ids))
-            jb = np.argsort(frame.features.ids)[jb]
+            _, _, jb = np.intersect1d(ids, frame.features.ids, return_indices=True)
             tri = triangulate(
                 self.K,
                 older.T_cw,
