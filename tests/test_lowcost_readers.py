@@ -182,8 +182,9 @@ def test_nmea_coordinates_round_trip(tmp_path, lat, lon, second):
 
 
 def test_utc_to_gps_leap_seconds():
-    assert utc_to_gps_seconds(dt.datetime(2017, 1, 1)) - utc_to_gps_seconds(
-        dt.datetime(2016, 12, 31, 23, 59, 59)
-    ) == pytest.approx(2.0)
-    with pytest.raises(ValueError):
-        utc_to_gps_seconds(dt.datetime(1990, 1, 1))
+    # The leap second at the end of 2016 makes these two UTC moments 3 days + 1 s apart.
+    before = utc_to_gps_seconds(dt.datetime(2016, 12, 30))
+    after = utc_to_gps_seconds(dt.datetime(2017, 1, 2))
+    assert after - before == pytest.approx(3 * 86400 + 1)
+    assert utc_to_gps_seconds(dt.datetime(1980, 1, 6)) == 0.0
+    assert utc_to_gps_seconds(dt.datetime(2018, 8, 2, tzinfo=dt.UTC)) == pytest.approx(1217203218.0)

@@ -66,8 +66,15 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--tau", type=_auto_or_float, default=None, help="bias averaging time s, or auto (Allan)"
     )
-    parser.add_argument(
+    window = parser.add_mutually_exclusive_group()
+    window.add_argument(
         "--standstill", type=_interval, help="standstill T0,T1 (s); default: found from speed"
+    )
+    window.add_argument(
+        "--straight",
+        type=_interval,
+        help="T0,T1 (s) of straight constant-course driving used instead of a standstill for "
+        "k and ε0 (a proxy for records without a standstill)",
     )
     parser.add_argument(
         "--wheel-speed", help="CSV t,speed_mps used to find the standstill (optional)"
@@ -102,7 +109,8 @@ def run(args: argparse.Namespace) -> int:
     config = DeadReckonConfig(
         k=args.k,
         tau_s=args.tau,
-        standstill=args.standstill,
+        standstill=args.standstill or args.straight,
+        window_is_standstill=args.straight is None,
         threshold=args.threshold,
         downsample=args.downsample,
         cluster_m=args.cluster_m,

@@ -18,21 +18,13 @@ import numpy as np
 from pynmeagps import NMEAMessageError, NMEAParseError, NMEAReader, NMEATypeError
 
 from vo_doppler.errors import InputError
+from vo_doppler.gnss.gpstime import calendar_to_gps_seconds
+from vo_doppler.gnss.gpstime import utc_to_gps_seconds as gpstime_utc_to_gps
 from vo_doppler.io.gyro_csv import read_numeric_csv
 
 log = logging.getLogger(__name__)
 
-GPS_EPOCH = dt.datetime(1980, 1, 6, tzinfo=dt.UTC)
 KNOT_MPS = 1852.0 / 3600.0
-# GPS − UTC (s) from each date on (IERS Bulletin C); dates before the first entry are refused.
-LEAP_SECONDS = (
-    (dt.date(1999, 1, 1), 13),
-    (dt.date(2006, 1, 1), 14),
-    (dt.date(2009, 1, 1), 15),
-    (dt.date(2012, 7, 1), 16),
-    (dt.date(2015, 7, 1), 17),
-    (dt.date(2017, 1, 1), 18),
-)
 
 
 @dataclass(frozen=True)
@@ -52,13 +44,14 @@ class GpsFixes:
 
 
 def utc_to_gps_seconds(moment: dt.datetime) -> float:
-    """UTC date-time (naive means UTC) to GPS seconds since 1980-01-06."""
-    if moment.tzinfo is None:
-        moment = moment.replace(tzinfo=dt.UTC)
-    leap = [s for day, s in LEAP_SECONDS if moment.date() >= day]
-    if not leap:
-        raise ValueError(f"no leap-second entry for {moment.date()} (table starts 1999)")
-    return (moment - GPS_EPOCH).total_seconds() + leap[-1]
+    """UTC date-time (naive means UTC) to GPS seconds since 1980-01-06 (leap seconds added)."""
+    if moment.tzinfo is not None:
+        moment = moment.astimezone(dt.UTC).replace(tzinfo=None)
+    second = moment.second + moment.microsecond * 1e-6
+    as_gps = calendar_to_gps_seconds(
+        moment.year, moment.month, moment.day, moment.hour, moment.minute, second
+    )
+    return float(gpstime_utc_to_gps(as_gps))
 
 
 def read_gps_csv(path: str | Path) -> GpsFixes:

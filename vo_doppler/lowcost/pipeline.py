@@ -50,7 +50,13 @@ SPEED_WINDOW_S = 5.0
 
 @dataclass(frozen=True)
 class DeadReckonConfig:
-    """Choices of the chain; ``None`` means "propose it from the data"."""
+    """Choices of the chain; ``None`` means "propose it from the data".
+
+    ``standstill`` is the interval over which k and ε0 are estimated. With
+    ``window_is_standstill=False`` it is instead a stretch of straight constant-course driving
+    (a proxy when the record has no standstill): the vehicle moves there, so its GPS steps are
+    kept.
+    """
 
     k: float | None = None
     tau_s: float | None = None
@@ -62,6 +68,7 @@ class DeadReckonConfig:
     standstill_min_s: float = 5.0
     drift_window_s: float = 5.0
     zero_steps_at_standstill: bool = True
+    window_is_standstill: bool = True
 
 
 @dataclass(frozen=True)
@@ -101,6 +108,8 @@ def _standstills(config, track_t, track_enu, speed):
         if t1 <= t0:
             raise InputError(f"standstill interval must end after it starts: {t0}, {t1}")
         others = [iv for iv in found if iv[1] < t0 or iv[0] > t1]
+        if not config.window_is_standstill:
+            return (t0, t1), others
         return (t0, t1), sorted([(t0, t1), *others])
     if not found:
         raise InputError(
