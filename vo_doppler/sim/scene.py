@@ -134,21 +134,21 @@ def _draw_wrapped_rect(canvas: np.ndarray, x: int, y: int, w: int, h: int, value
 
 
 def procedural_texture(
-    size: int, rng: np.random.Generator, rect_coverage: float = 0.12
+    size: int, rng: np.random.Generator, rect_coverage: float = 0.12, max_rect: float = 1 / 8
 ) -> np.ndarray:
     """A seamless, corner-rich, non-periodic grey tile (size × size uint8, size a power of two).
 
     Posterised pink noise (periods from 12 texels to half the tile) gives blobs of every scale
-    with sharp curved edges; random rectangles at octave scales from 4 texels to size/8 (each
-    scale covering about ``rect_coverage`` of the tile, random aspect and grey level) add
-    straight-edged corners; a little fine noise adds texture inside flat areas. Levels are
-    stretched to 12..243.
+    with sharp curved edges; random rectangles at octave scales from 4 texels to ``max_rect``
+    of the side (each scale covering about ``rect_coverage`` of the tile, random aspect and grey
+    level) add straight-edged corners; a little fine noise adds texture inside flat areas.
+    Levels are stretched to 12..243.
     """
     noise = _pink_noise(size, rng, 2.0 / size, 1.0 / 12.0)
     levels = np.quantile(noise, [0.2, 0.4, 0.6, 0.8])
     tile = (np.digitize(noise, levels).astype(np.float32) / 4.0) * 0.8 + 0.1
     side = 4.0
-    while side <= size / 8.0:
+    while side <= max_rect * size:
         count = int(rect_coverage * size * size / side**2)
         xy = rng.integers(0, size, size=(count, 2))
         wh = np.maximum((side * rng.uniform(0.5, 1.5, size=(count, 2))).astype(int), 2)
@@ -242,7 +242,7 @@ def city_scene(
     """
     rng = np.random.default_rng(seed)
     ground_tile = 2 * tile_size
-    textures = [procedural_texture(ground_tile, rng, rect_coverage=0.08)]
+    textures = [procedural_texture(ground_tile, rng, rect_coverage=0.1, max_rect=1 / 32)]
     textures += [procedural_texture(tile_size, rng) for _ in range(n_facade_textures)]
     layout = CityLayout(blocks_x, blocks_y, block_size, street_width)
     px, py = layout.pitch
