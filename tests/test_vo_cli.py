@@ -1,0 +1,112 @@
+"""The ``vo-doppler vo`` command end to end on a few real KITTI frames."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from tests.conftest import require_shared
+from vo_doppler.cli import main
+from vo_doppler.trajectory import read_kitti, read_tum
+
+N = 14
+
+
+@pytest.fixture(scope="module")
+def sequence(tmp_path_factory):
+    source = require_shared("kitti06_0000_0050")
+    folder = tmp_path_factory.mktemp("kitti")
+    images = folder / "image_0"
+    images.mkdir()
+    for f in sorted((source / "image_0").glob("*.png"))[:N]:
+        shutil.copy(f, images / f.name)
+    (images / "000007.png").write_bytes(b"\x89PNG\r\n\x1a\n truncated")
+    times = np.loadtxt(source / "times.txt")[:N]
+    np.savetxt(folder / "times.txt", times)
+    truth = read_kitti(source / "poses.txt").subset(slice(0, N))
+    steps = np.linalg.norm(np.diff(truth.positions, axis=0), axis=1) / np.diff(times)
+    speed = np.column_stack([times, np.r_[steps[0], steps]])
+    np.savetxt(folder / "speed.csv", speed, delimiter=",", header="t,speed_mps", comments="")
+    (folder / "poses.txt").write_text(
+        "\n".join((source / "poses.txt").read_text().splitlines()[:N]) + "\n"
+    )
+    return folder, source / "calib.txt"
+
+
+def test_vo_command_writes_every_output(sequence, capsys):
+    folder, calib = sequence
+    out = folder / "out"
+    code = main(
+        [
+            "vo",
+            str(folder / "image_0"),
+            "--calib",
+            str(calib),
+            "--speed",
+            str(folder / "speed.csv"),
+            "--gt",
+            str(folder / "poses.txt"),
+            "-o",
+            str(out),
+        ]
+    )
+    assert code == 0
+    tum = read_tum(out / "trajectory.tum")
+    kitti = read_kitti(out / "trajectory.kitti")
+    assert len(tum) == len(kitti) == N
+    np.testing.assert_allclose(tum.positions, kitti.positions, atol=1e-6)
+    stats = json.loads((out / "vo_stats.json").read_text())
+    for key in (
+        "frames",
+        "keyframes",
+        "fps",
+        "mean_tracks",
+        "ba_iterations",
+        "reprojection_rms_px",
+        "flagged_frames",
+    ):
+        assert key in stats
+    assert stats["frames"] == N and stats["metric_scale"] is True
+    assert [(f["index"], f["file"]) for f in stats["flagged_frames"]] == [(7, "000007.png")]
+    assert "unreadable" in stats["flagged_frames"][0]["reasons"]
+    assert stats["evaluation"]["final_drift_pct"] < 3.0
+    assert (out / "trajectory.png").stat().st_size > 10_000
+    assert "metric scale from speed" in capsys.readouterr().out
+
+
+def test_without_speed_the_scale_is_declared_arbitrary(sequence, capsys):
+    folder, calib = sequence
+    out = folder / "out_nospeed"
+    assert main(["vo", str(folder / "image_0"), "--calib", str(calib), "-o", str(out)]) == 0
+    assert "scale is arbitrary" in capsys.readouterr().out
+    assert json.loads((out / "vo_stats.json").read_text())["metric_scale"] is False
+
+
+def test_usage_and_input_errors(sequence, tmp_path, capsys):
+    folder, calib = sequence
+    with pytest.raises(SystemExit) as usage:
+        main(["vo", str(folder / "image_0"), "-o", str(tmp_path)])
+    assert usage.value.code == 2
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main(["vo", str(empty), "--calib", str(calib), "--fps", "10", "-o", str(tmp_path)]) == 1
+    assert "no PNG/JPG images" in capsys.readouterr().err
+    bad_times = tmp_path / "times.txt"
+    bad_times.write_text("0\n0.1\n0.1\n")
+    code = main(
+        [
+            "vo",
+            str(folder / "image_0"),
+            "--calib",
+            str(calib),
+            "--times",
+            str(bad_times),
+            "-o",
+            str(tmp_path),
+        ]
+    )
+    assert code == 1
+    assert f"3 timestamps for {N} images" in capsys.readouterr().err
