@@ -1,0 +1,150 @@
+"""VO heading correction (sec. 3.6, Eq. 11–13): exact synthetic cases."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from vo_doppler.fusion.heading_correction import (
+    FORWARD_CAMERA_TO_VEHICLE,
+    correct_heading,
+    headings_at,
+    vehicle_poses,
+    yaw_of,
+)
+from vo_doppler.geo import wrap_angle
+from vo_doppler.trajectory import Trajectory
+
+RATE_HZ = 10.0
+
+
+def _ground_truth(n=200, yaw0=2.5):
+    """Vehicle poses in ENU: weaving path, pitch/roll wobble that is zero at the start."""
+    t = np.arange(n) / RATE_HZ
+    yaw = yaw0 + 0.4 * np.sin(0.3 * t)
+    pitch = 0.03 * np.sin(0.7 * t)
+    roll = 0.02 * np.sin(0.5 * t)
+    speed = 8.0
+    step = speed / RATE_HZ
+    heading_mid = np.concatenate([[yaw[0]], 0.5 * (yaw[1:] + yaw[:-1])])
+    moves = step * np.stack([np.cos(heading_mid), np.sin(heading_mid), 0.01 * np.ones(n)], axis=1)
+    moves[0] = 0.0
+    positions = np.cumsum(moves, axis=0) + np.array([100.0, -50.0, 3.0])
+    rotations = Rotation.from_euler("ZYX", np.stack([yaw, pitch, roll], axis=1))
+    return t, yaw, Trajectory(t, positions, rotations)
+
+
+def _vo_output(vehicle_gt: Trajectory, camera_to_vehicle=FORWARD_CAMERA_TO_VEHICLE):
+    """Camera poses in the first camera frame, as a VO writes them (perfect VO)."""
+    T_E_cam = vehicle_gt.matrices @ camera_to_vehicle
+    return Trajectory.from_matrices(vehicle_gt.t, np.linalg.inv(T_E_cam[0]) @ T_E_cam)
+
+
+def _assert_equal_poses(actual: Trajectory, expected_matrices: np.ndarray, atol=1e-9):
+    np.testing.assert_allclose(actual.matrices, expected_matrices, atol=atol)
+
+
+def test_absolute_heading_everywhere_recovers_the_enu_trajectory():
+    t, yaw, gt = _ground_truth()
+    result = correct_heading(_vo_output(gt), t, yaw)
+    expected = gt.matrices.copy()
+    expected[:, :3, 3] -= gt.positions[0]
+    _assert_equal_poses(result.vehicle, expected)
+    assert result.has_absolute.all()
+    assert result.offset[0] == pytest.approx(-2.5)  # VO starts at yaw 0, truth at 2.5 rad
+    np.testing.assert_allclose(result.offset[1:], 0.0, atol=1e-12)
+
+
+def test_gap_holds_the_last_offset_and_rotation_is_about_the_oldest_window_pose():
+    t, yaw, gt = _ground_truth()
+    valid = (t >= 5.0) & (t <= 8.0)
+    window_s = 2.0
+    result = correct_heading(_vo_output(gt), t, yaw, valid, window_s=window_s)
+    vo_level = vehicle_poses(_vo_output(gt))
+    first_window = int(np.flatnonzero(t > 5.0 - window_s)[0])
+    before = np.arange(len(t)) < first_window
+    # Poses older than the first window with absolute heading stay as the VO put them.
+    _assert_equal_poses(result.vehicle.subset(before), vo_level[before])
+    # From that window's oldest pose on, the VO is rotated by the true start yaw about it.
+    rotate = Rotation.from_euler("Z", 2.5).as_matrix()
+    pivot = vo_level[first_window, :3, 3]
+    expected = vo_level[~before].copy()
+    expected[:, :3, 3] = pivot + (expected[:, :3, 3] - pivot) @ rotate.T
+    expected[:, :3, :3] = rotate @ expected[:, :3, :3]
+    _assert_equal_poses(result.vehicle.subset(~before), expected)
+    after = t > 8.0
+    assert not result.has_absolute[after].any()
+    np.testing.assert_allclose(result.total_correction[after], 2.5, atol=1e-12)
+    np.testing.assert_allclose(
+        wrap_angle(yaw_of(result.vehicle.matrices[after][:, :3, :3]) - yaw[after]), 0.0, atol=1e-9
+    )
+
+
+def test_pitch_and_roll_are_untouched_and_drift_is_removed():
+    t, yaw, gt = _ground_truth()
+    drift = 0.02 * t  # VO heading error growing 0.02 rad/s: rotate each step by the error
+    vo = _vo_output(gt)
+    level = vehicle_poses(vo)
+    steps = np.diff(level[:, :3, 3], axis=0)
+    turn = Rotation.from_euler("Z", drift[:, None]).as_matrix()
+    positions = np.concatenate(
+        [
+            [level[0, :3, 3]],
+            level[0, :3, 3] + np.cumsum(np.einsum("nij,nj->ni", turn[1:], steps), axis=0),
+        ]
+    )
+    drifted_vehicle = Trajectory(t, positions, Rotation.from_matrix(turn @ level[:, :3, :3]))
+    drifted_camera = Trajectory.from_matrices(
+        t, drifted_vehicle.matrices @ FORWARD_CAMERA_TO_VEHICLE
+    )
+    every_second = np.arange(len(t)) % 10 == 0  # 1 Hz absolute heading
+    result = correct_heading(drifted_camera, t[every_second], yaw[every_second], window_s=2.0)
+    euler_out = Rotation.from_matrix(result.vehicle.matrices[:, :3, :3]).as_euler("ZYX")
+    euler_in = drifted_vehicle.orientations.as_euler("ZYX")
+    np.testing.assert_allclose(euler_out[:, 1:], euler_in[:, 1:], atol=1e-12)
+    heading_error = np.abs(wrap_angle(euler_out[:, 0] - yaw))
+    uncorrected = np.abs(wrap_angle(euler_in[:, 0] + 2.5 - yaw))
+    # Eq. (11) averages over the 2 s window and the heading arrives at 1 Hz: the corrected
+    # error stays within the drift accumulated over window + sample interval (0.06 rad).
+    assert heading_error.max() < 0.02 * 3.0 < 0.3 < uncorrected.max()
+    truth_end = gt.positions[-1] - gt.positions[0]
+    end_error = np.linalg.norm(result.vehicle.positions[-1] - truth_end)
+    start_yaw_only = Rotation.from_euler("Z", 2.5).apply(drifted_vehicle.positions[-1])
+    assert end_error < 0.02 * gt.path_length
+    assert end_error < np.linalg.norm(start_yaw_only - truth_end) / 5
+
+
+def test_circular_mean_across_the_wrap():
+    t = np.arange(10) / RATE_HZ
+    east = Trajectory(t, np.stack([t, 0 * t, 0 * t], axis=1), Rotation.identity(len(t)))
+    absolute = np.where(np.arange(10) % 2 == 0, np.radians(179.0), np.radians(-179.0))
+    result = correct_heading(
+        east, t, absolute, camera_to_vehicle=np.eye(4), world="level", window_s=5.0
+    )
+    final_yaw = yaw_of(result.vehicle.matrices[:, :3, :3])[-1]
+    assert abs(wrap_angle(final_yaw - np.pi)) < np.radians(1.01)
+
+
+def test_camera_extrinsic_is_honoured():
+    t, yaw, gt = _ground_truth(n=60)
+    mount = np.eye(4)
+    mount[:3, :3] = Rotation.from_euler("Z", 0.2).as_matrix() @ FORWARD_CAMERA_TO_VEHICLE[:3, :3]
+    mount[:3, 3] = [1.5, 0.3, 1.2]
+    result = correct_heading(_vo_output(gt, mount), t, yaw, camera_to_vehicle=mount)
+    expected = gt.matrices.copy()
+    expected[:, :3, 3] -= gt.positions[0]
+    _assert_equal_poses(result.vehicle, expected)
+    expected_camera = expected @ mount
+    _assert_equal_poses(result.camera, expected_camera)
+
+
+def test_headings_at_interpolates_on_the_short_arc_and_respects_gaps():
+    t_h = np.array([0.0, 1.0, 2.0, 5.0])
+    yaw = np.radians([170.0, -170.0, -160.0, 0.0])
+    valid = np.array([True, True, True, True])
+    out, ok = headings_at(np.array([0.5, 1.0, 3.0, -1.0, 5.0]), t_h, yaw, valid, max_gap_s=1.5)
+    assert ok.tolist() == [True, True, False, False, True]
+    np.testing.assert_allclose(np.degrees(out[[0, 1, 4]]), [-180.0, -170.0, 0.0], atol=1e-9)
+    out, ok = headings_at(np.array([1.0]), t_h, yaw, np.array([True, False, True, True]), 1.5)
+    assert not ok[0]

@@ -1,0 +1,153 @@
+"""Heading correction of a visual-odometry trajectory with absolute heading (sec. 3.6, Eq. 11–13).
+
+Poses are processed in time order. For the window of poses in (t_i − W, t_i]:
+
+* Eq. (11): the offset Δθ is the circular mean of (VO heading − absolute heading) over the
+  poses of the window that have an absolute heading;
+* Eq. (12): the window's headings are shifted by −Δθ (a yaw rotation applied on the world
+  side, so pitch and roll are untouched);
+* Eq. (13): the window's positions are rotated by −Δθ about the window's oldest position.
+
+New VO increments are rotated by the accumulated correction, so the last correction is held
+through gaps in the absolute heading.
+
+Frames: the input trajectory holds camera poses (OpenCV axes) in the VO world, which by default
+is the first camera frame (what `vo-doppler vo`, KITTI and most VO systems write). With the
+camera→vehicle extrinsic, the vehicle poses (x forward, y left, z up) are expressed in the
+first vehicle frame, which is level when the vehicle starts level; ``world="level"`` declares
+that the input world is already z-up (e.g. ENU). Headings are yaw, counter-clockwise from
+east. The output world is ENU-aligned with its origin at the first position.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from vo_doppler.geo import wrap_angle
+from vo_doppler.trajectory import Trajectory
+
+# Forward-looking camera: camera z (forward) → vehicle x, camera x (right) → vehicle −y,
+# camera y (down) → vehicle −z.
+FORWARD_CAMERA_TO_VEHICLE = np.array(
+    [[0.0, 0.0, 1.0, 0.0], [-1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
+)
+
+
+@dataclass
+class HeadingCorrectionResult:
+    """Corrected vehicle poses, the offset Δθ applied at each pose (0 without absolute heading)
+    and whether an absolute heading was used at that pose."""
+
+    vehicle: Trajectory
+    camera: Trajectory
+    offset: np.ndarray
+    has_absolute: np.ndarray
+    total_correction: np.ndarray
+
+
+def vehicle_poses(
+    camera: Trajectory,
+    camera_to_vehicle: np.ndarray = FORWARD_CAMERA_TO_VEHICLE,
+    world: str = "first_camera",
+) -> np.ndarray:
+    """(N, 4, 4) vehicle poses in a level world: the first vehicle frame, or the input world."""
+    T_veh_cam = np.asarray(camera_to_vehicle, dtype=float)
+    T_w_veh = camera.matrices @ np.linalg.inv(T_veh_cam)
+    if world == "first_camera":
+        return np.linalg.inv(T_w_veh[0]) @ T_w_veh if len(T_w_veh) else T_w_veh
+    if world == "level":
+        return T_w_veh
+    raise ValueError(f"unknown world {world!r} (first_camera or level)")
+
+
+def yaw_of(rotations: np.ndarray) -> np.ndarray:
+    """Yaw (ZYX Euler, counter-clockwise about z) of (N, 3, 3) body-to-world rotations."""
+    return np.arctan2(rotations[:, 1, 0], rotations[:, 0, 0])
+
+
+def headings_at(
+    t_query: np.ndarray,
+    t_heading: np.ndarray,
+    yaw: np.ndarray,
+    valid: np.ndarray | None = None,
+    max_gap_s: float = 1.5,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Absolute yaw at ``t_query``, interpolated along the shorter arc between the two valid
+    samples around each time when they are at most ``max_gap_s`` apart; NaN/False otherwise."""
+    t_heading = np.asarray(t_heading, dtype=float)
+    yaw = np.asarray(yaw, dtype=float)
+    ok = np.isfinite(yaw) & np.isfinite(t_heading)
+    if valid is not None:
+        ok &= np.asarray(valid, dtype=bool)
+    th, yh = t_heading[ok], yaw[ok]
+    t_query = np.asarray(t_query, dtype=float)
+    if len(th) == 0:
+        return np.full(t_query.shape, np.nan), np.zeros(t_query.shape, dtype=bool)
+    right = np.clip(np.searchsorted(th, t_query, side="left"), 0, len(th) - 1)
+    left = np.clip(right - 1, 0, len(th) - 1)
+    exact = np.abs(th[right] - t_query) < 1e-9
+    left = np.where(exact, right, left)
+    span = th[right] - th[left]
+    inside = (th[left] <= t_query + 1e-9) & (th[right] >= t_query - 1e-9) & (span <= max_gap_s)
+    fraction = np.where(span > 0, (t_query - th[left]) / np.where(span > 0, span, 1.0), 0.0)
+    out = yh[left] + fraction * wrap_angle(yh[right] - yh[left])
+    return np.where(inside, wrap_angle(out), np.nan), inside
+
+
+def _rz(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def correct_heading(
+    camera: Trajectory,
+    t_heading: np.ndarray,
+    yaw_heading: np.ndarray,
+    valid: np.ndarray | None = None,
+    window_s: float = 2.0,
+    camera_to_vehicle: np.ndarray = FORWARD_CAMERA_TO_VEHICLE,
+    world: str = "first_camera",
+    max_gap_s: float = 1.5,
+) -> HeadingCorrectionResult:
+    """Correct the VO heading with absolute headings (sec. 3.6, Eq. 11–13).
+
+    ``t_heading``/``yaw_heading`` are on the trajectory's clock (shift them beforehand);
+    ``valid`` marks the usable samples.
+    """
+    poses = vehicle_poses(camera, camera_to_vehicle, world)
+    n = len(poses)
+    absolute, has_absolute = headings_at(camera.t, t_heading, yaw_heading, valid, max_gap_s)
+    vo_positions = poses[:, :3, 3] - (poses[0, :3, 3] if n else 0.0)
+    vo_rotations = poses[:, :3, :3]
+    positions = np.zeros((n, 3))
+    rotations = np.zeros((n, 3, 3))
+    offset = np.zeros(n)
+    total = np.zeros(n)
+    correction = 0.0
+    oldest = 0
+    for i in range(n):
+        rotate = _rz(correction)
+        if i:
+            positions[i] = positions[i - 1] + rotate @ (vo_positions[i] - vo_positions[i - 1])
+        rotations[i] = rotate @ vo_rotations[i]
+        while camera.t[oldest] <= camera.t[i] - window_s:
+            oldest += 1
+        window = slice(oldest, i + 1)
+        use = has_absolute[window]
+        if use.any():
+            difference = wrap_angle(yaw_of(rotations[window][use]) - absolute[window][use])
+            delta = float(np.arctan2(np.mean(np.sin(difference)), np.mean(np.cos(difference))))
+            turn = _rz(-delta)
+            pivot = positions[oldest].copy()
+            positions[window] = pivot + (positions[window] - pivot) @ turn.T
+            rotations[window] = turn @ rotations[window]
+            correction -= delta
+            offset[i] = delta
+        total[i] = correction
+    vehicle = Trajectory(camera.t.copy(), positions, Rotation.from_matrix(rotations))
+    T_veh_cam = np.asarray(camera_to_vehicle, dtype=float)
+    camera_out = Trajectory.from_matrices(camera.t.copy(), vehicle.matrices @ T_veh_cam)
+    return HeadingCorrectionResult(vehicle, camera_out, offset, has_absolute, total)
