@@ -1,0 +1,330 @@
+"""Conventional Doppler velocity: receiver velocity and clock drift per epoch (DESIGN.md,
+"Conventional Doppler velocity").
+
+Sign convention (RINEX 3.05 sec. 5.2.10: Doppler is positive for approaching satellites):
+range rate ρ̇ = −λ·D. With the unit line of sight e = (x_s − x_r)/|x_s − x_r| (receiver →
+satellite, ECEF of the reception epoch), satellite velocity v_s, receiver velocity v, receiver
+clock drift b = c·δṫ_r (m/s) and satellite clock drift c·δṫ_s (m/s):
+
+    ρ̇ = e·(v_s − v) + b − c·δṫ_s
+    ⇔ ρ̇ − e·v_s + c·δṫ_s = −e·v + b            (one row [−e, 1] of the design matrix)
+
+Weights: σ_i = σ₀ · 10^((C/N0_ref − C/N0_i)/20) / sin(elevation_i). Fault detection and
+exclusion: chi-square test, iterated (``lsq.lsq_with_exclusion``). Fewer than four satellites
+(after mask and exclusion) → the epoch is unavailable (NaN, ``valid`` False), never guessed.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.gnss.ephemeris import transmit_states
+from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion
+from vo_doppler.gnss.signals import strength_code, wavelengths
+from vo_doppler.gnss.spp import elevation_azimuth
+from vo_doppler.io.rinex_nav import Navigation
+from vo_doppler.io.rinex_obs import Observations
+
+log = logging.getLogger(__name__)
+
+SIGMA_RANGE_RATE_MPS = 0.05
+CN0_REFERENCE_DBHZ = 45.0
+CN0_DEFAULT_DBHZ = 40.0
+MIN_SATELLITES = 4
+
+
+@dataclass(frozen=True)
+class DopplerRows:
+    """One row per (epoch, satellite, Doppler observable) with everything a Doppler solver needs.
+
+    Flat numpy arrays of length N (vectors N×3, ECEF of the reception epoch):
+    ``t`` GPS s of reception; ``epoch`` index into the observation epochs; ``system``, ``prn``,
+    ``code`` (e.g. 'D1C'); ``wavelength_m``; ``los`` unit vector receiver → satellite;
+    ``sat_position``, ``sat_vel`` (m, m/s, at transmission, rotated to the reception frame);
+    ``sat_clock_drift_mps`` = c·δṫ_s; ``range_rate_mps`` = −λ·D (measured); ``cn0`` dB-Hz (NaN
+    when not logged); ``elevation``/``azimuth`` rad; ``receiver_ecef`` the position used.
+    Model: range_rate = los·(sat_vel − v) + b − sat_clock_drift_mps (b receiver clock drift, m/s).
+    Counts: ``n_no_ephemeris`` rows dropped for lack of a healthy ephemeris (``missing`` lists
+    'SAT@t' once per satellite), ``n_no_wavelength`` (GLONASS channel unknown),
+    ``n_below_mask``.
+    """
+
+    t: np.ndarray
+    epoch: np.ndarray
+    system: np.ndarray
+    prn: np.ndarray
+    code: np.ndarray
+    wavelength_m: np.ndarray
+    los: np.ndarray
+    sat_position: np.ndarray
+    sat_vel: np.ndarray
+    sat_clock_drift_mps: np.ndarray
+    range_rate_mps: np.ndarray
+    cn0: np.ndarray
+    elevation: np.ndarray
+    azimuth: np.ndarray
+    receiver_ecef: np.ndarray
+    n_no_ephemeris: int = 0
+    n_no_wavelength: int = 0
+    n_below_mask: int = 0
+    missing: tuple[str, ...] = field(default=())
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def corrected_range_rate(self) -> np.ndarray:
+        """ρ̇ − e·v_s + c·δṫ_s, which equals −e·v + b."""
+        return (
+            self.range_rate_mps
+            - np.einsum("ij,ij->i", self.los, self.sat_vel)
+            + self.sat_clock_drift_mps
+        )
+
+    def sigma(self, sigma0: float = SIGMA_RANGE_RATE_MPS) -> np.ndarray:
+        """Standard deviation per row from C/N0 and elevation (module docstring)."""
+        cn0 = np.where(np.isfinite(self.cn0), self.cn0, CN0_DEFAULT_DBHZ)
+        strength = 10.0 ** ((CN0_REFERENCE_DBHZ - np.minimum(cn0, 55.0)) / 20.0)
+        return sigma0 * strength / np.sin(np.maximum(self.elevation, np.deg2rad(5.0)))
+
+
+@dataclass(frozen=True)
+class VelocitySolution:
+    """Per-epoch receiver velocity (ECEF and ENU at the receiver, m/s) and clock drift (m/s).
+
+    ``covariance`` 4×4 of (v_x, v_y, v_z, b) in ECEF; ``dop`` columns (GDOP, PDOP, HDOP, VDOP,
+    TDOP) of the velocity geometry (unweighted). Unavailable epochs: ``valid`` False, NaN values.
+    """
+
+    t: np.ndarray
+    velocity_ecef: np.ndarray
+    velocity_enu: np.ndarray
+    clock_drift_mps: np.ndarray
+    covariance: np.ndarray
+    dop: np.ndarray
+    n_sat: np.ndarray
+    n_obs: np.ndarray
+    n_excluded: np.ndarray
+    residual_rms_mps: np.ndarray
+    valid: np.ndarray
+    n_no_ephemeris: int = 0
+
+    @property
+    def speed_mps(self) -> np.ndarray:
+        return np.linalg.norm(self.velocity_enu, axis=1)
+
+    @property
+    def course_deg(self) -> np.ndarray:
+        """Course over ground, degrees clockwise from north in [0, 360)."""
+        e, n = self.velocity_enu[:, 0], self.velocity_enu[:, 1]
+        return np.mod(np.rad2deg(np.arctan2(e, n)), 360.0)
+
+
+def doppler_codes(obs: Observations, systems: str, bands: str | None = None) -> list[str]:
+    """Doppler observables present for the systems (optionally only the given band digits)."""
+    codes = set()
+    for system in systems:
+        codes.update(c for c in obs.codes_of(system) if c.startswith("D"))
+    return sorted(c for c in codes if bands is None or c[1:2] in bands)
+
+
+def doppler_rows(
+    obs: Observations,
+    nav: Navigation,
+    receiver_ecef: np.ndarray,
+    systems: str = "GREJC",
+    bands: str | None = None,
+    elevation_mask_rad: float = np.deg2rad(10.0),
+) -> DopplerRows:
+    """Doppler rows of the chosen systems/bands with satellite states and geometry.
+
+    ``receiver_ecef``: (3,) or one position per observation epoch (E, 3; NaN rows are skipped).
+    Satellite states are taken at signal transmission (travel time from the geometric range) in
+    the ECEF frame of reception. Rows without ephemeris or wavelength are dropped and counted.
+    """
+    n_epochs = obs.epoch_time.size
+    receiver = np.broadcast_to(np.asarray(receiver_ecef, dtype=float), (n_epochs, 3))
+    channels = dict(obs.header.glonass_channels)
+    if len(nav.glonass):
+        channels = {**nav.glonass_channels(), **channels}
+    keep = np.zeros(len(obs), dtype=bool)
+    for system in systems:
+        for code in doppler_codes(obs, system, bands):
+            keep |= obs.mask(system, code)
+    sel = obs.subset(keep & np.isfinite(obs.value))
+    code_names = np.array(obs.codes, dtype="U3")[sel.code] if len(sel) else np.zeros(0, "U3")
+    wavelength = np.full(len(sel), np.nan)
+    cn0 = np.full(len(sel), np.nan)
+    for code in np.unique(code_names):
+        rows = code_names == code
+        wavelength[rows] = wavelengths(
+            sel.system[rows], sel.prn[rows], str(code), channels, obs.header.version
+        )
+        cn0[rows] = _signal_strength(obs, sel, rows, strength_code(str(code)))
+    epoch = np.searchsorted(obs.epoch_time, sel.time)
+    position = receiver[epoch]
+    has_position = np.isfinite(position).all(axis=1)
+    n_no_wavelength = int((~np.isfinite(wavelength)).sum())
+    usable = np.isfinite(wavelength) & has_position
+    states, _ = transmit_states(
+        nav,
+        sel.system[usable],
+        sel.prn[usable],
+        sel.time[usable],
+        receiver_ecef=position[usable],
+    )
+    no_eph = np.zeros(len(sel), dtype=bool)
+    no_eph[np.flatnonzero(usable)[~states.valid]] = True
+    missing = _missing_messages(sel, no_eph)
+    vector = states.position - position[usable]
+    los = vector / np.linalg.norm(vector, axis=1, keepdims=True)
+    elevation, azimuth = elevation_azimuth(position[usable], los)
+    good = states.valid & (elevation >= elevation_mask_rad)
+    n_below = int((states.valid & ~good).sum())
+    idx = np.flatnonzero(usable)[good]
+    return DopplerRows(
+        t=sel.time[idx],
+        epoch=epoch[idx],
+        system=sel.system[idx],
+        prn=sel.prn[idx],
+        code=code_names[idx],
+        wavelength_m=wavelength[idx],
+        los=los[good],
+        sat_position=states.position[good],
+        sat_vel=states.velocity[good],
+        sat_clock_drift_mps=SPEED_OF_LIGHT * states.clock_drift[good],
+        range_rate_mps=-wavelength[idx] * sel.value[idx],
+        cn0=cn0[idx],
+        elevation=elevation[good],
+        azimuth=azimuth[good],
+        receiver_ecef=position[idx],
+        n_no_ephemeris=int(no_eph.sum()),
+        n_no_wavelength=n_no_wavelength,
+        n_below_mask=n_below,
+        missing=missing,
+    )
+
+
+def _signal_strength(obs: Observations, sel: Observations, rows: np.ndarray, code: str):
+    """C/N0 of the same signal at the same epoch and satellite (NaN when absent)."""
+    strength = obs.select(code=code)
+    out = np.full(int(rows.sum()), np.nan)
+    if len(strength) == 0:
+        return out
+    key = _row_keys(strength)
+    order = np.argsort(key)
+    wanted = _row_keys(sel.subset(rows))
+    pos = np.clip(np.searchsorted(key[order], wanted), 0, key.size - 1)
+    hit = key[order][pos] == wanted
+    out[hit] = strength.value[order][pos[hit]]
+    return out
+
+
+def _row_keys(obs: Observations) -> np.ndarray:
+    """Integer key (epoch time in 0.1 µs, system, prn) for joining rows of one file."""
+    ticks = np.round(obs.time * 1e7).astype(np.int64)
+    system = np.array([ord(s) for s in obs.system], dtype=np.int64) if len(obs) else ticks
+    return (ticks * 128 + system) * 1024 + obs.prn.astype(np.int64)
+
+
+def _missing_messages(sel: Observations, no_eph: np.ndarray) -> tuple[str, ...]:
+    messages = []
+    if no_eph.any():
+        sats = sel.satellites()[no_eph]
+        times = sel.time[no_eph]
+        for sat in np.unique(sats):
+            first = times[sats == sat].min()
+            count = int((sats == sat).sum())
+            messages.append(f"{sat}: no healthy ephemeris from GPS time {first:.1f} ({count} rows)")
+            log.warning("satellite %s skipped", messages[-1])
+    return tuple(messages)
+
+
+def solve_velocity(
+    rows: DopplerRows,
+    epoch_time: np.ndarray,
+    sigma0: float = SIGMA_RANGE_RATE_MPS,
+    alpha: float = DEFAULT_ALPHA,
+) -> VelocitySolution:
+    """Weighted LS velocity + clock drift per epoch with iterated chi-square FDE."""
+    n = epoch_time.size
+    velocity = np.full((n, 3), np.nan)
+    velocity_enu = np.full((n, 3), np.nan)
+    drift = np.full(n, np.nan)
+    covariance = np.full((n, 4, 4), np.nan)
+    dop = np.full((n, 5), np.nan)
+    n_sat = np.zeros(n, dtype=np.int64)
+    n_obs = np.zeros(n, dtype=np.int64)
+    n_excluded = np.zeros(n, dtype=np.int64)
+    rms = np.full(n, np.nan)
+    order = np.argsort(rows.epoch, kind="stable")
+    bounds = np.searchsorted(rows.epoch[order], np.arange(n + 1))
+    y_all = rows.corrected_range_rate()
+    sigma_all = rows.sigma(sigma0)
+    satellite = np.char.add(rows.system, rows.prn.astype(str)) if len(rows) else rows.system
+    for k in range(n):
+        r = order[bounds[k] : bounds[k + 1]]
+        if np.unique(satellite[r]).size < MIN_SATELLITES:
+            n_sat[k] = np.unique(satellite[r]).size
+            continue
+        H = np.hstack([-rows.los[r], np.ones((r.size, 1))])
+        result = lsq_with_exclusion(H, y_all[r], sigma_all[r], satellite[r], MIN_SATELLITES, alpha)
+        n_sat[k] = np.unique(satellite[r][result.used]).size if result.valid else 0
+        if not result.valid:
+            continue
+        velocity[k] = result.x[:3]
+        drift[k] = result.x[3]
+        covariance[k] = result.covariance
+        n_obs[k] = int(result.used.sum())
+        n_excluded[k] = int((~result.used).sum())
+        rms[k] = float(np.sqrt(np.mean(result.residuals[result.used] ** 2)))
+        lat, lon, _ = ecef_to_geodetic(rows.receiver_ecef[r[0]])
+        rotation = ecef_to_enu_rotation(float(lat), float(lon))
+        velocity_enu[k] = rotation @ result.x[:3]
+        dop[k] = _dop(H[result.used], rotation)
+    return VelocitySolution(
+        t=epoch_time,
+        velocity_ecef=velocity,
+        velocity_enu=velocity_enu,
+        clock_drift_mps=drift,
+        covariance=covariance,
+        dop=dop,
+        n_sat=n_sat,
+        n_obs=n_obs,
+        n_excluded=n_excluded,
+        residual_rms_mps=rms,
+        valid=np.isfinite(drift),
+        n_no_ephemeris=rows.n_no_ephemeris,
+    )
+
+
+def _dop(H: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """GDOP, PDOP, HDOP, VDOP, TDOP of a velocity design matrix (rows [−e, 1])."""
+    q = np.linalg.inv(H.T @ H)
+    q_enu = rotation @ q[:3, :3] @ rotation.T
+    return np.sqrt(
+        [
+            np.trace(q),
+            np.trace(q[:3, :3]),
+            q_enu[0, 0] + q_enu[1, 1],
+            q_enu[2, 2],
+            q[3, 3],
+        ]
+    )
+
+
+def doppler_velocity(
+    obs: Observations,
+    nav: Navigation,
+    receiver_ecef: np.ndarray,
+    systems: str = "GREJC",
+    bands: str | None = None,
+    elevation_mask_rad: float = np.deg2rad(10.0),
+    sigma0: float = SIGMA_RANGE_RATE_MPS,
+) -> tuple[VelocitySolution, DopplerRows]:
+    """Rows and per-epoch solution in one call (see ``doppler_rows`` and ``solve_velocity``)."""
+    rows = doppler_rows(obs, nav, receiver_ecef, systems, bands, elevation_mask_rad)
+    return solve_velocity(rows, obs.epoch_time, sigma0), rows

@@ -1,0 +1,81 @@
+"""Weighted least squares with chi-square fault detection and exclusion (iterated).
+
+Global test: the weighted sum of squared residuals Ω = rᵀWr of a correct model with n rows and
+u unknowns follows χ²(n − u); when Ω exceeds the (1 − α) quantile, the row with the largest
+normalised residual |r_i| / √(Q_vv,ii), Q_vv = W⁻¹ − H (HᵀWH)⁻¹ Hᵀ (Baarda's w-test), is
+excluded and the solution repeated, while enough distinct satellites remain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+DEFAULT_ALPHA = 1e-3
+
+
+@dataclass(frozen=True)
+class LsqResult:
+    """Solution of one weighted least-squares problem after fault exclusion.
+
+    ``residuals`` = y − H x for every row (excluded rows included); ``used`` marks the rows kept.
+    ``chi_square`` = Ω of the kept rows, ``dof`` = kept rows − unknowns.
+    """
+
+    x: np.ndarray
+    covariance: np.ndarray
+    residuals: np.ndarray
+    used: np.ndarray
+    chi_square: float
+    dof: int
+    valid: bool
+
+
+def weighted_lsq(H: np.ndarray, y: np.ndarray, sigma: np.ndarray):
+    """x, covariance (HᵀWH)⁻¹ and residuals of min Σ ((y − Hx)_i / σ_i)²."""
+    w = 1.0 / sigma
+    Hw = H * w[:, None]
+    normal = Hw.T @ Hw
+    covariance = np.linalg.inv(normal)
+    x = covariance @ (Hw.T @ (y * w))
+    return x, covariance, y - H @ x
+
+
+def lsq_with_exclusion(
+    H: np.ndarray,
+    y: np.ndarray,
+    sigma: np.ndarray,
+    groups: np.ndarray,
+    min_groups: int,
+    alpha: float = DEFAULT_ALPHA,
+    max_excluded_fraction: float = 0.34,
+) -> LsqResult:
+    """Weighted LS with iterated chi-square FDE; ``groups`` labels rows by satellite.
+
+    The solution is invalid (never guessed) when fewer than ``min_groups`` distinct groups or
+    fewer rows than unknowns are available, or the geometry is singular.
+    """
+    n, u = H.shape
+    used = np.ones(n, dtype=bool)
+    unavailable = LsqResult(
+        np.full(u, np.nan), np.full((u, u), np.nan), np.full(n, np.nan), ~used, np.nan, 0, False
+    )
+    max_excluded = int(max_excluded_fraction * n)
+    while True:
+        if np.unique(groups[used]).size < min_groups or used.sum() < u:
+            return unavailable
+        Hu, yu, su = H[used], y[used], sigma[used]
+        if np.linalg.matrix_rank(Hu) < u:
+            return unavailable
+        x, covariance, _ = weighted_lsq(Hu, yu, su)
+        residuals = y - H @ x
+        dof = int(used.sum()) - u
+        omega = float(np.sum((residuals[used] / su) ** 2))
+        if dof < 1 or omega <= chi2.ppf(1.0 - alpha, dof) or (~used).sum() >= max_excluded:
+            return LsqResult(x, covariance, residuals, used.copy(), omega, dof, True)
+        q_vv = su**2 - np.einsum("ij,jk,ik->i", Hu, covariance, Hu)
+        normalised = np.abs(residuals[used]) / np.sqrt(np.maximum(q_vv, 1e-30))
+        worst = np.flatnonzero(used)[int(np.argmax(normalised))]
+        used[worst] = False

@@ -1,0 +1,237 @@
+"""Pseudorange single-point positioning: position and one receiver clock per system, per epoch.
+
+Model (IS-GPS-200 sec. 20.3.3.3.3): P = ρ + c·δt_r,sys − c·(δt_sv − T_GD) + T + ε with the
+satellite state at transmission (``transmit_states``), Earth rotation during travel, the
+Saastamoinen troposphere with a standard atmosphere (Saastamoinen 1972), no ionosphere model
+(single-frequency position errors of a few metres remain; the positions serve the line-of-sight
+vectors and the ENU origin). Gauss–Newton iterations, elevation mask once the position is known,
+then chi-square fault exclusion (``lsq``) and a final pass without the excluded rows.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.gnss.ephemeris import rotate_earth, satellite_states
+from vo_doppler.gnss.lsq import lsq_with_exclusion, weighted_lsq
+from vo_doppler.io.rinex_nav import Navigation
+from vo_doppler.io.rinex_obs import Observations
+
+log = logging.getLogger(__name__)
+
+PSEUDORANGE_PRIORITY = {
+    "G": ("C1C", "C1W", "C1X", "C1", "P1", "C2W", "C2L", "C5Q", "P2"),
+    "R": ("C1C", "C1P", "C1", "P1", "C2C", "C2P", "P2"),
+    "E": ("C1C", "C1X", "C1B", "C1", "C5Q", "C5X", "C7Q", "C7X"),
+    "C": ("C2I", "C2X", "C1I", "C7I", "C1P", "C1X", "C6I"),
+    "J": ("C1C", "C1X", "C1", "C2L", "C5Q"),
+    "S": ("C1C", "C1"),
+    "I": ("C5A", "C9A"),
+}
+SIGMA_PSEUDORANGE_M = 3.0
+EARTH_SURFACE_M = 6.0e6
+_GROUP_DELAY_FIELD = {("G", "1"): "tgd", ("J", "1"): "tgd", ("E", "1"): "iodc", ("C", "2"): "tgd"}
+
+
+@dataclass(frozen=True)
+class SppSolution:
+    """Per-epoch positions (ECEF m), receiver clock bias per system (m), quality figures."""
+
+    t: np.ndarray
+    position_ecef: np.ndarray
+    clock_bias_m: dict[str, np.ndarray]
+    n_sat: np.ndarray
+    residual_rms_m: np.ndarray
+    pdop: np.ndarray
+    valid: np.ndarray
+    n_no_ephemeris: int
+
+
+def pseudorange_codes(obs: Observations, systems: str) -> dict[str, str]:
+    """The preferred pseudorange observable per system present in the file."""
+    chosen = {}
+    for system in systems:
+        present = set(obs.codes_of(system))
+        for code in PSEUDORANGE_PRIORITY.get(system, ()):
+            if code in present:
+                chosen[system] = code
+                break
+    return chosen
+
+
+def elevation_azimuth(receiver_ecef: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Elevation and azimuth (rad, azimuth clockwise from north) of unit vectors at receivers."""
+    receiver_ecef = np.broadcast_to(receiver_ecef, los.shape)
+    lat, lon, _ = ecef_to_geodetic(receiver_ecef)
+    lat, lon = np.atleast_1d(lat), np.atleast_1d(lon)
+    east = np.stack([-np.sin(lon), np.cos(lon), np.zeros_like(lon)], axis=-1)
+    north = np.stack([-np.sin(lat) * np.cos(lon), -np.sin(lat) * np.sin(lon), np.cos(lat)], axis=-1)
+    up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
+    e, n, u = (np.sum(los * axis, axis=-1) for axis in (east, north, up))
+    return np.arcsin(np.clip(u, -1.0, 1.0)), np.mod(np.arctan2(e, n), 2.0 * np.pi)
+
+
+def troposphere_delay(receiver_ecef: np.ndarray, elevation: np.ndarray) -> np.ndarray:
+    """Saastamoinen slant delay (m) for a standard atmosphere (humidity 70 %)."""
+    _, _, height = ecef_to_geodetic(receiver_ecef)
+    h = np.clip(height, 0.0, 1e4)
+    pressure = 1013.25 * (1.0 - 2.2557e-5 * h) ** 5.2568
+    temperature = 15.0 - 6.5e-3 * h + 273.16
+    vapour = 6.108 * 0.7 * np.exp((17.15 * temperature - 4684.0) / (temperature - 38.45))
+    zenith = np.pi / 2.0 - np.maximum(elevation, np.deg2rad(3.0))
+    return (
+        0.002277
+        / np.cos(zenith)
+        * (pressure + (1255.0 / temperature + 0.05) * vapour - np.tan(zenith) ** 2)
+    )
+
+
+def solve_spp(
+    obs: Observations,
+    nav: Navigation,
+    systems: str = "GREJC",
+    elevation_mask_rad: float = np.deg2rad(10.0),
+) -> SppSolution:
+    """Single-point position per data epoch of ``obs`` (invalid epochs NaN, never guessed)."""
+    codes = pseudorange_codes(obs, systems)
+    rows = np.zeros(len(obs), dtype=bool)
+    for system, code in codes.items():
+        rows |= obs.mask(system, code)
+    sel = obs.subset(rows & np.isfinite(obs.value) & (obs.value > 1e6))
+    travel = sel.value / SPEED_OF_LIGHT
+    first = satellite_states(nav, sel.system, sel.prn, sel.time - travel)
+    t_tx = sel.time - travel - np.nan_to_num(first.clock_bias_s)
+    states = satellite_states(nav, sel.system, sel.prn, t_tx)
+    group_delay = np.zeros(len(sel))
+    for (system, band), name in _GROUP_DELAY_FIELD.items():
+        code = codes.get(system, "")
+        hit = (sel.system == system) & states.valid
+        if code[1:2] == band and hit.any():
+            group_delay[hit] = nav.kepler[name][states.record[hit]]
+    satellite_clock_m = SPEED_OF_LIGHT * (states.clock_bias_s - np.nan_to_num(group_delay))
+    n_no_ephemeris = int((~states.valid).sum())
+    epoch = np.searchsorted(obs.epoch_time, sel.time)
+    bounds = np.searchsorted(epoch, np.arange(obs.epoch_time.size + 1))
+    start = obs.header.approx_position
+    if start is None or np.linalg.norm(start) < EARTH_SURFACE_M:
+        start = np.zeros(3)
+    system_list = sorted(codes)
+    n_epochs = obs.epoch_time.size
+    position = np.full((n_epochs, 3), np.nan)
+    clocks = {s: np.full(n_epochs, np.nan) for s in system_list}
+    n_sat = np.zeros(n_epochs, dtype=np.int64)
+    rms = np.full(n_epochs, np.nan)
+    pdop = np.full(n_epochs, np.nan)
+    for k in range(n_epochs):
+        r = np.arange(bounds[k], bounds[k + 1])
+        r = r[states.valid[r]]
+        result = _solve_epoch(
+            states.position[r],
+            sel.value[r] + satellite_clock_m[r],
+            sel.system[r],
+            sel.prn[r],
+            start,
+            system_list,
+            elevation_mask_rad,
+        )
+        if result is None:
+            continue
+        x, clock, used, residuals, dop = result
+        position[k] = x
+        for s, value in clock.items():
+            clocks[s][k] = value
+        n_sat[k] = used
+        rms[k] = residuals
+        pdop[k] = dop
+        start = x
+    return SppSolution(
+        obs.epoch_time,
+        position,
+        clocks,
+        n_sat,
+        rms,
+        pdop,
+        np.isfinite(position[:, 0]),
+        n_no_ephemeris,
+    )
+
+
+def _solve_epoch(sat_position, corrected_range, system, prn, start, system_list, mask):
+    """Gauss–Newton with elevation mask and FDE; None when fewer than 3 + n_clock satellites."""
+    keep = np.ones(corrected_range.size, dtype=bool)
+    x = np.asarray(start, dtype=float).copy()
+    clocks = np.zeros(len(system_list))
+    for _ in range(2):
+        for _ in range(12):
+            H, residual, sigma, keep_now, present = _linearise(
+                sat_position, corrected_range, system, x, clocks, system_list, mask, keep
+            )
+            if keep_now.sum() < 3 + present.sum():
+                return None
+            H = H[keep_now][:, np.r_[True, True, True, present]]
+            dx, _, _ = weighted_lsq(H, residual[keep_now], sigma[keep_now])
+            x += dx[:3]
+            clocks[present] += dx[3:]
+            if np.linalg.norm(dx[:3]) < 1e-4:
+                break
+        groups = np.char.add(system[keep_now], prn[keep_now].astype(str))
+        result = lsq_with_exclusion(
+            H, residual[keep_now], sigma[keep_now], groups, 3 + int(present.sum())
+        )
+        if not result.valid:
+            return None
+        if result.used.all():
+            break
+        keep[np.flatnonzero(keep_now)[~result.used]] = False
+    if np.linalg.norm(x) < EARTH_SURFACE_M:
+        return None
+    used = keep_now.sum()
+    rms_value = float(np.sqrt(np.mean(result.residuals[result.used] ** 2)))
+    pdop = float(np.sqrt(np.trace(np.linalg.inv(H.T @ H)[:3, :3])))
+    clock = {s: clocks[i] for i, s in enumerate(system_list) if present[i]}
+    return x, clock, int(used - (~result.used).sum()), rms_value, pdop
+
+
+def _linearise(sat_position, corrected_range, system, x, clocks, system_list, mask, keep):
+    travel = np.linalg.norm(sat_position - x, axis=1) / SPEED_OF_LIGHT
+    rotated = rotate_earth(sat_position, travel)
+    vector = rotated - x
+    rho = np.linalg.norm(vector, axis=1)
+    los = vector / rho[:, None]
+    keep_now = keep.copy()
+    sigma = np.full(rho.size, SIGMA_PSEUDORANGE_M)
+    troposphere = np.zeros(rho.size)
+    if np.linalg.norm(x) > EARTH_SURFACE_M:
+        elevation, _ = elevation_azimuth(x, los)
+        keep_now &= elevation >= mask
+        sigma = SIGMA_PSEUDORANGE_M / np.sin(np.maximum(elevation, np.deg2rad(5.0)))
+        troposphere = troposphere_delay(x, elevation)
+    one_hot = np.stack([system == s for s in system_list], axis=1).astype(float)
+    present = one_hot[keep_now].any(axis=0)
+    predicted = rho + one_hot @ clocks + troposphere
+    H = np.hstack([-los, one_hot])
+    return H, corrected_range - predicted, sigma, keep_now, present
+
+
+def enu_rotation_at(position_ecef: np.ndarray) -> np.ndarray:
+    """ECEF→ENU rotation at a receiver position."""
+    lat, lon, _ = ecef_to_geodetic(position_ecef)
+    return ecef_to_enu_rotation(float(lat), float(lon))
+
+
+def receiver_positions(solution: SppSolution, fallback: np.ndarray | None) -> np.ndarray:
+    """One position per epoch: the SPP fix, else the nearest valid fix in time, else
+    ``fallback`` (e.g. the RINEX approximate position); NaN rows when none exists."""
+    out = solution.position_ecef.copy()
+    valid = solution.valid
+    if valid.any():
+        good = np.flatnonzero(valid)
+        nearest = good[np.abs(solution.t[:, None] - solution.t[good][None, :]).argmin(axis=1)]
+        out[~valid] = solution.position_ecef[nearest[~valid]]
+    elif fallback is not None and np.linalg.norm(fallback) > EARTH_SURFACE_M:
+        out[:] = fallback
+    return out
