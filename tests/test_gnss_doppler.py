@@ -112,14 +112,14 @@ def test_one_faulty_satellite_is_excluded(nav):
     bad = (obs.system == "G") & (obs.prn == 20)  # elevation 50°
     value[bad] += 30.0  # 30 Hz ≈ 6 m/s on one satellite
     faulty = Observations(**{**obs.__dict__, "value": value})
-    solution, _ = doppler_velocity(faulty, nav, RECEIVER, "GREC")
+    solution, _ = doppler_velocity(faulty, nav, RECEIVER, systems="GREC")
     assert solution.n_excluded[0] == 3
     np.testing.assert_allclose(solution.velocity_ecef[0], VELOCITY, atol=0.05)
 
 
 def test_fewer_than_four_satellites_is_unavailable(nav):
     obs = _synthetic_obs(nav, n_epochs=2, satellites={"G": (5, 6, 7)})
-    solution, rows = doppler_velocity(obs, nav, RECEIVER, "G", elevation_mask_rad=-1.0)
+    solution, rows = doppler_velocity(obs, nav, RECEIVER, systems="G", elevation_mask_rad=-1.0)
     assert len(rows) == 2 * 3 * 3
     assert not solution.valid.any()
     assert np.isnan(solution.velocity_enu).all()
@@ -149,7 +149,7 @@ def septentrio():
 @pytest.mark.parametrize("systems", ["GREJC", "G"])
 def test_static_septentrio_speed(septentrio, systems):
     obs, nav, position = septentrio
-    solution, _ = doppler_velocity(obs, nav, position, systems)
+    solution, _ = doppler_velocity(obs, nav, position, systems=systems)
     speed = solution.speed_mps
     assert solution.valid.all()
     assert np.median(speed) <= 0.02
@@ -161,7 +161,7 @@ def test_yamatogawa_walk_speeds():
     obs = read_obs(require_shared("yamatogawa_ublox_walk/yamatogawa_rover.obs"))
     nav = read_nav(require_shared("yamatogawa_ublox_walk/brdc0060.10n"))
     position = receiver_positions(solve_spp(obs, nav, "G"), obs.header.approx_position)
-    solution, _ = doppler_velocity(obs, nav, position, "G")
+    solution, _ = doppler_velocity(obs, nav, position, systems="G")
     t = solution.t - solution.t[0]
     speed = solution.speed_mps
     assert solution.valid.all()

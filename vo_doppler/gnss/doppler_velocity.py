@@ -320,11 +320,10 @@ def doppler_velocity(
     obs: Observations,
     nav: Navigation,
     receiver_ecef: np.ndarray,
-    systems: str = "GREJC",
-    bands: str | None = None,
-    elevation_mask_rad: float = np.deg2rad(10.0),
     sigma0: float = SIGMA_RANGE_RATE_MPS,
+    **row_options,
 ) -> tuple[VelocitySolution, DopplerRows]:
-    """Rows and per-epoch solution in one call (see ``doppler_rows`` and ``solve_velocity``)."""
-    rows = doppler_rows(obs, nav, receiver_ecef, systems, bands, elevation_mask_rad)
+    """Rows (``doppler_rows`` with ``row_options``: systems, bands, elevation_mask_rad) and the
+    per-epoch solution (``solve_velocity``) in one call."""
+    rows = doppler_rows(obs, nav, receiver_ecef, **row_options)
     return solve_velocity(rows, obs.epoch_time, sigma0), rows
