@@ -188,3 +188,29 @@ def test_comma_can_bias_and_scale_from_receiver_doppler():
         kalman_scale.add(t_fix[i], doppler_speed[i], wheel[i])
     assert abs(np.degrees(kalman_bias.estimate.value - bias_gt)) <= 0.05
     assert abs(kalman_scale.estimate.value / scale_gt - 1.0) <= 0.003
+
+
+def test_standstill_runs_give_the_bias_without_a_course():
+    t, speed, yaw_rate, yaw = _drive(n=600)
+    stopped = (t < 15.0) | ((t > 40.0) & (t < 45.0))
+    true_rate = np.where(stopped, 0.0, yaw_rate)
+    speed = np.where(stopped, 0.03, speed)
+    bias = np.radians(-0.3)
+    phi = integrate_rate(t, true_rate + bias, t)
+    doppler_yaw = np.where(stopped, np.nan, yaw)  # no course while stopped
+    only_stopped = estimate_gyro_bias(
+        t[t < 15.0], doppler_yaw[t < 15.0], phi[t < 15.0], speed[t < 15.0]
+    )
+    assert only_stopped.value == pytest.approx(bias, abs=1e-12)
+    heading_true = 3.0 + integrate_rate(t, true_rate, t)
+    both = estimate_gyro_bias(t, np.where(stopped, np.nan, heading_true), phi, speed)
+    assert both.value == pytest.approx(bias, abs=1e-12)
+    assert both.n_used == len(t)
+    disabled = estimate_gyro_bias(
+        t[t < 15.0],
+        doppler_yaw[t < 15.0],
+        phi[t < 15.0],
+        speed[t < 15.0],
+        config=GateConfig(stationary_speed_mps=0.0),
+    )
+    assert not disabled.valid

@@ -36,6 +36,7 @@ class GateConfig:
     max_yaw_jump_rad: float = np.radians(2.0)
     max_yaw_drift_rad_s: float = np.radians(1.0)
     min_speed_mps: float = 1.0
+    stationary_speed_mps: float = 0.1
     window_s: float = 60.0
     min_samples: int = 10
 
@@ -121,31 +122,50 @@ def estimate_gyro_bias(
 
     ``doppler_yaw`` is the Doppler course as yaw (rad, counter-clockwise from east),
     ``integrated_yaw`` is Φ(t), the integral of the measured (counter-clockwise) yaw rate.
+    Moving samples share one intercept ψ₀. Extension beyond the seed: while the Doppler speed
+    is below ``config.stationary_speed_mps`` the vehicle cannot turn, so −Φ(t) = c − b·t with an
+    intercept of its own for each stationary run (no course is needed there).
     """
     t = np.asarray(t, dtype=float)
     speed = np.asarray(doppler_speed, dtype=float)
-    z = np.asarray(doppler_yaw, dtype=float) - np.asarray(integrated_yaw, dtype=float)
-    usable = np.isfinite(z) & np.isfinite(speed) & (speed >= config.min_speed_mps)
-    if doppler_valid is not None:
-        usable &= np.asarray(doppler_valid, dtype=bool)
-    z_unwrapped = np.full_like(z, np.nan)
-    z_unwrapped[usable] = np.unwrap(wrap_angle(z[usable]))
-    keep = variation_gate(
-        t, z_unwrapped, config.max_yaw_jump_rad, config.max_yaw_drift_rad_s, usable
-    )
+    phi = np.asarray(integrated_yaw, dtype=float)
+    valid = np.ones(len(t), dtype=bool) if doppler_valid is None else np.asarray(doppler_valid)
+    z = np.asarray(doppler_yaw, dtype=float) - phi
+    moving = valid & np.isfinite(z) & np.isfinite(speed) & (speed >= config.min_speed_mps)
+    stationary = valid & np.isfinite(phi) & (speed <= config.stationary_speed_mps)
+    group = np.where(moving, 0, -1)
+    run_starts = stationary & ~np.concatenate([[False], stationary[:-1]])
+    group = np.where(stationary, np.cumsum(run_starts), group)
+    value = np.full_like(z, np.nan)
+    if moving.any():
+        value[moving] = np.unwrap(wrap_angle(z[moving]))
+    value[stationary] = -phi[stationary]
+    keep = np.zeros(len(t), dtype=bool)
+    for g in np.unique(group[group >= 0]):
+        members = group == g
+        keep |= variation_gate(
+            t, value, config.max_yaw_jump_rad, config.max_yaw_drift_rad_s, members
+        )
+    usable = group >= 0
     n, rejected = int(keep.sum()), int(usable.sum() - keep.sum())
     if n < max(config.min_samples, 3):
         return CalibrationEstimate(np.nan, np.nan, n, rejected)
-    tau = t[keep] - t[keep].mean()
-    if np.ptp(tau) <= 0:
+    tau, y = t[keep], value[keep]
+    groups = group[keep]
+    for g in np.unique(groups):
+        members = groups == g
+        tau[members] -= tau[members].mean()
+        y[members] -= y[members].mean()
+    sxx = float(tau @ tau)
+    if sxx <= 0:
         return CalibrationEstimate(np.nan, np.nan, n, rejected)
-    A = np.column_stack([np.ones(n), -tau])
-    y = z_unwrapped[keep]
-    (intercept, bias), *_ = np.linalg.lstsq(A, y, rcond=None)
-    residual = y - A @ np.array([intercept, bias])
-    variance = float(residual @ residual) / (n - 2)
-    sigma = np.sqrt(variance / float(tau @ tau))
-    return CalibrationEstimate(float(bias), float(sigma), n, rejected)
+    bias = -float(tau @ y) / sxx
+    residual = y + bias * tau
+    dof = n - 1 - len(np.unique(groups))
+    if dof < 1:
+        return CalibrationEstimate(np.nan, np.nan, n, rejected)
+    sigma = np.sqrt(float(residual @ residual) / dof / sxx)
+    return CalibrationEstimate(bias, float(sigma), n, rejected)
 
 
 class _RecentSamples:
