@@ -1,0 +1,160 @@
+"""KITTI 06 clip: the project's VO against a classic frame-to-frame baseline, in one run.
+
+Both pipelines read every image from disk, take their step lengths from the same speed signal
+(ground-truth step lengths written as a ``t,speed_mps`` CSV, a stand-in for wheel speed) and
+are timed end to end. The runs alternate (``--repeats``) so that machine load hits both alike;
+frames per second are the median over the repeats.
+
+    python benchmarks/vo_kitti.py [--data ../shared/data/kitti06_0000_0050] [--json FILE]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from vo_doppler.eval.metrics import evaluate
+from vo_doppler.io.images import list_images, read_image, read_times
+from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
+from vo_doppler.trajectory import Trajectory, read_kitti
+from vo_doppler.vo.baseline import FrameToFrameVO
+from vo_doppler.vo.batch import run_visual_odometry
+from vo_doppler.vo.camera import read_camera
+from vo_doppler.vo.scale import metric_positions
+
+ROOT = Path(__file__).resolve().parents[1]
+CAMERA_UP = np.array([0.0, -1.0, 0.0])
+
+
+def default_data() -> Path:
+    shared = Path(os.environ.get("VO_DOPPLER_SHARED_DATA", ROOT.parent / "shared" / "data"))
+    return shared / "kitti06_0000_0050"
+
+
+def write_speed_csv(truth: Trajectory, path: Path) -> None:
+    """Speed samples whose trapezoidal integral between frames is the true step length."""
+    steps = np.linalg.norm(np.diff(truth.positions, axis=0), axis=1)
+    dt = np.diff(truth.t)
+    speed = np.empty(len(truth))
+    speed[0] = steps[0] / dt[0]
+    for i in range(1, len(truth)):
+        speed[i] = 2.0 * steps[i - 1] / dt[i - 1] - speed[i - 1]
+    if np.any(speed < 0):
+        speed = np.r_[steps[0] / dt[0], steps / dt]
+    rows = np.column_stack([truth.t, speed])
+    np.savetxt(path, rows, delimiter=",", header=f"t,{SPEED_COLUMN}", comments="", fmt="%.9f")
+
+
+def run_project_vo(files, times, camera, speed):
+    start = time.perf_counter()
+    output = run_visual_odometry((read_image(f) for f in files), times, camera, None, speed)
+    return output.trajectory, time.perf_counter() - start, output.stats
+
+
+def run_baseline(files, times, camera, speed):
+    start = time.perf_counter()
+    baseline = FrameToFrameVO(camera.K)
+    poses = np.array([baseline.process(read_image(f)) for f in files])
+    poses[:, :3, 3] = metric_positions(poses, times, speed[0], speed[1])
+    elapsed = time.perf_counter() - start
+    return Trajectory.from_matrices(times, poses), elapsed, None
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data", type=Path, default=default_data())
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--json", type=Path, default=ROOT / "benchmarks/results/vo_kitti.json")
+    args = parser.parse_args(argv)
+    if not args.data.is_dir():
+        print(f"KITTI clip not found at {args.data}", file=sys.stderr)
+        return 2
+    files = list_images(args.data / "image_0")
+    times = read_times(args.data / "times.txt", len(files))
+    truth = read_kitti(args.data / "poses.txt", times)
+    camera = read_camera(args.data / "calib.txt")
+    with tempfile.TemporaryDirectory() as tmp:
+        speed_csv = Path(tmp) / "speed.csv"
+        write_speed_csv(truth, speed_csv)
+        series = read_sensor_csv(speed_csv, SPEED_COLUMN)
+    speed = (series.t, series.value)
+    pipelines = {"vo-doppler (window BA)": run_project_vo, "baseline (FAST+KLT+E)": run_baseline}
+    seconds: dict[str, list[float]] = {name: [] for name in pipelines}
+    results = {}
+    for _ in range(args.repeats):
+        for name, pipeline in pipelines.items():
+            trajectory, elapsed, stats = pipeline(files, times, camera, speed)
+            seconds[name].append(elapsed)
+            results[name] = (trajectory, stats)
+    rows = {}
+    for name, (trajectory, stats) in results.items():
+        errors = evaluate(trajectory, truth, "start", CAMERA_UP)
+        aligned = evaluate(trajectory, truth, "se2", CAMERA_UP)
+        rows[name] = {
+            "fps": len(files) / float(np.median(seconds[name])),
+            "seconds": seconds[name],
+            "final_position_error_m": errors.final_position_error_m,
+            "final_drift_pct": errors.final_drift_pct,
+            "end_yaw_error_deg": errors.end_yaw_error_deg,
+            "ate_rmse_m": errors.ate_rmse_m,
+            "rotation_deg_per_100m": errors.mean_rotation_deg_per_100m,
+            "se2_end_yaw_error_deg": aligned.end_yaw_error_deg,
+            "se2_final_position_error_m": aligned.final_position_error_m,
+        }
+        if stats is not None:
+            rows[name]["flagged_frames"] = len(stats.flagged_frames)
+            rows[name]["reprojection_rms_px"] = stats.reprojection_rms_px
+    ours, base = rows["vo-doppler (window BA)"], rows["baseline (FAST+KLT+E)"]
+    ratios = {
+        "final_error_ratio": ours["final_position_error_m"] / base["final_position_error_m"],
+        "fps_ratio": ours["fps"] / base["fps"],
+    }
+    table = Table(
+        title=f"KITTI 06 frames 0-{len(files) - 1} ({truth.path_length:.1f} m), start-aligned"
+    )
+    for column in (
+        "pipeline",
+        "fps",
+        "final error [m]",
+        "drift [%]",
+        "end yaw [deg]",
+        "ATE [m]",
+        "rot [deg/100 m]",
+        "SE(2) end yaw [deg]",
+    ):
+        table.add_column(column, justify="right")
+    for name, row in rows.items():
+        table.add_row(
+            name,
+            f"{row['fps']:.1f}",
+            f"{row['final_position_error_m']:.3f}",
+            f"{row['final_drift_pct']:.2f}",
+            f"{row['end_yaw_error_deg']:+.3f}",
+            f"{row['ate_rmse_m']:.3f}",
+            f"{row['rotation_deg_per_100m']:.3f}",
+            f"{row['se2_end_yaw_error_deg']:+.3f}",
+        )
+    console = Console(width=150)
+    console.print(table)
+    console.print(
+        f"final error ratio (ours/baseline) {ratios['final_error_ratio']:.2f} (target <= 0.5); "
+        f"fps ratio {ratios['fps_ratio']:.2f} (target >= 0.7); "
+        f"end yaw {ours['end_yaw_error_deg']:+.3f} deg (target |.| <= 0.2)"
+    )
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(json.dumps({"frames": len(files), "pipelines": rows, **ratios}, indent=2))
+    console.print(f"wrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
