@@ -27,7 +27,7 @@ from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.gnss.spp import elevation_azimuth
 from vo_doppler.io.rinex_nav import Navigation
-from vo_doppler.io.rinex_obs import Observations
+from vo_doppler.io.rinex_obs import Observations, lookup, row_keys
 
 log = logging.getLogger(__name__)
 
@@ -211,23 +211,9 @@ def doppler_rows(
 def _signal_strength(obs: Observations, sel: Observations, rows: np.ndarray, code: str):
     """C/N0 of the same signal at the same epoch and satellite (NaN when absent)."""
     strength = obs.select(code=code)
-    out = np.full(int(rows.sum()), np.nan)
-    if len(strength) == 0:
-        return out
-    key = _row_keys(strength)
-    order = np.argsort(key)
-    wanted = _row_keys(sel.subset(rows))
-    pos = np.clip(np.searchsorted(key[order], wanted), 0, key.size - 1)
-    hit = key[order][pos] == wanted
-    out[hit] = strength.value[order][pos[hit]]
-    return out
-
-
-def _row_keys(obs: Observations) -> np.ndarray:
-    """Integer key (epoch time in 0.1 µs, system, prn) for joining rows of one file."""
-    ticks = np.round(obs.time * 1e7).astype(np.int64)
-    system = np.array([ord(s) for s in obs.system], dtype=np.int64) if len(obs) else ticks
-    return (ticks * 128 + system) * 1024 + obs.prn.astype(np.int64)
+    keys = row_keys(obs.epoch_time, strength.time, strength.system, strength.prn)
+    wanted = row_keys(obs.epoch_time, sel.time[rows], sel.system[rows], sel.prn[rows])
+    return lookup(keys, strength.value, wanted)
 
 
 def _missing_messages(sel: Observations, no_eph: np.ndarray) -> tuple[str, ...]:

@@ -498,3 +498,23 @@ def _decode(path, header, epochs, records, typesets, problems) -> Observations:
         epoch_flag=np.asarray(epochs.flag, dtype=np.int8),
         problems=tuple(problems),
     )
+
+
+def row_keys(epoch_time: np.ndarray, time, system, prn, code=None) -> np.ndarray:
+    """Integer key per row from (epoch, system, prn[, code]) for joining rows of one file."""
+    epoch = np.searchsorted(epoch_time, np.asarray(time, dtype=float)).astype(np.int64)
+    letters = np.array([ord(s) for s in system], dtype=np.int64).reshape(epoch.shape)
+    key = (epoch * 128 + letters) * 128 + np.asarray(prn, dtype=np.int64)
+    return key if code is None else key * 4096 + np.asarray(code, dtype=np.int64)
+
+
+def lookup(keys: np.ndarray, values: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """values[i] where keys[i] == wanted, NaN where no key matches."""
+    out = np.full(wanted.shape, np.nan)
+    if keys.size == 0 or wanted.size == 0:
+        return out
+    order = np.argsort(keys)
+    pos = np.clip(np.searchsorted(keys[order], wanted), 0, keys.size - 1)
+    hit = keys[order][pos] == wanted
+    out[hit] = values[order][pos[hit]]
+    return out
