@@ -140,7 +140,7 @@ def _east_line(metres):
 def test_select_fixes_every_mth_and_cluster():
     lat, lon = _east_line([0, 1, 2, 3.5, 4, 10, 11, 11.5, 12, 20])
     np.testing.assert_array_equal(select_fixes(lat, lon, 1, 3.0), [0, 3, 5, 9])
-    np.testing.assert_array_equal(select_fixes(lat, lon, 2, 3.0), [0, 4, 6])
+    np.testing.assert_array_equal(select_fixes(lat, lon, 2, 3.0), [0, 4, 6, 9])
     np.testing.assert_array_equal(select_fixes(lat, lon, 1, 3.0, np.array([1])), [0, 1, 4, 5, 9])
     np.testing.assert_array_equal(select_fixes(lat, lon, 1, 0.0), np.arange(10))
 
@@ -169,7 +169,8 @@ def test_reconstruction_returns_one_point_per_original_time(offsets, m, cluster)
     lon = np.radians(179.9999) + np.cumsum(offsets) / M_PER_RAD
     track = reconstruct_track(t, lat, lon, m, cluster)
     assert len(track.t) == len(t) and np.all(track.t == t)
-    assert track.kept[0] == 0 and np.all(np.diff(track.kept) > 0)
+    assert track.kept[0] == 0 and track.kept[-1] == len(t) - 1
+    assert np.all(np.diff(track.kept) > 0)
     np.testing.assert_allclose(track.lat[track.kept], lat[track.kept], atol=1e-12)
     assert np.all(np.isfinite(track.lat)) and np.all(np.abs(track.lon) <= np.pi)
 

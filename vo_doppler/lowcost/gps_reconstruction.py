@@ -51,8 +51,9 @@ def select_fixes(
     cluster_m: float = 3.0,
     always_keep: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Eq. (10): indices of the kept fixes — every ``downsample``-th fix (the first always),
-    minus those closer than ``cluster_m`` metres to the previously kept fix.
+    """Eq. (10): indices of the kept fixes — every ``downsample``-th fix, minus those closer
+    than ``cluster_m`` metres to the previously kept fix. The first and the last fix are always
+    kept, so that interpolation never has to hold a stale position at either end.
 
     ``always_keep`` (our addition) names fixes kept whatever their distance, e.g. the last fix
     of a standstill: without it the first metres of a drive are lost while the vehicle drives
@@ -67,6 +68,7 @@ def select_fixes(
     if len(lat) == 0:
         return np.zeros(0, dtype=int)
     forced = set() if always_keep is None else {int(i) for i in always_keep}
+    forced.add(len(lat) - 1)
     candidates = sorted({*range(downsample, len(lat), downsample), *forced} - {0})
     kept = [0]
     for i in candidates:
@@ -101,7 +103,7 @@ def reconstruct_track(
     always_keep: np.ndarray | None = None,
 ) -> ReconstructedTrack:
     """Eq. (10)–(11): select fixes, then interpolate latitude and longitude linearly between the
-    kept fixes at every original time (times after the last kept fix hold its position).
+    kept fixes at every original time.
 
     ``t`` must be strictly increasing (see ``vo_doppler.lowcost.series.clean_series``).
     """

@@ -1,0 +1,81 @@
+"""The comma2k19 processed-log layout: signals as folders of extensionless numpy arrays.
+
+Each signal folder holds ``t`` (s, the logger's monotonic clock) and ``value``. Read here:
+the IMU gyro as a yaw rate, the u-blox receiver fixes, and ground truth from ``global_pose``.
+Conventions on the way out (DESIGN.md): the IMU axes are forward/right/down, so the
+counter-clockwise yaw rate is −gyro_z; the ground-truth yaw is the course of the ECEF velocity
+rotated into the ENU frame at its own position, as a CCW-from-east angle, unwrapped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from vo_doppler.errors import InputError
+from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.gnss.gpstime import SECONDS_PER_WEEK, utc_to_gps_seconds
+from vo_doppler.io.gps_fixes import GpsFixes
+
+UNIX_TO_GPS_EPOCH_S = 315964800.0
+
+
+def load_array(base: str | Path, *parts: str) -> np.ndarray:
+    """One extensionless numpy array of the layout, e.g. ``("global_pose", "frame_times")``."""
+    path = Path(base).joinpath(*parts)
+    try:
+        return np.load(path, allow_pickle=False)
+    except (OSError, ValueError) as exc:
+        raise InputError(f"cannot load comma2k19 array: {exc}", path) from exc
+
+
+def read_gyro_yaw_rate(base: str | Path, signal: str = "gyro") -> tuple[np.ndarray, np.ndarray]:
+    """(t, yaw rate rad/s CCW) from ``processed_log/IMU/<signal>`` (−gyro_z)."""
+    t = load_array(base, "processed_log", "IMU", signal, "t")
+    value = load_array(base, "processed_log", "IMU", signal, "value")
+    return t, -value[:, 2]
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """``global_pose`` on the monotonic clock: yaw (rad, CCW, unwrapped), lat/lon (rad)."""
+
+    t: np.ndarray
+    yaw: np.ndarray
+    lat: np.ndarray
+    lon: np.ndarray
+    height: np.ndarray
+    gps_minus_mono_s: float
+
+
+def read_ground_truth(base: str | Path) -> GroundTruth:
+    t = load_array(base, "global_pose", "frame_times")
+    positions = load_array(base, "global_pose", "frame_positions")
+    velocity = load_array(base, "global_pose", "frame_velocities")
+    gps_times = load_array(base, "global_pose", "frame_gps_times")
+    lat, lon, height = ecef_to_geodetic(positions)
+    rotation = np.stack([ecef_to_enu_rotation(a, b) for a, b in zip(lat, lon, strict=True)])
+    enu = np.einsum("nij,nj->ni", rotation, velocity)
+    yaw = np.unwrap(np.arctan2(enu[:, 1], enu[:, 0]))
+    offset = float(np.median(gps_times[:, 1] - t))
+    return GroundTruth(t, yaw, lat, lon, height, offset)
+
+
+def read_live_fixes(
+    base: str | Path, gps_minus_mono_s: float | None = None, receiver: str = "live_gnss_ublox"
+) -> GpsFixes:
+    """Receiver fixes with their speed. Times are the fix epochs (from the UTC field) on the
+    monotonic clock when ``gps_minus_mono_s`` (seconds of week − monotonic, see
+    ``GroundTruth``) is given; otherwise the logging times, which lag the epochs."""
+    folder = ("processed_log", "GNSS", receiver)
+    value = load_array(base, *folder, "value")
+    if gps_minus_mono_s is None:
+        t = load_array(base, *folder, "t")
+    else:
+        utc_as_gps = value[:, 3] / 1000.0 - UNIX_TO_GPS_EPOCH_S
+        t = np.mod(utc_to_gps_seconds(utc_as_gps), SECONDS_PER_WEEK) - gps_minus_mono_s
+    return GpsFixes(
+        t, np.radians(value[:, 0]), np.radians(value[:, 1]), value[:, 2], Path(base, *folder)
+    )
