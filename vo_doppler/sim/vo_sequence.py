@@ -188,6 +188,9 @@ def drive(
     _, _, curvature = route.at(s)
     limit = np.minimum(max_speed, np.sqrt(max_lateral_accel / np.maximum(np.abs(curvature), 1e-9)))
     stop_index = sorted({round(stop / step_m) for stop in stops_m if 0 < stop < route.length})
+    # A step's limit binds both of its ends, so interpolated speeds respect it too.
+    limit[1:] = np.minimum(limit[1:], limit[:-1].copy())
+    limit[:-1] = np.minimum(limit[:-1], limit[1:].copy())
     limit[stop_index] = 0.0
     v = np.empty_like(s)
     v[0] = min(initial_speed, limit[0])
