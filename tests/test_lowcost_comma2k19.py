@@ -1,0 +1,70 @@
+"""Low-cost path mapping on the real comma2k19 minute: gyro z + CAN yaw rate + u-blox fixes
+against global_pose. No standstill: k and ε0 come from the first 5 s of straight driving."""
+
+from __future__ import annotations
+
+import pytest
+
+from benchmarks.lowcost_comma2k19 import gps_scatter, heading_run, load
+from tests.conftest import require_shared
+from vo_doppler.lowcost.drift import VARIANTS
+
+pytestmark = pytest.mark.shared_data
+DEBIASED = VARIANTS.index("combined + ε0 removed")
+DEBIASED_THRESHOLD = VARIANTS.index("combined + ε0 removed + threshold")
+
+
+@pytest.fixture(scope="module")
+def comma():
+    require_shared("comma2k19_example1/global_pose/frame_times")
+    return load(require_shared("comma2k19_example1"))
+
+
+def _final_errors(run):
+    return {row.variant: row.final_heading_error_deg for row in run.rows}
+
+
+def test_inputs_and_time_bases(comma):
+    truth, fixes, gyro, can = comma
+    assert len(truth.t) == 1200 and len(fixes.t) == 579
+    assert fixes.t[-1] - fixes.t[0] == pytest.approx(60.0, abs=1.0)
+    assert 100 < 1 / (gyro[0][1] - gyro[0][0]) < 110  # the IMU runs near 104 Hz
+    assert len(can[0]) > 4000  # KINEMATICS frames decoded from can_motion.log
+
+
+def test_heading_after_the_minute_with_five_second_eps0(comma):
+    run = heading_run(*comma, window_s=5.0, k=None)
+    errors = _final_errors(run)
+    assert run.selected_trajectory.t[-1] - run.selected_trajectory.t[0] > 59.0
+    assert abs(errors["sensor 2"]) > 20.0  # CAN YAW_RATE's ≈ −0.4 deg/s bias, uncorrected
+    assert abs(errors["combined + ε0 removed + threshold"]) <= 1.0
+    for k in (0.0, 2.0):  # each sensor alone, de-biased by its own ε0
+        assert (
+            abs(heading_run(*comma, window_s=5.0, k=k).rows[DEBIASED].final_heading_error_deg) < 2.5
+        )
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="measured −1.55°: 5-s means of (sensor − truth) rate scatter by ≈0.025 deg/s "
+    "(common to both sensors), ≈1.5° over the minute; see benchmarks/lowcost_comma2k19.py",
+)
+def test_debiased_combined_heading_within_one_degree_with_five_second_eps0(comma):
+    run = heading_run(*comma, window_s=5.0, k=None)
+    assert abs(run.rows[DEBIASED].final_heading_error_deg) <= 1.0
+
+
+def test_longer_eps0_window_meets_one_degree(comma):
+    run = heading_run(*comma, window_s=20.0, k=None)
+    assert abs(run.rows[DEBIASED].final_heading_error_deg) <= 1.0
+
+
+def test_reconstructed_track_scatters_less_than_raw_fixes(comma):
+    truth, fixes, _, _ = comma
+    scatter, _, _, _ = gps_scatter(truth, fixes, (5, 10), 3.0)
+    raw = scatter["raw"]
+    for m in (5, 10):
+        track = scatter[f"reconstructed M={m}"]
+        assert track["std_about_mean_m"] < raw["std_about_mean_m"]
+        assert track["jitter_rms_m"] < raw["jitter_rms_m"]
+        assert track["rms_m"] < raw["rms_m"] + 0.01
