@@ -89,6 +89,7 @@ def summary(result: DeadReckonResult) -> dict:
         "eps0_deg_per_s": {name: float(np.degrees(v)) for name, v in model.eps0.items()},
         "threshold_deg_per_s": float(np.degrees(model.h)),
         "standstill": list(prepared.standstill),
+        "standstill_is_straight_driving": not result.config.window_is_standstill,
         "standstills": [list(iv) for iv in prepared.standstills],
         "reference": result.reference_source,
         "selected_variant": result.selected,

@@ -244,6 +244,7 @@ class DeadReckonResult:
     prepared: PreparedTrack
     model: BiasModel
     reference_source: str
+    config: DeadReckonConfig
     trajectories: dict[str, DeadReckoning] = field(default_factory=dict)
     rows: list[DriftRow] = field(default_factory=list)
     selected: str = "combined + ε0 removed"
@@ -294,7 +295,7 @@ def run_deadreckon(
         raise InputError(f"the {source} covers fewer than 2 dead-reckoning epochs")
     yaw0 = float(reference_yaw[np.flatnonzero(valid)[0]])
 
-    result = DeadReckonResult(rates, prepared, model, source)
+    result = DeadReckonResult(rates, prepared, model, source, config)
     if config.threshold is not None:
         result.selected = "combined + ε0 removed + threshold"
     start = (float(epoch_enu[0, 0]), float(epoch_enu[0, 1]))
