@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.cli import main
+from vo_doppler.errors import InputError
 from vo_doppler.fusion.heading_correction import (
     FORWARD_CAMERA_TO_VEHICLE,
     correct_heading,
@@ -14,7 +16,9 @@ from vo_doppler.fusion.heading_correction import (
     yaw_of,
 )
 from vo_doppler.geo import wrap_angle
-from vo_doppler.trajectory import Trajectory
+from vo_doppler.heading.pipeline import HeadingTable
+from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
+from vo_doppler.trajectory import Trajectory, read_tum, write_tum
 
 RATE_HZ = 10.0
 
@@ -148,3 +152,82 @@ def test_headings_at_interpolates_on_the_short_arc_and_respects_gaps():
     np.testing.assert_allclose(np.degrees(out[[0, 1, 4]]), [-180.0, -170.0, 0.0], atol=1e-9)
     out, ok = headings_at(np.array([1.0]), t_h, yaw, np.array([True, False, True, True]), 1.5)
     assert not ok[0]
+
+
+def _table(t, yaw, reliable, conv_valid):
+    n = len(t)
+    return HeadingTable(
+        t=t,
+        yaw_tc=np.where(reliable, yaw, np.nan),
+        sigma_tc=np.full(n, 0.01),
+        tc_reliable=reliable,
+        n_obs_window=np.full(n, 12),
+        n_sat_epoch=np.full(n, 2),
+        yaw_conv=np.where(conv_valid, yaw + 0.5, np.nan),  # deliberately off: must not be used
+        conv_valid=conv_valid,
+        gyro_bias=np.full(n, 0.001),
+        wheel_scale=np.full(n, 1.01),
+    )
+
+
+def test_heading_csv_round_trip(tmp_path):
+    t = np.arange(5.0) + 1e9
+    yaw = np.radians([10.0, -170.0, 90.0, 179.0, -90.0])
+    table = _table(t, yaw, np.array([True, True, False, True, True]), np.array([True] * 5))
+    path = tmp_path / "heading.csv"
+    write_heading_csv(path, table)
+    header = path.read_text().splitlines()[0]
+    assert header.startswith("gps_time_s,heading_tc_deg,heading_tc_sigma_deg,tc_reliable")
+    back = read_heading_csv(path)
+    ok = table.tc_available
+    np.testing.assert_allclose(wrap_angle(back.yaw_tc[ok] - yaw[ok]), 0.0, atol=1e-6)
+    assert np.isnan(back.yaw_tc[2]) and back.tc_reliable.tolist() == table.tc_reliable.tolist()
+    np.testing.assert_allclose(back.gyro_bias, 0.001, atol=1e-7)
+    first_course = float(path.read_text().splitlines()[1].split(",")[1])
+    assert first_course == pytest.approx(80.0)  # yaw 10° ccw from east = course 80°
+    yaw_abs, valid = back.absolute_heading("tc+conv")
+    assert valid.all() and yaw_abs[2] == pytest.approx(back.yaw_conv[2])
+    path.write_text(path.read_text() + "1,2,3\n")
+    with pytest.raises(InputError, match=r"heading.csv:7"):
+        read_heading_csv(path)
+
+
+def test_correct_cli_recovers_the_enu_trajectory(tmp_path):
+    t, yaw, gt = _ground_truth(n=80)
+    gps_offset = 1.4e9
+    write_tum(tmp_path / "vo.tum", _vo_output(gt))
+    table = _table(t + gps_offset, yaw, np.ones(len(t), bool), np.ones(len(t), bool))
+    write_heading_csv(tmp_path / "heading.csv", table)
+    out = tmp_path / "out" / "corrected.tum"
+    code = main(
+        [
+            "correct",
+            str(tmp_path / "vo.tum"),
+            "--heading",
+            str(tmp_path / "heading.csv"),
+            "--time-offset",
+            str(gps_offset),
+            "--source",
+            "tc",
+            "-o",
+            str(out),
+        ]
+    )
+    assert code == 0
+    corrected = read_tum(out)
+    expected = gt.positions - gt.positions[0]
+    # Headings are rounded to 1e-4° in the CSV: 2e-6 rad over 80 m.
+    np.testing.assert_allclose(corrected.positions, expected, atol=1e-3)
+    assert (
+        main(
+            [
+                "correct",
+                str(tmp_path / "vo.tum"),
+                "--heading",
+                str(tmp_path / "heading.csv"),
+                "-o",
+                str(out),
+            ]
+        )
+        == 1
+    )  # no --time-offset: times do not overlap

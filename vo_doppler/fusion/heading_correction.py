@@ -28,12 +28,9 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.trajectory import Trajectory
+from vo_doppler.vo.camera import CAMERA_TO_VEHICLE_FORWARD
 
-# Forward-looking camera: camera z (forward) → vehicle x, camera x (right) → vehicle −y,
-# camera y (down) → vehicle −z.
-FORWARD_CAMERA_TO_VEHICLE = np.array(
-    [[0.0, 0.0, 1.0, 0.0], [-1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
-)
+FORWARD_CAMERA_TO_VEHICLE = CAMERA_TO_VEHICLE_FORWARD
 
 
 @dataclass

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.rows import DopplerRows
 
 
@@ -80,3 +81,26 @@ def simulate_doppler(
         np.array([f"G{i + 1:02d}" for i in sat]),
     )
     return DopplerScenario(rows, t_epoch, s, psi, psi - psi[0], rho)
+
+
+def gyro_from_heading(
+    t: np.ndarray,
+    yaw: np.ndarray,
+    valid: np.ndarray,
+    bias: float,
+    noise_rad_s: float,
+    rate_hz: float = 10.0,
+    seed: int = 0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gyro samples (times, counter-clockwise yaw rate) whose rate between consecutive valid
+    headings is their difference over the interval (0 where a heading is missing, e.g. at
+    standstill), sampled at ``rate_hz`` in the middle of sub-intervals, plus bias and noise."""
+    rng = np.random.default_rng(seed)
+    t = np.asarray(t, dtype=float)
+    ok = np.asarray(valid, dtype=bool) & np.isfinite(yaw)
+    steps = wrap_angle(np.diff(np.where(ok, yaw, 0.0)))
+    interval_rate = np.where(ok[:-1] & ok[1:], steps / np.diff(t), 0.0)
+    t_gyro = np.arange(t[0] + 0.5 / rate_hz, t[-1], 1.0 / rate_hz)
+    interval = np.clip(np.searchsorted(t, t_gyro, side="right") - 1, 0, len(t) - 2)
+    rate = interval_rate[interval] + bias + rng.normal(0.0, noise_rad_s, len(t_gyro))
+    return t_gyro, rate

@@ -1,0 +1,100 @@
+"""``heading.csv``: one row per GNSS epoch, headings as course in degrees clockwise from north.
+
+Columns: gps_time_s, heading_tc_deg, heading_tc_sigma_deg, tc_reliable, n_obs_window,
+n_sat_epoch, heading_conv_deg, conv_valid, gyro_bias_dps, wheel_scale. Unavailable headings are
+written as ``nan``; flags as 0/1. Reading converts back to yaw (rad, counter-clockwise from east).
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from vo_doppler.errors import InputError
+from vo_doppler.geo import course_to_yaw
+from vo_doppler.heading.pipeline import HeadingTable
+
+COLUMNS = (
+    "gps_time_s",
+    "heading_tc_deg",
+    "heading_tc_sigma_deg",
+    "tc_reliable",
+    "n_obs_window",
+    "n_sat_epoch",
+    "heading_conv_deg",
+    "conv_valid",
+    "gyro_bias_dps",
+    "wheel_scale",
+)
+
+
+def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
+    columns = [
+        table.t,
+        np.degrees(table.course_tc),
+        np.degrees(table.sigma_tc),
+        table.tc_reliable.astype(int),
+        table.n_obs_window.astype(int),
+        table.n_sat_epoch.astype(int),
+        np.degrees(table.course_conv),
+        table.conv_valid.astype(int),
+        np.degrees(table.gyro_bias),
+        table.wheel_scale,
+    ]
+    formats = (
+        "{:.3f}",
+        "{:.4f}",
+        "{:.4f}",
+        "{:d}",
+        "{:d}",
+        "{:d}",
+        "{:.4f}",
+        "{:d}",
+        "{:.5f}",
+        "{:.6f}",
+    )
+    with Path(path).open("w", newline="") as handle:
+        handle.write(",".join(COLUMNS) + "\n")
+        for values in zip(*columns, strict=True):
+            handle.write(",".join(f.format(v) for f, v in zip(formats, values, strict=True)) + "\n")
+
+
+def read_heading_csv(path: str | Path) -> HeadingTable:
+    """Read a heading CSV; bad rows raise :class:`InputError` naming the line."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except OSError as exc:
+        raise InputError(f"cannot read heading CSV: {exc.strerror or exc}", path) from exc
+    if not lines:
+        raise InputError("heading CSV is empty", path)
+    header = [name.strip() for name in next(csv.reader([lines[0]]))]
+    missing = [c for c in COLUMNS if c not in header]
+    if missing:
+        raise InputError(f"heading CSV lacks columns {missing}", path, 1)
+    index = [header.index(c) for c in COLUMNS]
+    rows = []
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        fields = next(csv.reader([line]))
+        try:
+            rows.append([float(fields[i]) for i in index])
+        except (ValueError, IndexError) as exc:
+            raise InputError(f"bad heading row ({exc})", path, number) from exc
+    data = np.array(rows, dtype=float).reshape(-1, len(COLUMNS))
+    tc_deg, conv_deg = data[:, 1], data[:, 6]
+    return HeadingTable(
+        t=data[:, 0],
+        yaw_tc=np.where(np.isfinite(tc_deg), course_to_yaw(np.radians(tc_deg)), np.nan),
+        sigma_tc=np.radians(data[:, 2]),
+        tc_reliable=data[:, 3] > 0.5,
+        n_obs_window=data[:, 4].astype(int),
+        n_sat_epoch=data[:, 5].astype(int),
+        yaw_conv=np.where(np.isfinite(conv_deg), course_to_yaw(np.radians(conv_deg)), np.nan),
+        conv_valid=(data[:, 7] > 0.5) & np.isfinite(conv_deg),
+        gyro_bias=np.radians(data[:, 8]),
+        wheel_scale=data[:, 9],
+    )
