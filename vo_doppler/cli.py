@@ -10,13 +10,20 @@ import logging
 import sys
 
 from vo_doppler import __version__
-from vo_doppler.commands import correct_command, deadreckon_command, eval_command, vo_command
+from vo_doppler.commands import (
+    correct_command,
+    deadreckon_command,
+    eval_command,
+    gnss_command,
+    vo_command,
+)
 from vo_doppler.errors import VoDopplerError
 
 SUBCOMMANDS = (
     eval_command,
     deadreckon_command,
     vo_command,
+    gnss_command,
     correct_command,
 )
 

@@ -1,0 +1,111 @@
+"""``vo-doppler gnss``: Doppler velocity and single-point positions from RINEX files."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from vo_doppler.errors import VoDopplerError
+from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
+from vo_doppler.gnss.spp import solve_spp
+from vo_doppler.io.gnss_report import (
+    spp_figure,
+    velocity_figure,
+    write_spp_csv,
+    write_velocity_csv,
+)
+from vo_doppler.io.rinex_nav import read_nav
+from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
+
+log = logging.getLogger(__name__)
+
+
+def _systems(text: str) -> str:
+    letters = text.upper()
+    unknown = sorted(set(letters) - set(SYSTEMS))
+    if not letters or unknown:
+        raise argparse.ArgumentTypeError(f"systems are letters of {SYSTEMS}, got {text!r}")
+    return letters
+
+
+def _common(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("obs", type=Path, help="RINEX 2/3 observation file (.gz / Hatanaka ok)")
+    parser.add_argument(
+        "--nav", type=Path, action="append", required=True, help="RINEX navigation file (repeat)"
+    )
+    parser.add_argument("--systems", type=_systems, default="GREJC", help="default GREJC")
+    parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees (default 10)")
+    parser.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
+    parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser("gnss", help="GNSS Doppler velocity and positions from RINEX")
+    actions = parser.add_subparsers(dest="gnss_command", metavar="ACTION", required=True)
+    velocity = actions.add_parser(
+        "velocity",
+        help="per-epoch receiver velocity and clock drift from Doppler",
+        description="Weighted least squares of ENU velocity and clock drift per epoch from the "
+        "Doppler of the chosen systems, with chi-square fault exclusion. Epochs with fewer "
+        "than four satellites are written with valid = 0.",
+    )
+    _common(velocity)
+    velocity.add_argument("--bands", help="band digits to use, e.g. 12 (default all)")
+    velocity.add_argument(
+        "--range-rate",
+        choices=RANGE_RATE_SOURCES,
+        default="doppler",
+        help="'phase': carrier-phase rate instead of the logged Doppler",
+    )
+    velocity.set_defaults(func=run)
+    spp = actions.add_parser("spp", help="per-epoch pseudorange single-point positions")
+    _common(spp)
+    spp.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    obs = read_obs(args.obs)
+    nav = read_nav(args.nav)
+    mask = np.deg2rad(args.elev_mask)
+    figure = args.figure or args.output.with_suffix(".png")
+    title = f"{args.obs.name} ({args.systems})"
+    if args.gnss_command == "spp":
+        solution = solve_spp(obs, nav, args.systems, mask)
+        write_spp_csv(args.output, solution)
+        spp_figure(figure, solution, title)
+        valid = solution.valid
+    else:
+        result = gnss_velocity(obs, nav, args.systems, mask, args.bands, args.range_rate)
+        solution = result.velocity
+        write_velocity_csv(args.output, solution)
+        velocity_figure(figure, solution, title)
+        valid = solution.valid
+        rows = result.rows
+        if rows.n_no_ephemeris:
+            log.warning(
+                "%d Doppler rows skipped without ephemeris: %s",
+                rows.n_no_ephemeris,
+                "; ".join(rows.missing),
+            )
+        if valid.any():
+            speed = solution.speed_mps[valid]
+            log.info(
+                "speed median %.3f m/s, 95th percentile %.3f m/s",
+                np.median(speed),
+                np.percentile(speed, 95),
+            )
+    skipped = len(obs.problems) + len(nav.problems)
+    log.info(
+        "%d of %d epochs valid; wrote %s and %s%s",
+        int(valid.sum()),
+        valid.size,
+        args.output,
+        figure,
+        f"; {skipped} bad records skipped" if skipped else "",
+    )
+    if not valid.any():
+        raise VoDopplerError("no epoch could be solved (too few satellites with ephemerides)")
+    return 0

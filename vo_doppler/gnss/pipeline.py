@@ -1,0 +1,59 @@
+"""RINEX observations + navigation → SPP positions and Doppler velocities (no file I/O)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.gnss.doppler_velocity import DopplerRows, VelocitySolution, doppler_velocity
+from vo_doppler.gnss.phase_rate import carrier_phase_doppler
+from vo_doppler.gnss.spp import SppSolution, receiver_positions, solve_spp
+from vo_doppler.io.rinex_nav import Navigation
+from vo_doppler.io.rinex_obs import Observations
+
+
+@dataclass(frozen=True)
+class GnssVelocityResult:
+    """Velocity solution, the Doppler rows it used, the SPP fixes and the positions used."""
+
+    velocity: VelocitySolution
+    rows: DopplerRows
+    spp: SppSolution
+    receiver_ecef: np.ndarray
+
+
+RANGE_RATE_SOURCES = ("doppler", "phase")
+
+
+def gnss_velocity(
+    obs: Observations,
+    nav: Navigation,
+    systems: str = "GREJC",
+    elevation_mask_rad: float = np.deg2rad(10.0),
+    bands: str | None = None,
+    range_rate: str = "doppler",
+    receiver_ecef: np.ndarray | None = None,
+) -> GnssVelocityResult:
+    """Per-epoch Doppler velocity. Line-of-sight vectors use the SPP fix of each epoch (or the
+    nearest one, or ``receiver_ecef`` / the RINEX approximate position when SPP fails);
+    ``range_rate`` 'phase' replaces the Doppler by the carrier-phase rate (``phase_rate``)."""
+    if range_rate not in RANGE_RATE_SOURCES:
+        raise ValueError(f"range_rate must be one of {RANGE_RATE_SOURCES}")
+    spp = solve_spp(obs, nav, systems, elevation_mask_rad)
+    fallback = receiver_ecef if receiver_ecef is not None else obs.header.approx_position
+    position = (
+        np.broadcast_to(receiver_ecef, (obs.epoch_time.size, 3))
+        if receiver_ecef is not None
+        else receiver_positions(spp, fallback)
+    )
+    source = carrier_phase_doppler(obs) if range_rate == "phase" else obs
+    velocity, rows = doppler_velocity(
+        source,
+        nav,
+        position,
+        systems=systems,
+        bands=bands,
+        elevation_mask_rad=elevation_mask_rad,
+    )
+    return GnssVelocityResult(velocity, rows, spp, np.asarray(position))
