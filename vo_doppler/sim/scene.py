@@ -2,8 +2,8 @@
 
 World frame ENU (x east, y north, z up), ground at z = 0. A city is a grid of building blocks
 separated by streets; each block is split into a few buildings (boxes) of random height. Only
-the faces that can be seen are kept: outer walls down to the ground, and the part of a shared
-wall that rises above the lower neighbour. Everything is deterministic per seed.
+faces that can be seen are kept: outer walls down to the ground, the part of a shared wall that
+rises above the lower neighbour, and roofs. Everything is deterministic per seed.
 
 Textures are seamless square tiles (wrap addressing), built from multi-scale posterised pink
 noise (blobs with sharp, curved edges) overlaid with random axis-aligned rectangles of random
@@ -162,7 +162,7 @@ def procedural_texture(
 
 
 def _split(length: float, parts: int, rng: np.random.Generator) -> np.ndarray:
-    """Random split points 0 = c0 < c1 < … < c_parts = length, each part ≥ length / (2·parts)."""
+    """Random split points 0 = c0 < c1 < … < c_parts = length, each part ≥ length / (3·parts)."""
     weights = rng.uniform(0.5, 1.5, size=parts)
     return np.concatenate([[0.0], np.cumsum(weights) / weights.sum() * length])
 

@@ -70,7 +70,9 @@ class Route:
         return last.s0 + last.length
 
     @classmethod
-    def from_pieces(cls, start: tuple[float, float, float], pieces: Sequence[tuple[float, float]]):
+    def from_pieces(
+        cls, start: tuple[float, float, float], pieces: Sequence[tuple[float, float]]
+    ) -> Route:
         """Route from a start (x, y, yaw) and pieces (length m, curvature 1/m; > 0 turns left)."""
         segments = []
         x, y, yaw = start
