@@ -184,7 +184,11 @@ class _RecentSamples:
 
 
 class _StreamingFit:
-    """Stored recent samples plus the latest estimate, refreshed on every sample."""
+    """Stored recent samples plus the latest estimate, refreshed on every valid sample.
+
+    Samples without a valid Doppler solution are not stored, so an outage keeps the data (and
+    the estimate) from before it instead of ageing them out.
+    """
 
     n_columns = 0
 
@@ -197,20 +201,21 @@ class _StreamingFit:
 class WheelScaleCalibrator(_StreamingFit):
     """Streaming sec. 3.3: least squares over the stored recent samples, refreshed per sample."""
 
-    n_columns = 4
+    n_columns = 3
 
     def add(
         self, t: float, doppler_speed: float, wheel_speed: float, doppler_valid: bool = True
     ) -> CalibrationEstimate:
-        tt, vd, vw, ok = self._samples.add(t, doppler_speed, wheel_speed, doppler_valid)
-        self.estimate = estimate_wheel_scale(tt, vd, vw, ok > 0.5, self.config)
+        if doppler_valid:
+            tt, vd, vw = self._samples.add(t, doppler_speed, wheel_speed)
+            self.estimate = estimate_wheel_scale(tt, vd, vw, None, self.config)
         return self.estimate
 
 
 class GyroBiasCalibrator(_StreamingFit):
     """Streaming sec. 3.4: least squares over the stored recent samples, refreshed per sample."""
 
-    n_columns = 5
+    n_columns = 4
 
     def add(
         self,
@@ -220,9 +225,9 @@ class GyroBiasCalibrator(_StreamingFit):
         doppler_speed: float,
         doppler_valid: bool = True,
     ) -> CalibrationEstimate:
-        columns = self._samples.add(t, doppler_yaw, integrated_yaw, doppler_speed, doppler_valid)
-        tt, yaw, phi, speed, ok = columns
-        self.estimate = estimate_gyro_bias(tt, yaw, phi, speed, ok > 0.5, self.config)
+        if doppler_valid:
+            tt, yaw, phi, speed = self._samples.add(t, doppler_yaw, integrated_yaw, doppler_speed)
+            self.estimate = estimate_gyro_bias(tt, yaw, phi, speed, None, self.config)
         return self.estimate
 
 

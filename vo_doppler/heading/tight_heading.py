@@ -27,6 +27,7 @@ them exist and all agree within the gate.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -198,7 +199,8 @@ def solve_windows(y, a, b, tau, w, config: TightHeadingConfig = TightHeadingConf
 def _robust_scale(normalised, w, config):
     """1.4826 × median |normalised residual| per window (floored), the Huber scale."""
     masked = np.where(w > 0, normalised, np.nan)
-    with np.errstate(all="ignore"):
+    with warnings.catch_warnings():  # windows without rows give NaN, replaced below
+        warnings.simplefilter("ignore", RuntimeWarning)
         mad = 1.4826 * np.nanmedian(masked, axis=1)
         mean_w = np.nanmean(np.where(w > 0, w, np.nan), axis=1)
     floor = config.sigma_floor_mps * np.sqrt(np.nan_to_num(mean_w, nan=1.0))
