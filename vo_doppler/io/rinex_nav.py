@@ -202,6 +202,7 @@ def _decode(path, records, systems, names, version, leap, problems) -> NavRecord
     values = np.full(text.shape, np.nan)
     blank = (chars == ord(" ")).all(axis=2)
     good = np.ones(len(rows), dtype=bool)
+    bad_line = np.zeros(len(rows), dtype=np.int64)
     try:
         values[~blank] = text[~blank].astype(float)
     except ValueError:
@@ -210,6 +211,7 @@ def _decode(path, records, systems, names, version, leap, problems) -> NavRecord
                 values[r, c] = float(text[r, c])
             except ValueError:
                 good[r] = False
+                bad_line[r] = c // 4
     columns = [4 * k + j for k, group in enumerate(names) for j in range(len(group))]
     flat_names = [name for group in names for name in group]
     values = values[:, columns]
@@ -224,7 +226,9 @@ def _decode(path, records, systems, names, version, leap, problems) -> NavRecord
         except ValueError:
             good[r] = False
     for r in np.flatnonzero(~good):
-        _problem(problems, path, lines[r], "unreadable number or date: record skipped")
+        _problem(
+            problems, path, lines[r] + bad_line[r], "unreadable number or date: record skipped"
+        )
     params = {name: values[good, i] for i, name in enumerate(flat_names)}
     return NavRecords(
         np.array([s for s, _ in ids], dtype="U1")[good] if ids else np.zeros(0, dtype="U1"),
