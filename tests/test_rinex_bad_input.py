@@ -87,8 +87,10 @@ def test_truncated_real_file_keeps_complete_records(tmp_path):
     full = read_obs(require_shared("septentrio_static/rover.obs"))
     assert 140 <= obs.epoch_time.size <= 160
     # every value read from the truncated file equals the full file's value
-    keys_full = dict(zip(zip(full.time, full.satellites(), full.code), full.value, strict=True))
-    for key, value in zip(zip(obs.time, obs.satellites(), obs.code), obs.value, strict=True):
+    full_keys = zip(full.time, full.satellites(), full.code, strict=True)
+    keys_full = dict(zip(full_keys, full.value, strict=True))
+    keys = zip(obs.time, obs.satellites(), obs.code, strict=True)
+    for key, value in zip(keys, obs.value, strict=True):
         assert keys_full[key] == value
 
 
