@@ -33,6 +33,9 @@ NEAR_M = 0.05
 _PAD = 2
 """Wrapped border (texels) around every texture in every atlas level, for bilinear reads."""
 
+_SUBSAMPLES = np.array([[-0.375, -0.125], [0.125, -0.375], [0.375, 0.125], [-0.125, 0.375]])
+"""Rotated-grid 2×2 sub-pixel offsets (u, v) for anti-aliasing geometric edges."""
+
 
 @dataclass
 class RenderResult:
@@ -175,6 +178,12 @@ class Renderer:
         # Index 0 of every per-plane table is the sky.
         self._gain = np.concatenate([[0.0], [p.gain for p in planes]]).astype(np.float32)
         self._bias = np.concatenate([[scene.sky], [p.bias for p in planes]]).astype(np.float32)
+        extent = np.array([[p.width, p.height] for p in planes], dtype=float).reshape(-1, 2)
+        low = self._offset
+        high = self._offset + extent / self._texel[:, None]
+        # Texture-coordinate range of each rectangle (unwrapped); the sky's range is empty.
+        self._low = np.vstack([[np.inf, np.inf], low]).astype(np.float32)
+        self._high = np.vstack([[-np.inf, -np.inf], high]).astype(np.float32)
         atlas = self.atlas
         self._size_s = np.concatenate([[1.0], atlas.size[texture, 0]]).astype(np.float32)
         self._size_t = np.concatenate([[1.0], atlas.size[texture, 1]]).astype(np.float32)
@@ -222,6 +231,7 @@ class Renderer:
         index = np.zeros((h, w), dtype=np.int32)
         homographies = np.zeros((len(self.scene.planes) + 1, 9), dtype=np.float32)
         homographies[0] = (0, 0, 0, 0, 0, 0, 0, 0, 1)
+        inverse_depth_planes = np.zeros((len(self.scene.planes) + 1, 3), dtype=np.float32)
         mask = np.zeros((h, w), dtype=np.uint8)
         for k in self._visible_planes(R_cw, t_cw, centre):
             polygon = self._corners[k] @ R_cw.T + t_cw
@@ -254,7 +264,9 @@ class Renderer:
             np.copyto(inv_depth[y0 : y1 + 1, x0 : x1 + 1], plane_inv, where=closer)
             np.copyto(index[y0 : y1 + 1, x0 : x1 + 1], k + 1, where=closer)
             homographies[k + 1] = self._texture_homography(k, R_cw, centre, n_c, d_c).ravel()
-        image = self._shade(index, homographies)
+            inverse_depth_planes[k + 1] = (a, b, c)
+        image = self._shade(index, homographies, self._uu, self._vv)
+        self._resolve_edges(image, index, inv_depth, homographies, inverse_depth_planes)
         if noise_std > 0:
             image += (
                 np.random.default_rng(seed).normal(0.0, noise_std, image.shape).astype(np.float32)
@@ -307,15 +319,66 @@ class Renderer:
         rows.append(n_c)
         return np.array(rows) @ self._K_inv
 
-    def _shade(self, index: np.ndarray, homographies: np.ndarray) -> np.ndarray:
-        """Rip-mapped texture lookup and per-plane gain/bias for every pixel (float32).
+    def _resolve_edges(
+        self,
+        image: np.ndarray,
+        index: np.ndarray,
+        inv_depth: np.ndarray,
+        homographies: np.ndarray,
+        inverse_depth_planes: np.ndarray,
+    ) -> None:
+        """Exact coverage and anti-aliasing on plane/plane and plane/sky boundaries (in place).
+
+        The polygon fill is conservative (it also takes pixels the outline only touches), so
+        every pixel next to a change of plane is ray-cast again against the planes seen at it
+        and its 4 neighbours (nearest hit inside its rectangle wins): at its centre, which fixes
+        index and depth, and at four rotated-grid sub-samples whose mean is its grey value.
+        Interior pixels keep their centre sample, which the texture pre-filter band-limits.
+        """
+        edge = np.zeros(index.shape, dtype=bool)
+        across = index[:, 1:] != index[:, :-1]
+        edge[:, 1:] |= across
+        edge[:, :-1] |= across
+        down = index[1:, :] != index[:-1, :]
+        edge[1:, :] |= down
+        edge[:-1, :] |= down
+        rows, cols = np.nonzero(edge)
+        if len(rows) == 0:
+            return
+        padded = np.pad(index, 1, mode="edge")
+        neighbours = ((0, 0), (0, 1), (0, -1), (1, 0), (-1, 0))
+        offsets = np.vstack([_SUBSAMPLES, [0.0, 0.0]])
+        u = (cols[None, :] + offsets[:, :1]).astype(np.float32)
+        v = (rows[None, :] + offsets[:, 1:]).astype(np.float32)
+        nearest = np.zeros(u.shape, dtype=np.float32)
+        seen = np.zeros(u.shape, dtype=np.int32)
+        for dr, dc in neighbours:
+            k = padded[rows + 1 + dr, cols + 1 + dc]
+            a, b, c = inverse_depth_planes[k].T
+            inverse = a * u + b * v + c
+            H = homographies[k]
+            w = H[:, 6] * u + H[:, 7] * v + H[:, 8]
+            s = (H[:, 0] * u + H[:, 1] * v + H[:, 2]) / w
+            t = (H[:, 3] * u + H[:, 4] * v + H[:, 5]) / w
+            low, high = self._low[k], self._high[k]
+            hit = (inverse > nearest) & (inverse < 1.0 / NEAR_M)
+            hit &= (s >= low[:, 0]) & (s <= high[:, 0]) & (t >= low[:, 1]) & (t <= high[:, 1])
+            nearest = np.where(hit, inverse, nearest)
+            seen = np.where(hit, k, seen)
+        image[rows, cols] = self._shade(seen[:4], homographies, u[:4], v[:4]).mean(axis=0)
+        index[rows, cols] = seen[4]
+        inv_depth[rows, cols] = nearest[4]
+
+    def _shade(
+        self, index: np.ndarray, homographies: np.ndarray, u: np.ndarray, v: np.ndarray
+    ) -> np.ndarray:
+        """Rip-mapped texture lookup and per-plane gain/bias at pixel positions (u, v) (float32).
 
         The footprint of a pixel along s is |∂s/∂(u, v)| texels (likewise t); its log2 plus the
         bias picks the s and t levels, and four bilinear reads (the neighbouring integer level
         pairs) are blended.
         """
         h0, h1, h2, h3, h4, h5, h6, h7, h8 = (np.take(homographies[:, m], index) for m in range(9))
-        u, v = self._uu, self._vv
         inv_w = 1.0 / (h6 * u + h7 * v + h8)
         s = (h0 * u + h1 * v + h2) * inv_w
         t = (h3 * u + h4 * v + h5) * inv_w
