@@ -13,8 +13,12 @@ $(STAMP): $(BIN)/python pyproject.toml
 	$(BIN)/pip install --quiet -e ".[test]"
 	touch $(STAMP)
 
+DEMO_SEQ := out/demo/sequence
+
 demo: $(STAMP)
-	$(BIN)/vo-doppler demo -o out/demo
+	$(BIN)/python -m vo_doppler.sim.vo_sequence $(DEMO_SEQ) --duration 20 --fps 10 --seed 1
+	$(BIN)/vo-doppler vo $(DEMO_SEQ)/image_0 --calib $(DEMO_SEQ)/calib.yaml \
+		--speed $(DEMO_SEQ)/speed.csv --gt $(DEMO_SEQ)/ground_truth_camera.kitti -o out/demo
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
