@@ -15,6 +15,7 @@ from vo_doppler.commands import (
     deadreckon_command,
     eval_command,
     gnss_command,
+    heading_command,
     vo_command,
 )
 from vo_doppler.errors import VoDopplerError
@@ -25,6 +26,7 @@ SUBCOMMANDS = (
     vo_command,
     gnss_command,
     correct_command,
+    heading_command,
 )
 
 log = logging.getLogger("vo_doppler")

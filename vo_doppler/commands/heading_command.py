@@ -1,0 +1,172 @@
+"""``vo-doppler heading OBS --nav NAV ...``: tightly coupled Doppler–gyro–wheel heading."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from vo_doppler.errors import InputError, VoDopplerError
+from vo_doppler.fusion.heading_correction import yaw_of
+from vo_doppler.gnss.pipeline import gnss_velocity
+from vo_doppler.heading.from_gnss import emulated_canyon, heading_rows
+from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConfig, heading_pipeline
+from vo_doppler.heading.sensors import sample_at
+from vo_doppler.heading.tight_heading import TightHeadingConfig
+from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.io.heading_figure import heading_figure
+from vo_doppler.io.rinex_nav import read_nav
+from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
+from vo_doppler.trajectory import read_trajectory
+
+log = logging.getLogger(__name__)
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "heading",
+        help="tightly coupled Doppler-gyro-wheel heading per GNSS epoch",
+        description="Calibrate wheel scale and gyro bias from the conventional Doppler velocity "
+        "(sec. 3.3-3.4) and estimate the heading from a window of Doppler rows of all "
+        "satellites with the calibrated speed and yaw rate (sec. 3.5). Writes one CSV row per "
+        "GNSS epoch (headings as course, degrees clockwise from north) and a figure.",
+    )
+    parser.add_argument("obs", type=Path, help="RINEX observation file")
+    parser.add_argument("--nav", type=Path, action="append", required=True)
+    parser.add_argument("--systems", default="GREJC")
+    parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
+    sensors = parser.add_argument_group("vehicle sensors (CAN log + DBC, or two CSV files)")
+    sensors.add_argument("--can", type=Path, help="candump -l, .asc, .blf or python-can .csv")
+    sensors.add_argument("--dbc", type=Path)
+    sensors.add_argument("--yaw-rate", help="MESSAGE.SIGNAL of the yaw rate")
+    sensors.add_argument("--wheel-speed", help="MESSAGE.SIGNAL[,MESSAGE.SIGNAL...] (averaged)")
+    sensors.add_argument(
+        "--yaw-rate-sign",
+        type=float,
+        choices=(1.0, -1.0),
+        default=1.0,
+        help="-1 when the bus reports clockwise-positive yaw rate",
+    )
+    sensors.add_argument("--can-channel", help="only frames of this channel/bus")
+    sensors.add_argument("--yaw-rate-csv", type=Path, help="CSV t,yaw_rate_rad_s (ccw +)")
+    sensors.add_argument("--speed-csv", type=Path, help="CSV t,speed_mps")
+    sensors.add_argument(
+        "--time-offset-can",
+        type=float,
+        default=0.0,
+        help="seconds added to CAN times to give GPS time",
+    )
+    sensors.add_argument(
+        "--time-offset-yaw",
+        type=float,
+        default=0.0,
+        help="extra seconds added to the yaw-rate times",
+    )
+    sensors.add_argument(
+        "--time-offset-speed",
+        type=float,
+        default=0.0,
+        help="extra seconds added to the speed times",
+    )
+    parser.add_argument("--window-s", type=float, default=2.0, help="heading window (s)")
+    parser.add_argument("--calibration", choices=CALIBRATION_METHODS, default="ls")
+    parser.add_argument("--gyro-bias", type=float, help="fixed gyro bias (deg/s) instead")
+    parser.add_argument("--wheel-scale", type=float, help="fixed wheel scale instead")
+    parser.add_argument("--max-sats", type=int, help="emulated canyon: satellites kept per epoch")
+    parser.add_argument(
+        "--max-sats-after",
+        type=float,
+        default=0.0,
+        help="seconds after the first epoch from which --max-sats applies",
+    )
+    parser.add_argument("--gt", type=Path, help="ground truth TUM (GPS time, z-up world)")
+    parser.add_argument("-o", "--output", type=Path, required=True, help="heading CSV")
+    parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
+    parser.set_defaults(func=run)
+
+
+def _sensors(args):
+    if args.can is not None:
+        if not (args.dbc and args.yaw_rate and args.wheel_speed):
+            raise InputError("--can needs --dbc, --yaw-rate and --wheel-speed")
+        motion = read_can_motion(
+            args.can,
+            args.dbc,
+            args.yaw_rate,
+            args.wheel_speed,
+            args.yaw_rate_sign,
+            args.time_offset_can + args.time_offset_yaw,
+            args.time_offset_can + args.time_offset_speed,
+            args.can_channel,
+        )
+        return motion.speed, motion.yaw_rate
+    if args.yaw_rate_csv is None or args.speed_csv is None:
+        raise InputError("give --can/--dbc/--yaw-rate/--wheel-speed or --yaw-rate-csv/--speed-csv")
+    return (
+        read_speed_csv(args.speed_csv, args.time_offset_speed),
+        read_yaw_rate_csv(args.yaw_rate_csv, args.time_offset_yaw),
+    )
+
+
+def _truth_yaw(path: Path, t: np.ndarray) -> np.ndarray:
+    truth = read_trajectory(path)
+    yaw = np.unwrap(yaw_of(truth.matrices[:, :3, :3]))
+    return sample_at(truth.t, yaw, t)
+
+
+def run(args: argparse.Namespace) -> int:
+    speed, yaw_rate = _sensors(args)
+    obs = read_obs(args.obs)
+    nav = read_nav(args.nav)
+    systems, mask = args.systems.upper(), np.radians(args.elev_mask)
+    if args.max_sats is None:
+        gnss = gnss_velocity(obs, nav, systems, mask)
+        rows, conventional = gnss.rows, gnss.velocity
+    else:
+        start = obs.epoch_time[0] + args.max_sats_after
+        rows, conventional = emulated_canyon(obs, nav, args.max_sats, start, systems, mask)
+    overlap = sample_at(speed.t, speed.value, obs.epoch_time)
+    if not np.isfinite(overlap).any():
+        raise InputError(
+            f"sensor times ({speed.t[:1]}..{speed.t[-1:]}) do not overlap the GNSS epochs "
+            f"({obs.epoch_time[0]:.1f}..{obs.epoch_time[-1]:.1f} GPS s); use --time-offset-*"
+        )
+    config = HeadingPipelineConfig(
+        calibration=args.calibration,
+        tight=TightHeadingConfig(window_s=args.window_s),
+        fixed_gyro_bias=None if args.gyro_bias is None else np.radians(args.gyro_bias),
+        fixed_wheel_scale=args.wheel_scale,
+    )
+    table = heading_pipeline(
+        obs.epoch_time,
+        heading_rows(rows),
+        conventional.velocity_enu,
+        conventional.valid,
+        speed,
+        yaw_rate,
+        config,
+    )
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    write_heading_csv(args.output, table)
+    truth = _truth_yaw(args.gt, table.t) if args.gt else None
+    figure = args.figure or args.output.with_suffix(".png")
+    heading_figure(figure, table, truth, args.obs.name)
+    summary = {
+        "epochs": len(table),
+        "tc_available": float(table.tc_available.mean()),
+        "tc_reliable": float(table.tc_reliable.mean()),
+        "conv_valid": float(table.conv_valid.mean()),
+        "gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
+        "wheel_scale": float(table.wheel_scale[-1]),
+        "output": str(args.output),
+        "figure": str(figure),
+    }
+    print(json.dumps(summary))
+    if not table.tc_available.any() and not table.conv_valid.any():
+        raise VoDopplerError("no heading could be computed at any epoch")
+    return 0
