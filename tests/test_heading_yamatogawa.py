@@ -137,3 +137,79 @@ def test_heading_cli_on_the_walk(walk, tmp_path):
     np.testing.assert_array_equal(table.tc_available, expected.tc_available)
     ok = expected.tc_available
     np.testing.assert_allclose(wrap_angle(table.yaw_tc[ok] - expected.yaw_tc[ok]), 0.0, atol=1e-5)
+
+
+CAN_DBC = """VERSION ""
+BS_:
+BU_: XXX
+BO_ 36 KIN: 8 XXX
+ SG_ YAW_RATE : 7|16@0- (0.01,0) [-300|300] "deg/s" XXX
+BO_ 170 WHEELS: 8 XXX
+ SG_ WL : 7|16@0+ (0.001,0) [0|60] "km/h" XXX
+ SG_ WR : 23|16@0+ (0.001,0) [0|60] "km/h" XXX
+"""
+
+
+def test_heading_cli_from_a_can_log(walk, tmp_path):
+    """The same run with the sensors packed into a candump log on a clock 1000 s behind GPS,
+    the yaw rate clockwise-positive on the bus (flipped by --yaw-rate-sign -1)."""
+    import can
+    import cantools
+
+    db = cantools.database.load_string(CAN_DBC, "dbc")
+    (tmp_path / "car.dbc").write_text(CAN_DBC)
+    kin, wheels = db.get_message_by_name("KIN"), db.get_message_by_name("WHEELS")
+    offset = 1000.0
+    yaw, speed = walk["yaw_rate"], walk["speed"]
+    with can.Logger(str(tmp_path / "car.log")) as log:
+        for t, w in zip(yaw.t, yaw.value, strict=True):
+            data = kin.encode({"YAW_RATE": -np.degrees(w)})
+            log.on_message_received(
+                can.Message(
+                    timestamp=t - offset, arbitration_id=36, data=data, is_extended_id=False
+                )
+            )
+        for t, v in zip(speed.t, speed.value, strict=True):
+            data = wheels.encode({"WL": 3.6 * v, "WR": 3.6 * v})
+            log.on_message_received(
+                can.Message(
+                    timestamp=t - offset + 0.01, arbitration_id=170, data=data, is_extended_id=False
+                )
+            )
+    folder = require_shared(FOLDER)
+    out = tmp_path / "heading.csv"
+    args = [
+        "heading",
+        str(folder / "yamatogawa_rover.obs"),
+        "--nav",
+        str(folder / "yamatogawa_rover.nav"),
+        "--systems",
+        "G",
+        "--max-sats",
+        "2",
+        "--max-sats-after",
+        "60",
+        "--window-s",
+        "8",
+        "-o",
+        str(out),
+        "--can",
+        str(tmp_path / "car.log"),
+        "--dbc",
+        str(tmp_path / "car.dbc"),
+        "--yaw-rate",
+        "KIN.YAW_RATE",
+        "--wheel-speed",
+        "WHEELS.WL,WHEELS.WR",
+        "--yaw-rate-sign",
+        "-1",
+        "--time-offset-can",
+        str(offset),
+    ]
+    assert main(args) == 0
+    table = read_heading_csv(out)
+    walking = walk["walking"]
+    difference = np.degrees(np.abs(wrap_angle(table.yaw_tc - walk["yaw_ref"])))[walking]
+    assert table.tc_available[walking].mean() >= 0.90 and np.nanmedian(difference) <= 3.0
+    assert abs(np.degrees(table.gyro_bias[walking][0] - BIAS)) <= 0.05
+    assert main([*args[:-12], "--can", str(tmp_path / "car.log")]) == 1  # --dbc etc. missing
