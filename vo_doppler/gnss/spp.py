@@ -2,10 +2,10 @@
 
 Model (IS-GPS-200 sec. 20.3.3.3.3): P = ρ + c·δt_r,sys − c·(δt_sv − T_GD) + T + ε with the
 satellite state at transmission (``transmit_states``), Earth rotation during travel, the
-Saastamoinen troposphere with a standard atmosphere (Saastamoinen 1972), no ionosphere model
-(single-frequency position errors of a few metres remain; the positions serve the line-of-sight
-vectors and the ENU origin). Gauss–Newton iterations, elevation mask once the position is known,
-then chi-square fault exclusion (``lsq``) and a final pass without the excluded rows.
+Saastamoinen troposphere and the broadcast Klobuchar ionosphere (``atmosphere``); the positions
+serve the line-of-sight vectors and the ENU origin. Gauss–Newton iterations, elevation
+mask once the position is known, then chi-square fault exclusion (``lsq``) and a final pass
+without the excluded rows.
 """
 
 from __future__ import annotations
@@ -15,9 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_geodetic
+from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
 from vo_doppler.gnss.ephemeris import rotate_earth, satellite_states
 from vo_doppler.gnss.lsq import lsq_with_exclusion, weighted_lsq
+from vo_doppler.gnss.signals import wavelengths
 from vo_doppler.io.rinex_nav import Navigation
 from vo_doppler.io.rinex_obs import Observations
 
@@ -63,31 +65,21 @@ def pseudorange_codes(obs: Observations, systems: str) -> dict[str, str]:
     return chosen
 
 
-def elevation_azimuth(receiver_ecef: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Elevation and azimuth (rad, azimuth clockwise from north) of unit vectors at receivers."""
-    receiver_ecef = np.broadcast_to(receiver_ecef, los.shape)
-    lat, lon, _ = ecef_to_geodetic(receiver_ecef)
+def elevation_azimuth(
+    receiver_ecef: np.ndarray, los: np.ndarray, lat_lon: tuple[float, float] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Elevation and azimuth (rad, azimuth clockwise from north) of unit vectors at receivers
+    (``lat_lon`` of a single receiver may be passed to skip the geodetic conversion)."""
+    if lat_lon is None:
+        lat, lon, _ = ecef_to_geodetic(np.broadcast_to(receiver_ecef, los.shape))
+    else:
+        lat, lon = lat_lon
     lat, lon = np.atleast_1d(lat), np.atleast_1d(lon)
     east = np.stack([-np.sin(lon), np.cos(lon), np.zeros_like(lon)], axis=-1)
     north = np.stack([-np.sin(lat) * np.cos(lon), -np.sin(lat) * np.sin(lon), np.cos(lat)], axis=-1)
     up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
     e, n, u = (np.sum(los * axis, axis=-1) for axis in (east, north, up))
     return np.arcsin(np.clip(u, -1.0, 1.0)), np.mod(np.arctan2(e, n), 2.0 * np.pi)
-
-
-def troposphere_delay(receiver_ecef: np.ndarray, elevation: np.ndarray) -> np.ndarray:
-    """Saastamoinen slant delay (m) for a standard atmosphere (humidity 70 %)."""
-    _, _, height = ecef_to_geodetic(receiver_ecef)
-    h = np.clip(height, 0.0, 1e4)
-    pressure = 1013.25 * (1.0 - 2.2557e-5 * h) ** 5.2568
-    temperature = 15.0 - 6.5e-3 * h + 273.16
-    vapour = 6.108 * 0.7 * np.exp((17.15 * temperature - 4684.0) / (temperature - 38.45))
-    zenith = np.pi / 2.0 - np.maximum(elevation, np.deg2rad(3.0))
-    return (
-        0.002277
-        / np.cos(zenith)
-        * (pressure + (1255.0 / temperature + 0.05) * vapour - np.tan(zenith) ** 2)
-    )
 
 
 def solve_spp(
@@ -114,30 +106,36 @@ def solve_spp(
             group_delay[hit] = nav.kepler[name][states.record[hit]]
     satellite_clock_m = SPEED_OF_LIGHT * (states.clock_bias_s - np.nan_to_num(group_delay))
     n_no_ephemeris = int((~states.valid).sum())
+    channels = {**nav.glonass_channels(), **obs.header.glonass_channels}
+    frequency = np.full(len(sel), L1_HZ)
+    for system, code in codes.items():
+        hit = sel.system == system
+        lam = wavelengths(sel.system[hit], sel.prn[hit], code, channels, obs.header.version)
+        frequency[hit] = np.nan_to_num(SPEED_OF_LIGHT / lam, nan=L1_HZ)
     epoch = np.searchsorted(obs.epoch_time, sel.time)
     bounds = np.searchsorted(epoch, np.arange(obs.epoch_time.size + 1))
     start = obs.header.approx_position
     if start is None or np.linalg.norm(start) < EARTH_SURFACE_M:
         start = np.zeros(3)
-    system_list = sorted(codes)
+    model = _Model(sorted(codes), elevation_mask_rad, nav.klobuchar)
     n_epochs = obs.epoch_time.size
     position = np.full((n_epochs, 3), np.nan)
-    clocks = {s: np.full(n_epochs, np.nan) for s in system_list}
+    clocks = {s: np.full(n_epochs, np.nan) for s in model.systems}
     n_sat = np.zeros(n_epochs, dtype=np.int64)
     rms = np.full(n_epochs, np.nan)
     pdop = np.full(n_epochs, np.nan)
     for k in range(n_epochs):
         r = np.arange(bounds[k], bounds[k + 1])
         r = r[states.valid[r]]
-        result = _solve_epoch(
+        data = _EpochData(
+            obs.epoch_time[k],
             states.position[r],
             sel.value[r] + satellite_clock_m[r],
             sel.system[r],
             sel.prn[r],
-            start,
-            system_list,
-            elevation_mask_rad,
+            frequency[r],
         )
+        result = _solve_epoch(data, model, start)
         if result is None:
             continue
         x, clock, used, residuals, dop = result
@@ -160,16 +158,33 @@ def solve_spp(
     )
 
 
-def _solve_epoch(sat_position, corrected_range, system, prn, start, system_list, mask):
+@dataclass(frozen=True)
+class _EpochData:
+    """One epoch's pseudoranges, corrected for the satellite clock and group delay."""
+
+    t: float
+    sat_position: np.ndarray
+    corrected_range: np.ndarray
+    system: np.ndarray
+    prn: np.ndarray
+    frequency: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Model:
+    systems: list[str]
+    mask: float
+    klobuchar: np.ndarray | None
+
+
+def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray):
     """Gauss–Newton with elevation mask and FDE; None when fewer than 3 + n_clock satellites."""
-    keep = np.ones(corrected_range.size, dtype=bool)
+    keep = np.ones(data.corrected_range.size, dtype=bool)
     x = np.asarray(start, dtype=float).copy()
-    clocks = np.zeros(len(system_list))
+    clocks = np.zeros(len(model.systems))
     for _ in range(2):
         for _ in range(12):
-            H, residual, sigma, keep_now, present = _linearise(
-                sat_position, corrected_range, system, x, clocks, system_list, mask, keep
-            )
+            H, residual, sigma, keep_now, present = _linearise(data, model, x, clocks, keep)
             if keep_now.sum() < 3 + present.sum():
                 return None
             H = H[keep_now][:, np.r_[True, True, True, present]]
@@ -178,7 +193,7 @@ def _solve_epoch(sat_position, corrected_range, system, prn, start, system_list,
             clocks[present] += dx[3:]
             if np.linalg.norm(dx[:3]) < 1e-4:
                 break
-        groups = np.char.add(system[keep_now], prn[keep_now].astype(str))
+        groups = np.char.add(data.system[keep_now], data.prn[keep_now].astype(str))
         result = lsq_with_exclusion(
             H, residual[keep_now], sigma[keep_now], groups, 3 + int(present.sum())
         )
@@ -192,35 +207,33 @@ def _solve_epoch(sat_position, corrected_range, system, prn, start, system_list,
     used = keep_now.sum()
     rms_value = float(np.sqrt(np.mean(result.residuals[result.used] ** 2)))
     pdop = float(np.sqrt(np.trace(np.linalg.inv(H.T @ H)[:3, :3])))
-    clock = {s: clocks[i] for i, s in enumerate(system_list) if present[i]}
+    clock = {s: clocks[i] for i, s in enumerate(model.systems) if present[i]}
     return x, clock, int(used - (~result.used).sum()), rms_value, pdop
 
 
-def _linearise(sat_position, corrected_range, system, x, clocks, system_list, mask, keep):
-    travel = np.linalg.norm(sat_position - x, axis=1) / SPEED_OF_LIGHT
-    rotated = rotate_earth(sat_position, travel)
-    vector = rotated - x
+def _linearise(data: _EpochData, model: _Model, x, clocks, keep):
+    travel = np.linalg.norm(data.sat_position - x, axis=1) / SPEED_OF_LIGHT
+    vector = rotate_earth(data.sat_position, travel) - x
     rho = np.linalg.norm(vector, axis=1)
     los = vector / rho[:, None]
     keep_now = keep.copy()
     sigma = np.full(rho.size, SIGMA_PSEUDORANGE_M)
-    troposphere = np.zeros(rho.size)
+    atmosphere = np.zeros(rho.size)
     if np.linalg.norm(x) > EARTH_SURFACE_M:
-        elevation, _ = elevation_azimuth(x, los)
-        keep_now &= elevation >= mask
+        lat, lon, height = (float(v) for v in ecef_to_geodetic(x))
+        elevation, azimuth = elevation_azimuth(x, los, (lat, lon))
+        keep_now &= elevation >= model.mask
         sigma = SIGMA_PSEUDORANGE_M / np.sin(np.maximum(elevation, np.deg2rad(5.0)))
-        troposphere = troposphere_delay(x, elevation)
-    one_hot = np.stack([system == s for s in system_list], axis=1).astype(float)
+        atmosphere = troposphere_delay(lat, height, elevation)
+        if model.klobuchar is not None:
+            atmosphere = atmosphere + klobuchar_delay(
+                model.klobuchar, lat, lon, elevation, azimuth, data.t, data.frequency
+            )
+    one_hot = np.stack([data.system == s for s in model.systems], axis=1).astype(float)
     present = one_hot[keep_now].any(axis=0)
-    predicted = rho + one_hot @ clocks + troposphere
+    predicted = rho + one_hot @ clocks + atmosphere
     H = np.hstack([-los, one_hot])
-    return H, corrected_range - predicted, sigma, keep_now, present
-
-
-def enu_rotation_at(position_ecef: np.ndarray) -> np.ndarray:
-    """ECEF→ENU rotation at a receiver position."""
-    lat, lon, _ = ecef_to_geodetic(position_ecef)
-    return ecef_to_enu_rotation(float(lat), float(lon))
+    return H, data.corrected_range - predicted, sigma, keep_now, present
 
 
 def receiver_positions(solution: SppSolution, fallback: np.ndarray | None) -> np.ndarray:

@@ -86,6 +86,7 @@ class Navigation:
     glonass: NavRecords
     leap_seconds: int | None = None
     problems: tuple[str, ...] = field(default=())
+    klobuchar: np.ndarray | None = None
 
     def merged(self, other: Navigation) -> Navigation:
         return Navigation(
@@ -93,6 +94,7 @@ class Navigation:
             _concat(self.glonass, other.glonass),
             self.leap_seconds if self.leap_seconds is not None else other.leap_seconds,
             self.problems + other.problems,
+            self.klobuchar if self.klobuchar is not None else other.klobuchar,
         )
 
     def glonass_channels(self) -> dict[int, int]:
@@ -143,7 +145,32 @@ def _read_one(path: Path) -> Navigation:
     records = _split_records(path, version, system, body, len(header) + 1, problems)
     kepler = _decode(path, records, KEPLER_SYSTEMS, KEPLER_FIELDS, version, leap, problems)
     glonass = _decode(path, records, "R", GLONASS_FIELDS, version, leap, problems)
-    return Navigation(_kepler_times(kepler), _glonass_si(glonass), leap, tuple(problems))
+    return Navigation(
+        _kepler_times(kepler),
+        _glonass_si(glonass),
+        leap,
+        tuple(problems),
+        _klobuchar(header),
+    )
+
+
+def _klobuchar(header: list[str]) -> np.ndarray | None:
+    """GPS Klobuchar α0–α3, β0–β3 ('IONOSPHERIC CORR' GPSA/GPSB, RINEX 2 'ION ALPHA/BETA')."""
+    parts: dict[str, str] = {}
+    for line in header:
+        key = label(line)
+        if key == "IONOSPHERIC CORR" and line[:4] in ("GPSA", "GPSB"):
+            parts[line[3]] = line[5:53]
+        elif key in ("ION ALPHA", "ION BETA"):
+            parts[key[4]] = line[2:50]
+    if set(parts) != {"A", "B"}:
+        return None
+    try:
+        text = parts["A"] + parts["B"]
+        values = [float(text[i : i + 12].replace("D", "E")) for i in range(0, 96, 12)]
+    except ValueError:
+        return None
+    return np.array(values)
 
 
 def _split_records(path, version, file_system, body, first_line, problems):

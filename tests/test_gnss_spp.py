@@ -1,0 +1,56 @@
+"""Atmosphere models against RTKLIB (pyrtklib, test-only); SPP on the static Septentrio file."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.conftest import require_shared
+from vo_doppler.geo import EnuFrame, geodetic_to_ecef
+from vo_doppler.gnss.atmosphere import klobuchar_delay, troposphere_delay
+from vo_doppler.gnss.spp import solve_spp
+from vo_doppler.io.rinex_nav import read_nav
+from vo_doppler.io.rinex_obs import read_obs
+
+KLOBUCHAR = np.array([1.8626e-08, 2.2352e-08, -1.1921e-07, -5.9605e-08])
+KLOBUCHAR = np.concatenate([KLOBUCHAR, [1.2902e05, 1.6384e05, -1.9661e05, -2.6214e05]])
+
+
+def _array(rtk, values):
+    out = rtk.Arr1Ddouble(len(values))
+    for i, v in enumerate(values):
+        out[i] = float(v)
+    return out
+
+
+@pytest.mark.parametrize("t", [1403252400.0, 1403252400.0 + 5 * 3600, 1403252400.0 + 14 * 3600])
+@pytest.mark.parametrize("lat_deg", [35.13, -60.0, 5.0])
+def test_klobuchar_and_saastamoinen_match_rtklib(t, lat_deg):
+    rtk = pytest.importorskip("pyrtklib")
+    lat, lon, height = np.deg2rad(lat_deg), np.deg2rad(136.98), 104.9
+    week = int(t // 604800)
+    time = rtk.gpst2time(week, t - week * 604800)
+    for elevation_deg, azimuth_deg in [(10.0, 30.0), (45.0, 200.0), (85.0, 300.0)]:
+        el, az = np.deg2rad(elevation_deg), np.deg2rad(azimuth_deg)
+        pos = _array(rtk, [lat, lon, height])
+        azel = _array(rtk, [az, el])
+        iono = rtk.ionmodel(time, _array(rtk, KLOBUCHAR), pos, azel)
+        ours = klobuchar_delay(KLOBUCHAR, lat, lon, np.array([el]), np.array([az]), t)[0]
+        assert ours == pytest.approx(iono, abs=1e-6)
+        tropo = rtk.tropmodel(time, pos, azel, 0.7)
+        assert troposphere_delay(lat, height, np.array([el]))[0] == pytest.approx(tropo, abs=1e-6)
+
+
+@pytest.mark.shared_data
+@pytest.mark.parametrize("systems", ["GREC", "G"])
+def test_static_septentrio_spp(systems):
+    obs = read_obs(require_shared("septentrio_static/rover.obs"))
+    nav = read_nav(require_shared("septentrio_static/base.nav"))
+    lat, lon, height = np.loadtxt(require_shared("septentrio_static/rover_position.txt"))
+    truth = geodetic_to_ecef(np.deg2rad(lat), np.deg2rad(lon), height)
+    solution = solve_spp(obs, nav, systems)
+    assert solution.valid.all()
+    enu = EnuFrame.from_ecef(truth).ecef_to_enu(solution.position_ecef)
+    assert np.median(np.linalg.norm(enu[:, :2], axis=1)) < 5.0
+    assert np.median(np.abs(enu[:, 2])) < 5.0
+    assert np.all(np.std(enu, axis=0) < 1.0)
