@@ -1,0 +1,63 @@
+"""Trajectory error per 100 m of path, the figure of the seed's evaluation.
+
+For every window of the path that is 100 m long on the ground truth, the estimate is
+translated (not rotated) so that it coincides with the truth at the window's start; the
+error is the position difference at the window's end. Mean and maximum over all windows are
+reported in metres per 100 m. Paths shorter than the window use the whole path and scale the
+error to 100 m.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.trajectory import Trajectory
+
+
+@dataclass
+class ErrorPerDistance:
+    window_m: float
+    mean_m_per_100m: float
+    max_m_per_100m: float
+    n_windows: int
+    errors_m: np.ndarray
+    """Error at the end of each window (m), in window order."""
+    start_distance_m: np.ndarray
+
+
+def error_per_100m(
+    estimate: Trajectory, truth: Trajectory, window_m: float = 100.0, step_m: float = 1.0
+) -> ErrorPerDistance:
+    """Error growth over every ``window_m`` stretch, windows starting every ``step_m`` metres.
+
+    ``estimate`` and ``truth`` must have matching rows (associate them by time first).
+    """
+    if len(estimate) != len(truth):
+        raise ValueError(f"estimate has {len(estimate)} poses, ground truth {len(truth)}")
+    distance = truth.cumulative_distance()
+    total = float(distance[-1]) if len(distance) else 0.0
+    if total <= 0.0:
+        empty = np.zeros(0)
+        return ErrorPerDistance(window_m, float("nan"), float("nan"), 0, empty, empty)
+    scale = 1.0
+    if total < window_m:
+        scale = window_m / total
+        window_m = total
+    start_marks = np.arange(0.0, total - window_m + 1e-9, step_m)
+    starts = np.searchsorted(distance, start_marks, side="left")
+    ends = np.searchsorted(distance, distance[starts] + window_m - 1e-9, side="left")
+    keep = ends < len(distance)
+    starts, ends = starts[keep], ends[keep]
+    est_delta = estimate.positions[ends] - estimate.positions[starts]
+    gt_delta = truth.positions[ends] - truth.positions[starts]
+    errors = np.linalg.norm(est_delta - gt_delta, axis=1) * scale
+    return ErrorPerDistance(
+        window_m=window_m,
+        mean_m_per_100m=float(errors.mean()) if errors.size else float("nan"),
+        max_m_per_100m=float(errors.max()) if errors.size else float("nan"),
+        n_windows=int(errors.size),
+        errors_m=errors,
+        start_distance_m=distance[starts],
+    )
