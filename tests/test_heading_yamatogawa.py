@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from tests.conftest import require_shared
 from vo_doppler.cli import main
@@ -32,6 +33,7 @@ from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import SensorSeries, write_sensor_csv
 from vo_doppler.sim.doppler_rows import gyro_from_heading
+from vo_doppler.trajectory import Trajectory, write_tum
 
 pytestmark = pytest.mark.shared_data
 
@@ -106,6 +108,13 @@ def test_two_second_window_is_too_short_at_1hz(walk):
 def test_heading_cli_on_the_walk(walk, tmp_path):
     write_sensor_csv(tmp_path / "yaw.csv", walk["yaw_rate"], "yaw_rate_rad_s")
     write_sensor_csv(tmp_path / "speed.csv", walk["speed"], "speed_mps")
+    known = np.isfinite(walk["yaw_ref"])  # the reference course stands in for ground truth
+    truth = Trajectory(
+        walk["t"][known],
+        np.zeros((known.sum(), 3)),
+        Rotation.from_euler("z", walk["yaw_ref"][known][:, None]),
+    )
+    write_tum(tmp_path / "truth.tum", truth)
     folder = require_shared(FOLDER)
     out = tmp_path / "heading.csv"
     code = main(
@@ -126,6 +135,8 @@ def test_heading_cli_on_the_walk(walk, tmp_path):
             "60",
             "--window-s",
             "8",
+            "--gt",
+            str(tmp_path / "truth.tum"),
             "-o",
             str(out),
         ]

@@ -232,6 +232,8 @@ def tight_heading_series(
     speed = np.asarray(speed, dtype=float)
     yaw_angle = np.asarray(yaw_angle, dtype=float)
     m = len(t_epoch)
+    if np.any(np.diff(t_epoch) <= 0):
+        raise ValueError("epoch times must be strictly increasing")
     epoch_of_row = _match_epochs(rows.t, t_epoch, config.epoch_match_s) if m else np.zeros(0, int)
     y_all = rows.reduced()
     usable = (
