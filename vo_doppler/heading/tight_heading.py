@@ -56,6 +56,7 @@ class TightHeadingConfig:
     reliability_epochs: int = 10
     reliability_min_epochs: int = 5
     reliability_gate_rad: float = np.radians(3.0)
+    reliability_n_sigma: float = 3.0
     epoch_match_s: float = 1e-3
     chunk_windows: int = 2048
 
@@ -321,7 +322,7 @@ def _decide(sol, t_epoch, speed, yaw_angle, n_sat_epoch, config) -> TightHeading
             available[k] = True
         if available[k]:
             last = k
-    reliable = _reliability(yaw, available, yaw_angle, config)
+    reliable = _reliability(yaw, sigma, available, yaw_angle, config)
     return TightHeadingResult(
         t=t_epoch,
         yaw=np.where(available, wrap_angle(yaw), np.nan),
@@ -336,8 +337,13 @@ def _decide(sol, t_epoch, speed, yaw_angle, n_sat_epoch, config) -> TightHeading
     )
 
 
-def _reliability(yaw, available, yaw_angle, config):
-    """Gyro-consistency over the last ``reliability_epochs`` epochs (sec. 3.5)."""
+def _reliability(yaw, sigma, available, yaw_angle, config):
+    """Gyro-consistency over the last ``reliability_epochs`` epochs (sec. 3.5).
+
+    Each earlier heading propagated by the gyro must agree with the current one within
+    max(gate, n_sigma · √(σ_k² + σ_j²)): a fixed gate for precise headings, the combined
+    uncertainty for imprecise ones (so that a wrong solution, not mere noise, is rejected).
+    """
     m = len(yaw)
     count = np.zeros(m, dtype=int)
     worst = np.zeros(m)
@@ -347,10 +353,10 @@ def _reliability(yaw, available, yaw_angle, config):
         both = available[lag:] & available[:-lag]
         predicted = yaw[:-lag] + yaw_angle[lag:] - yaw_angle[:-lag]
         error = np.abs(wrap_angle(yaw[lag:] - predicted))
+        allowed = np.maximum(
+            config.reliability_gate_rad,
+            config.reliability_n_sigma * np.hypot(sigma[lag:], sigma[:-lag]),
+        )
         count[lag:] += both
-        worst[lag:] = np.maximum(worst[lag:], np.where(both, error, 0.0))
-    return (
-        available
-        & (count >= config.reliability_min_epochs)
-        & (worst <= config.reliability_gate_rad)
-    )
+        worst[lag:] = np.maximum(worst[lag:], np.where(both, error / allowed, 0.0))
+    return available & (count >= config.reliability_min_epochs) & (worst <= 1.0)
