@@ -5,6 +5,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tests.conftest import REPO_ROOT
 from vo_doppler.sim.scene import CityLayout, city_scene
@@ -64,6 +66,28 @@ def test_speed_profile_limits_and_kinematics():
     turned = 0.5 * (motion.yaw_rate[1:] + motion.yaw_rate[:-1]) * 0.01
     np.testing.assert_allclose(np.diff(motion.yaw)[same], turned[same], atol=1e-9)
     assert motion.yaw[-1] == pytest.approx(np.pi / 2 * round(motion.yaw[-1] / (np.pi / 2)))
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    max_speed=st.floats(3.0, 16.0),
+    lateral=st.floats(1.0, 4.0),
+    accel=st.floats(0.5, 3.0),
+    decel=st.floats(0.5, 4.0),
+    initial=st.floats(0.0, 16.0),
+    stop=st.floats(20.0, 150.0),
+)
+def test_speed_profile_respects_its_limits(max_speed, lateral, accel, decel, initial, stop):
+    route = loop_route(LAYOUT, laps=4)
+    t = np.arange(0.0, 90.0, 0.02)
+    motion = drive(route, t, max_speed, lateral, accel, decel, initial, stops_m=[stop])
+    assert np.all(motion.speed >= 0.0)
+    assert np.all(motion.speed <= max_speed + 1e-9)
+    turning = np.abs(motion.yaw_rate) > 0
+    assert np.all(motion.speed[turning] <= np.sqrt(lateral * 10.0) + 1e-6)
+    change = np.diff(motion.speed) / 0.02
+    assert change.max() <= accel + 1e-3 and change.min() >= -decel - 1e-3
+    assert np.any(motion.speed == 0.0)  # the stop comes within 90 s even at 3 m/s
 
 
 def test_stop_holds_the_vehicle_still():
