@@ -172,3 +172,40 @@ def test_glonass_time_system_is_converted_to_gps(tmp_path):
     path = tmp_path / "glo.24o"
     path.write_text(text + rinex3_epoch("2024 06 24 08 20  0.0000000", [("R01", [field(1.0)])]))
     assert read_obs(path).epoch_time[0] == T0 + 18.0
+
+
+def test_rinex2_mixed_file_events_and_blank_system_letter(tmp_path):
+    types = ["C1", "D1"]
+    g = [("  5", [field(2.0e7), field(-100.0)]), ("R 3", [field(2.1e7), field(200.0)])]
+    text = rinex2_header(types, system="M")
+    text += rinex2_epoch(" 10  1  6  5 57  3.0000000", g)
+    # flag 4: header records inside the body change the observation types
+    new_types = "     3    D1    C1    S1" + " " * 36 + "# / TYPES OF OBSERV \n"
+    text += " " * 28 + "4  2\n" + new_types + " " * 60 + "COMMENT             \n"
+    text += rinex2_epoch(
+        " 10  1  6  5 57  4.0000000", [("G05", [field(-101.0), field(2.0e7 + 1), field(45.0)])]
+    )
+    text += rinex2_epoch(" 10  1  6  5 57  5.0000000", [("G05", [field(1.0)] * 3)], flag=6)
+    path = tmp_path / "mixed.10o"
+    path.write_text(text)
+    obs = read_obs(path)
+    assert obs.problems == ()
+    t0 = float(calendar_to_gps_seconds(2010, 1, 6, 5, 57, 3.0))
+    np.testing.assert_array_equal(obs.epoch_time, [t0, t0 + 1])
+    assert obs.satellites()[obs.time == t0].tolist() == ["G05", "G05", "R03", "R03"]
+    second = obs.time == t0 + 1
+    assert obs.value[second & obs.mask(code="D1")].tolist() == [-101.0]
+    assert obs.value[second & obs.mask(code="S1")].tolist() == [45.0]
+
+
+def test_hatanaka_rinex3_real_file_equals_plain(tmp_path):
+    from tests.conftest import require_shared
+
+    source = require_shared("septentrio_static/rover.obs")
+    crx = tmp_path / "rover.crx.gz"
+    crx.write_bytes(hatanaka.compress(source.read_bytes(), compression="gz"))
+    plain, compressed = read_obs(source), read_obs(crx)
+    np.testing.assert_array_equal(compressed.value, plain.value)
+    np.testing.assert_array_equal(compressed.ssi, plain.ssi)
+    np.testing.assert_array_equal(compressed.lli, plain.lli)
+    assert compressed.codes == plain.codes

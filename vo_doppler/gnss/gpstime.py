@@ -56,19 +56,27 @@ def calendar_to_gps_seconds(year, month, day, hour, minute, second) -> np.ndarra
     )
 
 
+def _leap_table() -> tuple[np.ndarray, np.ndarray]:
+    """UTC instants (as calendar seconds) from which GPS − UTC takes each value."""
+    years, months = np.array(_LEAP_SECOND_DATES).T
+    starts_utc = calendar_to_gps_seconds(years, months, 1, 0, 0, 0)
+    return starts_utc, np.arange(1.0, len(years) + 1.0)
+
+
 def gps_minus_utc(gps_seconds) -> np.ndarray:
     """Leap seconds GPS − UTC in force at the given GPS times (IERS Bulletin C history)."""
-    years, months = np.array(_LEAP_SECOND_DATES).T
-    counts = np.arange(1, len(years) + 1)
-    starts = calendar_to_gps_seconds(years, months, 1, 0, 0, 0) + counts
-    values = np.concatenate(([0.0], counts))
-    return values[np.searchsorted(starts, np.asarray(gps_seconds, dtype=float), side="right")]
+    starts_utc, counts = _leap_table()
+    index = np.searchsorted(starts_utc + counts, np.asarray(gps_seconds, float), side="right")
+    return np.concatenate(([0.0], counts))[index]
 
 
 def utc_to_gps_seconds(utc_as_gps_seconds, leap_seconds: float | None = None) -> np.ndarray:
     """UTC calendar time (converted as if it were GPS time) to true GPS seconds."""
     t = np.asarray(utc_as_gps_seconds, dtype=float)
-    return t + (gps_minus_utc(t) if leap_seconds is None else leap_seconds)
+    if leap_seconds is not None:
+        return t + leap_seconds
+    starts_utc, counts = _leap_table()
+    return t + np.concatenate(([0.0], counts))[np.searchsorted(starts_utc, t, side="right")]
 
 
 def time_of_week(gps_seconds) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,116 @@
+"""Navigation reader: every ephemeris parameter equals georinex's (test-only) on the shared
+files; RINEX 2 GLONASS records read like their RINEX 3 twins."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from tests.conftest import require_shared
+from vo_doppler.gnss.gpstime import BDT_MINUS_GPST_S
+from vo_doppler.io.rinex_nav import read_nav
+
+KEPLER_NAMES = {
+    "af0": "SVclockBias",
+    "af1": "SVclockDrift",
+    "af2": "SVclockDriftRate",
+    "crs": "Crs",
+    "delta_n": "DeltaN",
+    "m0": "M0",
+    "cuc": "Cuc",
+    "e": "Eccentricity",
+    "cus": "Cus",
+    "sqrt_a": "sqrtA",
+    "toe_sow": "Toe",
+    "cic": "Cic",
+    "omega0": "Omega0",
+    "cis": "Cis",
+    "i0": "Io",
+    "crc": "Crc",
+    "omega": "omega",
+    "omega_dot": "OmegaDot",
+    "idot": "IDOT",
+}
+GLONASS_NAMES = {"minus_tau_n": "SVclockBias", "gamma_n": "SVrelFreqBias"}
+GLONASS_M = {"x": "X", "vx": "dX", "ax": "dX2", "y": "Y", "vy": "dY", "z": "Z", "vz": "dZ"}
+FILES = ("septentrio_static/base.nav", "yamatogawa_ublox_walk/brdc0060.10n")
+GPS_EPOCH = np.datetime64("1980-01-06T00:00:00", "ns")
+
+
+@pytest.fixture(scope="module", params=FILES)
+def both(request):
+    georinex = pytest.importorskip("georinex")
+    path = require_shared(request.param)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        reference = georinex.load(path)
+    return read_nav(path), reference
+
+
+def _matches(reference, sat, toc_calendar, expected: dict[str, float], rtol: float) -> bool:
+    """True when one georinex entry of this satellite and epoch has all expected values."""
+    when = GPS_EPOCH + np.timedelta64(int(round(toc_calendar * 1e9)), "ns")
+    if when not in reference.time.values:
+        return False
+    at = reference.sel(time=when)
+    for sv in (str(s) for s in reference.sv.values if str(s).startswith(sat)):
+        values = [float(at[name].sel(sv=sv)) for name in expected]
+        if np.allclose(values, list(expected.values()), rtol=rtol, atol=0.0):
+            return True
+    return False
+
+
+def test_kepler_parameters_equal_georinex(both):
+    nav, reference = both
+    k = nav.kepler
+    assert len(k) > 10
+    for i in range(len(k)):
+        sat = f"{k.system[i]}{k.prn[i]:02d}"
+        toc = k.toc[i] + (BDT_MINUS_GPST_S if k.system[i] == "C" else 0.0)
+        expected = {name: float(k[ours][i]) for ours, name in KEPLER_NAMES.items()}
+        assert _matches(reference, sat, toc, expected, rtol=0.0), (sat, k.line[i])
+
+
+def test_glonass_parameters_equal_georinex(both):
+    nav, reference = both
+    g = nav.glonass
+    for i in range(len(g)):
+        sat = f"R{g.prn[i]:02d}"
+        toc = g.toc[i] - nav.leap_seconds
+        expected = {name: float(g[ours][i]) for ours, name in GLONASS_NAMES.items()}
+        expected |= {name: float(g[ours][i]) for ours, name in GLONASS_M.items()}  # georinex: m
+        assert _matches(reference, sat, toc, expected, rtol=1e-14), (sat, g.line[i])
+
+
+def _rinex2_glonass(rinex3_text: str) -> str:
+    """The GLONASS records of a RINEX 3 navigation file, written as a RINEX 2.11 'G' file."""
+    lines = rinex3_text.splitlines()
+    start = next(i for i, line in enumerate(lines) if "END OF HEADER" in line) + 1
+    out = [
+        f"{'     2.11           G: GLONASS NAV DATA':<60}RINEX VERSION / TYPE",
+        f"{'    18':<60}LEAP SECONDS",
+        f"{'':<60}END OF HEADER",
+    ]
+    for i in range(start, len(lines)):
+        line = lines[i]
+        if line.startswith("R"):
+            y, mo, d, h, mi, s = (int(p) for p in line[4:23].split())
+            out.append(f"{int(line[1:3]):2d} {y % 100:02d} {mo:2d} {d:2d} {h:2d} {mi:2d}{s:5.1f}")
+            out[-1] += line[23:80]
+            out.extend("   " + lines[i + k][4:80] for k in (1, 2, 3))
+    return "\n".join(out) + "\n"
+
+
+def test_rinex2_glonass_file(tmp_path):
+    source = require_shared("septentrio_static/base.nav")
+    path = tmp_path / "glonass.24g"
+    path.write_text(_rinex2_glonass(source.read_text()))
+    v2, v3 = read_nav(path), read_nav(source)
+    assert v2.problems == ()
+    assert len(v2.glonass) == len(v3.glonass) > 0
+    assert len(v2.kepler) == 0
+    np.testing.assert_array_equal(v2.glonass.toc, v3.glonass.toc)
+    for name, values in v3.glonass.params.items():
+        np.testing.assert_array_equal(v2.glonass[name], values, err_msg=name)
