@@ -209,3 +209,17 @@ def test_hatanaka_rinex3_real_file_equals_plain(tmp_path):
     np.testing.assert_array_equal(compressed.ssi, plain.ssi)
     np.testing.assert_array_equal(compressed.lli, plain.lli)
     assert compressed.codes == plain.codes
+
+
+def test_matrix_helper(tmp_path):
+    text = rinex3_header(TYPES)
+    text += rinex3_epoch("2024 06 24 08 20  0.0000000", [("G05", [field(1.0)] * 4)])
+    both = [("G05", [field(2.0)] * 4), ("E04", [field(3.0)] * 4)]
+    text += rinex3_epoch("2024 06 24 08 20  1.0000000", both)
+    path = tmp_path / "m.24o"
+    path.write_text(text)
+    names, values = read_obs(path).matrix("C1C")
+    assert names.tolist() == ["E04", "G05"]
+    np.testing.assert_array_equal(values, [[np.nan, 1.0], [3.0, 2.0]])
+    names, _ = read_obs(path).matrix("C1C", system="G")
+    assert names.tolist() == ["G05"]

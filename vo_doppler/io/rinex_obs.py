@@ -125,6 +125,19 @@ class Observations:
         """Rows of one system and/or observable code."""
         return self.subset(self.mask(system, code))
 
+    def matrix(self, code: str, system: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """One observable as an (epoch × satellite) array, NaN where absent.
+
+        Returns the satellite identifiers (columns, sorted) and the values; rows follow
+        ``epoch_time``.
+        """
+        rows = self.select(system, code)
+        sats = rows.satellites()
+        names, column = np.unique(sats, return_inverse=True)
+        values = np.full((self.epoch_time.size, names.size), np.nan)
+        values[np.searchsorted(self.epoch_time, rows.time), column] = rows.value
+        return names, values
+
 
 @dataclass
 class _Records:
