@@ -152,6 +152,14 @@ def test_generated_files_read_back(tmp_path, small_scene):
     np.testing.assert_allclose(speed, np.column_stack([times, plan.motion.speed]), atol=1e-6)
 
 
+def test_regenerating_replaces_older_frames(tmp_path, small_scene):
+    generate_vo_sequence(tmp_path, 0.5, 10.0, seed=2, scene=small_scene)
+    generate_vo_sequence(tmp_path, 0.3, 10.0, seed=2, scene=small_scene, image_format="jpg")
+    names = sorted(p.name for p in (tmp_path / "image_0").iterdir())
+    assert names == ["000000.jpg", "000001.jpg", "000002.jpg"]
+    assert len(np.loadtxt(tmp_path / "times.txt")) == 3
+
+
 def test_bundled_calibration_is_the_synthetic_camera():
     camera = read_camera(REPO_ROOT / "calib" / "synthetic.yaml")
     expected = synthetic_camera()

@@ -7,7 +7,7 @@ vehicle frame (x forward, y left, z up) sits on the ground; the camera is mounte
 camera → vehicle extrinsic of the calibration (default: forward-looking, 1.5 m above ground).
 
 Files written by :func:`generate_vo_sequence` (``out_dir``):
-``image_0/000000.png …`` grey frames; ``times.txt`` (one time in seconds per line);
+``image_0/000000.png …`` grey frames (or ``.jpg``); ``times.txt`` (one time in seconds per line);
 ``calib.yaml`` (camera YAML, :meth:`Camera.to_yaml`); ``ground_truth_camera.kitti`` and
 ``ground_truth_camera.tum`` (camera poses in the frame of the first camera, OpenCV axes — the
 convention of the VO output); ``ground_truth.tum`` (vehicle poses in the ENU world frame of the
@@ -298,9 +298,17 @@ def generate_vo_sequence(
     fps: float = 10.0,
     seed: int = 0,
     progress: bool = False,
+    image_format: str = "png",
     **options,
 ) -> VoPlan:
-    """Render a sequence to ``out_dir`` (layout in the module docstring) and return its plan."""
+    """Render a sequence to ``out_dir`` (layout in the module docstring) and return its plan.
+
+    ``image_format`` is ``png`` (lossless, ≈ 130 kB per 640×360 frame) or ``jpg`` (quality 95,
+    about half that). Numbered frames left in ``image_0`` by an earlier, longer run are removed
+    so that the folder holds exactly this sequence.
+    """
+    if image_format not in ("png", "jpg"):
+        raise ValueError(f"image_format must be png or jpg, not {image_format!r}")
     out = Path(out_dir)
     image_dir = out / "image_0"
     image_dir.mkdir(parents=True, exist_ok=True)
@@ -308,9 +316,17 @@ def generate_vo_sequence(
     frames = render_frames(plan)
     if progress:
         frames = track(frames, total=len(plan.times), description="rendering")
+    params = [cv2.IMWRITE_JPEG_QUALITY, 95] if image_format == "jpg" else []
+    names = set()
     for k, image in enumerate(frames):
-        if not cv2.imwrite(str(image_dir / f"{k:06d}.png"), image):
-            raise OSError(f"cannot write {image_dir / f'{k:06d}.png'}")
+        path = image_dir / f"{k:06d}.{image_format}"
+        if not cv2.imwrite(str(path), image, params):
+            raise OSError(f"cannot write {path}")
+        names.add(path.name)
+    for stale in sorted(image_dir.glob("[0-9][0-9][0-9][0-9][0-9][0-9].*")):
+        if stale.suffix in (".png", ".jpg") and stale.name not in names:
+            log.info("removing %s left by an earlier run", stale)
+            stale.unlink()
     write_sequence_files(out, plan)
     log.info("wrote %d frames to %s", len(plan.times), out)
     return plan
@@ -350,6 +366,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--stop", type=float, action="append", default=[], help="stop at this distance (m)"
     )
+    parser.add_argument("--format", choices=("png", "jpg"), default="png", help="image files")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     generate_vo_sequence(
@@ -358,6 +375,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args.fps,
         args.seed,
         progress=True,
+        image_format=args.format,
         camera=synthetic_camera(args.width, args.height),
         noise_std=args.noise,
         max_speed=args.max_speed,
