@@ -223,3 +223,20 @@ def test_conventional_heading_from_velocity():
     course, ok = course_from_velocity(v, valid=np.array([True, True, False, True]))
     np.testing.assert_allclose(course[:2], [np.pi / 2, 0.0])
     assert ok.tolist() == [True, True, False, False] and np.isnan(course[2:]).all()
+
+
+def test_no_epochs_no_rows_and_unmatched_rows_are_unavailable():
+    scenario, _ = _solve(turning, 3)
+    nothing = tight_heading_series(scenario.rows, np.zeros(0), np.zeros(0), np.zeros(0))
+    assert len(nothing.yaw) == 0
+    empty = scenario.rows.subset(np.zeros(len(scenario.rows), dtype=bool))
+    result = tight_heading_series(empty, scenario.t_epoch, scenario.speed, scenario.yaw_angle)
+    assert not result.available.any() and np.all(result.n_obs == 0)
+    shifted = tight_heading_series(
+        scenario.rows, scenario.t_epoch + 0.01, scenario.speed, scenario.yaw_angle
+    )
+    assert not shifted.available.any()
+    with pytest.raises(ValueError, match="strictly increasing"):
+        tight_heading_series(
+            scenario.rows, scenario.t_epoch[::-1], scenario.speed, scenario.yaw_angle
+        )

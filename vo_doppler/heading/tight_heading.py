@@ -235,7 +235,9 @@ def tight_heading_series(
     m = len(t_epoch)
     if np.any(np.diff(t_epoch) <= 0):
         raise ValueError("epoch times must be strictly increasing")
-    epoch_of_row = _match_epochs(rows.t, t_epoch, config.epoch_match_s) if m else np.zeros(0, int)
+    if m == 0:
+        return _unavailable(t_epoch)
+    epoch_of_row = _match_epochs(rows.t, t_epoch, config.epoch_match_s)
     y_all = rows.reduced()
     usable = (
         (epoch_of_row >= 0)
@@ -246,6 +248,8 @@ def tight_heading_series(
     epoch_safe = np.maximum(epoch_of_row, 0)
     usable &= np.isfinite(speed[epoch_safe]) & np.isfinite(yaw_angle[epoch_safe])
     index = np.flatnonzero(usable)
+    if len(index) == 0:
+        return _unavailable(t_epoch)
     row_epoch = epoch_of_row[index]
     n_sat_epoch = np.bincount(row_epoch, minlength=m)[:m]
     lo = np.searchsorted(t_epoch[row_epoch], t_epoch - config.window_s, side="right")
@@ -259,7 +263,7 @@ def tight_heading_series(
                 rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_angle, config
             )
         )
-    solution = _concatenate(solutions, m)
+    solution = _concatenate(solutions)
     return _decide(solution, t_epoch, speed, yaw_angle, n_sat_epoch, config)
 
 
@@ -267,9 +271,9 @@ def _solve_chunk(rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_a
     width = max(int(np.max(hi[k] - lo[k], initial=0)), 1)
     slot = lo[k][:, None] + np.arange(width)[None, :]
     inside = slot < hi[k][:, None]
-    slot = np.where(inside, slot, 0) if len(index) else np.zeros_like(slot)
-    row = index[slot] if len(index) else np.zeros_like(slot)
-    epoch = row_epoch[slot] if len(index) else np.zeros_like(slot)
+    slot = np.where(inside, slot, 0)
+    row = index[slot]
+    epoch = row_epoch[slot]
     delta = yaw_angle[epoch] - yaw_angle[k][:, None]
     tau = t_epoch[epoch] - t_epoch[k][:, None]
     s = speed[epoch]
@@ -277,16 +281,20 @@ def _solve_chunk(rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_a
     cos_d, sin_d = np.cos(delta), np.sin(delta)
     a = -s * (ge * cos_d + gn * sin_d)
     b = -s * (gn * cos_d - ge * sin_d)
-    w = np.where(inside & (len(index) > 0), rows.weight[row], 0.0)
+    w = np.where(inside, rows.weight[row], 0.0)
     y = np.where(w > 0, y_all[row], 0.0)
     a, b, tau = np.where(w > 0, a, 0.0), np.where(w > 0, b, 0.0), np.where(w > 0, tau, 0.0)
     return solve_windows(y, a, b, tau, w, config)
 
 
-def _concatenate(solutions, m):
-    if not solutions:
-        empty = np.zeros(0)
-        return _WindowSolution(*([empty] * 9), n_obs=np.zeros(0, dtype=int))
+def _unavailable(t_epoch) -> TightHeadingResult:
+    """Every epoch unavailable (no epochs, or no usable Doppler row at all)."""
+    m = len(t_epoch)
+    nan, flags, counts = np.full(m, np.nan), np.zeros(m, dtype=bool), np.zeros(m, dtype=int)
+    return TightHeadingResult(t_epoch, nan, nan, counts, counts, flags, flags, flags, nan, nan)
+
+
+def _concatenate(solutions):
     fields = _WindowSolution.__dataclass_fields__
     return _WindowSolution(
         **{f: np.concatenate([getattr(s, f) for s in solutions]) for f in fields}
