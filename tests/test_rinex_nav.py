@@ -51,7 +51,7 @@ def both(request):
 
 def _matches(reference, sat, toc_calendar, expected: dict[str, float], rtol: float) -> bool:
     """True when one georinex entry of this satellite and epoch has all expected values."""
-    when = GPS_EPOCH + np.timedelta64(int(round(toc_calendar * 1e9)), "ns")
+    when = GPS_EPOCH + np.timedelta64(round(float(toc_calendar) * 1e9), "ns")
     if when not in reference.time.values:
         return False
     at = reference.sel(time=when)
