@@ -1,4 +1,4 @@
-"""Ray-cast rendering of a planar scene into a grey pinhole image, with mip-mapped texturing.
+"""Ray-cast rendering of a planar scene into a grey pinhole image, with anti-aliased texturing.
 
 Poses are camera → world 4×4 matrices (``p_world = T[:3, :3] @ p_camera + T[:3, 3]``), camera
 frame OpenCV (x right, y down, z forward); pixel (u, v) is centred at integer coordinates and
@@ -6,15 +6,19 @@ projects from ``u = fx·x/z + cx``.
 
 Per frame, for every plane that survives back-face and frustum culling:
 1. its rectangle is clipped in 3-D against the view frustum (near plane and the four sides) and
-   the clipped polygon is filled in the image — the pixels whose rays hit the plane;
+   the clipped polygon is filled in the image (conservatively: edge pixels are resolved later);
 2. the inverse depth of a plane is affine in the pixel coordinates, ``1/z = (n·K⁻¹[u, v, 1])/d``
    for the plane ``n·X = d`` in camera coordinates, so the nearest hit is a z-buffer test of an
    affine function over the polygon's bounding box.
 Then every pixel's texture coordinate is the plane's homography applied to (u, v). The texture
-footprint of a pixel is the larger column norm of that homography's Jacobian (texels per pixel);
-its log2 (plus a bias) selects the mip level, and samples of the two nearest levels, each read
-bilinearly with ``cv2.remap``, are blended (trilinear filtering). Distant and grazing surfaces
-are therefore low-pass filtered before sampling and do not alias.
+footprint of a pixel along each texture axis is the norm of the corresponding row of that
+homography's Jacobian (texels per pixel); its log2 (plus a bias) selects a level of a rip map
+(textures pre-filtered and halved separately along s and t), and bilinear ``cv2.remap`` reads of
+the four neighbouring level pairs are blended. Distant and grazing surfaces are thus low-pass
+filtered before sampling and do not alias, while staying sharp across the direction of view
+(ground and facades of a street grid are foreshortened along a texture axis). Pixels on
+boundaries between planes or against the sky are ray-cast again exactly, at the centre (index
+and depth) and at four sub-samples (grey value), so silhouettes are anti-aliased as well.
 """
 
 from __future__ import annotations
