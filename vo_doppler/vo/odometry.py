@@ -133,6 +133,7 @@ class VisualOdometry:
         problem = self._image_problem(image)
         if problem:
             frame.flags.append(problem)
+            self._failures += 1
         elif self._ref_image is None:
             self._start(frame, image)
         else:
@@ -201,7 +202,8 @@ class VisualOdometry:
 
     def _track(self, frame: _Frame, image: np.ndarray) -> None:
         ref = self._ref_frame
-        result = self.tracker.track(self._ref_image, image, ref.features)
+        guess = self._predicted_positions(ref, frame) if ref.index < frame.index - 1 else None
+        result = self.tracker.track(self._ref_image, image, ref.features, guess)
         if result.n_tracked < MIN_TRACKED:
             self._fail(frame, image, "tracking-lost")
             return
@@ -228,13 +230,32 @@ class VisualOdometry:
         else:
             self._fail(frame, image, "pnp-failed")
 
+    def _predicted_positions(self, ref: _Frame, frame: _Frame) -> np.ndarray | None:
+        """Where the reference features should appear in ``frame`` by the motion prediction:
+        landmarks are projected; other features move by the landmarks' median displacement."""
+        if not self._initialised or not len(ref.features):
+            return None
+        has_landmark = np.array([int(i) in self._landmarks for i in ref.features.ids], bool)
+        if has_landmark.sum() < MIN_TRACKED:
+            return None
+        points = np.array([self._landmarks[int(i)] for i in ref.features.ids[has_landmark]])
+        in_front = transform_points(frame.T_cw, points)[:, 2] > 0.1
+        if in_front.sum() < MIN_TRACKED:
+            return None
+        projected = project(self.K, frame.T_cw, points[in_front])
+        moved = ref.features.points[has_landmark][in_front]
+        guess = ref.features.points + np.median(projected - moved, axis=0)
+        rows = np.flatnonzero(has_landmark)[in_front]
+        guess[rows] = projected
+        return guess
+
     def _fail(self, frame: _Frame, image: np.ndarray, reason: str) -> None:
         frame.flags.append(reason)
         frame.measured = False
         self._failures += 1
         if self._failures >= MAX_CONSECUTIVE_FAILURES:
             log.warning(
-                "frame %d: %s %d times in a row; re-initialising",
+                "frame %d: %s; %d frames in a row without a measured pose; re-initialising",
                 frame.index,
                 reason,
                 self._failures,

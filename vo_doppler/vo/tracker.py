@@ -89,13 +89,32 @@ class FeatureTracker:
         )
 
     def track(
-        self, previous_image: np.ndarray, image: np.ndarray, previous: TrackedFeatures
+        self,
+        previous_image: np.ndarray,
+        image: np.ndarray,
+        previous: TrackedFeatures,
+        guess: np.ndarray | None = None,
     ) -> TrackResult:
-        """KLT from ``previous_image`` to ``image`` with a forward–backward consistency check."""
+        """KLT from ``previous_image`` to ``image`` with a forward–backward consistency check.
+
+        ``guess`` (N, 2), if given, holds predicted positions in ``image`` where the search starts.
+        """
         if len(previous) == 0:
             return TrackResult(TrackedFeatures.empty(), 0, 0, float("nan"))
         p0 = previous.points.astype(np.float32).reshape(-1, 1, 2)
-        p1, status, _ = cv2.calcOpticalFlowPyrLK(previous_image, image, p0, None, **self._lk_params)
+        if guess is None:
+            p1, status, _ = cv2.calcOpticalFlowPyrLK(
+                previous_image, image, p0, None, **self._lk_params
+            )
+        else:
+            p1, status, _ = cv2.calcOpticalFlowPyrLK(
+                previous_image,
+                image,
+                p0,
+                guess.astype(np.float32).reshape(-1, 1, 2),
+                flags=cv2.OPTFLOW_USE_INITIAL_FLOW,
+                **self._lk_params,
+            )
         p0_back, status_back, _ = cv2.calcOpticalFlowPyrLK(
             image, previous_image, p1, None, **self._lk_params
         )
