@@ -119,3 +119,16 @@ def test_sudden_ninety_degree_rotation(kitti, clean_run):
     output = glitch_then_compare(kitti, clean_run, damaged, times, "tracking-lost")
     cosine = direction_of_travel(output.trajectory) @ direction_of_travel(clean_run.trajectory)
     assert cosine > np.cos(np.radians(1.0))
+
+
+def test_long_blackout_reinitialises_and_keeps_going(kitti, clean_run):
+    images, times, camera, _ = kitti
+    damaged = [np.zeros_like(im) if GLITCH <= i < GLITCH + 5 else im for i, im in enumerate(images)]
+    output = run(damaged, times, camera)
+    reasons = flagged(output)
+    assert all("blank" in reasons[i] for i in range(GLITCH, GLITCH + 5))
+    assert any("reinitialised" in r for r in reasons.values())
+    assert output.stats.initialisations == 2
+    assert np.all(np.isfinite(output.trajectory.positions))
+    cosine = direction_of_travel(output.trajectory) @ direction_of_travel(clean_run.trajectory)
+    assert cosine > np.cos(np.radians(2.0))
