@@ -25,7 +25,7 @@ SUN_DIRECTION = np.array([0.45, -0.55, 0.70]) / np.linalg.norm([0.45, -0.55, 0.7
 """Unit vector towards the sun (ENU), used for per-face brightness."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Plane:
     """A textured rectangle ``origin + a·u_axis + b·v_axis``, 0 ≤ a ≤ width, 0 ≤ b ≤ height.
 
