@@ -223,3 +223,56 @@ def test_matrix_helper(tmp_path):
     np.testing.assert_array_equal(values, [[np.nan, 1.0], [3.0, 2.0]])
     names, _ = read_obs(path).matrix("C1C", system="G")
     assert names.tolist() == ["G05"]
+
+
+TYPES2 = ["C1", "L1", "D1", "S1", "P2", "L2", "D2"]
+
+
+@st.composite
+def epochs2(draw):
+    satellites = draw(
+        st.lists(
+            st.tuples(st.sampled_from("GR"), st.integers(1, 32)),
+            min_size=1,
+            max_size=26,
+            unique=True,
+        )
+    )
+    return [
+        (f"{s}{p:2d}", [(draw(values), draw(indicators), draw(indicators)) for _ in TYPES2])
+        for s, p in satellites
+    ]
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(st.lists(epochs2(), min_size=1, max_size=3))
+def test_rinex2_round_trip(tmp_path, written):
+    text = rinex2_header(TYPES2, system="M")
+    expected = []
+    t0 = float(calendar_to_gps_seconds(2010, 1, 6, 5, 57, 0.0))
+    for k, records in enumerate(written):
+        text += rinex2_epoch(
+            f" 10  1  6  5 57 {k:2d}.0000000",
+            [(sat, [field(*f) for f in fields]) for sat, fields in records],
+        )
+        for sat, fields in records:
+            for code, (value, lli, ssi) in zip(TYPES2, fields, strict=True):
+                if value is not None:
+                    flags = (-1 if lli is None else lli, -1 if ssi is None else ssi)
+                    expected.append((t0 + k, sat.replace(" ", "0"), code, value, *flags))
+    path = tmp_path / "random.10o"
+    path.write_text(text)
+    obs = read_obs(path)
+    got = zip(
+        obs.time.tolist(),
+        obs.satellites().tolist(),
+        [obs.codes[c] for c in obs.code],
+        obs.value.tolist(),
+        obs.lli.tolist(),
+        obs.ssi.tolist(),
+        strict=True,
+    )
+    assert sorted(got) == sorted(expected)
+    assert obs.problems == ()
