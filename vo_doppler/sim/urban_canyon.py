@@ -1,0 +1,435 @@
+"""Urban-canyon multi-sensor simulator: a car drives a closed loop through a city of tall
+buildings; camera, GNSS receiver and CAN bus record it in the formats real sensors write.
+
+Everything is deterministic per seed. The world is the city's ENU frame (x east, y north,
+z up, ground at z = 0), anchored at a geodetic origin (default in Shinjuku, Tokyo). Vehicle
+frame: x forward, y left, z up, origin on the ground at the rear-axle centre. Times are GPS
+seconds; each sensor writes its own clock and ``sequence.yaml`` gives the offsets.
+
+Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
+
+    sequence.yaml            manifest (schema below)
+    image_0/000000.png …     grey frames (``camera.fps``, default 15 Hz; .png or .jpg)
+    times.txt                one frame time per line, camera clock (s, first frame at 0)
+    calib.yaml               camera calibration (Camera.to_yaml: intrinsics + camera→vehicle)
+    gnss/rover.obs           RINEX 3.04 observations, 20 Hz: C1C D1C S1C, GPS + Galileo
+    gnss/brdc.nav            RINEX 3.04 navigation (GPS + Galileo Keplerian, Klobuchar)
+    gnss/visibility.csv      truth per epoch: gps_time_s,n_above_mask,n_direct,n_reflected
+    can/vehicle.log          candump -l log (Unix time), frames every 12 ms
+    can/vehicle.dbc          DBC of the log
+    ground_truth.tum         vehicle poses (ENU world, GPS time), 100 Hz
+
+``sequence.yaml`` keys (paths relative to the folder; ``gps = sensor time + time_offset_s``)::
+
+    format: vo-doppler-sequence/1
+    name, scenario, seed, duration_s, command
+    origin: {lat_deg, lon_deg, height_m}          ENU origin (WGS-84, ellipsoidal height)
+    start_gps_s                                   GPS time of the drive start
+    camera: {images, times, calib, fps, width, height, time_offset_s}
+    gnss: {obs, nav: [..], rate_hz, systems, time_offset_s, antenna_lever_arm_m,
+           doppler_sign: "range_rate = -wavelength * doppler", visibility}
+    can: {log, dbc, period_s, time_offset_s, yaw_rate, yaw_rate_sign, wheel_speed}
+         yaw_rate / wheel_speed are MESSAGE.SIGNAL names as ``vo-doppler heading`` takes them
+    ground_truth: {trajectory, frame, rate_hz}
+    truth: generating sensor errors (wheel_scale_error, yaw_rate_bias_dps, …) — evaluation only
+    city: {blocks, block_size_m, street_width_m, height_range_m, corner_streets}
+    stats: path length, turns, stops, satellite availability (see ``SimulationStats``)
+"""
+
+from __future__ import annotations
+
+import logging
+import shutil
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import cv2
+import numpy as np
+import yaml
+from rich.progress import track
+
+from vo_doppler.geo import EnuFrame
+from vo_doppler.io.rinex_write import write_nav, write_obs
+from vo_doppler.sim.can_bus import (
+    DBC_PATH,
+    WHEEL_SPEED_SIGNALS,
+    YAW_RATE_SIGNAL,
+    CanSimConfig,
+    gps_to_unix_offset,
+    simulate_can,
+    write_candump,
+)
+from vo_doppler.sim.constellation import (
+    KLOBUCHAR,
+    REFERENCE_EPOCH,
+    broadcast_ephemerides,
+    navigation_from_records,
+)
+from vo_doppler.sim.gnss_observations import (
+    Boxes,
+    GnssSimConfig,
+    GnssSimulation,
+    simulate_gnss,
+)
+from vo_doppler.sim.scene import city_scene
+from vo_doppler.sim.vo_sequence import (
+    VehicleMotion,
+    VoPlan,
+    drive,
+    loop_route,
+    render_frames,
+    synthetic_camera,
+)
+from vo_doppler.trajectory import Trajectory, write_tum
+
+log = logging.getLogger(__name__)
+
+SCENARIOS = ("urban-canyon",)
+DEFAULT_START_GPS_S = REFERENCE_EPOCH + 2 * 3600.0 + 600.0
+"""2025-03-14 02:10:00 GPST."""
+SHINJUKU = (35.69380, 139.70340, 77.0)
+"""Default ENU origin: latitude, longitude (deg), ellipsoidal height (m)."""
+GROUND_TRUTH_RATE_HZ = 100.0
+CAMERA_START_DELAY_S = 0.02
+
+
+@dataclass(frozen=True)
+class CityConfig:
+    """Street grid and buildings (``vo_doppler.sim.scene.city_scene``)."""
+
+    blocks: tuple[int, int] = (5, 4)
+    block_size_m: tuple[float, float] = (45.0, 45.0)
+    street_width_m: float = 12.0
+    height_range_m: tuple[float, float] = (25.0, 70.0)
+    buildings_per_side: tuple[int, int] = (1, 3)
+    corner_streets: tuple[tuple[int, int], tuple[int, int]] = ((1, 1), (4, 3))
+    corner_radius_m: float = 9.0
+
+
+@dataclass(frozen=True)
+class UrbanCanyonConfig:
+    """Everything a simulation depends on (besides the seed)."""
+
+    duration_s: float = 120.0
+    seed: int = 0
+    city: CityConfig = field(default_factory=CityConfig)
+    max_speed_mps: float = 13.5
+    max_lateral_accel: float = 2.5
+    stops_per_lap: int = 1
+    stop_duration_s: float = 4.0
+    fps: float = 15.0
+    image_size: tuple[int, int] = (640, 360)
+    image_format: str = "png"
+    jpeg_quality: int = 90
+    image_noise: float = 2.0
+    render: bool = True
+    start_gps_s: float = DEFAULT_START_GPS_S
+    origin: tuple[float, float, float] = SHINJUKU
+    antenna_height_m: float = 1.6
+    leap_seconds: int = 18
+    gnss: GnssSimConfig = field(default_factory=GnssSimConfig)
+    can: CanSimConfig = field(default_factory=CanSimConfig)
+
+
+@dataclass(frozen=True)
+class SimulationStats:
+    """Measured figures of a generated sequence."""
+
+    path_length_m: float
+    turns: int
+    stops: int
+    max_speed_kmh: float
+    epochs: int
+    visible_min: int
+    visible_median: float
+    visible_max: int
+    fraction_epochs_lt4: float
+    fraction_epochs_lt4_moving: float
+    longest_lt4_s: float
+    reflected_fraction: float
+    frames: int
+    can_frames: int
+    seconds: dict[str, float]
+
+
+@dataclass
+class UrbanCanyonSimulation:
+    """In-memory result: configuration, frame, motion sampler, GNSS and CAN output, stats."""
+
+    config: UrbanCanyonConfig
+    frame: EnuFrame
+    gnss: GnssSimulation
+    stats: SimulationStats
+    files: dict[str, str]
+
+
+class _Drive:
+    """The vehicle on its route, sampled at any GPS times (``drive`` of the VO sequence)."""
+
+    def __init__(self, config: UrbanCanyonConfig, layout):
+        city = config.city
+        one_lap = loop_route(layout, city.corner_streets, corner_radius_m=city.corner_radius_m)
+        laps = int(np.ceil(config.max_speed_mps * config.duration_s / one_lap.length)) + 1
+        self.route = loop_route(
+            layout, city.corner_streets, corner_radius_m=city.corner_radius_m, laps=laps
+        )
+        n_stops = config.stops_per_lap * laps
+        self.stops_m = tuple(one_lap.length * (np.arange(n_stops) + 0.55) / config.stops_per_lap)
+        self.start = config.start_gps_s
+        self.options = {
+            "max_speed": config.max_speed_mps,
+            "max_lateral_accel": config.max_lateral_accel,
+            "initial_speed": 0.0,
+            "stops_m": self.stops_m,
+            "stop_duration_s": config.stop_duration_s,
+        }
+
+    def __call__(self, t_gps: np.ndarray) -> VehicleMotion:
+        elapsed = np.maximum(np.asarray(t_gps, dtype=float) - self.start, 0.0)
+        motion = drive(self.route, elapsed, **self.options)
+        motion.t = np.asarray(t_gps, dtype=float)
+        return motion
+
+
+def simulate_urban_canyon(
+    out_dir: str | Path, config: UrbanCanyonConfig, command: str = "", progress: bool = False
+) -> UrbanCanyonSimulation:
+    """Generate a complete sequence folder (layout in the module docstring)."""
+    out = Path(out_dir)
+    for sub in ("gnss", "can"):
+        (out / sub).mkdir(parents=True, exist_ok=True)
+    seconds: dict[str, float] = {}
+    clock = time.perf_counter()
+    rng = np.random.default_rng(config.seed)
+    gnss_rng, can_rng = (np.random.default_rng(s) for s in rng.integers(0, 2**63, 2))
+    city = config.city
+    scene = city_scene(
+        config.seed,
+        blocks_x=city.blocks[0],
+        blocks_y=city.blocks[1],
+        block_size=city.block_size_m,
+        street_width=city.street_width_m,
+        height_range=city.height_range_m,
+        buildings_per_side=city.buildings_per_side,
+    )
+    vehicle = _Drive(config, scene.layout)
+    frame = EnuFrame(np.radians(config.origin[0]), np.radians(config.origin[1]), config.origin[2])
+    t0, t1 = config.start_gps_s, config.start_gps_s + config.duration_s
+    seconds["city_and_route"] = time.perf_counter() - clock
+
+    clock = time.perf_counter()
+    records = broadcast_ephemerides(t0, t1, config.gnss.systems)
+    nav = navigation_from_records(records)
+    write_nav(out / "gnss" / "brdc.nav", records, config.leap_seconds, KLOBUCHAR)
+
+    def antenna(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        motion = vehicle(t)
+        position = np.column_stack([motion.xy, np.full(len(motion.t), config.antenna_height_m)])
+        heading = np.column_stack([np.cos(motion.yaw), np.sin(motion.yaw), np.zeros(len(t))])
+        return position, motion.speed[:, None] * heading
+
+    n_epochs = int(np.floor(config.duration_s * config.gnss.rate_hz + 1e-9)) + 1
+    epoch_time = t0 + np.arange(n_epochs) / config.gnss.rate_hz
+    gnss = simulate_gnss(
+        nav,
+        frame,
+        epoch_time,
+        antenna,
+        Boxes.from_buildings(scene.buildings),
+        config.gnss,
+        gnss_rng,
+    )
+    start_ecef = frame.enu_to_ecef(antenna(np.array([t0]))[0][0])
+    write_obs(
+        out / "gnss" / "rover.obs",
+        gnss.obs_epochs(),
+        start_ecef,
+        1.0 / config.gnss.rate_hz,
+        marker_name=f"URBAN_CANYON_{config.seed}",
+        antenna_height_m=config.antenna_height_m,
+    )
+    np.savetxt(
+        out / "gnss" / "visibility.csv",
+        np.column_stack([epoch_time, gnss.n_above_mask, gnss.n_direct, gnss.n_reflected]),
+        fmt=["%.3f", "%d", "%d", "%d"],
+        delimiter=",",
+        header="gps_time_s,n_above_mask,n_direct,n_reflected",
+        comments="",
+    )
+    seconds["gnss"] = time.perf_counter() - clock
+
+    clock = time.perf_counter()
+    can = simulate_can(vehicle, t0, t1, config.can, can_rng, config.leap_seconds)
+    write_candump(out / "can" / "vehicle.log", can)
+    shutil.copyfile(DBC_PATH, out / "can" / "vehicle.dbc")
+    seconds["can"] = time.perf_counter() - clock
+
+    clock = time.perf_counter()
+    t_truth = t0 + np.arange(int(np.floor(config.duration_s * GROUND_TRUTH_RATE_HZ)) + 1) / (
+        GROUND_TRUTH_RATE_HZ
+    )
+    truth = vehicle(t_truth)
+    write_tum(out / "ground_truth.tum", Trajectory.from_matrices(t_truth, truth.T_world_vehicle))
+    camera = synthetic_camera(*config.image_size)
+    n_frames = int(np.floor((config.duration_s - CAMERA_START_DELAY_S) * config.fps + 1e-9)) + 1
+    camera_clock = np.arange(n_frames) / config.fps
+    camera_offset = t0 + CAMERA_START_DELAY_S
+    np.savetxt(out / "times.txt", camera_clock, fmt="%.6f")
+    camera.to_yaml(out / "calib.yaml")
+    if config.render:
+        _render(out, config, scene, camera, vehicle(camera_clock + camera_offset), progress)
+    seconds["camera"] = time.perf_counter() - clock
+
+    stats = _stats(config, truth, gnss, n_frames, len(can.lines), seconds)
+    files = _write_manifest(out, config, command, camera_offset, stats)
+    log.info("wrote %s: %s", out, stats)
+    return UrbanCanyonSimulation(config, frame, gnss, stats, files)
+
+
+def _render(out: Path, config, scene, camera, motion: VehicleMotion, progress: bool) -> None:
+    image_dir = out / "image_0"
+    image_dir.mkdir(exist_ok=True)
+    plan = VoPlan(
+        scene,
+        camera,
+        motion.t,
+        motion,
+        motion.T_world_vehicle @ camera.T_vehicle_camera,
+        config.image_noise,
+        config.seed,
+    )
+    frames = render_frames(plan)
+    if progress:
+        frames = track(frames, total=len(motion.t), description="rendering")
+    suffix = ".jpg" if config.image_format == "jpg" else ".png"
+    params = [cv2.IMWRITE_JPEG_QUALITY, config.jpeg_quality] if suffix == ".jpg" else []
+    for k, image in enumerate(frames):
+        path = image_dir / f"{k:06d}{suffix}"
+        if not cv2.imwrite(str(path), image, params):
+            raise OSError(f"cannot write {path}")
+
+
+def _runs(flags: np.ndarray) -> np.ndarray:
+    """Lengths of the runs of True in a boolean array."""
+    padded = np.concatenate([[0], flags.astype(np.int8), [0]])
+    edges = np.flatnonzero(np.diff(padded))
+    return edges[1::2] - edges[::2]
+
+
+def _stats(config, truth: VehicleMotion, gnss: GnssSimulation, frames, can_frames, seconds):
+    step = np.hypot(*np.diff(truth.xy, axis=0).T)
+    yaw_change = abs(float(truth.yaw[-1] - truth.yaw[0]))
+    moving = truth.speed > 0.1
+    standing = _runs(~moving)
+    visible = gnss.n_visible
+    low = visible < 4
+    epoch_moving = np.interp(gnss.epoch_time, truth.t, moving.astype(float)) > 0.5
+    runs = _runs(low)
+    return SimulationStats(
+        path_length_m=float(step.sum()),
+        turns=int(np.floor(yaw_change / (np.pi / 2) + 0.25)),
+        stops=int(np.sum(standing[1:] * (1.0 / GROUND_TRUTH_RATE_HZ) >= 1.0)),
+        max_speed_kmh=float(truth.speed.max() * 3.6),
+        epochs=len(visible),
+        visible_min=int(visible.min()),
+        visible_median=float(np.median(visible)),
+        visible_max=int(visible.max()),
+        fraction_epochs_lt4=float(low.mean()),
+        fraction_epochs_lt4_moving=float(low[epoch_moving].mean()) if epoch_moving.any() else 0.0,
+        longest_lt4_s=float(runs.max() / config.gnss.rate_hz) if runs.size else 0.0,
+        reflected_fraction=float(gnss.reflected.mean()) if gnss.reflected.size else 0.0,
+        frames=frames,
+        can_frames=can_frames,
+        seconds={k: round(v, 2) for k, v in seconds.items()},
+    )
+
+
+def _write_manifest(out: Path, config, command, camera_offset, stats) -> dict[str, str]:
+    suffix = "jpg" if config.image_format == "jpg" else "png"
+    files = {
+        "images": "image_0",
+        "times": "times.txt",
+        "calib": "calib.yaml",
+        "obs": "gnss/rover.obs",
+        "nav": "gnss/brdc.nav",
+        "visibility": "gnss/visibility.csv",
+        "can_log": "can/vehicle.log",
+        "dbc": "can/vehicle.dbc",
+        "ground_truth": "ground_truth.tum",
+    }
+    city = config.city
+    manifest = {
+        "format": "vo-doppler-sequence/1",
+        "name": out.name,
+        "scenario": "urban-canyon",
+        "seed": config.seed,
+        "duration_s": config.duration_s,
+        "command": command,
+        "origin": dict(zip(("lat_deg", "lon_deg", "height_m"), config.origin, strict=True)),
+        "start_gps_s": config.start_gps_s,
+        "camera": {
+            "images": files["images"],
+            "image_format": suffix,
+            "times": files["times"],
+            "calib": files["calib"],
+            "fps": config.fps,
+            "width": config.image_size[0],
+            "height": config.image_size[1],
+            "time_offset_s": camera_offset,
+        },
+        "gnss": {
+            "obs": files["obs"],
+            "nav": [files["nav"]],
+            "rate_hz": config.gnss.rate_hz,
+            "systems": config.gnss.systems,
+            "time_offset_s": 0.0,
+            "antenna_lever_arm_m": [0.0, 0.0, config.antenna_height_m],
+            "doppler_sign": "range_rate = -wavelength * doppler",
+            "visibility": files["visibility"],
+        },
+        "can": {
+            "log": files["can_log"],
+            "dbc": files["dbc"],
+            "period_s": config.can.period_s,
+            "time_offset_s": -gps_to_unix_offset(config.leap_seconds),
+            "yaw_rate": YAW_RATE_SIGNAL,
+            "yaw_rate_sign": 1,
+            "wheel_speed": WHEEL_SPEED_SIGNALS,
+        },
+        "ground_truth": {
+            "trajectory": files["ground_truth"],
+            "frame": "vehicle poses in the ENU world (x forward, y left, z up; rear-axle centre "
+            "on the ground)",
+            "rate_hz": GROUND_TRUTH_RATE_HZ,
+        },
+        "truth": {
+            "wheel_scale_error": config.can.wheel_scale_error,
+            "yaw_rate_bias_dps": config.can.yaw_rate_bias_dps,
+            "yaw_bias_walk_dps_per_sqrt_s": config.can.yaw_bias_walk_dps,
+            "yaw_rate_noise_dps": config.can.yaw_rate_noise_dps,
+            "gnss": _plain(asdict(config.gnss)),
+        },
+        "city": {
+            "blocks": list(city.blocks),
+            "block_size_m": list(city.block_size_m),
+            "street_width_m": city.street_width_m,
+            "height_range_m": list(city.height_range_m),
+            "corner_streets": [list(p) for p in city.corner_streets],
+        },
+        "stats": _plain(asdict(stats)),
+    }
+    with open(out / "sequence.yaml", "w") as stream:
+        yaml.safe_dump(manifest, stream, sort_keys=False)
+    return files
+
+
+def _plain(value):
+    """numpy scalars and tuples → plain YAML types."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
