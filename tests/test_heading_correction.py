@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
+from tests.conftest import REPO_ROOT
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.heading_correction import (
@@ -18,7 +21,8 @@ from vo_doppler.fusion.heading_correction import (
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.pipeline import HeadingTable
 from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
-from vo_doppler.trajectory import Trajectory, read_tum, write_tum
+from vo_doppler.trajectory import Trajectory, read_kitti, read_tum, write_kitti, write_tum
+from vo_doppler.vo.camera import read_camera
 
 RATE_HZ = 10.0
 
@@ -231,3 +235,54 @@ def test_correct_cli_recovers_the_enu_trajectory(tmp_path):
         )
         == 1
     )  # no --time-offset: times do not overlap
+
+
+def test_correct_cli_reads_the_extrinsic_and_writes_kitti(tmp_path):
+    calib = REPO_ROOT / "calib" / "synthetic.yaml"
+    mount = read_camera(calib).T_vehicle_camera
+    t, yaw, gt = _ground_truth(n=40)
+    write_kitti(tmp_path / "vo.txt", _vo_output(gt, mount))
+    np.savetxt(tmp_path / "times.txt", t)
+    write_heading_csv(
+        tmp_path / "h.csv", _table(t, yaw, np.ones(len(t), bool), np.ones(len(t), bool))
+    )
+    out = tmp_path / "corrected.kitti"
+    args = [
+        "correct",
+        str(tmp_path / "vo.txt"),
+        "--format",
+        "kitti",
+        "--times",
+        str(tmp_path / "times.txt"),
+        "--heading",
+        str(tmp_path / "h.csv"),
+        "--calib",
+        str(calib),
+        "--body",
+        "camera",
+        "-o",
+        str(out),
+    ]
+    assert main(args) == 0
+    corrected = read_kitti(out)
+    expected = gt.matrices.copy()
+    expected[:, :3, 3] -= gt.positions[0]
+    np.testing.assert_allclose(corrected.matrices, expected @ mount, atol=1e-3)
+
+
+@settings(max_examples=25, deadline=None)
+@given(offset=st.floats(-np.pi, np.pi), yaw0=st.floats(-np.pi, np.pi))
+def test_any_constant_offset_is_removed_exactly(offset, yaw0):
+    t, yaw, gt = _ground_truth(n=30, yaw0=yaw0)
+    vo = _vo_output(gt)
+    level = vehicle_poses(vo)
+    turned = Rotation.from_euler("z", offset).as_matrix()
+    rotated = level.copy()
+    rotated[:, :3, :3] = turned @ level[:, :3, :3]
+    rotated[:, :3, 3] = level[:, :3, 3] @ turned.T
+    result = correct_heading(
+        Trajectory.from_matrices(t, rotated), t, yaw, camera_to_vehicle=np.eye(4), world="level"
+    )
+    expected = gt.matrices.copy()
+    expected[:, :3, 3] -= gt.positions[0]
+    np.testing.assert_allclose(result.vehicle.matrices, expected, atol=1e-9)
