@@ -16,6 +16,7 @@ from vo_doppler.commands import (
     eval_command,
     gnss_command,
     heading_command,
+    simulate_command,
     vo_command,
 )
 from vo_doppler.errors import VoDopplerError
@@ -27,6 +28,7 @@ SUBCOMMANDS = (
     gnss_command,
     correct_command,
     heading_command,
+    simulate_command,
 )
 
 log = logging.getLogger("vo_doppler")

@@ -283,7 +283,7 @@ def simulate_urban_canyon(
 
     stats = _stats(config, truth, gnss, n_frames, len(can.lines), seconds)
     files = _write_manifest(out, config, command, camera_offset, stats)
-    log.info("wrote %s: %s", out, stats)
+    log.info("wrote %s in %.1f s", out, sum(seconds.values()))
     return UrbanCanyonSimulation(config, frame, gnss, stats, files)
 
 

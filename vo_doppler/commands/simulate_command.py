@@ -1,0 +1,181 @@
+"""``vo-doppler simulate --scenario urban-canyon``: write a complete synthetic sequence folder."""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import shlex
+import sys
+from dataclasses import replace
+
+from rich.console import Console
+from rich.table import Table
+
+from vo_doppler.errors import InputError
+from vo_doppler.gnss.gpstime import calendar_to_gps_seconds
+from vo_doppler.sim.urban_canyon import (
+    SCENARIOS,
+    CityConfig,
+    UrbanCanyonConfig,
+    simulate_urban_canyon,
+)
+
+
+def _numbers(text: str, count: int, kind=float) -> tuple:
+    try:
+        values = tuple(kind(v) for v in text.split(","))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected {count} numbers") from exc
+    if len(values) != count:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected {count} comma-separated numbers")
+    return values
+
+
+def _pair(text: str) -> tuple:
+    return _numbers(text, 2)
+
+
+def _int_pair(text: str) -> tuple:
+    return _numbers(text, 2, int)
+
+
+def _loop(text: str) -> tuple:
+    i0, j0, i1, j1 = _numbers(text, 4, int)
+    return ((i0, j0), (i1, j1))
+
+
+def _origin(text: str) -> tuple:
+    return _numbers(text, 3)
+
+
+def register(subparsers) -> None:
+    defaults = UrbanCanyonConfig()
+    city = defaults.city
+    parser = subparsers.add_parser(
+        "simulate",
+        help="generate a synthetic multi-sensor sequence",
+        description="Drive a car around a closed loop through a city of tall buildings and "
+        "write camera images, RINEX 3 observations + navigation, a candump CAN log + DBC, "
+        "ground truth and sequence.yaml (deterministic per seed).",
+    )
+    parser.add_argument("--scenario", choices=SCENARIOS, default="urban-canyon")
+    parser.add_argument("--duration", type=float, default=defaults.duration_s, help="seconds")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("-o", "--output", required=True, help="sequence folder to write")
+    parser.add_argument("--fps", type=float, default=defaults.fps, help="camera rate (Hz)")
+    parser.add_argument("--size", type=_int_pair, default=defaults.image_size, help="W,H px")
+    parser.add_argument("--image-format", choices=("png", "jpg"), default="png")
+    parser.add_argument("--jpeg-quality", type=int, default=defaults.jpeg_quality)
+    parser.add_argument("--no-images", action="store_true", help="skip rendering (fast)")
+    parser.add_argument("--blocks", type=_int_pair, default=city.blocks, help="NX,NY blocks")
+    parser.add_argument("--block-size", type=_pair, default=city.block_size_m, help="X,Y m")
+    parser.add_argument("--street-width", type=float, default=city.street_width_m, help="m")
+    parser.add_argument(
+        "--heights", type=_pair, default=city.height_range_m, help="building heights MIN,MAX m"
+    )
+    parser.add_argument(
+        "--loop",
+        type=_loop,
+        default=city.corner_streets,
+        help="street lines I0,J0,I1,J1 of the loop's corners",
+    )
+    parser.add_argument(
+        "--max-speed", type=float, default=defaults.max_speed_mps * 3.6, help="km/h"
+    )
+    parser.add_argument("--stops-per-lap", type=int, default=defaults.stops_per_lap)
+    parser.add_argument("--gnss-rate", type=float, default=defaults.gnss.rate_hz, help="Hz")
+    parser.add_argument("--systems", default=defaults.gnss.systems, help="G, E or GE")
+    parser.add_argument("--nlos", action="store_true", help="add single facade reflections")
+    parser.add_argument("--no-noise", action="store_true", help="noise-free GNSS observations")
+    parser.add_argument("--wheel-scale-error", type=float, default=defaults.can.wheel_scale_error)
+    parser.add_argument(
+        "--yaw-bias", type=float, default=defaults.can.yaw_rate_bias_dps, help="deg/s"
+    )
+    parser.add_argument(
+        "--start",
+        default=None,
+        help="GPS start time YYYY-MM-DDTHH:MM:SS (default 2025-03-14T02:10)",
+    )
+    parser.add_argument("--origin", type=_origin, default=defaults.origin, help="LAT,LON,H")
+    parser.set_defaults(func=run)
+
+
+def _start_gps(text: str | None, default: float) -> float:
+    if text is None:
+        return default
+    try:
+        when = dt.datetime.fromisoformat(text)
+    except ValueError as exc:
+        raise InputError(f"--start {text!r} is not an ISO date and time") from exc
+    seconds = when.second + when.microsecond * 1e-6
+    return float(
+        calendar_to_gps_seconds(when.year, when.month, when.day, when.hour, when.minute, seconds)
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    defaults = UrbanCanyonConfig()
+    if set(args.systems) - set("GE") or not args.systems:
+        raise InputError(f"--systems {args.systems!r}: the simulator has G and E")
+    if args.duration <= 0.0:
+        raise InputError("--duration must be positive")
+    config = replace(
+        defaults,
+        duration_s=args.duration,
+        seed=args.seed,
+        city=CityConfig(
+            blocks=args.blocks,
+            block_size_m=args.block_size,
+            street_width_m=args.street_width,
+            height_range_m=args.heights,
+            corner_streets=args.loop,
+        ),
+        max_speed_mps=args.max_speed / 3.6,
+        stops_per_lap=args.stops_per_lap,
+        fps=args.fps,
+        image_size=args.size,
+        image_format=args.image_format,
+        jpeg_quality=args.jpeg_quality,
+        render=not args.no_images,
+        start_gps_s=_start_gps(args.start, defaults.start_gps_s),
+        origin=args.origin,
+        gnss=replace(
+            defaults.gnss,
+            rate_hz=args.gnss_rate,
+            systems=args.systems,
+            nlos=args.nlos,
+            noise=not args.no_noise,
+        ),
+        can=replace(
+            defaults.can, wheel_scale_error=args.wheel_scale_error, yaw_rate_bias_dps=args.yaw_bias
+        ),
+    )
+    try:
+        result = simulate_urban_canyon(
+            args.output, config, "vo-doppler " + shlex.join(sys.argv[1:]), progress=True
+        )
+    except ValueError as exc:
+        raise InputError(str(exc)) from exc
+    stats = result.stats
+    table = Table(title=f"urban-canyon sequence → {args.output}")
+    table.add_column("figure")
+    table.add_column("value", justify="right")
+    rows = [
+        ("path length", f"{stats.path_length_m:.0f} m"),
+        ("turns / stops", f"{stats.turns} / {stats.stops}"),
+        ("max speed", f"{stats.max_speed_kmh:.1f} km/h"),
+        ("camera frames", str(stats.frames)),
+        ("GNSS epochs", str(stats.epochs)),
+        (
+            "satellites min / median / max",
+            f"{stats.visible_min} / {stats.visible_median:g} / {stats.visible_max}",
+        ),
+        ("epochs with < 4 satellites", f"{100 * stats.fraction_epochs_lt4:.1f} %"),
+        ("longest stretch < 4", f"{stats.longest_lt4_s:.1f} s"),
+        ("CAN frames", str(stats.can_frames)),
+        ("seconds", ", ".join(f"{k} {v:.1f}" for k, v in stats.seconds.items())),
+    ]
+    for name, value in rows:
+        table.add_row(name, value)
+    Console().print(table)
+    return 0
