@@ -9,8 +9,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from matplotlib.ticker import MaxNLocator
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 from vo_doppler.geo import EnuFrame, ecef_to_geodetic
 from vo_doppler.gnss.doppler_velocity import VelocitySolution
