@@ -32,7 +32,10 @@ def header_line(content: str, label: str) -> str:
 
 
 def nav_number(value: float) -> str:
-    """A D19.12 field (RINEX 3.04 Table A6): ``' 1.234567890123D-04'``."""
+    """A D19.12 field (RINEX 3.04 Table A6): ``' 1.234567890123D-04'``; magnitudes below
+    1e-99 (a three-digit exponent would not fit) are written as zero."""
+    if abs(value) < 1e-99:
+        value = 0.0
     return f"{value:19.12E}".replace("E", "D")
 
 

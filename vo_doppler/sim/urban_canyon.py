@@ -56,6 +56,7 @@ from vo_doppler.sim.can_bus import (
     WHEEL_SPEED_SIGNALS,
     YAW_RATE_SIGNAL,
     CanSimConfig,
+    CanSimulation,
     gps_to_unix_offset,
     simulate_can,
     write_candump,
@@ -155,16 +156,19 @@ class SimulationStats:
 
 @dataclass
 class UrbanCanyonSimulation:
-    """In-memory result: configuration, frame, motion sampler, GNSS and CAN output, stats."""
+    """In-memory result: configuration, ENU frame, the vehicle (``vehicle(t_gps)`` →
+    :class:`VehicleMotion`), GNSS and CAN output, stats and the written files."""
 
     config: UrbanCanyonConfig
     frame: EnuFrame
+    vehicle: VehicleDrive
     gnss: GnssSimulation
+    can: CanSimulation
     stats: SimulationStats
     files: dict[str, str]
 
 
-class _Drive:
+class VehicleDrive:
     """The vehicle on its route, sampled at any GPS times (``drive`` of the VO sequence)."""
 
     def __init__(self, config: UrbanCanyonConfig, layout):
@@ -213,7 +217,7 @@ def simulate_urban_canyon(
         height_range=city.height_range_m,
         buildings_per_side=city.buildings_per_side,
     )
-    vehicle = _Drive(config, scene.layout)
+    vehicle = VehicleDrive(config, scene.layout)
     frame = EnuFrame(np.radians(config.origin[0]), np.radians(config.origin[1]), config.origin[2])
     t0, t1 = config.start_gps_s, config.start_gps_s + config.duration_s
     seconds["city_and_route"] = time.perf_counter() - clock
@@ -284,7 +288,7 @@ def simulate_urban_canyon(
     stats = _stats(config, truth, gnss, n_frames, len(can.lines), seconds)
     files = _write_manifest(out, config, command, camera_offset, stats)
     log.info("wrote %s in %.1f s", out, sum(seconds.values()))
-    return UrbanCanyonSimulation(config, frame, gnss, stats, files)
+    return UrbanCanyonSimulation(config, frame, vehicle, gnss, can, stats, files)
 
 
 def _render(out: Path, config, scene, camera, motion: VehicleMotion, progress: bool) -> None:
