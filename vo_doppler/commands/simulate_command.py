@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import shlex
-import sys
 from dataclasses import replace
 
 from rich.console import Console
@@ -113,6 +112,31 @@ def _start_gps(text: str | None, default: float) -> float:
     )
 
 
+def _command_line(args: argparse.Namespace) -> str:
+    """The full command that regenerates the sequence (every option spelled out)."""
+
+    def joined(values) -> str:
+        return ",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in values)
+
+    words = ["vo-doppler", "simulate", "--scenario", args.scenario]
+    words += ["--duration", f"{args.duration:g}", "--seed", str(args.seed)]
+    words += ["--fps", f"{args.fps:g}", "--size", joined(args.size)]
+    words += ["--image-format", args.image_format, "--jpeg-quality", str(args.jpeg_quality)]
+    words += ["--blocks", joined(args.blocks), "--block-size", joined(args.block_size)]
+    words += ["--street-width", f"{args.street_width:g}", "--heights", joined(args.heights)]
+    words += ["--loop", joined([*args.loop[0], *args.loop[1]])]
+    words += ["--max-speed", f"{args.max_speed:g}", "--stops-per-lap", str(args.stops_per_lap)]
+    words += ["--gnss-rate", f"{args.gnss_rate:g}", "--systems", args.systems]
+    words += ["--wheel-scale-error", f"{args.wheel_scale_error:g}"]
+    words += ["--yaw-bias", f"{args.yaw_bias:g}", "--origin", joined(args.origin)]
+    if args.start is not None:
+        words += ["--start", args.start]
+    for flag in ("no_images", "nlos", "no_noise"):
+        if getattr(args, flag):
+            words.append("--" + flag.replace("_", "-"))
+    return shlex.join([*words, "-o", str(args.output)])
+
+
 def run(args: argparse.Namespace) -> int:
     defaults = UrbanCanyonConfig()
     if set(args.systems) - set("GE") or not args.systems:
@@ -151,9 +175,7 @@ def run(args: argparse.Namespace) -> int:
         ),
     )
     try:
-        result = simulate_urban_canyon(
-            args.output, config, "vo-doppler " + shlex.join(sys.argv[1:]), progress=True
-        )
+        result = simulate_urban_canyon(args.output, config, _command_line(args), progress=True)
     except ValueError as exc:
         raise InputError(str(exc)) from exc
     stats = result.stats

@@ -1,0 +1,125 @@
+"""Simulator end to end: the sequence folder, its manifest, determinism per seed, the CLI."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from vo_doppler.cli import main
+from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+from vo_doppler.trajectory import read_tum
+from vo_doppler.vo.camera import read_camera
+
+SMALL = {"duration_s": 6.0, "fps": 5.0, "image_size": (160, 90)}
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {
+        str(p.relative_to(folder)): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file() and p.name != "sequence.yaml"
+    }
+
+
+@pytest.fixture(scope="module")
+def sequence(tmp_path_factory):
+    out = tmp_path_factory.mktemp("seq")
+    return out, simulate_urban_canyon(out, UrbanCanyonConfig(seed=4, **SMALL))
+
+
+def test_manifest_paths_and_time_offsets(sequence):
+    out, sim = sequence
+    manifest = yaml.safe_load((out / "sequence.yaml").read_text())
+    assert manifest["format"] == "vo-doppler-sequence/1"
+    for path in (
+        manifest["camera"]["times"],
+        manifest["camera"]["calib"],
+        manifest["gnss"]["obs"],
+        *manifest["gnss"]["nav"],
+        manifest["can"]["log"],
+        manifest["can"]["dbc"],
+        manifest["ground_truth"]["trajectory"],
+    ):
+        assert (out / path).is_file(), path
+    times = np.loadtxt(out / manifest["camera"]["times"])
+    images = sorted((out / manifest["camera"]["images"]).glob("*.png"))
+    assert len(images) == len(times) == 30
+    start = manifest["start_gps_s"]
+    assert times[0] + manifest["camera"]["time_offset_s"] == pytest.approx(start + 0.02)
+    camera = read_camera(out / manifest["camera"]["calib"])
+    assert (camera.width, camera.height) == (160, 90)
+    obs = read_obs(out / manifest["gnss"]["obs"])
+    assert obs.epoch_time[0] + manifest["gnss"]["time_offset_s"] == pytest.approx(start)
+    assert obs.header.interval == pytest.approx(0.05)
+    can = manifest["can"]
+    motion = read_can_motion(
+        out / can["log"],
+        out / can["dbc"],
+        can["yaw_rate"],
+        can["wheel_speed"],
+        can["yaw_rate_sign"],
+        can["time_offset_s"],
+        can["time_offset_s"],
+    )
+    assert start <= motion.speed.t[0] < start + 0.02
+    truth = read_tum(out / manifest["ground_truth"]["trajectory"])
+    assert truth.t[0] == pytest.approx(start)
+    speed_truth = np.interp(
+        motion.speed.t, truth.t[:-1], np.hypot(*np.diff(truth.positions[:, :2], axis=0).T) / 0.01
+    )
+    moving = speed_truth > 2.0
+    ratio = np.median(motion.speed.value[moving] / speed_truth[moving])
+    assert ratio == pytest.approx(1.0 + manifest["truth"]["wheel_scale_error"], abs=0.005)
+    origin = manifest["origin"]
+    assert np.degrees(sim.frame.lat_rad) == pytest.approx(origin["lat_deg"])
+    assert manifest["stats"]["epochs"] == 121
+
+
+def test_same_seed_same_files_other_seed_differs(sequence, tmp_path):
+    out, _ = sequence
+    simulate_urban_canyon(tmp_path / "again", UrbanCanyonConfig(seed=4, **SMALL))
+    first, second = _files(out), _files(tmp_path / "again")
+    assert first.keys() == second.keys()
+    assert [k for k in first if first[k] != second[k]] == []
+    simulate_urban_canyon(tmp_path / "other", UrbanCanyonConfig(seed=5, render=False, **SMALL))
+    other = _files(tmp_path / "other")
+    assert other["gnss/rover.obs"] != first["gnss/rover.obs"]
+    assert other["can/vehicle.log"] != first["can/vehicle.log"]
+
+
+def test_cli_writes_a_sequence(tmp_path, capsys):
+    out = tmp_path / "cli"
+    code = main(
+        [
+            "simulate",
+            "--duration",
+            "3",
+            "--seed",
+            "2",
+            "--no-images",
+            "--street-width",
+            "18",
+            "--heights",
+            "10,20",
+            "-o",
+            str(out),
+        ]
+    )
+    assert code == 0
+    manifest = yaml.safe_load((out / "sequence.yaml").read_text())
+    assert manifest["city"]["street_width_m"] == 18.0
+    assert manifest["city"]["height_range_m"] == [10.0, 20.0]
+    assert manifest["command"].startswith("vo-doppler simulate --scenario urban-canyon")
+    assert "--street-width 18 --heights 10,20" in manifest["command"]
+    assert "satellites" in capsys.readouterr().out
+
+
+def test_cli_rejects_unknown_system(tmp_path, capsys):
+    code = main(["simulate", "--duration", "3", "--systems", "GR", "-o", str(tmp_path / "x")])
+    assert code == 1
+    assert "G and E" in capsys.readouterr().err
