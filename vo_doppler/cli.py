@@ -16,6 +16,7 @@ from vo_doppler.commands import (
     eval_command,
     gnss_command,
     heading_command,
+    run_command,
     simulate_command,
     vo_command,
 )
@@ -29,6 +30,7 @@ SUBCOMMANDS = (
     correct_command,
     heading_command,
     simulate_command,
+    run_command,
 )
 
 log = logging.getLogger("vo_doppler")

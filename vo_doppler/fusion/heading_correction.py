@@ -108,11 +108,14 @@ def correct_heading(
     camera_to_vehicle: np.ndarray = FORWARD_CAMERA_TO_VEHICLE,
     world: str = "first_camera",
     max_gap_s: float = 1.5,
+    gate_rad: float | None = None,
 ) -> HeadingCorrectionResult:
     """Correct the VO heading with absolute headings (sec. 3.6, Eq. 11–13).
 
     ``t_heading``/``yaw_heading`` are on the trajectory's clock (shift them beforehand);
-    ``valid`` marks the usable samples.
+    ``valid`` marks the usable samples. With ``gate_rad``, once a first correction has been
+    made, absolute headings further than the gate from the corrected VO heading are ignored
+    (an innovation gate against wrong but self-consistent absolute solutions).
     """
     poses = vehicle_poses(camera, camera_to_vehicle, world)
     n = len(poses)
@@ -125,6 +128,7 @@ def correct_heading(
     total = np.zeros(n)
     correction = 0.0
     oldest = 0
+    established = False
     for i in range(n):
         rotate = _rz(correction)
         if i:
@@ -133,8 +137,12 @@ def correct_heading(
         while camera.t[oldest] <= camera.t[i] - window_s:
             oldest += 1
         window = slice(oldest, i + 1)
-        use = has_absolute[window]
+        use = has_absolute[window].copy()
+        if gate_rad is not None and established:
+            innovation = wrap_angle(yaw_of(rotations[window]) - absolute[window])
+            use &= np.abs(np.nan_to_num(innovation, nan=np.inf)) < gate_rad
         if use.any():
+            established = True
             difference = wrap_angle(yaw_of(rotations[window][use]) - absolute[window][use])
             delta = float(np.arctan2(np.mean(np.sin(difference)), np.mean(np.cos(difference))))
             turn = _rz(-delta)

@@ -1,0 +1,143 @@
+"""``vo-doppler run SEQUENCE_DIR -o OUT``: the whole pipeline on one sequence folder."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.progress import Progress
+from rich.table import Table
+
+from vo_doppler.errors import InputError
+from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
+from vo_doppler.eval.report import (
+    TABLE_COLUMNS,
+    error_per_100m_figure,
+    trajectories_figure,
+    write_html_report,
+)
+from vo_doppler.fusion.heading_correction import yaw_of
+from vo_doppler.fusion.pipeline import PipelineConfig, PipelineResult, run_pipeline
+from vo_doppler.heading.sensors import sample_at
+from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.io.heading_figure import heading_figure
+from vo_doppler.io.sequence import read_sequence
+from vo_doppler.trajectory import write_tum
+from vo_doppler.vo.config import VoConfig
+
+log = logging.getLogger(__name__)
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "run",
+        help="VO -> calibration -> tightly coupled heading -> correction on a sequence folder",
+        description="Run the main job on a sequence folder (sequence.yaml): monocular VO with "
+        "metric scale from the calibrated wheel speed, wheel-scale and gyro-bias calibration "
+        "from Doppler, tightly coupled Doppler heading, VO heading correction; evaluates "
+        "against the ground truth when the folder has one.",
+    )
+    parser.add_argument("sequence", type=Path, help="folder with sequence.yaml")
+    parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    parser.add_argument("--systems", default="GREJC", help="GNSS systems to use")
+    parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
+    parser.add_argument("--window", type=int, default=30, help="VO window (frames)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    inputs = read_sequence(args.sequence)
+    config = PipelineConfig(
+        systems=args.systems.upper(),
+        elevation_mask_deg=args.elev_mask,
+        vo=VoConfig(window_size=args.window),
+    )
+    console = Console()
+    console.print(
+        f"{inputs.name}: {len(inputs.image_paths)} images, "
+        f"{len(inputs.observations.epoch_time)} GNSS epochs, {len(inputs.wheel_speed)} wheel "
+        f"and {len(inputs.yaw_rate)} yaw-rate samples"
+    )
+    with Progress(console=console, transient=True) as progress:
+        task = progress.add_task("visual odometry", total=len(inputs.image_paths))
+        result = run_pipeline(inputs, config, lambda _: progress.advance(task))
+    out = args.output
+    out.mkdir(parents=True, exist_ok=True)
+    write_tum(out / "trajectory_vo.tum", result.trajectories["vo"])
+    write_tum(out / "trajectory_corrected.tum", result.trajectories["vo_gps_tc"])
+    for name in ("vo_gps_conv", "dr_gps_tc"):
+        if name in result.trajectories:
+            write_tum(out / f"trajectory_{name}.tum", result.trajectories[name])
+    write_heading_csv(out / "heading.csv", result.heading)
+    summary = summarise(result)
+    figures = [out / "trajectories.png", out / "heading.png"]
+    truth = inputs.truth
+    errors = {}
+    shown = result.trajectories
+    if truth is not None:
+        errors, per_100m, shown = evaluate_pipelines(
+            result.trajectories, result.heading, result.tc_usable, truth
+        )
+        summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
+        error_per_100m_figure(out / "error_per_100m.png", per_100m, inputs.name)
+        figures.append(out / "error_per_100m.png")
+    truth_yaw = None
+    if truth is not None:
+        truth_yaw = sample_at(
+            truth.t, np.unwrap(yaw_of(truth.orientations.as_matrix())), result.heading.t
+        )
+    trajectories_figure(figures[0], shown, truth, inputs.name)
+    heading_figure(figures[1], result.heading, truth_yaw, inputs.name)
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    facts = {key: str(value) for key, value in summary.items() if key != "evaluation"}
+    write_html_report(out / "report.html", f"vo-doppler run: {inputs.name}", facts, errors, figures)
+    print_summary(console, summary, errors)
+    console.print(f"wrote {out}/report.html and the trajectories, heading.csv, figures")
+    if not result.heading.tc_available.any():
+        raise InputError(
+            "the tightly coupled heading was unavailable at every epoch", args.sequence
+        )
+    return 0
+
+
+def summarise(result: PipelineResult) -> dict:
+    table = result.heading
+    return {
+        "gnss_epochs": len(table),
+        "conventional_heading_availability": float(np.mean(table.conv_valid)),
+        "tight_heading_availability": float(np.mean(table.tc_available)),
+        "tight_heading_reliable": float(np.mean(table.tc_reliable)),
+        "tight_heading_used": float(np.mean(result.tc_usable)),
+        "final_wheel_scale": float(table.wheel_scale[-1]),
+        "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
+        "vo_frames": result.vo.stats.frames,
+        "vo_flagged_frames": len(result.vo.stats.flagged_frames),
+        "vo_fps": result.vo.stats.fps,
+    }
+
+
+def print_summary(console: Console, summary: dict, errors: dict) -> None:
+    console.print(
+        f"heading available: conventional {summary['conventional_heading_availability']:.0%}, "
+        f"tightly coupled {summary['tight_heading_availability']:.0%} of "
+        f"{summary['gnss_epochs']} epochs; wheel scale {summary['final_wheel_scale']:.4f}, "
+        f"gyro bias {summary['final_gyro_bias_dps']:+.3f} deg/s; VO {summary['vo_frames']} "
+        f"frames ({summary['vo_flagged_frames']} flagged)"
+    )
+    if not errors:
+        return
+    table = Table(title="against ground truth")
+    table.add_column("pipeline")
+    for _, label, _ in TABLE_COLUMNS:
+        table.add_column(label, justify="right")
+    for name, row in errors.items():
+        values = row.to_dict()
+        table.add_row(
+            PIPELINE_LABELS.get(name, name),
+            *(fmt.format(values[key]) for key, _, fmt in TABLE_COLUMNS),
+        )
+    console.print(table)
