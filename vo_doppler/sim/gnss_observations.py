@@ -27,7 +27,9 @@ facade plane; the ray along it must hit a facade of that orientation first, and 
 the reflection point towards the satellite must be clear. For a facade at perpendicular
 distance d and line-of-sight component u_n along its normal, the extra path is 2·d·|u_n| and
 its rate −2·(v·m)·|u_n| (m: unit vector from the antenna towards the facade; the slow change
-of u_n is neglected). Reflected signals lose ``nlos_loss_db`` of C/N0.
+of u_n is neglected). Reflected signals lose ``nlos_loss_db`` of C/N0; only a fraction of the
+facades reflect (glass, drawn per building side), and signals whose mean C/N0 is below the
+tracking threshold are not received.
 
 C/N0 = C/N0_horizon + (C/N0_zenith − C/N0_horizon)·sin(el) (− reflection loss) + white noise;
 noise standard deviations scale as 10^((45 − C/N0)/20) (tracking-loop noise ∝ (C/N0)^−½).
@@ -72,6 +74,8 @@ class GnssSimConfig:
     atmosphere: bool = True
     nlos: bool = False
     nlos_loss_db: float = 8.0
+    nlos_reflective_fraction: float = 0.3
+    tracking_threshold_dbhz: float = 28.0
     clock_bias0_s: float | None = None
     clock_drift0_mps: float | None = None
     clock_drift_walk_mps: float = 0.01
@@ -115,11 +119,13 @@ class Boxes:
 
 @dataclass(frozen=True)
 class RayHits:
-    """First box hit per ray: ``hit``, distance along the ray and the axis of the face hit."""
+    """First box hit per ray: ``hit``, distance along the ray, the axis of the face hit and
+    the box index (−1 when nothing is hit)."""
 
     hit: np.ndarray
     distance: np.ndarray
     axis: np.ndarray
+    box: np.ndarray
 
 
 def ray_hits(origins: np.ndarray, directions: np.ndarray, boxes: Boxes) -> RayHits:
@@ -132,8 +138,9 @@ def ray_hits(origins: np.ndarray, directions: np.ndarray, boxes: Boxes) -> RayHi
     hit = np.zeros(n, dtype=bool)
     distance = np.full(n, np.inf)
     axis = np.full(n, -1, dtype=np.int64)
+    box = np.full(n, -1, dtype=np.int64)
     if n == 0 or len(boxes.lo) == 0:
-        return RayHits(hit, distance, axis)
+        return RayHits(hit, distance, axis, box)
     safe = np.where(np.abs(directions) < 1e-12, 1e-12, directions)
     inverse = 1.0 / safe
     for start in range(0, n, _RAY_CHUNK):
@@ -151,7 +158,8 @@ def ray_hits(origins: np.ndarray, directions: np.ndarray, boxes: Boxes) -> RayHi
         distance[sl] = entry[rows, first]
         hit[sl] = np.isfinite(distance[sl])
         axis[sl] = np.where(hit[sl], np.argmax(near[rows, first], axis=1), -1)
-    return RayHits(hit, distance, axis)
+        box[sl] = np.where(hit[sl], first, -1)
+    return RayHits(hit, distance, axis, box)
 
 
 @dataclass(frozen=True)
@@ -164,10 +172,15 @@ class Reflections:
 
 
 def facade_reflections(
-    origins: np.ndarray, directions: np.ndarray, velocity: np.ndarray, boxes: Boxes
+    origins: np.ndarray,
+    directions: np.ndarray,
+    velocity: np.ndarray,
+    boxes: Boxes,
+    reflective: np.ndarray | None = None,
 ) -> Reflections:
     """Best (shortest extra path) specular reflection on an x- or y-facing facade per ray
-    (unit ``directions`` towards the satellites; model in the module docstring)."""
+    (unit ``directions`` towards the satellites; model in the module docstring).
+    ``reflective`` (M, 2) says which boxes' x- and y-facing facades reflect (default all)."""
     n = len(origins)
     best = np.full(n, np.inf)
     rate = np.zeros(n)
@@ -176,6 +189,8 @@ def facade_reflections(
         mirrored[:, k] *= -1.0
         first = ray_hits(origins, mirrored, boxes)
         ok = first.hit & (first.axis == k) & (np.abs(directions[:, k]) > 1e-6)
+        if reflective is not None:
+            ok &= reflective[np.maximum(first.box, 0), k]
         point = origins + (first.distance[:, None] - 1e-3) * mirrored
         rows = np.flatnonzero(ok)
         onward = ray_hits(point[rows], directions[rows], boxes)
@@ -317,13 +332,19 @@ def simulate_gnss(
     excess_rate = np.zeros(rows.size)
     if config.nlos and np.any(blocked):
         b = np.flatnonzero(blocked)
+        reflective = rng.uniform(size=(len(boxes.lo), 2)) < config.nlos_reflective_fraction
         bounce = facade_reflections(
-            origins[b], los_enu[rows[b]], velocity_enu[epoch[rows[b]]], boxes
+            origins[b], los_enu[rows[b]], velocity_enu[epoch[rows[b]]], boxes, reflective
         )
         reflected[b] = bounce.found
         excess[b], excess_rate[b] = bounce.excess_m, bounce.excess_rate_mps
-    received = ~blocked | reflected
-    rows, reflected = rows[received], reflected[received]
+    cn0_mean = (
+        config.cn0_horizon_dbhz
+        + (config.cn0_zenith_dbhz - config.cn0_horizon_dbhz) * np.sin(elevation[rows])
+        - config.nlos_loss_db * reflected
+    )
+    received = (~blocked | reflected) & (cn0_mean >= config.tracking_threshold_dbhz)
+    rows, reflected, cn0 = rows[received], reflected[received], cn0_mean[received]
     excess, excess_rate = excess[received], excess_rate[received]
     k = epoch[rows]
     el, az = elevation[rows], azimuth[rows]
@@ -347,11 +368,6 @@ def simulate_gnss(
         pseudorange += troposphere_delay(frame.lat_rad, frame.height_m, el) + klobuchar_delay(
             nav.klobuchar, frame.lat_rad, frame.lon_rad, el, az, t_true[k], frequency
         )
-    cn0 = (
-        config.cn0_horizon_dbhz
-        + (config.cn0_zenith_dbhz - config.cn0_horizon_dbhz) * np.sin(el)
-        - config.nlos_loss_db * reflected
-    )
     true_range_rate = range_rate.copy()
     if config.noise:
         cn0 = cn0 + rng.normal(0.0, config.cn0_noise_db, rows.size)

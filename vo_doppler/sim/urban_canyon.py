@@ -101,8 +101,8 @@ class CityConfig:
 
     blocks: tuple[int, int] = (5, 4)
     block_size_m: tuple[float, float] = (45.0, 45.0)
-    street_width_m: float = 12.0
-    height_range_m: tuple[float, float] = (25.0, 70.0)
+    street_width_m: float = 20.0
+    height_range_m: tuple[float, float] = (20.0, 60.0)
     buildings_per_side: tuple[int, int] = (1, 3)
     corner_streets: tuple[tuple[int, int], tuple[int, int]] = ((1, 1), (4, 3))
     corner_radius_m: float = 9.0
