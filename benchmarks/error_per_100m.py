@@ -1,0 +1,119 @@
+"""Trajectory error per 100 m, side by side, for the four pipelines on each sequence:
+VO alone (initial heading from ground truth), VO + GPS (conventional Doppler heading),
+VO + GPS (tightly coupled heading), wheel + gyro dead reckoning + GPS (tightly coupled).
+
+    python benchmarks/error_per_100m.py SEQUENCE_DIR [SEQUENCE_DIR ...] [--json FILE]
+
+Each sequence folder needs a sequence.yaml with ground truth (``vo-doppler simulate`` writes
+one). Prints a table per sequence and writes JSON and the figures (trajectories, heading,
+error per 100 m) next to it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.progress import Progress
+from rich.table import Table
+
+from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
+from vo_doppler.eval.report import error_per_100m_figure, trajectories_figure
+from vo_doppler.fusion.heading_correction import yaw_of
+from vo_doppler.fusion.pipeline import run_pipeline
+from vo_doppler.heading.sensors import sample_at
+from vo_doppler.io.heading_figure import heading_figure
+from vo_doppler.io.sequence import read_sequence
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def evaluate_sequence(folder: Path, figures: Path, console: Console) -> dict:
+    inputs = read_sequence(folder)
+    if inputs.truth is None:
+        raise SystemExit(f"{folder}: no ground truth; the benchmark needs one")
+    with Progress(console=console, transient=True) as progress:
+        task = progress.add_task(f"{inputs.name}: VO", total=len(inputs.image_paths))
+        result = run_pipeline(inputs, on_frame=lambda _: progress.advance(task))
+    errors, per_100m, shown = evaluate_pipelines(
+        result.trajectories, result.heading, result.tc_usable, inputs.truth
+    )
+    table = result.heading
+    truth = inputs.truth
+    truth_yaw = sample_at(truth.t, np.unwrap(yaw_of(truth.orientations.as_matrix())), table.t)
+    figures.mkdir(parents=True, exist_ok=True)
+    trajectories_figure(figures / f"{inputs.name}_trajectories.png", shown, truth, inputs.name)
+    heading_figure(figures / f"{inputs.name}_heading.png", table, truth_yaw, inputs.name)
+    error_per_100m_figure(figures / f"{inputs.name}_error_per_100m.png", per_100m, inputs.name)
+    return {
+        "gnss_epochs": len(table),
+        "conventional_availability": float(np.mean(table.conv_valid)),
+        "tight_availability": float(np.mean(table.tc_available)),
+        "tight_used": float(np.mean(result.tc_usable)),
+        "path_length_m": truth.path_length,
+        "pipelines": {name: e.to_dict() for name, e in errors.items()},
+    }
+
+
+def print_sequence(console: Console, name: str, figures: dict) -> None:
+    table = Table(
+        title=f"{name}: {figures['path_length_m']:.0f} m, conventional heading on "
+        f"{figures['conventional_availability']:.0%} of epochs, tightly coupled on "
+        f"{figures['tight_availability']:.0%} (used {figures['tight_used']:.0%})"
+    )
+    for column in (
+        "pipeline",
+        "error/100 m mean [m]",
+        "max [m]",
+        "KITTI [%]",
+        "heading RMSE [deg]",
+        "heading availability",
+        "final error [m]",
+    ):
+        table.add_column(column, justify="right")
+    for key, row in figures["pipelines"].items():
+        table.add_row(
+            PIPELINE_LABELS[key],
+            f"{row['error_per_100m_m']:.2f}",
+            f"{row['error_per_100m_max_m']:.2f}",
+            f"{row['kitti_translation_pct']:.2f}",
+            f"{row['heading_rmse_deg']:.2f}",
+            f"{row['heading_availability']:.0%}",
+            f"{row['final_position_error_m']:.2f}",
+        )
+    console.print(table)
+    pipelines = figures["pipelines"]
+    if "vo_gps_tc" in pipelines and "vo_gps_conv" in pipelines:
+        ratio = (
+            pipelines["vo_gps_tc"]["error_per_100m_m"]
+            / pipelines["vo_gps_conv"]["error_per_100m_m"]
+        )
+        console.print(f"VO + GPS: tightly coupled / conventional error per 100 m = {ratio:.2f}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("sequences", nargs="+", type=Path)
+    parser.add_argument(
+        "--json", type=Path, default=ROOT / "benchmarks/results/error_per_100m.json"
+    )
+    args = parser.parse_args(argv)
+    console = Console(width=160)
+    figures = args.json.parent
+    results = {}
+    for folder in args.sequences:
+        name = folder.resolve().name
+        results[name] = evaluate_sequence(folder, figures, console)
+        print_sequence(console, name, results[name])
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(json.dumps({"sequences": results}, indent=2))
+    console.print(f"wrote {args.json} and figures in {figures}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
