@@ -20,9 +20,7 @@ SMALL = {"duration_s": 6.0, "fps": 5.0, "image_size": (160, 90)}
 
 def _files(folder: Path) -> dict[str, bytes]:
     return {
-        str(p.relative_to(folder)): p.read_bytes()
-        for p in sorted(folder.rglob("*"))
-        if p.is_file() and p.name != "sequence.yaml"
+        str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()
     }
 
 
@@ -85,7 +83,10 @@ def test_same_seed_same_files_other_seed_differs(sequence, tmp_path):
     simulate_urban_canyon(tmp_path / "again", UrbanCanyonConfig(seed=4, **SMALL))
     first, second = _files(out), _files(tmp_path / "again")
     assert first.keys() == second.keys()
-    assert [k for k in first if first[k] != second[k]] == []
+    assert [k for k in first if first[k] != second[k]] == ["sequence.yaml"]
+    manifests = [yaml.safe_load(files["sequence.yaml"]) for files in (first, second)]
+    assert manifests[0].pop("name") != manifests[1].pop("name")  # the folder names
+    assert manifests[0] == manifests[1]
     simulate_urban_canyon(tmp_path / "other", UrbanCanyonConfig(seed=5, render=False, **SMALL))
     other = _files(tmp_path / "other")
     assert other["gnss/rover.obs"] != first["gnss/rover.obs"]

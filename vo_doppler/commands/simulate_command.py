@@ -81,6 +81,9 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--max-speed", type=float, default=defaults.max_speed_mps * 3.6, help="km/h"
     )
+    parser.add_argument(
+        "--initial-speed", type=float, default=0.0, help="km/h at the start (default: from rest)"
+    )
     parser.add_argument("--stops-per-lap", type=int, default=defaults.stops_per_lap)
     parser.add_argument("--gnss-rate", type=float, default=defaults.gnss.rate_hz, help="Hz")
     parser.add_argument("--systems", default=defaults.gnss.systems, help="G, E or GE")
@@ -116,7 +119,7 @@ def _command_line(args: argparse.Namespace) -> str:
     """The full command that regenerates the sequence (every option spelled out)."""
 
     def joined(values) -> str:
-        return ",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in values)
+        return ",".join(f"{v:.10g}" if isinstance(v, float) else str(v) for v in values)
 
     words = ["vo-doppler", "simulate", "--scenario", args.scenario]
     words += ["--duration", f"{args.duration:g}", "--seed", str(args.seed)]
@@ -125,7 +128,8 @@ def _command_line(args: argparse.Namespace) -> str:
     words += ["--blocks", joined(args.blocks), "--block-size", joined(args.block_size)]
     words += ["--street-width", f"{args.street_width:g}", "--heights", joined(args.heights)]
     words += ["--loop", joined([*args.loop[0], *args.loop[1]])]
-    words += ["--max-speed", f"{args.max_speed:g}", "--stops-per-lap", str(args.stops_per_lap)]
+    words += ["--max-speed", f"{args.max_speed:g}", "--initial-speed", f"{args.initial_speed:g}"]
+    words += ["--stops-per-lap", str(args.stops_per_lap)]
     words += ["--gnss-rate", f"{args.gnss_rate:g}", "--systems", args.systems]
     words += ["--wheel-scale-error", f"{args.wheel_scale_error:g}"]
     words += ["--yaw-bias", f"{args.yaw_bias:g}", "--origin", joined(args.origin)]
@@ -155,6 +159,7 @@ def run(args: argparse.Namespace) -> int:
             corner_streets=args.loop,
         ),
         max_speed_mps=args.max_speed / 3.6,
+        initial_speed_mps=args.initial_speed / 3.6,
         stops_per_lap=args.stops_per_lap,
         fps=args.fps,
         image_size=args.size,

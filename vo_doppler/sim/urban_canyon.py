@@ -117,6 +117,7 @@ class UrbanCanyonConfig:
     city: CityConfig = field(default_factory=CityConfig)
     max_speed_mps: float = 13.5
     max_lateral_accel: float = 2.5
+    initial_speed_mps: float = 0.0
     stops_per_lap: int = 1
     stop_duration_s: float = 4.0
     fps: float = 15.0
@@ -184,7 +185,7 @@ class VehicleDrive:
         self.options = {
             "max_speed": config.max_speed_mps,
             "max_lateral_accel": config.max_lateral_accel,
-            "initial_speed": 0.0,
+            "initial_speed": config.initial_speed_mps,
             "stops_m": self.stops_m,
             "stop_duration_s": config.stop_duration_s,
         }
@@ -421,7 +422,7 @@ def _write_manifest(out: Path, config, command, camera_offset, stats) -> dict[st
             "height_range_m": list(city.height_range_m),
             "corner_streets": [list(p) for p in city.corner_streets],
         },
-        "stats": _plain(asdict(stats)),
+        "stats": _plain({k: v for k, v in asdict(stats).items() if k != "seconds"}),
     }
     with open(out / "sequence.yaml", "w") as stream:
         yaml.safe_dump(manifest, stream, sort_keys=False)
