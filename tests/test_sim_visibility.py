@@ -81,6 +81,11 @@ def test_facade_reflection_extra_path_and_rate():
     assert (moved.excess_m[0] - bounce.excess_m[0]) / 0.1 == pytest.approx(
         bounce.excess_rate_mps[0], rel=1e-6
     )
+    matte = np.zeros((2, 2), dtype=bool)
+    assert not facade_reflections(ANTENNA[None], u[None], velocity, boxes, matte).found[0]
+    glass_east = matte.copy()
+    glass_east[0, 0] = True  # only the east building's x-facing facades reflect
+    assert facade_reflections(ANTENNA[None], u[None], velocity, boxes, glass_east).found[0]
     low = direction(270.0, 30.0)  # reflected path blocked again by the west building
     assert not facade_reflections(ANTENNA[None], low[None], velocity, boxes).found[0]
 
