@@ -67,12 +67,13 @@ def print_sequence(console: Console, name: str, figures: dict) -> None:
     )
     for column in (
         "pipeline",
-        "error/100 m mean [m]",
+        "horizontal error/100 m mean [m]",
         "max [m]",
+        "3-D error/100 m [m]",
         "KITTI [%]",
         "heading RMSE [deg]",
         "heading availability",
-        "final error [m]",
+        "final horizontal error [m]",
     ):
         table.add_column(column, justify="right")
     for key, row in figures["pipelines"].items():
@@ -80,6 +81,7 @@ def print_sequence(console: Console, name: str, figures: dict) -> None:
             PIPELINE_LABELS[key],
             f"{row['error_per_100m_m']:.2f}",
             f"{row['error_per_100m_max_m']:.2f}",
+            f"{row['error_per_100m_3d_m']:.2f}",
             f"{row['kitti_translation_pct']:.2f}",
             f"{row['heading_rmse_deg']:.2f}",
             f"{row['heading_availability']:.0%}",

@@ -49,3 +49,12 @@ def test_scale_error_grows_linearly(scale, heading, n):
     estimate = Trajectory(truth.t, truth.positions * scale, truth.orientations)
     result = error_per_100m(estimate, truth)
     assert result.mean_m_per_100m == pytest.approx(100.0 * (scale - 1.0), rel=1e-6, abs=1e-9)
+
+
+def test_horizontal_error_ignores_height_drift():
+    truth = line(201, 1.0)
+    climbing = truth.positions.copy()
+    climbing[:, 2] = 0.01 * np.arange(201)
+    estimate = Trajectory(truth.t, climbing, truth.orientations)
+    assert error_per_100m(estimate, truth).mean_m_per_100m == pytest.approx(1.0, rel=1e-9)
+    assert error_per_100m(estimate, truth, horizontal=True).max_m_per_100m == pytest.approx(0.0)

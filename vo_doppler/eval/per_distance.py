@@ -4,7 +4,8 @@ For every window of the path that is 100 m long on the ground truth, the estimat
 translated (not rotated) so that it coincides with the truth at the window's start; the
 error is the position difference at the window's end. Mean and maximum over all windows are
 reported in metres per 100 m. Paths shorter than the window use the whole path and scale the
-error to 100 m.
+error to 100 m. ``horizontal=True`` measures the error in the x–y plane only (ENU east/north):
+the figure of a heading method for ground vehicles, blind to a VO's height drift.
 """
 
 from __future__ import annotations
@@ -28,7 +29,11 @@ class ErrorPerDistance:
 
 
 def error_per_100m(
-    estimate: Trajectory, truth: Trajectory, window_m: float = 100.0, step_m: float = 1.0
+    estimate: Trajectory,
+    truth: Trajectory,
+    window_m: float = 100.0,
+    step_m: float = 1.0,
+    horizontal: bool = False,
 ) -> ErrorPerDistance:
     """Error growth over every ``window_m`` stretch, windows starting every ``step_m`` metres.
 
@@ -52,7 +57,8 @@ def error_per_100m(
     starts, ends = starts[keep], ends[keep]
     est_delta = estimate.positions[ends] - estimate.positions[starts]
     gt_delta = truth.positions[ends] - truth.positions[starts]
-    errors = np.linalg.norm(est_delta - gt_delta, axis=1) * scale
+    axes = 2 if horizontal else 3
+    errors = np.linalg.norm((est_delta - gt_delta)[:, :axes], axis=1) * scale
     return ErrorPerDistance(
         window_m=window_m,
         mean_m_per_100m=float(errors.mean()) if errors.size else float("nan"),

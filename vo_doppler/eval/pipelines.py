@@ -25,8 +25,11 @@ PIPELINE_LABELS = {
 
 @dataclass
 class PipelineErrors:
+    """``error_per_100m_*`` are horizontal (east/north); ``error_per_100m_3d_m`` adds height."""
+
     error_per_100m_m: float
     error_per_100m_max_m: float
+    error_per_100m_3d_m: float
     kitti_translation_pct: float
     kitti_rotation_deg_per_100m: float
     heading_rmse_deg: float
@@ -61,17 +64,19 @@ def evaluate_trajectory(
 ) -> tuple[PipelineErrors, ErrorPerDistance]:
     matched_truth, inside = truth_at(truth, estimate.t)
     matched = estimate.subset(np.flatnonzero(inside))
-    per_100m = error_per_100m(matched, matched_truth)
+    per_100m = error_per_100m(matched, matched_truth, horizontal=True)
+    per_100m_3d = error_per_100m(matched, matched_truth)
     kitti = evaluate(matched, matched_truth, "start")
     errors = PipelineErrors(
         error_per_100m_m=per_100m.mean_m_per_100m,
         error_per_100m_max_m=per_100m.max_m_per_100m,
+        error_per_100m_3d_m=per_100m_3d.mean_m_per_100m,
         kitti_translation_pct=kitti.mean_translation_pct,
         kitti_rotation_deg_per_100m=kitti.mean_rotation_deg_per_100m,
         heading_rmse_deg=heading_rmse_deg(matched, matched_truth),
         heading_availability=availability,
         final_position_error_m=float(
-            np.linalg.norm(matched.positions[-1] - matched_truth.positions[-1])
+            np.linalg.norm(matched.positions[-1, :2] - matched_truth.positions[-1, :2])
         ),
         path_length_m=matched_truth.path_length,
     )

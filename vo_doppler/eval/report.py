@@ -12,12 +12,13 @@ from vo_doppler.eval.pipelines import PIPELINE_LABELS, PipelineErrors
 from vo_doppler.trajectory import Trajectory
 
 TABLE_COLUMNS = (
-    ("error_per_100m_m", "error per 100 m, mean [m]", "{:.2f}"),
+    ("error_per_100m_m", "horizontal error per 100 m, mean [m]", "{:.2f}"),
     ("error_per_100m_max_m", "max [m]", "{:.2f}"),
+    ("error_per_100m_3d_m", "3-D error per 100 m [m]", "{:.2f}"),
     ("kitti_translation_pct", "KITTI translation [%]", "{:.2f}"),
     ("heading_rmse_deg", "heading RMSE [deg]", "{:.2f}"),
     ("heading_availability", "heading availability", "{:.0%}"),
-    ("final_position_error_m", "final error [m]", "{:.2f}"),
+    ("final_position_error_m", "final horizontal error [m]", "{:.2f}"),
 )
 
 
@@ -67,7 +68,7 @@ def error_per_100m_figure(path: Path, per_100m: dict[str, ErrorPerDistance], tit
         )
     window = next(iter(per_100m.values())).window_m if per_100m else 100.0
     ax.set_xlabel("start of the window along the path [m]")
-    ax.set_ylabel(f"error after {window:.0f} m [m per 100 m]")
+    ax.set_ylabel(f"horizontal error after {window:.0f} m [m per 100 m]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title)
