@@ -1,0 +1,72 @@
+"""``vo-doppler run`` end to end on a short generated urban-canyon drive."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from vo_doppler.cli import main
+from vo_doppler.io.heading_csv import read_heading_csv
+from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+from vo_doppler.trajectory import read_tum
+
+
+@pytest.fixture(scope="module")
+def sequence(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("canyon") / "seq"
+    config = UrbanCanyonConfig(duration_s=25.0, seed=4, image_size=(480, 270))
+    simulate_urban_canyon(folder, config)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def run_output(sequence, tmp_path_factory):
+    out = tmp_path_factory.mktemp("run")
+    assert main(["run", str(sequence), "-o", str(out)]) == 0
+    return out
+
+
+def test_run_writes_every_output(run_output):
+    for name in (
+        "trajectory_vo.tum",
+        "trajectory_corrected.tum",
+        "trajectory_vo_gps_conv.tum",
+        "trajectory_dr_gps_tc.tum",
+        "heading.csv",
+        "trajectories.png",
+        "heading.png",
+        "error_per_100m.png",
+        "report.html",
+        "summary.json",
+    ):
+        assert (run_output / name).stat().st_size > 0, name
+    report = (run_output / "report.html").read_text()
+    assert "VO + GPS (tightly coupled)" in report and "<img src='trajectories.png'" in report
+
+
+def test_run_recovers_calibration_and_heading(sequence, run_output):
+    summary = json.loads((run_output / "summary.json").read_text())
+    assert summary["tight_heading_availability"] >= summary["conventional_heading_availability"]
+    assert summary["tight_heading_availability"] > 0.5
+    assert summary["final_gyro_bias_dps"] == pytest.approx(0.3, abs=0.1)
+    assert summary["final_wheel_scale"] == pytest.approx(1 / 1.02, abs=0.01)
+    table = read_heading_csv(run_output / "heading.csv")
+    assert np.all(np.diff(table.t) > 0)
+    evaluation = summary["evaluation"]
+    tc = evaluation["vo_gps_tc"]
+    assert tc["heading_rmse_deg"] < 3.0
+    assert tc["error_per_100m_m"] < 2.0
+
+
+def test_corrected_trajectory_is_finite_and_covers_every_image(sequence, run_output):
+    corrected = read_tum(run_output / "trajectory_corrected.tum")
+    images = list((sequence / "image_0").iterdir())
+    assert len(corrected) == len(images)
+    assert np.all(np.isfinite(corrected.positions))
+
+
+def test_missing_manifest_is_a_clear_error(tmp_path, capsys):
+    assert main(["run", str(tmp_path), "-o", str(tmp_path / "out")]) == 1
+    assert "sequence.yaml" in capsys.readouterr().err
