@@ -11,7 +11,7 @@ import yaml
 from vo_doppler.cli import main
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.rinex_obs import read_obs
-from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+from vo_doppler.sim.urban_canyon import CityConfig, UrbanCanyonConfig, simulate_urban_canyon
 from vo_doppler.trajectory import read_tum
 from vo_doppler.vo.camera import read_camera
 
@@ -124,3 +124,25 @@ def test_cli_rejects_unknown_system(tmp_path, capsys):
     code = main(["simulate", "--duration", "3", "--systems", "GR", "-o", str(tmp_path / "x")])
     assert code == 1
     assert "G and E" in capsys.readouterr().err
+
+
+def test_route_has_turns_stops_and_a_speed_limit(tmp_path):
+    config = UrbanCanyonConfig(
+        duration_s=40.0,
+        seed=3,
+        render=False,
+        initial_speed_mps=8.0,
+        stops_per_lap=2,
+        city=CityConfig(corner_streets=((1, 1), (2, 2))),
+    )
+    sim = simulate_urban_canyon(tmp_path, config)
+    truth = read_tum(tmp_path / "ground_truth.tum")
+    step = np.linalg.norm(np.diff(truth.positions, axis=0), axis=1)
+    speed = step / np.diff(truth.t)
+    assert speed.max() <= config.max_speed_mps + 1e-6
+    first_stop = sim.vehicle.stops_m[0]
+    at_stop = np.abs(np.concatenate([[0.0], np.cumsum(step)]) - first_stop) < 0.01
+    standing = np.sum(at_stop) / 100.0
+    assert standing == pytest.approx(config.stop_duration_s, abs=0.15)  # + creeping in and out
+    assert sim.stats.stops >= 1 and sim.stats.turns >= 2
+    assert sim.stats.path_length_m == pytest.approx(step.sum())

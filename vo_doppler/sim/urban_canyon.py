@@ -315,26 +315,26 @@ def _render(out: Path, config, scene, camera, motion: VehicleMotion, progress: b
             raise OSError(f"cannot write {path}")
 
 
-def _runs(flags: np.ndarray) -> np.ndarray:
-    """Lengths of the runs of True in a boolean array."""
+def _runs(flags: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start indices and lengths of the runs of True in a boolean array."""
     padded = np.concatenate([[0], flags.astype(np.int8), [0]])
     edges = np.flatnonzero(np.diff(padded))
-    return edges[1::2] - edges[::2]
+    return edges[::2], edges[1::2] - edges[::2]
 
 
 def _stats(config, truth: VehicleMotion, gnss: GnssSimulation, frames, can_frames, seconds):
     step = np.hypot(*np.diff(truth.xy, axis=0).T)
     yaw_change = abs(float(truth.yaw[-1] - truth.yaw[0]))
     moving = truth.speed > 0.1
-    standing = _runs(~moving)
+    stand_start, stand_length = _runs(~moving)
     visible = gnss.n_visible
     low = visible < 4
     epoch_moving = np.interp(gnss.epoch_time, truth.t, moving.astype(float)) > 0.5
-    runs = _runs(low)
+    _, runs = _runs(low)
     return SimulationStats(
         path_length_m=float(step.sum()),
         turns=int(np.floor(yaw_change / (np.pi / 2) + 0.25)),
-        stops=int(np.sum(standing[1:] * (1.0 / GROUND_TRUTH_RATE_HZ) >= 1.0)),
+        stops=int(np.sum((stand_start > 0) & (stand_length >= GROUND_TRUTH_RATE_HZ))),
         max_speed_kmh=float(truth.speed.max() * 3.6),
         epochs=len(visible),
         visible_min=int(visible.min()),
