@@ -25,7 +25,7 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     name, scenario, seed, duration_s, command
     origin: {lat_deg, lon_deg, height_m}          ENU origin (WGS-84, ellipsoidal height)
     start_gps_s                                   GPS time of the drive start
-    camera: {images, times, calib, fps, width, height, time_offset_s}
+    camera: {images, image_format, times, calib, fps, width, height, time_offset_s}
     gnss: {obs, nav: [..], rate_hz, systems, time_offset_s, antenna_lever_arm_m,
            doppler_sign: "range_rate = -wavelength * doppler", visibility}
     can: {log, dbc, period_s, time_offset_s, yaw_rate, yaw_rate_sign, wheel_speed}
@@ -33,7 +33,13 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     ground_truth: {trajectory, frame, rate_hz}
     truth: generating sensor errors (wheel_scale_error, yaw_rate_bias_dps, …) — evaluation only
     city: {blocks, block_size_m, street_width_m, height_range_m, corner_streets}
-    stats: path length, turns, stops, satellite availability (see ``SimulationStats``)
+    stats: path length, turns, stops, satellite availability (``SimulationStats`` without
+           the timings, so the manifest is identical for identical inputs)
+
+The camera images are rendered by ``vo_doppler.sim.render`` from the city's textured ground
+and facades (``vo_doppler.sim.scene``); the vehicle follows ``loop_route``/``drive`` of
+``vo_doppler.sim.vo_sequence``. GNSS: ``gnss_observations`` (model, sign convention) with the
+``constellation``; CAN: ``can_bus``.
 """
 
 from __future__ import annotations
