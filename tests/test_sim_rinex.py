@@ -155,3 +155,26 @@ def test_noise_scales_with_cn0(tmp_path):
     scale = 10.0 ** ((45.0 - noisy.cn0_dbhz) / 20.0)
     normalised = residual / (0.03 * scale)
     assert 0.9 < np.std(normalised) < 1.1
+
+
+@pytest.mark.filterwarnings("ignore::FutureWarning")
+def test_an_independent_reader_agrees(tmp_path):
+    """georinex (test-only) reads the written files to the same values."""
+    georinex = pytest.importorskip("georinex")
+    config = UrbanCanyonConfig(duration_s=1.0, seed=7, render=False)
+    sim = simulate_urban_canyon(tmp_path, config)
+    obs = georinex.load(tmp_path / "gnss" / "rover.obs")
+    gnss = sim.gnss
+    for row in range(len(gnss.epoch)):
+        sample = obs.sel(time=obs.time[gnss.epoch[row]], sv=gnss.satellite[row])
+        assert float(sample["C1C"]) == pytest.approx(gnss.pseudorange_m[row], abs=5e-4)
+        assert float(sample["D1C"]) == pytest.approx(gnss.doppler_hz[row], abs=5e-4)
+    nav = georinex.load(tmp_path / "gnss" / "brdc.nav")
+    mine = read_nav(tmp_path / "gnss" / "brdc.nav")
+    for k, sat in enumerate(
+        np.char.add(mine.kepler.system, np.char.zfill(mine.kepler.prn.astype(str), 2))
+    ):
+        record = nav.sel(sv=str(sat)).dropna("time", how="all")
+        assert float(record["sqrtA"][0]) == mine.kepler["sqrt_a"][k]
+        assert float(record["M0"][0]) == mine.kepler["m0"][k]
+        assert float(record["Omega0"][0]) == mine.kepler["omega0"][k]

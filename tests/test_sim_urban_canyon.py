@@ -51,6 +51,10 @@ def test_manifest_paths_and_time_offsets(sequence):
     assert times[0] + manifest["camera"]["time_offset_s"] == pytest.approx(start + 0.02)
     camera = read_camera(out / manifest["camera"]["calib"])
     assert (camera.width, camera.height) == (160, 90)
+    true_camera = manifest["truth"]["camera"]
+    assert camera.fx == pytest.approx(true_camera["fx"] * 0.99)
+    assert camera.cx - true_camera["cx"] == pytest.approx(3.0)
+    assert camera.cy - true_camera["cy"] == pytest.approx(-2.0)
     obs = read_obs(out / manifest["gnss"]["obs"])
     assert obs.epoch_time[0] + manifest["gnss"]["time_offset_s"] == pytest.approx(start)
     assert obs.header.interval == pytest.approx(0.05)

@@ -43,7 +43,7 @@ def _loop(text: str) -> tuple:
     return ((i0, j0), (i1, j1))
 
 
-def _origin(text: str) -> tuple:
+def _triple(text: str) -> tuple:
     return _numbers(text, 3)
 
 
@@ -66,6 +66,12 @@ def register(subparsers) -> None:
     parser.add_argument("--image-format", choices=("png", "jpg"), default="png")
     parser.add_argument("--jpeg-quality", type=int, default=defaults.jpeg_quality)
     parser.add_argument("--no-images", action="store_true", help="skip rendering (fast)")
+    parser.add_argument(
+        "--calib-error",
+        type=_triple,
+        default=(defaults.calib_focal_error, *defaults.calib_principal_offset_px),
+        help="written-calibration error FOCAL_FRACTION,DCX_PX,DCY_PX (0,0,0: exact)",
+    )
     parser.add_argument("--blocks", type=_int_pair, default=city.blocks, help="NX,NY blocks")
     parser.add_argument("--block-size", type=_pair, default=city.block_size_m, help="X,Y m")
     parser.add_argument("--street-width", type=float, default=city.street_width_m, help="m")
@@ -98,7 +104,7 @@ def register(subparsers) -> None:
         default=None,
         help="GPS start time YYYY-MM-DDTHH:MM:SS (default 2025-03-14T02:10)",
     )
-    parser.add_argument("--origin", type=_origin, default=defaults.origin, help="LAT,LON,H")
+    parser.add_argument("--origin", type=_triple, default=defaults.origin, help="LAT,LON,H")
     parser.set_defaults(func=run)
 
 
@@ -125,6 +131,7 @@ def _command_line(args: argparse.Namespace) -> str:
     words += ["--duration", f"{args.duration:g}", "--seed", str(args.seed)]
     words += ["--fps", f"{args.fps:g}", "--size", joined(args.size)]
     words += ["--image-format", args.image_format, "--jpeg-quality", str(args.jpeg_quality)]
+    words += ["--calib-error", joined(args.calib_error)]
     words += ["--blocks", joined(args.blocks), "--block-size", joined(args.block_size)]
     words += ["--street-width", f"{args.street_width:g}", "--heights", joined(args.heights)]
     words += ["--loop", joined([*args.loop[0], *args.loop[1]])]
@@ -166,6 +173,8 @@ def run(args: argparse.Namespace) -> int:
         image_format=args.image_format,
         jpeg_quality=args.jpeg_quality,
         render=not args.no_images,
+        calib_focal_error=args.calib_error[0],
+        calib_principal_offset_px=args.calib_error[1:],
         start_gps_s=_start_gps(args.start, defaults.start_gps_s),
         origin=args.origin,
         gnss=replace(

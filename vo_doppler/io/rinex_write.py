@@ -174,7 +174,7 @@ def write_obs(
         ),
     ]
     for system in systems:
-        lines.append(header_line(f"{system} L1C", "SYS / PHASE SHIFT"))
+        lines.append(header_line(system, "SYS / PHASE SHIFT"))
     lines.append(header_line("", "END OF HEADER"))
     strength = next((k for k, c in enumerate(data.codes) if c.startswith("S")), None)
     ssi = (

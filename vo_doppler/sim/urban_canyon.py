@@ -11,7 +11,9 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     sequence.yaml            manifest (schema below)
     image_0/000000.png …     grey frames (``camera.fps``, default 15 Hz; .png or .jpg)
     times.txt                one frame time per line, camera clock (s, first frame at 0)
-    calib.yaml               camera calibration (Camera.to_yaml: intrinsics + camera→vehicle)
+    calib.yaml               camera calibration (Camera.to_yaml: intrinsics + camera→vehicle),
+                             with a deliberate calibration error (default: focal −1 %,
+                             principal point +3/−2 px; true values in sequence.yaml ``truth``)
     gnss/rover.obs           RINEX 3.04 observations, 20 Hz: C1C D1C S1C, GPS + Galileo
     gnss/brdc.nav            RINEX 3.04 navigation (GPS + Galileo Keplerian, Klobuchar)
     gnss/visibility.csv      truth per epoch: gps_time_s,n_above_mask,n_direct,n_reflected
@@ -47,7 +49,7 @@ from __future__ import annotations
 import logging
 import shutil
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import cv2
@@ -89,6 +91,7 @@ from vo_doppler.sim.vo_sequence import (
     synthetic_camera,
 )
 from vo_doppler.trajectory import Trajectory, write_tum
+from vo_doppler.vo.camera import Camera
 
 log = logging.getLogger(__name__)
 
@@ -131,6 +134,8 @@ class UrbanCanyonConfig:
     image_format: str = "png"
     jpeg_quality: int = 90
     image_noise: float = 2.0
+    calib_focal_error: float = -0.01
+    calib_principal_offset_px: tuple[float, float] = (3.0, -2.0)
     render: bool = True
     start_gps_s: float = DEFAULT_START_GPS_S
     origin: tuple[float, float, float] = SHINJUKU
@@ -287,15 +292,26 @@ def simulate_urban_canyon(
     camera_clock = np.arange(n_frames) / config.fps
     camera_offset = t0 + CAMERA_START_DELAY_S
     np.savetxt(out / "times.txt", camera_clock, fmt="%.6f")
-    camera.to_yaml(out / "calib.yaml")
+    written_camera(camera, config).to_yaml(out / "calib.yaml")
     if config.render:
         _render(out, config, scene, camera, vehicle(camera_clock + camera_offset), progress)
     seconds["camera"] = time.perf_counter() - clock
 
     stats = _stats(config, truth, gnss, n_frames, len(can.lines), seconds)
-    files = _write_manifest(out, config, command, camera_offset, stats)
+    files = _write_manifest(out, config, command, camera, camera_offset, stats)
     log.info("wrote %s in %.1f s", out, sum(seconds.values()))
     return UrbanCanyonSimulation(config, frame, vehicle, gnss, can, stats, files)
+
+
+def written_camera(camera: Camera, config: UrbanCanyonConfig) -> Camera:
+    """The calibration as written to ``calib.yaml``: the rendering camera with the configured
+    calibration error (focal lengths × (1 + error), principal point shifted), as a real
+    calibration is never exact; ``sequence.yaml`` keeps the true values under ``truth``."""
+    dx, dy = config.calib_principal_offset_px
+    scale = 1.0 + config.calib_focal_error
+    return replace(
+        camera, fx=camera.fx * scale, fy=camera.fy * scale, cx=camera.cx + dx, cy=camera.cy + dy
+    )
 
 
 def _render(out: Path, config, scene, camera, motion: VehicleMotion, progress: bool) -> None:
@@ -356,7 +372,7 @@ def _stats(config, truth: VehicleMotion, gnss: GnssSimulation, frames, can_frame
     )
 
 
-def _write_manifest(out: Path, config, command, camera_offset, stats) -> dict[str, str]:
+def _write_manifest(out: Path, config, command, camera, camera_offset, stats) -> dict[str, str]:
     suffix = "jpg" if config.image_format == "jpg" else "png"
     files = {
         "images": "image_0",
@@ -415,6 +431,15 @@ def _write_manifest(out: Path, config, command, camera_offset, stats) -> dict[st
             "rate_hz": GROUND_TRUTH_RATE_HZ,
         },
         "truth": {
+            "camera": {
+                "fx": camera.fx,
+                "fy": camera.fy,
+                "cx": camera.cx,
+                "cy": camera.cy,
+                "focal_error": config.calib_focal_error,
+                "principal_offset_px": list(config.calib_principal_offset_px),
+                "image_noise_grey_levels": config.image_noise,
+            },
             "wheel_scale_error": config.can.wheel_scale_error,
             "yaw_rate_bias_dps": config.can.yaw_rate_bias_dps,
             "yaw_bias_walk_dps_per_sqrt_s": config.can.yaw_bias_walk_dps,
