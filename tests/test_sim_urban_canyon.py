@@ -27,7 +27,10 @@ def _files(folder: Path) -> dict[str, bytes]:
 @pytest.fixture(scope="module")
 def sequence(tmp_path_factory):
     out = tmp_path_factory.mktemp("seq")
-    return out, simulate_urban_canyon(out, UrbanCanyonConfig(seed=4, **SMALL))
+    config = UrbanCanyonConfig(
+        seed=4, calib_focal_error=-0.01, calib_principal_offset_px=(3.0, -2.0), **SMALL
+    )
+    return out, simulate_urban_canyon(out, config)
 
 
 def test_manifest_paths_and_time_offsets(sequence):
@@ -83,8 +86,8 @@ def test_manifest_paths_and_time_offsets(sequence):
 
 
 def test_same_seed_same_files_other_seed_differs(sequence, tmp_path):
-    out, _ = sequence
-    simulate_urban_canyon(tmp_path / "again", UrbanCanyonConfig(seed=4, **SMALL))
+    out, sim = sequence
+    simulate_urban_canyon(tmp_path / "again", sim.config)
     first, second = _files(out), _files(tmp_path / "again")
     assert first.keys() == second.keys()
     assert [k for k in first if first[k] != second[k]] == ["sequence.yaml"]

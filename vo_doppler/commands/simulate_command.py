@@ -70,7 +70,8 @@ def register(subparsers) -> None:
         "--calib-error",
         type=_triple,
         default=(defaults.calib_focal_error, *defaults.calib_principal_offset_px),
-        help="written-calibration error FOCAL_FRACTION,DCX_PX,DCY_PX (0,0,0: exact)",
+        help="written-calibration error FOCAL_FRACTION,DCX_PX,DCY_PX (default 0,0,0: exact; "
+        "e.g. -0.01,3,-2 for a realistic VO heading drift)",
     )
     parser.add_argument("--blocks", type=_int_pair, default=city.blocks, help="NX,NY blocks")
     parser.add_argument("--block-size", type=_pair, default=city.block_size_m, help="X,Y m")

@@ -12,8 +12,8 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     image_0/000000.png …     grey frames (``camera.fps``, default 15 Hz; .png or .jpg)
     times.txt                one frame time per line, camera clock (s, first frame at 0)
     calib.yaml               camera calibration (Camera.to_yaml: intrinsics + camera→vehicle),
-                             with a deliberate calibration error (default: focal −1 %,
-                             principal point +3/−2 px; true values in sequence.yaml ``truth``)
+                             exact by default; ``calib_focal_error`` / ``calib_principal_offset_px``
+                             write a deliberately wrong one (true values in ``truth.camera``)
     gnss/rover.obs           RINEX 3.04 observations, 20 Hz: C1C D1C S1C, GPS + Galileo
     gnss/brdc.nav            RINEX 3.04 navigation (GPS + Galileo Keplerian, Klobuchar)
     gnss/visibility.csv      truth per epoch: gps_time_s,n_above_mask,n_direct,n_reflected
@@ -134,8 +134,8 @@ class UrbanCanyonConfig:
     image_format: str = "png"
     jpeg_quality: int = 90
     image_noise: float = 2.0
-    calib_focal_error: float = -0.01
-    calib_principal_offset_px: tuple[float, float] = (3.0, -2.0)
+    calib_focal_error: float = 0.0
+    calib_principal_offset_px: tuple[float, float] = (0.0, 0.0)
     render: bool = True
     start_gps_s: float = DEFAULT_START_GPS_S
     origin: tuple[float, float, float] = SHINJUKU
