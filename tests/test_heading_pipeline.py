@@ -73,14 +73,17 @@ def test_causal_calibration_holds_and_overrides():
     valid = t < 15.0
     yaw = np.zeros(len(t))
     phi = 0.01 * t  # bias 0.01 rad/s, no real turn
-    bias, scale = causal_calibration(t, speed, yaw, valid, speed / 1.1, phi)
+    cal = causal_calibration(t, speed, yaw, valid, speed / 1.1, phi)
+    bias, scale = cal.bias, cal.scale
     assert bias[0] == 0.0 and scale[0] == 1.0  # nothing estimated yet
     np.testing.assert_allclose(bias[-1], 0.01, atol=1e-12)
     np.testing.assert_allclose(scale[-1], 1.1, atol=1e-12)
     np.testing.assert_array_equal(bias[15:], bias[14])  # held once Doppler is gone
     fixed = HeadingPipelineConfig(fixed_gyro_bias=0.02, fixed_wheel_scale=0.9)
-    bias, scale = causal_calibration(t, speed, yaw, valid, speed, phi, fixed)
+    cal = causal_calibration(t, speed, yaw, valid, speed, phi, fixed)
+    bias, scale = cal.bias, cal.scale
     assert np.all(bias == 0.02) and np.all(scale == 0.9)
     kalman = HeadingPipelineConfig(calibration="kalman")
-    bias, scale = causal_calibration(t, speed, yaw, valid, speed / 1.1, phi, kalman)
+    cal = causal_calibration(t, speed, yaw, valid, speed / 1.1, phi, kalman)
+    bias, scale = cal.bias, cal.scale
     assert abs(bias[-1] - 0.01) < 1e-3 and abs(scale[-1] - 1.1) < 1e-3

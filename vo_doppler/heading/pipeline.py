@@ -3,8 +3,14 @@ the tightly coupled heading (sec. 3.5), with the conventional heading (sec. 3.2)
 
 Calibration is causal: at each GNSS epoch the wheel scale and gyro bias are refreshed from the
 conventional Doppler speed and course of the epochs so far (stored recent data), and the
-estimates current at an epoch calibrate the sensors from that epoch to the next. Before the
-first estimate, and while none can be made, scale 1 and bias 0 (or the last estimate) hold.
+estimates current at an epoch calibrate the sensors from that epoch to the next. Only
+conventional velocities precise enough (``calibration_max_velocity_sigma_mps``) calibrate: with
+four satellites and a poor geometry a "valid" velocity can be metres per second off. The
+least-squares estimates are combined with a prior (scale 1, bias 0, with the spread of
+uncalibrated sensors), so that a fit over a few samples cannot swing the bias to tens of
+degrees per second; before the first estimate, and while none can be made, the prior (or the
+last estimate) holds. The standard deviations of the calibration go to the tightly coupled
+solver, which propagates them into each heading's standard deviation.
 """
 
 from __future__ import annotations
@@ -38,6 +44,13 @@ class HeadingPipelineConfig:
     gate: GateConfig = field(default_factory=GateConfig)
     tight: TightHeadingConfig = field(default_factory=TightHeadingConfig)
     conventional_min_speed_mps: float = 0.5
+    calibration_max_velocity_sigma_mps: float = 2.0
+    """Conventional velocities with a larger standard deviation (√trace of the 3-D velocity
+    covariance) do not calibrate."""
+    prior_gyro_bias_sigma: float = np.radians(0.5)
+    """Spread of an uncalibrated gyro bias about zero (rad/s)."""
+    prior_wheel_scale_sigma: float = 0.03
+    """Spread of an uncalibrated wheel scale about one."""
     fixed_gyro_bias: float | None = None
     fixed_wheel_scale: float | None = None
 
@@ -99,6 +112,27 @@ def _calibrators(config: HeadingPipelineConfig):
     raise ValueError(f"unknown calibration {config.calibration!r} ({CALIBRATION_METHODS})")
 
 
+@dataclass
+class CalibrationSeries:
+    """Gyro bias (rad/s) and wheel scale current at each epoch, with standard deviations."""
+
+    bias: np.ndarray
+    scale: np.ndarray
+    bias_sigma: np.ndarray
+    scale_sigma: np.ndarray
+
+
+def _with_prior(estimate, prior: float, prior_sigma: float) -> tuple[float, float]:
+    """Inverse-variance combination of an estimate with the prior (the prior alone if none)."""
+    if not estimate.valid:
+        return prior, prior_sigma
+    var_e, var_p = estimate.sigma**2, prior_sigma**2
+    if var_e + var_p == 0:
+        return estimate.value, 0.0
+    value = (estimate.value * var_p + prior * var_e) / (var_e + var_p)
+    return value, float(np.sqrt(var_e * var_p / (var_e + var_p)))
+
+
 def causal_calibration(
     t_epoch: np.ndarray,
     doppler_speed: np.ndarray,
@@ -107,27 +141,33 @@ def causal_calibration(
     wheel_speed: np.ndarray,
     raw_yaw_angle: np.ndarray,
     config: HeadingPipelineConfig = HeadingPipelineConfig(),
-) -> tuple[np.ndarray, np.ndarray]:
-    """Gyro bias (rad/s) and wheel scale current at each epoch, refreshed epoch by epoch."""
+) -> CalibrationSeries:
+    """Gyro bias and wheel scale current at each epoch, refreshed epoch by epoch, with their
+    standard deviations (least squares: combined with the prior; fixed values: zero)."""
     m = len(t_epoch)
-    bias = np.zeros(m)
-    scale = np.ones(m)
+    out = CalibrationSeries(np.zeros(m), np.ones(m), np.zeros(m), np.zeros(m))
     bias_cal, scale_cal = _calibrators(config)
-    current_bias, current_scale = 0.0, 1.0
+    current_bias = (0.0, config.prior_gyro_bias_sigma)
+    current_scale = (1.0, config.prior_wheel_scale_sigma)
     for k in range(m):
         if bias_cal is not None:
             b = bias_cal.add(
                 t_epoch[k], doppler_yaw[k], raw_yaw_angle[k], doppler_speed[k], doppler_valid[k]
             )
             s = scale_cal.add(t_epoch[k], doppler_speed[k], wheel_speed[k], doppler_valid[k])
-            current_bias = b.value if b.valid else current_bias
-            current_scale = s.value if s.valid else current_scale
-        bias[k], scale[k] = current_bias, current_scale
+            if config.calibration == "ls":
+                current_bias = _with_prior(b, 0.0, config.prior_gyro_bias_sigma)
+                current_scale = _with_prior(s, 1.0, config.prior_wheel_scale_sigma)
+            else:
+                current_bias = (b.value, b.sigma) if b.valid else current_bias
+                current_scale = (s.value, s.sigma) if s.valid else current_scale
+        out.bias[k], out.bias_sigma[k] = current_bias
+        out.scale[k], out.scale_sigma[k] = current_scale
     if config.fixed_gyro_bias is not None:
-        bias[:] = config.fixed_gyro_bias
+        out.bias[:], out.bias_sigma[:] = config.fixed_gyro_bias, 0.0
     if config.fixed_wheel_scale is not None:
-        scale[:] = config.fixed_wheel_scale
-    return bias, scale
+        out.scale[:], out.scale_sigma[:] = config.fixed_wheel_scale, 0.0
+    return out
 
 
 def heading_pipeline(
@@ -138,29 +178,41 @@ def heading_pipeline(
     speed: SensorSeries,
     yaw_rate: SensorSeries,
     config: HeadingPipelineConfig = HeadingPipelineConfig(),
+    conventional_sigma_mps: np.ndarray | None = None,
 ) -> HeadingTable:
-    """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise)."""
+    """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise).
+
+    ``conventional_sigma_mps``: standard deviation of each conventional velocity (√trace of
+    its covariance); when given, only velocities within ``calibration_max_velocity_sigma_mps``
+    calibrate the sensors.
+    """
     t_epoch = np.asarray(t_epoch, dtype=float)
     velocity = np.asarray(conventional_velocity_enu, dtype=float).reshape(-1, 3)
     conv_yaw, conv_ok = heading_from_velocity(
         velocity, conventional_valid, config.conventional_min_speed_mps
     )
-    conv_speed = np.where(conventional_valid, np.linalg.norm(velocity, axis=1), np.nan)
+    # Horizontal speed: the tightly coupled model's velocity is horizontal, and the vertical
+    # component of a canyon fix is noisy (large VDOP), which would bias |v| and the scale up.
+    conv_speed = np.where(conventional_valid, np.hypot(velocity[:, 0], velocity[:, 1]), np.nan)
+    calibrating = np.asarray(conventional_valid, bool).copy()
+    if conventional_sigma_mps is not None:
+        sigma = np.nan_to_num(np.asarray(conventional_sigma_mps, dtype=float), nan=np.inf)
+        calibrating &= sigma <= config.calibration_max_velocity_sigma_mps
     wheel = sample_at(speed.t, speed.value, t_epoch)
     raw_angle = integrate_rate(yaw_rate.t, yaw_rate.value, t_epoch)
-    bias, scale = causal_calibration(
-        t_epoch,
-        conv_speed,
-        conv_yaw,
-        np.asarray(conventional_valid, bool),
-        wheel,
-        raw_angle,
-        config,
-    )
+    cal = causal_calibration(t_epoch, conv_speed, conv_yaw, calibrating, wheel, raw_angle, config)
     # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
-    bias_integral = np.concatenate([[0.0], np.cumsum(bias[:-1] * np.diff(t_epoch))])[: len(bias)]
-    yaw_angle = raw_angle - bias_integral
-    result = tight_heading_series(rows, t_epoch, scale * wheel, yaw_angle, config.tight)
+    steps = cal.bias[:-1] * np.diff(t_epoch)
+    yaw_angle = raw_angle - np.concatenate([[0.0], np.cumsum(steps)])[: len(t_epoch)]
+    result = tight_heading_series(
+        rows,
+        t_epoch,
+        cal.scale * wheel,
+        yaw_angle,
+        config.tight,
+        speed_scale_sigma=cal.scale_sigma / cal.scale,
+        gyro_bias_sigma=cal.bias_sigma,
+    )
     return HeadingTable(
         t=t_epoch,
         yaw_tc=result.yaw,
@@ -170,6 +222,6 @@ def heading_pipeline(
         n_sat_epoch=result.n_sat_epoch,
         yaw_conv=conv_yaw,
         conv_valid=conv_ok,
-        gyro_bias=bias,
-        wheel_scale=scale,
+        gyro_bias=cal.bias,
+        wheel_scale=cal.scale,
     )

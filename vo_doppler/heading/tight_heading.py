@@ -18,7 +18,14 @@ both, Gauss–Newton refines them, and iteratively re-weighted passes apply Hube
 minima that fit equally well (e.g. two satellites on a straight road) make the window
 *ambiguous*: the one nearer the previous heading propagated by the gyro is kept, or the epoch
 is unavailable. The θ₀ variance is s²/(J_θᵀ P J_θ) (the marginal of the full covariance),
-s² the a-posteriori variance factor. Every window is solved at once with numpy.
+s² the a-posteriori variance factor, or more where the profiled cost is not a parabola (a flat
+side, a near second minimum: the Δcost = n²·s² intervals, n = 1 … 3, are read off the cost),
+plus the errors that white Doppler noise does not cover:
+the uncertainty of the speed scale and gyro bias calibration and the random walk of the clock
+drift about its linear model, propagated through the least-squares gain. Those are
+correlated over the window (one scale, one bias, one clock path), so the residuals cannot
+reveal them, and with one or two satellites they dominate. Every window is solved at once
+with numpy.
 
 Reliability (sec. 3.5): the heading at epoch k is compared with the headings of the previous
 epochs of the last ``reliability_epochs`` propagated by the gyro; it is reliable when enough of
@@ -59,6 +66,10 @@ class TightHeadingConfig:
     reliability_n_sigma: float = 3.0
     epoch_match_s: float = 1e-3
     chunk_windows: int = 2048
+    profile_step_rad: float = np.radians(0.25)
+    profile_max_rad: float = np.radians(30.0)
+    clock_drift_walk_mps: float = 0.01
+    """Random walk of the receiver clock drift (m/s per √s) that the linear model leaves out."""
 
 
 @dataclass
@@ -94,6 +105,10 @@ class _WindowSolution:
     rho0: np.ndarray
     alpha: np.ndarray
     n_obs: np.ndarray
+    profile_sigma: np.ndarray
+    scale_gain: np.ndarray
+    bias_gain: np.ndarray
+    clock_walk_gain: np.ndarray
 
 
 def _projected_normal_matrix(X, T, w):
@@ -183,6 +198,7 @@ def solve_windows(y, a, b, tau, w, config: TightHeadingConfig = TightHeadingConf
     mean_w = np.sum(w, axis=1) / np.maximum(n_obs, 1)
     floor = config.sigma_floor_mps**2 * mean_w
     posterior = np.where(dof > 0, np.maximum(cost, 0) / np.maximum(dof, 1), 1.0)
+    variance_factor = np.maximum(posterior, floor)
     return _WindowSolution(
         theta=theta,
         theta_second=np.where(np.isfinite(cost2), theta2, np.nan),
@@ -190,11 +206,69 @@ def solve_windows(y, a, b, tau, w, config: TightHeadingConfig = TightHeadingConf
         cost_second=cost2,
         info=_quadratic(Q, dz, dz),
         info_raw=_quadratic(XtWX, dz, dz),
-        variance_factor=np.maximum(posterior, floor),
+        variance_factor=variance_factor,
+        profile_sigma=_profile_sigma(Q, theta, cost, variance_factor, config),
         rho0=params[:, 0],
         alpha=params[:, 1],
         n_obs=n_obs,
+        **_error_gains(a, b, tau, weights, theta),
     )
+
+
+def _profile_sigma(Q, theta, cost, variance_factor, config):
+    """Standard deviation of θ₀ read off the profiled cost: max over n of w_n / n, with w_n the
+    largest distance from θ₀ at which the cost is still within n² variance factors of its
+    minimum (n = 1 … 3).
+
+    The cost is a trigonometric polynomial of θ₀, not a parabola: with one or two satellites
+    it can be flat on one side of the minimum, or have a second minimum nearby that fits
+    almost as well, so the curvature at the minimum overstates the precision and an error of
+    "five sigmas" is not rare. For a quadratic cost every w_n / n equals the curvature's σ; a
+    flat side or a near second minimum makes one of them larger. The distances are found on a
+    grid of ``profile_step_rad`` both sides, up to ``profile_max_rad``.
+    """
+    offsets = np.arange(0, round(config.profile_max_rad / config.profile_step_rad) + 1)
+    offsets = offsets * config.profile_step_rad
+    rows = np.arange(len(Q))
+    width = np.zeros(len(Q))
+    for side in (-1.0, 1.0):
+        Z = _z(np.nan_to_num(theta)[:, None] + side * offsets[None, :])
+        rise = (np.einsum("kgi,kij,kgj->kg", Z, Q, Z) - cost[:, None]) / variance_factor[:, None]
+        rise[:, 0] = 0.0
+        for n in (1.0, 2.0, 3.0):
+            inside = rise < n**2
+            last = len(offsets) - 1 - np.argmax(inside[:, ::-1], axis=1)
+            after = np.minimum(last + 1, len(offsets) - 1)
+            step = np.maximum(rise[rows, after] - rise[rows, last], 1e-300)
+            fraction = np.clip((n**2 - rise[rows, last]) / step, 0.0, 1.0)
+            reach = offsets[last] + fraction * (offsets[after] - offsets[last])
+            width = np.maximum(width, reach / n)
+    return width
+
+
+def _error_gains(a, b, tau, weights, theta):
+    """How errors the noise model leaves out move θ₀, per window (linearised at θ₀).
+
+    The weighted least-squares gain g = e₀ᵀ(JᵀWJ)⁺JᵀW of θ₀ (J = ∂model/∂(θ₀, ρ₀, α)) maps
+    a model error δm to δθ₀ = g·δm. A relative speed-scale error ε gives δm = ε·(a cos θ₀ +
+    b sin θ₀); a yaw-rate bias error δb rotates row t by −δb·τ, δm = −δb·τ·J_θ; a clock drift
+    that random-walks with unit intensity adds ∫ (Σ_{t_i ≥ s} g_i)² ds to var θ₀ (Brownian
+    covariance min(s, t) − t_start, with the constant and linear parts absorbed by ρ₀ and α).
+    """
+    # Windows without a solution (no rows, or no yaw at their end) are unavailable anyway.
+    theta, a, b, weights = (np.nan_to_num(x) for x in (theta, a, b, weights))
+    cos_t, sin_t = np.cos(theta)[:, None], np.sin(theta)[:, None]
+    j_theta = -a * sin_t + b * cos_t
+    J = np.stack([j_theta, np.ones_like(tau), -tau], axis=-1)
+    normal_inv = np.linalg.pinv(np.einsum("kri,kr,krj->kij", J, weights, J), hermitian=True)
+    g = np.einsum("kj,krj,kr->kr", normal_inv[:, 0, :], J, weights)
+    tail = np.cumsum(g[:, ::-1], axis=1)[:, ::-1]
+    step = np.diff(tau, axis=1, prepend=tau[:, :1])
+    return {
+        "scale_gain": np.sum(g * (a * cos_t + b * sin_t), axis=1),
+        "bias_gain": -np.sum(g * tau * j_theta, axis=1),
+        "clock_walk_gain": np.sum(np.maximum(step, 0.0) * tail**2, axis=1),
+    }
 
 
 def _robust_scale(normalised, w, config):
@@ -223,16 +297,23 @@ def tight_heading_series(
     speed: np.ndarray,
     yaw_angle: np.ndarray,
     config: TightHeadingConfig = TightHeadingConfig(),
+    speed_scale_sigma: np.ndarray | float = 0.0,
+    gyro_bias_sigma: np.ndarray | float = 0.0,
 ) -> TightHeadingResult:
     """Heading at every epoch from the window of Doppler rows ending there (sec. 3.5).
 
     ``speed`` (m/s) and ``yaw_angle`` Φ (rad, integral of the calibrated counter-clockwise yaw
-    rate) are given per epoch; rows are matched to epochs by time.
+    rate) are given per epoch; rows are matched to epochs by time. ``speed_scale_sigma``
+    (relative) and ``gyro_bias_sigma`` (rad/s), per epoch or scalars, are the uncertainties of
+    the calibration behind them; they enter the heading's standard deviation together with
+    the Doppler noise and the clock-drift random walk (``config.clock_drift_walk_mps``).
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     speed = np.asarray(speed, dtype=float)
     yaw_angle = np.asarray(yaw_angle, dtype=float)
     m = len(t_epoch)
+    scale_sigma = np.broadcast_to(np.asarray(speed_scale_sigma, dtype=float), (m,))
+    bias_sigma = np.broadcast_to(np.asarray(gyro_bias_sigma, dtype=float), (m,))
     if np.any(np.diff(t_epoch) <= 0):
         raise ValueError("epoch times must be strictly increasing")
     if m == 0:
@@ -264,7 +345,12 @@ def tight_heading_series(
             )
         )
     solution = _concatenate(solutions)
-    return _decide(solution, t_epoch, speed, yaw_angle, n_sat_epoch, config)
+    model_variance = (
+        (solution.scale_gain * scale_sigma) ** 2
+        + (solution.bias_gain * bias_sigma) ** 2
+        + solution.clock_walk_gain * config.clock_drift_walk_mps**2
+    )
+    return _decide(solution, model_variance, t_epoch, speed, yaw_angle, n_sat_epoch, config)
 
 
 def _solve_chunk(rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_angle, config):
@@ -301,10 +387,15 @@ def _concatenate(solutions):
     )
 
 
-def _decide(sol, t_epoch, speed, yaw_angle, n_sat_epoch, config) -> TightHeadingResult:
+def _decide(
+    sol, model_variance, t_epoch, speed, yaw_angle, n_sat_epoch, config
+) -> TightHeadingResult:
+    """Availability, ambiguity resolution and reliability; σ from the noise (s²/info) plus
+    ``model_variance``, the calibration and clock errors the model leaves out."""
     m = len(t_epoch)
     with np.errstate(divide="ignore", invalid="ignore"):
-        sigma = np.sqrt(sol.variance_factor / sol.info)
+        noise_variance = np.maximum(sol.variance_factor / sol.info, sol.profile_sigma**2)
+        sigma = np.sqrt(noise_variance + model_variance)
         observable = (sol.info > 0) & (sol.info >= config.observability_ratio * sol.info_raw)
         chi2_gap = (sol.cost_second - sol.cost) / sol.variance_factor
     separated = (
