@@ -18,12 +18,8 @@ $(TEST_STAMP): $(BIN)/python pyproject.toml
 	$(BIN)/pip install --quiet -e ".[test]"
 	touch $(STAMP) $(TEST_STAMP)
 
-DEMO_SEQ := out/demo/sequence
-
 demo: $(STAMP)
-	$(BIN)/python -m vo_doppler.sim.vo_sequence $(DEMO_SEQ) --duration 20 --fps 10 --seed 1
-	$(BIN)/vo-doppler vo $(DEMO_SEQ)/image_0 --calib $(DEMO_SEQ)/calib.yaml \
-		--speed $(DEMO_SEQ)/speed.csv --gt $(DEMO_SEQ)/ground_truth_camera.kitti -o out/demo
+	$(BIN)/vo-doppler run sample_sequences/urban_canyon_small -o out/demo
 
 test: $(TEST_STAMP)
 	$(BIN)/python -m pytest -q

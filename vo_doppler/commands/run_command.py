@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -56,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
         elevation_mask_deg=args.elev_mask,
         vo=VoConfig(window_size=args.window),
     )
-    console = Console()
+    console = Console(width=None if sys.stdout.isatty() else 150)
     console.print(
         f"{inputs.name}: {len(inputs.image_paths)} images, "
         f"{len(inputs.observations.epoch_time)} GNSS epochs, {len(inputs.wheel_speed)} wheel "
