@@ -150,6 +150,7 @@ def run(args: argparse.Namespace) -> int:
         speed,
         yaw_rate,
         config,
+        conventional_sigma_mps=conventional.sigma_mps,
     )
     args.output.parent.mkdir(parents=True, exist_ok=True)
     write_heading_csv(args.output, table)

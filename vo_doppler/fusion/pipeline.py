@@ -175,9 +175,7 @@ def run_pipeline(
         inputs.wheel_speed,
         inputs.yaw_rate,
         config.heading,
-        conventional_sigma_mps=np.sqrt(
-            np.trace(gnss.velocity.covariance[:, :3, :3], axis1=1, axis2=2)
-        ),
+        conventional_sigma_mps=gnss.velocity.sigma_mps,
     )
     speed = calibrated_speed(inputs.wheel_speed, table)
     vo = run_visual_odometry(

@@ -117,6 +117,11 @@ class VelocitySolution:
         return np.linalg.norm(self.velocity_enu, axis=1)
 
     @property
+    def sigma_mps(self) -> np.ndarray:
+        """√trace of the velocity covariance (m/s): one figure of each fix's precision."""
+        return np.sqrt(np.trace(self.covariance[:, :3, :3], axis1=1, axis2=2))
+
+    @property
     def course_deg(self) -> np.ndarray:
         """Course over ground, degrees clockwise from north in [0, 360)."""
         e, n = self.velocity_enu[:, 0], self.velocity_enu[:, 1]
