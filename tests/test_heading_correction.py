@@ -286,3 +286,16 @@ def test_any_constant_offset_is_removed_exactly(offset, yaw0):
     expected = gt.matrices.copy()
     expected[:, :3, 3] -= gt.positions[0]
     np.testing.assert_allclose(result.vehicle.matrices, expected, atol=1e-9)
+
+
+def test_innovation_gate_ignores_an_outlier_burst_once_established():
+    t, yaw, gt = _ground_truth()
+    corrupted = yaw.copy()
+    burst = (t > 8.0) & (t < 9.0)
+    corrupted[burst] += np.radians(40.0)
+    expected = gt.matrices.copy()
+    expected[:, :3, 3] -= gt.positions[0]
+    gated = correct_heading(_vo_output(gt), t, corrupted, gate_rad=np.radians(10.0))
+    _assert_equal_poses(gated.vehicle, expected, atol=1e-9)
+    ungated = correct_heading(_vo_output(gt), t, corrupted)
+    assert np.max(np.abs(wrap_angle(yaw_of(ungated.vehicle.matrices[:, :3, :3]) - yaw))) > 0.1

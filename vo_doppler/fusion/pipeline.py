@@ -69,8 +69,9 @@ class PipelineConfig:
     heading: HeadingPipelineConfig = field(default_factory=HeadingPipelineConfig)
     vo: VoConfig = field(default_factory=VoConfig)
     correction_window_s: float = 2.0
-    correction_gate_deg: float = 10.0
-    """Absolute headings this far from the corrected VO heading are not used (0 = no gate)."""
+    correction_gate_deg: float = 0.0
+    """If > 0, absolute headings this far from the corrected VO heading are not used. Off by
+    default: a wrong first heading would then lock out the right ones (sec. 3.6 has no gate)."""
     tc_max_sigma_deg: float = 2.0
     """Tightly coupled headings with a larger standard deviation do not correct."""
     dead_reckoning_rate_hz: float = 20.0
