@@ -87,3 +87,30 @@ def test_causal_calibration_holds_and_overrides():
     cal = causal_calibration(t, speed, yaw, valid, speed / 1.1, phi, kalman)
     bias, scale = cal.bias, cal.scale
     assert abs(bias[-1] - 0.01) < 1e-3 and abs(scale[-1] - 1.1) < 1e-3
+
+
+def test_conventional_speeds_far_from_the_wheel_speed_do_not_calibrate():
+    t, scenario, velocity = _drive()
+    rng = np.random.default_rng(6)
+    conv_velocity = velocity + rng.normal(0.0, 0.03, velocity.shape)
+    reflected = rng.random(len(t)) < 0.2  # NLOS-like bursts: speed 40 % too high
+    conv_velocity[reflected] *= 1.4
+    t_gyro, rate = gyro_from_heading(
+        t, scenario.yaw, np.ones(len(t), bool), 0.0, np.radians(0.05), rate_hz=50.0
+    )
+    wheel = SensorSeries(t, scenario.speed / 1.03)
+    valid = np.ones(len(t), bool)
+    gated = heading_pipeline(
+        t, scenario.rows, conv_velocity, valid, wheel, SensorSeries(t_gyro, rate)
+    )
+    assert abs(gated.wheel_scale[-1] / 1.03 - 1.0) < 0.003
+    ungated = heading_pipeline(
+        t,
+        scenario.rows,
+        conv_velocity,
+        valid,
+        wheel,
+        SensorSeries(t_gyro, rate),
+        HeadingPipelineConfig(calibration_max_speed_mismatch_mps=np.inf),
+    )
+    assert abs(ungated.wheel_scale[-1] / 1.03 - 1.0) > 0.02

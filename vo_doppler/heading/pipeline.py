@@ -47,6 +47,11 @@ class HeadingPipelineConfig:
     calibration_max_velocity_sigma_mps: float = 2.0
     """Conventional velocities with a larger standard deviation (√trace of the 3-D velocity
     covariance) do not calibrate."""
+    calibration_max_speed_mismatch_mps: float = 0.5
+    calibration_max_speed_mismatch_ratio: float = 0.1
+    """A conventional speed further than max(these, as m/s and as a fraction) from the raw wheel
+    speed does not calibrate: wheel scale errors are a few per cent, a reflected (NLOS) Doppler
+    is often far more."""
     prior_gyro_bias_sigma: float = np.radians(0.5)
     """Spread of an uncalibrated gyro bias about zero (rad/s)."""
     prior_wheel_scale_sigma: float = 0.03
@@ -199,6 +204,11 @@ def heading_pipeline(
         sigma = np.nan_to_num(np.asarray(conventional_sigma_mps, dtype=float), nan=np.inf)
         calibrating &= sigma <= config.calibration_max_velocity_sigma_mps
     wheel = sample_at(speed.t, speed.value, t_epoch)
+    tolerance = np.maximum(
+        config.calibration_max_speed_mismatch_mps,
+        config.calibration_max_speed_mismatch_ratio * np.abs(wheel),
+    )
+    calibrating &= np.abs(np.nan_to_num(conv_speed - wheel, nan=np.inf)) <= tolerance
     raw_angle = integrate_rate(yaw_rate.t, yaw_rate.value, t_epoch)
     cal = causal_calibration(t_epoch, conv_speed, conv_yaw, calibrating, wheel, raw_angle, config)
     # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
