@@ -5,10 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import evaluate
 from vo_doppler.sim.vo_sequence import simulate_vo
 from vo_doppler.trajectory import Trajectory
 from vo_doppler.vo.batch import run_visual_odometry
+from vo_doppler.vo.odometry import VisualOdometry
 
 CAMERA_UP = np.array([0.0, -1.0, 0.0])
 
@@ -40,3 +42,13 @@ def test_unscaled_vo_is_declared_and_similar_up_to_scale(drive):
     assert not output.metric
     aligned = evaluate(output.trajectory, truth.subset(slice(0, 40)), "sim3", CAMERA_UP)
     assert aligned.ate_rmse_m < 0.01 * truth.subset(slice(0, 40)).path_length
+
+
+def test_streaming_rejects_times_that_do_not_increase(drive):
+    vo = VisualOdometry(drive.plan.camera)
+    vo.process(drive.images[0], 1.0)
+    with pytest.raises(InputError, match=r"frame 1: time 1.0 is not after"):
+        vo.process(drive.images[1], 1.0)
+    with pytest.raises(InputError, match="frame 1: time nan"):
+        vo.process(drive.images[1], float("nan"))
+    assert vo.process(drive.images[1], 1.1).index == 1

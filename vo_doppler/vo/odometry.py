@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vo_doppler.errors import InputError
 from vo_doppler.vo.camera import Camera
 from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.geometry import (
@@ -128,6 +129,9 @@ class VisualOdometry:
     def process(self, image: np.ndarray | None, t: float) -> FrameResult:
         """Estimate the pose of one image (``None`` = unreadable) taken at time ``t``."""
         index = self._frames_seen
+        last = self._window[-1].t if self._window else None
+        if not np.isfinite(t) or (last is not None and t <= last):
+            raise InputError(f"frame {index}: time {t!r} is not after the previous frame's {last}")
         self._frames_seen += 1
         frame = _Frame(index, float(t), self._predict(), TrackedFeatures.empty(), False)
         problem = self._image_problem(image)
