@@ -9,8 +9,10 @@ from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import evaluate
 from vo_doppler.sim.vo_sequence import simulate_vo
 from vo_doppler.trajectory import Trajectory
+from vo_doppler.vo.baseline import FrameToFrameVO
 from vo_doppler.vo.batch import run_visual_odometry
 from vo_doppler.vo.odometry import VisualOdometry
+from vo_doppler.vo.scale import metric_positions
 
 CAMERA_UP = np.array([0.0, -1.0, 0.0])
 
@@ -52,3 +54,14 @@ def test_streaming_rejects_times_that_do_not_increase(drive):
     with pytest.raises(InputError, match="frame 1: time nan"):
         vo.process(drive.images[1], float("nan"))
     assert vo.process(drive.images[1], 1.1).index == 1
+
+
+def test_frame_to_frame_baseline_follows_a_straight_stretch(drive):
+    plan = drive.plan
+    truth = Trajectory.from_matrices(plan.times, plan.T_first_camera).subset(slice(0, 30))
+    baseline = FrameToFrameVO(plan.camera.K)
+    poses = np.array([baseline.process(image) for image in list(drive.images)[:30]])
+    steps = np.linalg.norm(np.diff(truth.positions, axis=0), axis=1) / np.diff(truth.t)
+    poses[:, :3, 3] = metric_positions(poses, truth.t, truth.t, np.r_[steps[0], steps])
+    errors = evaluate(Trajectory.from_matrices(truth.t, poses), truth, "start", CAMERA_UP)
+    assert errors.final_drift_pct < 3.0
