@@ -4,10 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
+from matplotlib.figure import Figure
 
 from vo_doppler.trajectory import Trajectory
 
@@ -23,7 +20,8 @@ def plot_top_view(
 ) -> None:
     """Plot each trajectory's positions on ``plane`` (horizontal, vertical axis names)."""
     h, v = AXIS_INDEX[plane[0]], AXIS_INDEX[plane[1]]
-    fig, ax = plt.subplots(figsize=(7, 6), dpi=110)
+    fig = Figure(figsize=(7, 6), dpi=110)
+    ax = fig.subplots()
     for label, trajectory in trajectories.items():
         if not len(trajectory):
             continue
@@ -39,4 +37,3 @@ def plot_top_view(
         ax.set_title(title)
     fig.tight_layout()
     fig.savefig(path)
-    plt.close(fig)
