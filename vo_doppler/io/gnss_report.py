@@ -5,11 +5,8 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from vo_doppler.geo import EnuFrame, ecef_to_geodetic
@@ -115,7 +112,8 @@ def write_spp_csv(path: str | Path, solution: SppSolution) -> None:
 def velocity_figure(path: str | Path, solution: VelocitySolution, title: str = "") -> None:
     """Speed, course and satellite count over time (PNG)."""
     t = solution.t - solution.t[0] if solution.t.size else solution.t
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7))
+    fig = Figure(figsize=(9, 7))
+    axes = fig.subplots(3, 1, sharex=True)
     axes[0].plot(t, solution.speed_mps, ".-", ms=3)
     axes[0].set_ylabel("speed (m/s)")
     course = np.where(solution.speed_mps > 0.2, solution.course_deg, np.nan)
@@ -137,7 +135,8 @@ def velocity_figure(path: str | Path, solution: VelocitySolution, title: str = "
 def spp_figure(path: str | Path, solution: SppSolution, title: str = "") -> None:
     """East/north/up about the median fix and satellite count over time (PNG)."""
     t = solution.t - solution.t[0] if solution.t.size else solution.t
-    fig, axes = plt.subplots(2, 1, sharex=True, figsize=(9, 6))
+    fig = Figure(figsize=(9, 6))
+    axes = fig.subplots(2, 1, sharex=True)
     if solution.valid.any():
         frame = EnuFrame.from_ecef(np.median(solution.position_ecef[solution.valid], axis=0))
         enu = frame.ecef_to_enu(solution.position_ecef)
@@ -158,4 +157,3 @@ def _save(fig, path: str | Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
-    plt.close(fig)
