@@ -299,3 +299,18 @@ def test_innovation_gate_ignores_an_outlier_burst_once_established():
     _assert_equal_poses(gated.vehicle, expected, atol=1e-9)
     ungated = correct_heading(_vo_output(gt), t, corrupted)
     assert np.max(np.abs(wrap_angle(yaw_of(ungated.vehicle.matrices[:, :3, :3]) - yaw))) > 0.1
+
+
+def test_course_reference_is_immune_to_an_extrinsic_yaw_error():
+    t, yaw, gt = _ground_truth()
+    skewed = FORWARD_CAMERA_TO_VEHICLE.copy()
+    skewed[:3, :3] = Rotation.from_euler("z", 2.0, degrees=True).as_matrix() @ skewed[:3, :3]
+    vo = _vo_output(gt, skewed)
+    expected = gt.positions - gt.positions[0]
+    by_course = correct_heading(vo, t, yaw, reference="course")
+    np.testing.assert_allclose(by_course.vehicle.positions, expected, atol=1e-9)
+    by_orientation = correct_heading(vo, t, yaw)
+    error = np.linalg.norm(by_orientation.vehicle.positions - expected, axis=1)
+    assert error.max() > 1.0
+    with pytest.raises(ValueError, match="reference must be"):
+        correct_heading(vo, t, yaw, reference="sideways")

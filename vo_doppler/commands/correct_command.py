@@ -40,6 +40,13 @@ def register(subparsers) -> None:
     parser.add_argument("--world", choices=("first_camera", "level"), default="first_camera")
     parser.add_argument("--body", choices=("vehicle", "camera"), default="vehicle")
     parser.add_argument("--max-gap-s", type=float, default=1.5)
+    parser.add_argument(
+        "--reference",
+        choices=("course", "orientation"),
+        default="course",
+        help="compare the absolute heading with the VO's direction of travel (course, default) "
+        "or with its orientation yaw (sec. 3.6 as written)",
+    )
     parser.add_argument("-o", "--output", required=True, help="corrected trajectory (.tum/.kitti)")
     parser.set_defaults(func=run)
 
@@ -70,7 +77,15 @@ def run(args: argparse.Namespace) -> int:
             args.trajectory,
         )
     result = correct_heading(
-        trajectory, table.t, yaw, valid, args.window_s, extrinsic, args.world, args.max_gap_s
+        trajectory,
+        table.t,
+        yaw,
+        valid,
+        args.window_s,
+        extrinsic,
+        args.world,
+        args.max_gap_s,
+        reference=args.reference,
     )
     out = result.vehicle if args.body == "vehicle" else result.camera
     output = Path(args.output)

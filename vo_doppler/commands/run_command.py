@@ -47,6 +47,13 @@ def register(subparsers) -> None:
     parser.add_argument("--systems", default="GREJC", help="GNSS systems to use")
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
     parser.add_argument("--window", type=int, default=30, help="VO window (frames)")
+    parser.add_argument(
+        "--reference",
+        choices=("course", "orientation"),
+        default="course",
+        help="heading correction compares the absolute heading with the VO's course (default) "
+        "or its orientation yaw (sec. 3.6 as written)",
+    )
     parser.set_defaults(func=run)
 
 
@@ -56,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
         systems=args.systems.upper(),
         elevation_mask_deg=args.elev_mask,
         vo=VoConfig(window_size=args.window),
+        correction_reference=args.reference,
     )
     console = Console(width=None if sys.stdout.isatty() else 150)
     console.print(

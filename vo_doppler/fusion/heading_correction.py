@@ -99,6 +99,24 @@ def _rz(angle: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def _window_yaw(
+    positions: np.ndarray,
+    rotations: np.ndarray,
+    start: int,
+    stop: int,
+    reference: str,
+    min_step_m: float,
+) -> np.ndarray:
+    """VO yaw of poses start..stop−1: orientation yaw, or the course of the step into each pose
+    (NaN where the step is shorter than ``min_step_m`` or there is none)."""
+    if reference == "orientation":
+        return yaw_of(rotations[start:stop])
+    index = np.arange(start, stop)
+    step = positions[index, :2] - positions[np.maximum(index - 1, 0), :2]
+    moving = np.hypot(step[:, 0], step[:, 1]) >= min_step_m
+    return np.where(moving, np.arctan2(step[:, 1], step[:, 0]), np.nan)
+
+
 def correct_heading(
     camera: Trajectory,
     t_heading: np.ndarray,
@@ -109,6 +127,8 @@ def correct_heading(
     world: str = "first_camera",
     max_gap_s: float = 1.5,
     gate_rad: float | None = None,
+    reference: str = "orientation",
+    min_step_m: float = 0.05,
 ) -> HeadingCorrectionResult:
     """Correct the VO heading with absolute headings (sec. 3.6, Eq. 11–13).
 
@@ -116,10 +136,23 @@ def correct_heading(
     ``valid`` marks the usable samples. With ``gate_rad``, once a first correction has been
     made, absolute headings further than the gate from the corrected VO heading are ignored
     (an innovation gate against wrong but self-consistent absolute solutions).
+
+    ``reference`` is what Eq. (11) compares with the absolute heading: the VO's
+    ``"orientation"`` (vehicle yaw), or its ``"course"``, the direction of each step of at
+    least ``min_step_m`` compared with the absolute heading at the step's middle time. A
+    Doppler heading is a direction of travel, so "course" is immune to a yaw error of the
+    camera→vehicle extrinsic or to a VO whose motion is skewed against its optical axis.
     """
+    if reference not in ("orientation", "course"):
+        raise ValueError(f"reference must be 'orientation' or 'course', not {reference!r}")
     poses = vehicle_poses(camera, camera_to_vehicle, world)
     n = len(poses)
-    absolute, has_absolute = headings_at(camera.t, t_heading, yaw_heading, valid, max_gap_s)
+    t_compare = camera.t
+    if reference == "course" and n:
+        t_compare = np.concatenate([[camera.t[0]], 0.5 * (camera.t[1:] + camera.t[:-1])])
+    absolute, has_absolute = headings_at(t_compare, t_heading, yaw_heading, valid, max_gap_s)
+    if reference == "course" and n:
+        has_absolute[0] = False
     vo_positions = poses[:, :3, 3] - (poses[0, :3, 3] if n else 0.0)
     vo_rotations = poses[:, :3, :3]
     positions = np.zeros((n, 3))
@@ -137,13 +170,14 @@ def correct_heading(
         while camera.t[oldest] <= camera.t[i] - window_s:
             oldest += 1
         window = slice(oldest, i + 1)
-        use = has_absolute[window].copy()
+        vo_yaw = _window_yaw(positions, rotations, oldest, i + 1, reference, min_step_m)
+        use = has_absolute[window] & np.isfinite(vo_yaw)
         if gate_rad is not None and established:
-            innovation = wrap_angle(yaw_of(rotations[window]) - absolute[window])
+            innovation = wrap_angle(vo_yaw - absolute[window])
             use &= np.abs(np.nan_to_num(innovation, nan=np.inf)) < gate_rad
         if use.any():
             established = True
-            difference = wrap_angle(yaw_of(rotations[window][use]) - absolute[window][use])
+            difference = wrap_angle(vo_yaw[use] - absolute[window][use])
             delta = float(np.arctan2(np.mean(np.sin(difference)), np.mean(np.cos(difference))))
             turn = _rz(-delta)
             pivot = positions[oldest].copy()

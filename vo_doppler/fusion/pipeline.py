@@ -69,6 +69,10 @@ class PipelineConfig:
     heading: HeadingPipelineConfig = field(default_factory=HeadingPipelineConfig)
     vo: VoConfig = field(default_factory=VoConfig)
     correction_window_s: float = 2.0
+    correction_reference: str = "course"
+    """What the absolute heading is compared with: the VO's 'course' (direction of travel, as a
+    Doppler heading is) or its 'orientation' yaw (sec. 3.6 as written). The course is immune to
+    camera-calibration and extrinsic yaw errors that skew the VO's motion against its axis."""
     correction_gate_deg: float = 0.0
     """If > 0, absolute headings this far from the corrected VO heading are not used. Off by
     default: a wrong first heading would then lock out the right ones (sec. 3.6 has no gate)."""
@@ -258,7 +262,15 @@ def corrected_level(
     """Heading correction (Eq. 11–13) of vehicle poses already in the level ENU world."""
     gate = np.radians(config.correction_gate_deg) if config.correction_gate_deg > 0 else None
     corrected = correct_heading(
-        trajectory, t, yaw, valid, config.correction_window_s, np.eye(4), "level", gate_rad=gate
+        trajectory,
+        t,
+        yaw,
+        valid,
+        config.correction_window_s,
+        np.eye(4),
+        "level",
+        gate_rad=gate,
+        reference=config.correction_reference,
     )
     poses = corrected.vehicle.matrices
     poses[:, :3, 3] += trajectory.positions[0]
