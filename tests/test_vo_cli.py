@@ -90,6 +90,9 @@ def test_usage_and_input_errors(sequence, tmp_path, capsys):
     with pytest.raises(SystemExit) as usage:
         main(["vo", str(folder / "image_0"), "-o", str(tmp_path)])
     assert usage.value.code == 2
+    with pytest.raises(SystemExit) as short_window:
+        main(["vo", str(folder / "image_0"), "--calib", str(calib), "--window", "2", "-o", "x"])
+    assert short_window.value.code == 2
     empty = tmp_path / "empty"
     empty.mkdir()
     assert main(["vo", str(empty), "--calib", str(calib), "--fps", "10", "-o", str(tmp_path)]) == 1

@@ -13,6 +13,7 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
+from vo_doppler.commands.vo_command import window_size
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
 from vo_doppler.eval.report import (
@@ -46,7 +47,7 @@ def register(subparsers) -> None:
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     parser.add_argument("--systems", default="GREJC", help="GNSS systems to use")
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
-    parser.add_argument("--window", type=int, default=30, help="VO window (frames)")
+    parser.add_argument("--window", type=window_size, default=30, help="VO window (frames, >= 3)")
     parser.add_argument(
         "--reference",
         choices=("course", "orientation"),

@@ -45,15 +45,23 @@ def register(subparsers) -> None:
     timing.add_argument("--times", type=Path, help="times.txt or CSV with a t column")
     timing.add_argument("--fps", type=float, help="fixed frame rate (Hz)")
     parser.add_argument("--speed", type=Path, help="CSV t,speed_mps for metric scale")
-    parser.add_argument("--window", type=int, default=30, help="bundle-adjustment window (frames)")
+    parser.add_argument(
+        "--window", type=window_size, default=30, help="bundle-adjustment window (frames, >= 3)"
+    )
     parser.add_argument("--gt", type=Path, help="ground truth (KITTI poses or TUM) to evaluate")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     parser.set_defaults(func=run)
 
 
+def window_size(text: str) -> int:
+    """argparse type: a sliding-window length of at least 3 frames."""
+    value = int(text)
+    if value < 3:
+        raise argparse.ArgumentTypeError(f"must be at least 3 frames, got {value}")
+    return value
+
+
 def run(args: argparse.Namespace) -> int:
-    if args.window < 3:
-        raise InputError(f"--window must be at least 3 frames, got {args.window}")
     files = list_images(args.images)
     camera = read_camera(args.calib)
     if args.fps is not None:
