@@ -23,6 +23,21 @@ values = st.one_of(
 indicators = st.one_of(st.none(), st.integers(0, 9))
 
 
+def observation_rows(obs) -> list[tuple]:
+    """Every observation as (time, satellite, code, value, LLI, SSI), sorted."""
+    return sorted(
+        zip(
+            obs.time.tolist(),
+            obs.satellites().tolist(),
+            [obs.codes[c] for c in obs.code],
+            obs.value.tolist(),
+            obs.lli.tolist(),
+            obs.ssi.tolist(),
+            strict=True,
+        )
+    )
+
+
 @st.composite
 def epochs(draw):
     satellites = draw(
@@ -68,18 +83,7 @@ def test_rinex3_round_trip(tmp_path, written):
     path = tmp_path / "random.24o"
     path.write_text(text)
     obs = read_obs(path)
-    got = sorted(
-        zip(
-            obs.time.tolist(),
-            obs.satellites().tolist(),
-            [obs.codes[c] for c in obs.code],
-            obs.value.tolist(),
-            obs.lli.tolist(),
-            obs.ssi.tolist(),
-            strict=True,
-        )
-    )
-    assert got == sorted(expected)
+    assert observation_rows(obs) == sorted(expected)
     assert obs.problems == ()
     np.testing.assert_array_equal(obs.epoch_time, T0 + np.arange(len(written)))
 
@@ -265,14 +269,5 @@ def test_rinex2_round_trip(tmp_path, written):
     path = tmp_path / "random.10o"
     path.write_text(text)
     obs = read_obs(path)
-    got = zip(
-        obs.time.tolist(),
-        obs.satellites().tolist(),
-        [obs.codes[c] for c in obs.code],
-        obs.value.tolist(),
-        obs.lli.tolist(),
-        obs.ssi.tolist(),
-        strict=True,
-    )
-    assert sorted(got) == sorted(expected)
+    assert observation_rows(obs) == sorted(expected)
     assert obs.problems == ()
