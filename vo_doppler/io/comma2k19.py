@@ -4,7 +4,8 @@ Each signal folder holds ``t`` (s, the logger's monotonic clock) and ``value``. 
 the IMU gyro as a yaw rate, the u-blox receiver fixes, and ground truth from ``global_pose``.
 Conventions on the way out (DESIGN.md): the IMU axes are forward/right/down, so the
 counter-clockwise yaw rate is −gyro_z; the ground-truth yaw is the course of the ECEF velocity
-rotated into the ENU frame at its own position, as a CCW-from-east angle, unwrapped.
+rotated into the ENU frame at its own position, as a CCW-from-east angle, unwrapped. The
+ground truth's body yaw is the same angle for the forward axis of ``frame_orientations``.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
@@ -40,10 +42,13 @@ def read_gyro_yaw_rate(base: str | Path, signal: str = "gyro") -> tuple[np.ndarr
 
 @dataclass(frozen=True)
 class GroundTruth:
-    """``global_pose`` on the monotonic clock: yaw (rad, CCW, unwrapped), lat/lon (rad)."""
+    """``global_pose`` on the monotonic clock: yaw (rad, CCW, unwrapped) of the velocity and
+    body yaw of the device's forward axis (a constant mounting offset apart, the same heading
+    when the vehicle does not slip), lat/lon (rad)."""
 
     t: np.ndarray
     yaw: np.ndarray
+    body_yaw: np.ndarray
     lat: np.ndarray
     lon: np.ndarray
     height: np.ndarray
@@ -54,13 +59,17 @@ def read_ground_truth(base: str | Path) -> GroundTruth:
     t = load_array(base, "global_pose", "frame_times")
     positions = load_array(base, "global_pose", "frame_positions")
     velocity = load_array(base, "global_pose", "frame_velocities")
+    quaternion_wxyz = load_array(base, "global_pose", "frame_orientations")
     gps_times = load_array(base, "global_pose", "frame_gps_times")
     lat, lon, height = ecef_to_geodetic(positions)
     rotation = np.stack([ecef_to_enu_rotation(a, b) for a, b in zip(lat, lon, strict=True)])
     enu = np.einsum("nij,nj->ni", rotation, velocity)
     yaw = np.unwrap(np.arctan2(enu[:, 1], enu[:, 0]))
+    device_to_ecef = Rotation.from_quat(quaternion_wxyz[:, [1, 2, 3, 0]]).as_matrix()
+    forward = np.einsum("nij,nj->ni", rotation, device_to_ecef[:, :, 0])
+    body_yaw = np.unwrap(np.arctan2(forward[:, 1], forward[:, 0]))
     offset = float(np.median(gps_times[:, 1] - t))
-    return GroundTruth(t, yaw, lat, lon, height, offset)
+    return GroundTruth(t, yaw, body_yaw, lat, lon, height, offset)
 
 
 def read_live_fixes(
