@@ -8,6 +8,8 @@ import pytest
 from tests.conftest import require_shared
 from vo_doppler.geo import course_to_yaw, ecef_to_enu_rotation, ecef_to_geodetic, wrap_angle
 from vo_doppler.heading.calibration import (
+    PRIOR_GYRO_BIAS_SIGMA,
+    PRIOR_WHEEL_SCALE_SIGMA,
     GateConfig,
     GyroBiasCalibrator,
     GyroBiasKalman,
@@ -17,6 +19,7 @@ from vo_doppler.heading.calibration import (
     estimate_wheel_scale,
     variation_gate,
 )
+from vo_doppler.heading.pipeline import HeadingPipelineConfig, causal_calibration
 from vo_doppler.heading.sensors import integrate_rate, sample_at
 from vo_doppler.io.can import read_can_motion
 
@@ -114,6 +117,67 @@ def test_kalman_variants_converge_with_noise():
     assert abs(b.value - bias) < max(3 * b.sigma, np.radians(0.02))
     assert abs(k.value - 1.02) < max(3 * k.sigma, 5e-4)
     assert sigmas[-1] < sigmas[50] / 3
+
+
+def test_kalman_with_the_prior_equals_least_squares_with_the_prior():
+    """Linear-Gaussian case: no random walk, Kalman measurement noise equal to the residual
+    spread that least squares estimates, every sample accepted by both gates. The Kalman
+    filters started at the prior then give least squares combined with the same prior."""
+    rng = np.random.default_rng(11)
+    t, speed, yaw_rate, yaw = _drive(n=100)
+    bias, scale = np.radians(0.7), 1.04
+    phi = integrate_rate(t, yaw_rate + bias, t)
+    doppler_yaw = wrap_angle(yaw + rng.normal(0.0, np.radians(0.5), len(t)))
+    doppler_speed = speed + rng.normal(0.0, 0.05, len(t))
+    wheel = speed / scale
+    valid = np.ones(len(t), dtype=bool)
+    ls = causal_calibration(t, doppler_speed, doppler_yaw, valid, wheel, phi)
+
+    fit_b = estimate_gyro_bias(t, doppler_yaw, phi, doppler_speed)
+    fit_k = estimate_wheel_scale(t, doppler_speed, wheel)
+    assert fit_b.n_used == fit_k.n_used == len(t)
+    yaw_sigma = fit_b.sigma * np.sqrt(np.sum((t - t.mean()) ** 2))
+    speed_sigma = fit_k.sigma * np.sqrt(wheel @ wheel)
+    kb = GyroBiasKalman(yaw_sigma, bias_walk_rad_s_per_sqrt_s=0.0)
+    kw = WheelScaleKalman(speed_sigma, q_per_sqrt_s=0.0)
+    for i in range(len(t)):
+        b = kb.add(t[i], doppler_yaw[i], phi[i], doppler_speed[i])
+        k = kw.add(t[i], doppler_speed[i], wheel[i])
+    assert b.n_used == k.n_used == len(t)
+    assert b.value == pytest.approx(ls.bias[-1], abs=1e-9)
+    assert b.sigma == pytest.approx(ls.bias_sigma[-1], rel=1e-9)
+    assert k.value == pytest.approx(ls.scale[-1], abs=1e-9)
+    assert k.sigma == pytest.approx(ls.scale_sigma[-1], rel=1e-9)
+    # The prior pulls both estimates off the data's own by far more than the tolerance.
+    assert abs(ls.bias[-1] - fit_b.value) > 1e-6 and abs(ls.scale[-1] - fit_k.value) > 1e-6
+
+
+def test_kalman_stays_at_the_prior_without_informative_samples():
+    assert HeadingPipelineConfig().prior_gyro_bias_sigma == PRIOR_GYRO_BIAS_SIGMA
+    assert HeadingPipelineConfig().prior_wheel_scale_sigma == PRIOR_WHEEL_SCALE_SIGMA
+    kb, kw = GyroBiasKalman(), WheelScaleKalman()
+    for estimate, prior, sigma in (
+        (kb.estimate, 0.0, PRIOR_GYRO_BIAS_SIGMA),
+        (kw.estimate, 1.0, PRIOR_WHEEL_SCALE_SIGMA),
+    ):
+        assert (estimate.value, estimate.sigma, estimate.n_used) == (prior, sigma, 0)
+        assert estimate.valid
+    # Too slow to carry a course or a wheel speed: nothing changes.
+    b = kb.add(0.0, 1.0, 0.2, 0.5)
+    k = kw.add(0.0, 0.5, 0.4)
+    assert (b.value, b.sigma, k.value, k.sigma) == (
+        0.0,
+        PRIOR_GYRO_BIAS_SIGMA,
+        1.0,
+        PRIOR_WHEEL_SCALE_SIGMA,
+    )
+    # One course sample fixes the heading offset and says nothing about the bias.
+    b = kb.add(1.0, 1.0, 0.2, 10.0)
+    assert (b.value, b.sigma, b.n_used) == (0.0, PRIOR_GYRO_BIAS_SIGMA, 1)
+    # A 1.5° step 0.1 s later would be a 15 deg/s bias alone; the prior holds it near zero.
+    b = kb.add(1.1, 1.0 + np.radians(1.5), 0.2, 10.0)
+    assert b.n_used == 2
+    assert abs(np.degrees(b.value)) < 0.1 and 0.99 < b.sigma / PRIOR_GYRO_BIAS_SIGMA < 1.0
 
 
 def _comma_ground_truth():

@@ -14,6 +14,13 @@ recent data, refreshed as samples arrive (:class:`WheelScaleCalibrator`,
 :class:`GyroBiasCalibrator`); Kalman filters with a random-walk state are the alternative
 (:class:`WheelScaleKalman`, :class:`GyroBiasKalman`). Each returns the estimate and its
 standard deviation.
+
+Prior: an uncalibrated wheel scale is one and an uncalibrated gyro bias zero, with the spreads
+:data:`PRIOR_WHEEL_SCALE_SIGMA` and :data:`PRIOR_GYRO_BIAS_SIGMA`. The least-squares path
+combines its estimates with this prior by inverse variance (``heading.pipeline``); the Kalman
+filters start from it, which in the linear-Gaussian case (no random walk, measurement noise
+equal to the least-squares residual spread) gives the same estimate and standard deviation.
+Before any informative sample a Kalman filter therefore reports the prior.
 """
 
 from __future__ import annotations
@@ -25,6 +32,13 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 from vo_doppler.geo import wrap_angle
+
+PRIOR_WHEEL_SCALE = 1.0
+PRIOR_WHEEL_SCALE_SIGMA = 0.03
+"""Spread of an uncalibrated wheel scale about one (tyre radius, load, wear)."""
+PRIOR_GYRO_BIAS = 0.0
+PRIOR_GYRO_BIAS_SIGMA = float(np.radians(0.5))
+"""Spread of an uncalibrated gyro yaw-rate bias about zero (rad/s)."""
 
 
 @dataclass(frozen=True)
@@ -257,10 +271,9 @@ class _StreamGate:
 
 
 class _KalmanFit:
-    """A filterpy filter whose state ``index`` is the calibrated quantity."""
+    """A filterpy filter whose state ``index`` is the calibrated quantity, started at its prior."""
 
     index = 0
-    min_used = 1
 
     def __init__(self, dim_x: int, config: GateConfig):
         self.filter = KalmanFilter(dim_x=dim_x, dim_z=1)
@@ -271,26 +284,27 @@ class _KalmanFit:
 
     @property
     def estimate(self) -> CalibrationEstimate:
-        if self.n_used < self.min_used:
-            return CalibrationEstimate(np.nan, np.nan, self.n_used, self.n_rejected)
+        """The filtered value and its standard deviation: the prior until data inform it."""
         i = self.index
         value, sigma = float(self.filter.x[i, 0]), float(np.sqrt(self.filter.P[i, i]))
         return CalibrationEstimate(value, sigma, self.n_used, self.n_rejected)
 
 
 class WheelScaleKalman(_KalmanFit):
-    """Kalman variant of sec. 3.3: state k, a random walk of ``q_per_sqrt_s`` per √s."""
+    """Kalman variant of sec. 3.3: state k, a random walk of ``q_per_sqrt_s`` per √s, starting
+    at the prior ``prior`` ± ``prior_sigma``."""
 
     def __init__(
         self,
         speed_sigma_mps: float = 0.1,
         q_per_sqrt_s: float = 1e-4,
-        initial_sigma: float = 0.1,
+        prior: float = PRIOR_WHEEL_SCALE,
+        prior_sigma: float = PRIOR_WHEEL_SCALE_SIGMA,
         config: GateConfig = GateConfig(),
     ):
         super().__init__(1, config)
-        self.filter.x = np.array([[1.0]])
-        self.filter.P = np.array([[initial_sigma**2]])
+        self.filter.x = np.array([[prior]])
+        self.filter.P = np.array([[prior_sigma**2]])
         self.filter.R = np.array([[speed_sigma_mps**2]])
         self.q_per_sqrt_s = q_per_sqrt_s
         self._gate = _StreamGate(config.max_speed_jump_mps, config.max_speed_drift_mps2)
@@ -321,24 +335,27 @@ class WheelScaleKalman(_KalmanFit):
 class GyroBiasKalman(_KalmanFit):
     """Kalman variant of sec. 3.4: state [e, b] with e = ψ_true − Φ, ė = −b, b a random walk.
 
+    b starts at the prior ``prior`` ± ``prior_sigma``; e has no prior (a flat one), so the
+    first accepted measurement sets it with the measurement variance and leaves b at its prior.
     The measurement is ψ_doppler − Φ = e + noise; it is unwrapped next to the predicted e.
     The variation gate applies to the change of the innovation between accepted samples.
     """
 
     index = 1
-    min_used = 2
 
     def __init__(
         self,
         yaw_sigma_rad: float = np.radians(0.5),
         bias_walk_rad_s_per_sqrt_s: float = np.radians(0.001),
-        initial_bias_sigma_rad_s: float = np.radians(1.0),
+        prior: float = PRIOR_GYRO_BIAS,
+        prior_sigma: float = PRIOR_GYRO_BIAS_SIGMA,
         config: GateConfig = GateConfig(),
     ):
         super().__init__(2, config)
         self.filter.H = np.array([[1.0, 0.0]])
         self.filter.R = np.array([[yaw_sigma_rad**2]])
-        self.filter.P = np.diag([np.pi**2, initial_bias_sigma_rad_s**2])
+        self.filter.x = np.array([[0.0], [prior]])
+        self.filter.P = np.diag([np.inf, prior_sigma**2])
         self.bias_walk = bias_walk_rad_s_per_sqrt_s
         self._gate = _StreamGate(config.max_yaw_jump_rad, config.max_yaw_drift_rad_s)
 
@@ -354,14 +371,17 @@ class GyroBiasKalman(_KalmanFit):
         usable = doppler_valid and np.isfinite(z) and doppler_speed >= self.config.min_speed_mps
         if not usable:
             return self.estimate
-        if self._t is None:
-            self.filter.x = np.array([[float(wrap_angle(z))], [0.0]])
+        if self._t is None:  # the flat prior on e updated by z: e = z ± R, b untouched
+            self.filter.x[0, 0] = float(wrap_angle(z))
             self.filter.P[0, 0] = self.filter.R[0, 0]
-        else:
-            dt = max(t - self._t, 0.0)
-            self.filter.predict(
-                F=np.array([[1.0, -dt], [0.0, 1.0]]), Q=np.diag([0.0, self.bias_walk**2 * dt])
-            )
+            self._gate.passes(t, 0.0)
+            self._t = t
+            self.n_used = 1
+            return self.estimate
+        dt = max(t - self._t, 0.0)
+        self.filter.predict(
+            F=np.array([[1.0, -dt], [0.0, 1.0]]), Q=np.diag([0.0, self.bias_walk**2 * dt])
+        )
         self._t = t
         predicted = float(self.filter.x[0, 0])
         z_near = predicted + float(wrap_angle(z - predicted))
