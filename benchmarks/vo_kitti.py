@@ -68,6 +68,17 @@ def attitude_roughness_deg(truth: Trajectory) -> np.ndarray:
     return np.degrees(np.linalg.norm(np.diff(relative, axis=0), axis=1))
 
 
+def travel_direction_deg(trajectory: Trajectory) -> tuple[float, float]:
+    """Mean elevation (up) and azimuth (right) of the frame-to-frame motion in the camera frame
+    (deg). A rotation error in the ground truth's camera extrinsic shows here as an offset
+    common to every pipeline."""
+    M = trajectory.matrices
+    step = np.einsum("nij,nj->ni", np.linalg.inv(M[:-1])[:, :3, :3], M[1:, :3, 3] - M[:-1, :3, 3])
+    elevation = np.degrees(np.arctan2(-step[:, 1], step[:, 2]))
+    azimuth = np.degrees(np.arctan2(step[:, 0], step[:, 2]))
+    return float(np.mean(elevation)), float(np.mean(azimuth))
+
+
 def run_project_vo(files, times, camera, speed):
     start = time.perf_counter()
     output = run_visual_odometry((read_image(f) for f in files), times, camera, None, speed)
@@ -133,6 +144,7 @@ def main(argv: list[str] | None = None) -> int:
             "se2_final_position_error_m": aligned.final_position_error_m,
             "from_measured_final_position_error_m": measured.final_position_error_m,
             "from_measured_end_yaw_error_deg": measured.end_yaw_error_deg,
+            "travel_direction_elevation_azimuth_deg": travel_direction_deg(trajectory),
         }
         if stats is not None:
             rows[name]["flagged_frames"] = len(stats.flagged_frames)
@@ -178,6 +190,7 @@ def main(argv: list[str] | None = None) -> int:
     roughness = attitude_roughness_deg(truth)
     split = args.measured_from - 1
     truth_check = {
+        "travel_direction_elevation_azimuth_deg": travel_direction_deg(truth),
         "attitude_roughness_rms_deg_before": float(np.sqrt(np.mean(roughness[:split] ** 2))),
         "attitude_roughness_rms_deg_after": float(np.sqrt(np.mean(roughness[split:] ** 2))),
     }
@@ -186,6 +199,13 @@ def main(argv: list[str] | None = None) -> int:
         f"frames 1-{split} {truth_check['attitude_roughness_rms_deg_before']:.5f}°, "
         f"frames {args.measured_from}-{len(files) - 2} "
         f"{truth_check['attitude_roughness_rms_deg_after']:.5f}°"
+    )
+    directions = {"ground truth": truth_check["travel_direction_elevation_azimuth_deg"]} | {
+        name: row["travel_direction_elevation_azimuth_deg"] for name, row in rows.items()
+    }
+    console.print(
+        "mean direction of travel in the camera frame (elevation, azimuth): "
+        + "; ".join(f"{name} {e:+.3f}°, {a:+.3f}°" for name, (e, a) in directions.items())
     )
     console.print(
         f"final error ratio (ours/baseline) {ratios['final_error_ratio']:.2f} (target <= 0.5); "
