@@ -122,9 +122,9 @@ def gps_scatter(truth, fixes, downsamples, cluster_m):
     return results, (t, at_t), raw, tracks
 
 
-def fitted_latency(truth, fixes) -> float:
+def fitted_time_offset(truth, fixes) -> float:
     """Time shift (s) added to the fix times that minimises their RMS distance to the truth at
-    the shifted times: the receiver's position latency (an evaluation alignment, like
+    the shifted times: the offset between the two time bases (an evaluation alignment, like
     associating timestamps)."""
     frame = EnuFrame(float(truth.lat[0]), float(truth.lon[0]), float(truth.height[0]))
     truth_enu = frame.geodetic_to_enu(truth.lat, truth.lon, truth.height)[:, :2]
@@ -248,12 +248,12 @@ def main(argv=None) -> int:
     scatter, (t_fix, at_truth), raw, tracks = gps_scatter(truth, fixes, (1, 2, 5, 10), 3.0)
     out["gps_scatter"] = scatter
     console.print(scatter_table("GPS track around global_pose (m)", scatter, len(raw)))
-    latency = fitted_latency(truth, fixes)
-    shifted = dataclasses.replace(fixes, t=fixes.t + latency)
+    offset = fitted_time_offset(truth, fixes)
+    shifted = dataclasses.replace(fixes, t=fixes.t + offset)
     aligned, _, _, _ = gps_scatter(truth, shifted, (1, 2, 5, 10), 3.0)
-    out["fix_latency_s"] = latency
-    out["gps_scatter_latency_removed"] = aligned
-    title = f"Same, fix times shifted by the fitted latency {latency:+.3f} s"
+    out["fix_time_offset_s"] = offset
+    out["gps_scatter_time_offset_removed"] = aligned
+    title = f"Same, fix times shifted by the fitted offset {offset:+.3f} s"
     console.print(scatter_table(title, aligned, len(raw)))
 
     fig = Figure(figsize=(11, 5))

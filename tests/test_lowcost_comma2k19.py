@@ -8,7 +8,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from benchmarks.lowcost_comma2k19 import fitted_latency, gps_scatter, heading_run, load
+from benchmarks.lowcost_comma2k19 import fitted_time_offset, gps_scatter, heading_run, load
 from tests.conftest import require_shared
 from vo_doppler.lowcost.drift import VARIANTS
 
@@ -89,11 +89,11 @@ def test_ground_truth_body_yaw_is_the_forward_axis(comma):
     assert 0.3 < abs(change_gap) < 0.6
 
 
-def test_fix_latency_and_scatter_once_it_is_removed(comma):
+def test_fix_time_offset_and_scatter_once_it_is_removed(comma):
     truth, fixes, _, _ = comma
-    latency = fitted_latency(truth, fixes)
-    assert 0.08 < latency < 0.16  # ≈ 2 m along-track at highway speed
-    shifted = dataclasses.replace(fixes, t=fixes.t + latency)
+    offset = fitted_time_offset(truth, fixes)
+    assert 0.08 < offset < 0.16  # ≈ 2 m along-track at highway speed
+    shifted = dataclasses.replace(fixes, t=fixes.t + offset)
     scatter, _, _, _ = gps_scatter(truth, shifted, (10,), 3.0)
     raw, track = scatter["raw"], scatter["reconstructed M=10"]
     assert raw["rms_m"] < 0.5
