@@ -16,6 +16,14 @@ def heading_figure(
     path: str | Path, table: HeadingTable, truth_yaw: np.ndarray | None = None, title: str = ""
 ) -> None:
     """Write the PNG; ``truth_yaw`` (rad, per epoch, NaN where unknown) adds an error panel."""
+    build_heading_figure(table, truth_yaw, title).savefig(path, dpi=110)
+
+
+def build_heading_figure(
+    table: HeadingTable, truth_yaw: np.ndarray | None = None, title: str = ""
+) -> Figure:
+    """The figure of :func:`heading_figure`. The satellite curve is ``table.n_sat_epoch``, one
+    step per epoch centred on it."""
     t = table.t - (table.t[0] if len(table) else 0.0)
     panels = 3 if truth_yaw is not None else 2
     fig = Figure(figsize=(10, 2.6 * panels + 1))
@@ -55,4 +63,4 @@ def heading_figure(
     axes[-1].set_xlabel("time since first epoch (s)")
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    return fig
