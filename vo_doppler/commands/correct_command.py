@@ -10,7 +10,10 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading
 from vo_doppler.fusion.heading_correction import FORWARD_CAMERA_TO_VEHICLE, correct_heading
+from vo_doppler.fusion.pipeline import CORRECTION_METHODS, PipelineConfig
+from vo_doppler.heading.tight_heading import TightHeadingConfig
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.trajectory import read_trajectory, write_kitti, write_tum
 from vo_doppler.vo.camera import read_camera
@@ -22,10 +25,12 @@ def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "correct",
         help="correct a VO trajectory's heading with Doppler headings",
-        description="Shift the heading of a VO trajectory (TUM or KITTI, any VO system) to the "
-        "absolute heading over a sliding window and rotate the positions about the window's "
-        "oldest position (sec. 3.6, Eq. 11-13). Output: vehicle (or camera) poses in an "
-        "ENU-aligned frame with its origin at the first position.",
+        description="Correct the heading of a VO trajectory (TUM or KITTI, any VO system) with "
+        "absolute headings: by the window method (shift to the window's absolute heading and "
+        "rotate the positions about the window's oldest position, sec. 3.6, Eq. 11-13) or by "
+        "the Kalman blend (a filter and smoother on the VO heading offset whose noise is fitted "
+        "to the drive). Output: vehicle (or camera) poses in an ENU-aligned frame with its "
+        "origin at the first position.",
     )
     parser.add_argument("trajectory", help="VO trajectory, TUM or KITTI (camera poses)")
     parser.add_argument("--heading", required=True, help="heading.csv from `vo-doppler heading`")
@@ -35,7 +40,18 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--time-offset", type=float, default=0.0, help="seconds added to trajectory times -> GPS"
     )
-    parser.add_argument("--window-s", type=float, default=2.0)
+    parser.add_argument(
+        "--correction",
+        choices=CORRECTION_METHODS,
+        default=PipelineConfig().correction_method,
+        help="window: the seed's Eq. 11-13; kalman: the adaptive blend (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--causal",
+        action="store_true",
+        help="kalman: forward filter only (each pose uses the headings up to its time)",
+    )
+    parser.add_argument("--window-s", type=float, default=2.0, help="window method's W")
     parser.add_argument("--source", choices=("tc", "conv", "tc+conv"), default="tc+conv")
     parser.add_argument("--world", choices=("first_camera", "level"), default="first_camera")
     parser.add_argument("--body", choices=("vehicle", "camera"), default="vehicle")
@@ -76,17 +92,31 @@ def run(args: argparse.Namespace) -> int:
             "use --time-offset",
             args.trajectory,
         )
-    result = correct_heading(
-        trajectory,
-        table.t,
-        yaw,
-        valid,
-        args.window_s,
-        extrinsic,
-        args.world,
-        args.max_gap_s,
-        reference=args.reference,
-    )
+    if args.correction == "kalman":
+        tight = table.tc_reliable & table.tc_available
+        result = blend_heading(
+            trajectory,
+            table.t,
+            yaw,
+            np.where(tight, table.sigma_tc, np.nan),
+            valid,
+            np.where(tight, TightHeadingConfig().window_s, 0.0),
+            extrinsic,
+            args.world,
+            BlendConfig(smooth=not args.causal, reference=args.reference, max_gap_s=args.max_gap_s),
+        )
+    else:
+        result = correct_heading(
+            trajectory,
+            table.t,
+            yaw,
+            valid,
+            args.window_s,
+            extrinsic,
+            args.world,
+            args.max_gap_s,
+            reference=args.reference,
+        )
     out = result.vehicle if args.body == "vehicle" else result.camera
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)

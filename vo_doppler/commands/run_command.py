@@ -22,8 +22,14 @@ from vo_doppler.eval.report import (
     trajectories_figure,
     write_html_report,
 )
+from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.fusion.heading_correction import yaw_of
-from vo_doppler.fusion.pipeline import PipelineConfig, PipelineResult, run_pipeline
+from vo_doppler.fusion.pipeline import (
+    CORRECTION_METHODS,
+    PipelineConfig,
+    PipelineResult,
+    run_pipeline,
+)
 from vo_doppler.heading.sensors import sample_at
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.heading_figure import heading_figure
@@ -55,6 +61,18 @@ def register(subparsers) -> None:
         help="heading correction compares the absolute heading with the VO's course (default) "
         "or its orientation yaw (sec. 3.6 as written)",
     )
+    parser.add_argument(
+        "--correction",
+        choices=CORRECTION_METHODS,
+        default=PipelineConfig().correction_method,
+        help="heading correction: window (the seed's Eq. 11-13) or kalman (adaptive blend, "
+        "filter and smoother on the VO heading offset); default %(default)s",
+    )
+    parser.add_argument(
+        "--causal",
+        action="store_true",
+        help="kalman: forward filter only (each pose uses the headings up to its time)",
+    )
     parser.set_defaults(func=run)
 
 
@@ -65,6 +83,8 @@ def run(args: argparse.Namespace) -> int:
         elevation_mask_deg=args.elev_mask,
         vo=VoConfig(window_size=args.window),
         correction_reference=args.reference,
+        correction_method=args.correction,
+        blend=BlendConfig(smooth=not args.causal),
     )
     console = Console(width=None if sys.stdout.isatty() else 150)
     console.print(

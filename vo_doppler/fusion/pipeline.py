@@ -7,7 +7,8 @@ Stages (DESIGN.md "Architecture"):
 2. Calibration (sec. 3.3–3.4) and tightly coupled heading (sec. 3.5), epoch by epoch: the wheel
    scale and gyro bias current at each epoch, the heading of every epoch's window.
 3. VO on the images with metric steps from the calibrated wheel speed.
-4. Heading correction of the VO (sec. 3.6, Eq. 11–13) with the tightly coupled heading; the
+4. Heading correction of the VO with the tightly coupled heading, by the seed's window
+   (sec. 3.6, Eq. 11–13) or by our Kalman blend (:mod:`vo_doppler.fusion.heading_blend`); the
    conventional heading gives a second corrected trajectory for comparison.
 5. A dead-reckoning trajectory from calibrated wheel speed and gyro, corrected the same way.
 
@@ -19,12 +20,13 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading
 from vo_doppler.fusion.heading_correction import correct_heading, vehicle_poses, yaw_of
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
@@ -42,6 +44,8 @@ from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.scale import travelled_distance
 
 log = logging.getLogger(__name__)
+
+CORRECTION_METHODS = ("window", "kalman")
 
 
 @dataclass
@@ -68,6 +72,11 @@ class PipelineConfig:
     elevation_mask_deg: float = 10.0
     heading: HeadingPipelineConfig = field(default_factory=HeadingPipelineConfig)
     vo: VoConfig = field(default_factory=VoConfig)
+    correction_method: str = "window"
+    """'window': the seed's sec. 3.6, Eq. 11–13; 'kalman': the adaptive blend (B1)–(B4) of
+    :mod:`vo_doppler.fusion.heading_blend` (the smoother; ``blend.smooth=False`` is causal)."""
+    blend: BlendConfig = field(default_factory=BlendConfig)
+    """Kalman blend parameters; its ``reference`` is replaced by ``correction_reference``."""
     correction_window_s: float = 2.0
     correction_reference: str = "course"
     """What the absolute heading is compared with: the VO's 'course' (direction of travel, as a
@@ -236,17 +245,15 @@ def correct_all(
         vo_yaw0 = dr_yaw0 = initial_yaw
     vo_level = Trajectory.from_matrices(t_vo, level_with_yaw(vo_vehicle, vo_yaw0, start))
     trajectories = {"vo": vo_level}
-    sources = {
-        "vo_gps_conv": (table.yaw_conv, table.conv_valid),
-        "vo_gps_tc": (table.yaw_tc, tc_valid),
-    }
-    for name, (yaw, valid) in sources.items():
-        trajectories[name] = corrected_level(vo_level, table.t, yaw, valid, config)
+    tight = AbsoluteHeading(
+        table.t, table.yaw_tc, tc_valid, table.sigma_tc, config.heading.tight.window_s
+    )
+    conventional = AbsoluteHeading(table.t, table.yaw_conv, table.conv_valid)
+    trajectories["vo_gps_conv"] = corrected_level(vo_level, conventional, config)
+    trajectories["vo_gps_tc"] = corrected_level(vo_level, tight, config)
     if dr is not None:
         dr_level = Trajectory.from_matrices(dr.t, level_with_yaw(dr.matrices, dr_yaw0, start))
-        trajectories["dr_gps_tc"] = corrected_level(
-            dr_level, table.t, table.yaw_tc, tc_valid, config
-        )
+        trajectories["dr_gps_tc"] = corrected_level(dr_level, tight, config)
     return trajectories
 
 
@@ -256,22 +263,52 @@ def usable_tight_heading(table: HeadingTable, config: PipelineConfig) -> np.ndar
     return table.tc_available & table.tc_reliable & precise
 
 
+@dataclass
+class AbsoluteHeading:
+    """Absolute yaw per GNSS epoch with its validity, standard deviation (NaN: unknown, the
+    blend's default) and error-correlation time (s; 0 for single-epoch headings)."""
+
+    t: np.ndarray
+    yaw: np.ndarray
+    valid: np.ndarray
+    sigma: np.ndarray | None = None
+    correlation_s: float = 0.0
+
+
 def corrected_level(
-    trajectory: Trajectory, t: np.ndarray, yaw: np.ndarray, valid: np.ndarray, config
+    trajectory: Trajectory, heading: AbsoluteHeading, config: PipelineConfig
 ) -> Trajectory:
-    """Heading correction (Eq. 11–13) of vehicle poses already in the level ENU world."""
-    gate = np.radians(config.correction_gate_deg) if config.correction_gate_deg > 0 else None
-    corrected = correct_heading(
-        trajectory,
-        t,
-        yaw,
-        valid,
-        config.correction_window_s,
-        np.eye(4),
-        "level",
-        gate_rad=gate,
-        reference=config.correction_reference,
-    )
+    """Heading correction of vehicle poses already in the level ENU world: the seed's window
+    (Eq. 11–13) or the Kalman blend (B1)–(B4), per ``config.correction_method``."""
+    if config.correction_method == "kalman":
+        corrected = blend_heading(
+            trajectory,
+            heading.t,
+            heading.yaw,
+            heading.sigma,
+            heading.valid,
+            heading.correlation_s,
+            np.eye(4),
+            "level",
+            replace(config.blend, reference=config.correction_reference),
+        )
+    elif config.correction_method == "window":
+        gate = np.radians(config.correction_gate_deg) if config.correction_gate_deg > 0 else None
+        corrected = correct_heading(
+            trajectory,
+            heading.t,
+            heading.yaw,
+            heading.valid,
+            config.correction_window_s,
+            np.eye(4),
+            "level",
+            gate_rad=gate,
+            reference=config.correction_reference,
+        )
+    else:
+        raise ValueError(
+            f"unknown correction method {config.correction_method!r} {CORRECTION_METHODS}"
+        )
     poses = corrected.vehicle.matrices
     poses[:, :3, 3] += trajectory.positions[0]
     return Trajectory.from_matrices(trajectory.t, poses)

@@ -1,0 +1,438 @@
+"""Adaptive heading blend: a 1-D Kalman filter (and RTS smoother) on the VO heading offset.
+
+This is our addition beyond the seed. The seed's correction (sec. 3.6, Eq. 11–13, see
+:mod:`vo_doppler.fusion.heading_correction`) replaces the VO heading by the window's mean
+absolute heading, so a good VO inherits the absolute heading's noise; a fixed blend time
+constant helps a good VO but hurts a drifting one. Here the gain follows from a model of both.
+
+State: the offset δ = (true course − VO course), a scalar in rad, held unwrapped.
+
+* Process (VO heading drift, a random walk in distance and in turning)::
+
+      δ(b) = δ(a) + w,   w ~ N(0, q),   q = σ_d²·ΔD(a→b) + σ_ψ²·ΔΨ(a→b)           (B1)
+
+  with ΔD the horizontal distance the VO travelled (m) and ΔΨ the absolute yaw it turned (rad)
+  between the two times. Monocular VO loses heading through small rotation errors at every
+  frame (a per-distance random walk, σ_d in rad/√m) and through a yaw-scale error while turning
+  (σ_ψ in rad/√rad); standing still, it drifts neither.
+
+* Measurement of an absolute heading (yaw) h::
+
+      z_j = wrap(h_j − c_VO(t_j)) = δ(t_j) + v_j,   v_j ~ N(0, r_j),   r_j = (s·σ_j)²·κ_j   (B2)
+
+  at the middle time t_j of every VO step (of at least ``min_step_m``; at every pose for the
+  orientation reference), c_VO(t_j) the step's course (or the pose's yaw), h_j and its
+  standard deviation σ_j interpolated between GNSS epochs, s a scale on σ_j and
+  κ_j = max(1, T_c/Δt) the number of measurements within the heading's error-correlation time
+  T_c: the tight heading of consecutive epochs comes from overlapping windows (T_c = its
+  window), so the κ measurements of one window carry about one measurement's information.
+
+* Forward filter, wrapping the innovation ν_j = wrap(z_j − δ⁻_j) and starting diffuse (the
+  first measurement sets δ = z, P = r)::
+
+      P⁻_j = P_{j−1} + q_j,  S_j = P⁻_j + r_j,  K_j = P⁻_j/S_j,
+      δ_j = δ⁻_j + K_j·ν_j,  P_j = (1 − K_j)·P⁻_j                                      (B3)
+
+* RTS smoother (offline use), and between measurement nodes a < b, at a time k::
+
+      C_j = P_j/P⁻_{j+1},  δˢ_j = δ_j + C_j·(δˢ_{j+1} − δ_j)
+      δˢ(k) = δ_a + (P_a + q(a→k))/(P_a + q(a→b))·(δˢ_b − δ_a)                          (B4)
+
+  which is the RTS recursion of (B1) carried through the steps between the nodes: with no
+  measurement the smoothed offset moves from one node to the next in proportion to the
+  process variance (distance and turning) accumulated. The forward (causal) filter holds the
+  last estimate through gaps.
+
+* Noise by maximum likelihood over the drive: σ_d, σ_ψ and s maximise the innovation
+  log-likelihood −½·Σ(ln S_j + ν_j²/S_j) of (B3) on a log grid, over measurements at least T_c
+  apart (so that their errors are close to independent, as (B2) assumes); σ_d and σ_ψ have
+  floors. Without enough measurements the defaults hold. On the simulated drives the fit
+  follows the VO: σ_ψ ≈ 0.001 for a well-calibrated camera, ≈ 0.01 for one whose focal length
+  is 1 % off (its heading error grows by 1 % of every turn).
+
+The corrected trajectory rotates every VO increment by δ at its middle time and every
+orientation by δ at its time, both as a yaw rotation on the world side (pitch and roll kept),
+as Eq. (12)–(13) do with the window's offset; frames and extrinsics as in
+:func:`vo_doppler.fusion.heading_correction.correct_heading`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from vo_doppler.fusion.heading_correction import (
+    FORWARD_CAMERA_TO_VEHICLE,
+    headings_at,
+    vehicle_poses,
+    yaw_of,
+)
+from vo_doppler.geo import wrap_angle
+from vo_doppler.trajectory import Trajectory
+
+SIGMA_GRID = np.logspace(-4.0, -1.0, 16)
+"""Candidate σ_d (rad/√m) and σ_ψ (rad/√rad) for the maximum-likelihood fit, steps of 1.6×:
+σ_d from 0.06° to 57° per √(100 m), σ_ψ from 0.01 % to 10 % of the turn."""
+SCALE_GRID = np.logspace(-0.6, 1.2, 10)
+"""Candidate scales s of the headings' standard deviations (0.25 to 16, steps of 1.6×)."""
+
+
+@dataclass(frozen=True)
+class BlendConfig:
+    """Parameters of (B1)–(B4); angles in rad."""
+
+    sigma_distance: float | None = None
+    """σ_d (rad/√m) of (B1); None: maximum-likelihood fit over the drive."""
+    sigma_turn: float | None = None
+    """σ_ψ (rad/√rad) of (B1); None: fitted with σ_d."""
+    measurement_scale: float | None = None
+    """s of (B2); None: fitted with σ_d."""
+    default_sigma_distance: float = 0.002
+    """σ_d without enough measurements to fit: 1.1° of drift per √(100 m), a common
+    monocular VO (KITTI rotation errors are 0.5–2° per 100 m)."""
+    default_sigma_turn: float = 0.01
+    """σ_ψ without enough measurements to fit: a 90° turn adds 0.7° of drift std, as a 1 %
+    yaw-scale error of the VO (e.g. a focal length 1 % off) would."""
+    min_sigma_distance: float = 1e-4
+    """Floor on σ_d: the VO is never trusted beyond 0.06° per √(100 m)."""
+    min_sigma_turn: float = 1e-4
+    """Floor on σ_ψ: 0.01 % yaw-scale error."""
+    default_measurement_sigma: float = np.radians(1.0)
+    """σ_j of epochs whose heading carries no standard deviation (conventional heading)."""
+    smooth: bool = True
+    """RTS smoother (B4, offline); False: forward filter only (causal)."""
+    reference: str = "course"
+    """Compare the absolute heading with the VO's 'course' or its 'orientation' yaw."""
+    min_step_m: float = 0.05
+    """VO steps shorter than this have no course."""
+    max_gap_s: float = 1.5
+    """Longest gap across which the VO course (or yaw) is interpolated to an epoch."""
+    min_fit_measurements: int = 20
+
+    def __post_init__(self) -> None:
+        if self.reference not in ("course", "orientation"):
+            raise ValueError(f"reference must be 'course' or 'orientation', not {self.reference!r}")
+
+
+@dataclass
+class OffsetMeasurements:
+    """(B2) at the VO direction samples that have an absolute heading."""
+
+    t: np.ndarray
+    z: np.ndarray
+    sigma: np.ndarray
+    """σ_j (rad), before the scale s and the inflation κ_j."""
+    correlation_s: np.ndarray
+    """T_c of each epoch (s)."""
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+
+@dataclass
+class FilterOutput:
+    """Forward pass (B3) at the measurement nodes: filtered δ and P, predicted P, and the
+    innovation log-likelihood (all but the first, diffuse, measurement)."""
+
+    x: np.ndarray
+    P: np.ndarray
+    P_pred: np.ndarray
+    log_likelihood: np.ndarray
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """σ_d (rad/√m) and σ_ψ (rad/√rad) of (B1), s of (B2), and whether they were fitted."""
+
+    sigma_distance: float
+    sigma_turn: float
+    scale: float
+    fitted: bool
+
+
+@dataclass
+class BlendResult:
+    """Corrected poses and the offset δ (rad, added to the VO yaw) at each pose."""
+
+    vehicle: Trajectory
+    camera: Trajectory
+    offset: np.ndarray
+    offset_sigma: np.ndarray
+    has_absolute: np.ndarray
+    """Poses with an absolute heading within ``max_gap_s`` (as the window method reports)."""
+    noise: NoiseModel
+    measurements: int
+
+    @property
+    def total_correction(self) -> np.ndarray:
+        return self.offset
+
+
+def vo_direction(
+    t: np.ndarray, positions: np.ndarray, rotations: np.ndarray, reference: str, min_step_m
+) -> tuple[np.ndarray, np.ndarray]:
+    """Times and yaw (rad) of the VO direction: the course of every step of at least
+    ``min_step_m`` at its middle time, or the orientation yaw at every pose."""
+    if reference == "orientation":
+        return t, yaw_of(rotations)
+    step = np.diff(positions[:, :2], axis=0)
+    moving = np.hypot(step[:, 0], step[:, 1]) >= min_step_m
+    middle = 0.5 * (t[1:] + t[:-1])
+    return middle[moving], np.arctan2(step[moving, 1], step[moving, 0])
+
+
+def offset_measurements(
+    t_heading: np.ndarray,
+    yaw_heading: np.ndarray,
+    sigma_heading: np.ndarray,
+    correlation_s: np.ndarray,
+    t_direction: np.ndarray,
+    yaw_direction: np.ndarray,
+    max_gap_s: float,
+) -> OffsetMeasurements:
+    """z of (B2) at the VO direction samples (step middles for the course, as Eq. (11)'s
+    course reference compares them) that have an absolute heading interpolated on the short
+    arc between epochs at most ``max_gap_s`` apart; σ and T_c interpolated alike."""
+    ok = np.isfinite(yaw_heading) & np.isfinite(sigma_heading)
+    absolute, inside = headings_at(t_direction, t_heading, yaw_heading, ok, max_gap_s)
+    t = t_direction[inside]
+    t_ok = t_heading[ok]
+    return OffsetMeasurements(
+        t,
+        wrap_angle(absolute[inside] - yaw_direction[inside]),
+        np.interp(t, t_ok, sigma_heading[ok]) if len(t) else np.zeros(0),
+        np.interp(t, t_ok, correlation_s[ok]) if len(t) else np.zeros(0),
+    )
+
+
+def inflation(measurements: OffsetMeasurements) -> np.ndarray:
+    """κ_j of (B2): epochs per correlation time, at least 1."""
+    if len(measurements) < 2:
+        return np.ones(len(measurements))
+    spacing = float(np.median(np.diff(measurements.t)))
+    if spacing <= 0:
+        return np.ones(len(measurements))
+    return np.maximum(1.0, measurements.correlation_s / spacing)
+
+
+def forward_filter(z: np.ndarray, r: np.ndarray, q: np.ndarray) -> FilterOutput:
+    """(B3) over measurements ``z`` (M,) with variances ``r`` and process variances ``q``
+    since the previous measurement (q[0] unused); ``r`` and ``q`` may carry a trailing axis
+    of G parameter sets, filtered side by side."""
+    r = np.asarray(r, dtype=float)
+    q = np.asarray(q, dtype=float)
+    shape = (len(z), *np.broadcast_shapes(r.shape[1:], q.shape[1:]))
+    r = np.broadcast_to(r.reshape(r.shape + (1,) * (len(shape) - r.ndim)), shape)
+    q = np.broadcast_to(q.reshape(q.shape + (1,) * (len(shape) - q.ndim)), shape)
+    x = np.empty(shape)
+    P = np.empty(shape)
+    P_pred = np.full(shape, np.inf)
+    log_likelihood = np.zeros(shape[1:])
+    if len(z) == 0:
+        return FilterOutput(x, P, P_pred, log_likelihood)
+    x[0], P[0] = z[0], r[0]
+    for j in range(1, len(z)):
+        P_pred[j] = P[j - 1] + q[j]
+        S = P_pred[j] + r[j]
+        innovation = wrap_angle(z[j] - x[j - 1])
+        gain = P_pred[j] / S
+        x[j] = x[j - 1] + gain * innovation
+        P[j] = (1.0 - gain) * P_pred[j]
+        log_likelihood -= 0.5 * (np.log(2.0 * np.pi * S) + innovation**2 / S)
+    return FilterOutput(x, P, P_pred, log_likelihood)
+
+
+def rts_smooth(forward: FilterOutput) -> tuple[np.ndarray, np.ndarray]:
+    """(B4) at the measurement nodes: smoothed δ and its variance."""
+    x, P = forward.x.copy(), forward.P.copy()
+    for j in range(len(x) - 2, -1, -1):
+        gain = forward.P[j] / forward.P_pred[j + 1] if forward.P_pred[j + 1] > 0 else 1.0
+        x[j] = forward.x[j] + gain * (x[j + 1] - forward.x[j])
+        P[j] = forward.P[j] + gain**2 * (P[j + 1] - forward.P_pred[j + 1])
+    return x, P
+
+
+@dataclass
+class DriftClock:
+    """Cumulative distance D and turn Ψ of the VO at its pose times, for q of (B1)."""
+
+    t: np.ndarray
+    distance: np.ndarray
+    turn: np.ndarray
+
+    @classmethod
+    def from_poses(cls, t: np.ndarray, positions: np.ndarray, rotations: np.ndarray):
+        step = np.hypot(*np.diff(positions[:, :2], axis=0).T)
+        turn = np.abs(wrap_angle(np.diff(yaw_of(rotations))))
+        return cls(
+            t, np.concatenate([[0.0], np.cumsum(step)]), np.concatenate([[0.0], np.cumsum(turn)])
+        )
+
+    def variance(self, t: np.ndarray, sigma_distance, sigma_turn) -> np.ndarray:
+        """σ_d²·D(t) + σ_ψ²·Ψ(t), the accumulated process variance of (B1) at times ``t``;
+        with arrays of G values of σ_d and σ_ψ, one column per pair (shape (len(t), G))."""
+        distance = np.interp(t, self.t, self.distance)
+        turn = np.interp(t, self.t, self.turn)
+        return np.multiply.outer(distance, np.square(sigma_distance)) + np.multiply.outer(
+            turn, np.square(sigma_turn)
+        )
+
+
+def decimate(t: np.ndarray, spacing_s: np.ndarray) -> np.ndarray:
+    """Indices of measurements kept greedily so that each is at least its own correlation
+    time after the previous kept one."""
+    keep = []
+    last = -np.inf
+    for j, (tj, gap) in enumerate(zip(t, spacing_s, strict=True)):
+        if tj >= last + gap:
+            keep.append(j)
+            last = tj
+    return np.asarray(keep, dtype=int)
+
+
+def fit_process_noise(
+    measurements: OffsetMeasurements, clock: DriftClock, config: BlendConfig
+) -> NoiseModel:
+    """σ_d, σ_ψ and s (those the config leaves None) maximising the innovation likelihood of
+    (B3) over decimated measurements (module docstring), each on its log grid with its floor;
+    the defaults when fewer than ``min_fit_measurements`` remain or nothing is left to fit."""
+    keep = decimate(measurements.t, measurements.correlation_s)
+    fixed = (config.sigma_distance, config.sigma_turn, config.measurement_scale)
+    defaults = (config.default_sigma_distance, config.default_sigma_turn, 1.0)
+    chosen = [d if f is None else f for f, d in zip(fixed, defaults, strict=True)]
+    if len(keep) < config.min_fit_measurements or all(f is not None for f in fixed):
+        return NoiseModel(*chosen, fitted=False)
+    grids = (
+        np.maximum(SIGMA_GRID, config.min_sigma_distance),
+        np.maximum(SIGMA_GRID, config.min_sigma_turn),
+        SCALE_GRID,
+    )
+    axes = [np.array([f]) if f is not None else g for f, g in zip(fixed, grids, strict=True)]
+    grid_d, grid_psi, grid_s = (g.ravel() for g in np.meshgrid(*axes, indexing="ij"))
+    accumulated = clock.variance(measurements.t[keep], grid_d, grid_psi)
+    q = np.diff(accumulated, axis=0, prepend=accumulated[:1])
+    r = np.multiply.outer(measurements.sigma[keep] ** 2, grid_s**2)
+    log_likelihood = forward_filter(measurements.z[keep], r, q).log_likelihood
+    best = int(np.argmax(log_likelihood))
+    return NoiseModel(float(grid_d[best]), float(grid_psi[best]), float(grid_s[best]), True)
+
+
+def offset_at(
+    t_query: np.ndarray,
+    t_node: np.ndarray,
+    forward: FilterOutput,
+    smoothed: tuple[np.ndarray, np.ndarray] | None,
+    clock_node: np.ndarray,
+    clock_query: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """δ and its variance at query times from the node estimates (``clock_*``: accumulated
+    process variance of (B1) at the nodes and at the queries).
+
+    Forward (``smoothed`` None, causal): the last node's estimate is held, its variance
+    growing; before the first node δ = 0 (nothing known yet). Smoothed: (B4) between nodes,
+    the end nodes' estimates held outside them."""
+    n_query = len(t_query)
+    if len(t_node) == 0:
+        return np.zeros(n_query), np.full(n_query, np.inf)
+    a = np.searchsorted(t_node, t_query, side="right") - 1
+    before = a < 0
+    a = np.clip(a, 0, len(t_node) - 1)
+    grown = np.maximum(clock_query - clock_node[a], 0.0)
+    held = forward.P[a] + grown
+    if smoothed is None:
+        return np.where(before, 0.0, forward.x[a]), np.where(before, np.inf, held)
+    x_s, P_s = smoothed
+    b = np.minimum(a + 1, len(t_node) - 1)
+    predicted = forward.P[a] + np.maximum(clock_node[b] - clock_node[a], 0.0)
+    interior = (b > a) & (predicted > 0)
+    weight = np.where(interior, held / np.where(interior, predicted, 1.0), 0.0)
+    value = np.where(interior, forward.x[a] + weight * (x_s[b] - forward.x[a]), x_s[a])
+    variance = np.where(
+        interior,
+        held - weight * held + weight**2 * P_s[b],
+        P_s[a] + grown,
+    )
+    first_grown = np.maximum(clock_node[0] - clock_query, 0.0)
+    return np.where(before, x_s[0], value), np.where(before, P_s[0] + first_grown, variance)
+
+
+def blend_heading(
+    camera: Trajectory,
+    t_heading: np.ndarray,
+    yaw_heading: np.ndarray,
+    sigma_heading: np.ndarray | float | None = None,
+    valid: np.ndarray | None = None,
+    correlation_s: np.ndarray | float = 0.0,
+    camera_to_vehicle: np.ndarray = FORWARD_CAMERA_TO_VEHICLE,
+    world: str = "first_camera",
+    config: BlendConfig = BlendConfig(),
+) -> BlendResult:
+    """Correct the VO heading with absolute headings by the Kalman blend (B1)–(B4).
+
+    ``t_heading``/``yaw_heading`` (yaw, rad) are on the trajectory's clock; ``sigma_heading``
+    their standard deviations (NaN or None: ``default_measurement_sigma``), ``valid`` marks
+    the usable epochs, ``correlation_s`` is T_c of (B2) per epoch or for all (the tight
+    heading's window; 0 for the single-epoch conventional heading). Frames as in
+    :func:`~vo_doppler.fusion.heading_correction.correct_heading`."""
+    t_heading = np.asarray(t_heading, dtype=float)
+    n_heading = len(t_heading)
+    yaw = np.asarray(yaw_heading, dtype=float).copy()
+    if valid is not None:
+        yaw[~np.asarray(valid, dtype=bool)] = np.nan
+    sigma = np.broadcast_to(
+        np.asarray(np.nan if sigma_heading is None else sigma_heading, dtype=float), (n_heading,)
+    )
+    sigma = np.where(np.isfinite(sigma), sigma, config.default_measurement_sigma)
+    correlation = np.broadcast_to(np.asarray(correlation_s, dtype=float), (n_heading,))
+    poses = vehicle_poses(camera, camera_to_vehicle, world)
+    t = camera.t
+    positions = poses[:, :3, 3] - (poses[0, :3, 3] if len(poses) else 0.0)
+    rotations = poses[:, :3, :3]
+    t_direction, yaw_direction = vo_direction(
+        t, positions, rotations, config.reference, config.min_step_m
+    )
+    measurements = offset_measurements(
+        t_heading, yaw, sigma, correlation, t_direction, yaw_direction, config.max_gap_s
+    )
+    clock = DriftClock.from_poses(t, positions, rotations)
+    noise = fit_process_noise(measurements, clock, config)
+    clock_node = clock.variance(measurements.t, noise.sigma_distance, noise.sigma_turn)
+    r = np.maximum((noise.scale * measurements.sigma) ** 2 * inflation(measurements), 1e-18)
+    forward = forward_filter(measurements.z, r, np.diff(clock_node, prepend=clock_node[:1]))
+    smoothed = rts_smooth(forward) if config.smooth else None
+    middle = np.concatenate([t[:1], 0.5 * (t[1:] + t[:-1])])
+    delta_step, _ = offset_at(
+        middle,
+        measurements.t,
+        forward,
+        smoothed,
+        clock_node,
+        clock.variance(middle, noise.sigma_distance, noise.sigma_turn),
+    )
+    delta, variance = offset_at(
+        t,
+        measurements.t,
+        forward,
+        smoothed,
+        clock_node,
+        clock.variance(t, noise.sigma_distance, noise.sigma_turn),
+    )
+    turn_step = Rotation.from_euler("z", delta_step[:, None]).as_matrix()
+    steps = np.einsum("nij,nj->ni", turn_step[1:], np.diff(positions, axis=0))
+    corrected_positions = np.concatenate([positions[:1], positions[:1] + np.cumsum(steps, axis=0)])
+    corrected_rotations = Rotation.from_euler("z", delta[:, None]).as_matrix() @ rotations
+    vehicle = Trajectory(t.copy(), corrected_positions, Rotation.from_matrix(corrected_rotations))
+    T_veh_cam = np.asarray(camera_to_vehicle, dtype=float)
+    camera_out = Trajectory.from_matrices(t.copy(), vehicle.matrices @ T_veh_cam)
+    _, has_absolute = headings_at(t, t_heading, yaw, None, config.max_gap_s)
+    return BlendResult(
+        vehicle,
+        camera_out,
+        delta,
+        np.sqrt(variance),
+        has_absolute,
+        noise,
+        len(measurements),
+    )
