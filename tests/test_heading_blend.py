@@ -19,6 +19,7 @@ from vo_doppler.fusion.heading_blend import (
     fit_process_noise,
     forward_filter,
     rts_smooth,
+    velocity_heading_sigma,
 )
 from vo_doppler.fusion.heading_correction import (
     FORWARD_CAMERA_TO_VEHICLE,
@@ -279,3 +280,18 @@ def test_correct_cli_kalman_recovers_the_enu_trajectory(tmp_path, extra):
     corrected = read_tum(out)
     # Headings are rounded to 1e-4° in the CSV: 2e-6 rad over 80 m.
     np.testing.assert_allclose(corrected.positions, gt.positions - gt.positions[0], atol=1e-3)
+
+
+def test_velocity_heading_sigma_is_the_cross_track_sigma_over_the_speed():
+    rotation = Rotation.from_euler("xyz", [0.3, -0.7, 1.1]).as_matrix()  # some ECEF→ENU
+    velocity = np.array([[3.0, 4.0, 0.5], [-10.0, 0.0, 0.0], [0.0, 0.0, 2.0]])
+    # East-north covariances: isotropic 0.04; then 1.0 along east only (along-track), which
+    # leaves a westward velocity's yaw exact; a vertical velocity has no yaw.
+    enu = np.zeros((3, 3, 3))
+    enu[0] = 0.04 * np.eye(3)
+    enu[1, 0, 0], enu[1, 1, 1], enu[1, 2, 2] = 1.0, 1e-4, 9.0
+    enu[2] = np.eye(3)
+    ecef = rotation.T @ enu @ rotation
+    sigma = velocity_heading_sigma(velocity, ecef, rotation)
+    np.testing.assert_allclose(sigma[:2], [0.2 / 5.0, 0.01 / 10.0], rtol=1e-9)
+    assert np.isnan(sigma[2])

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading
+from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading, velocity_heading_sigma
 from vo_doppler.fusion.heading_correction import correct_heading, vehicle_poses, yaw_of
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
@@ -201,7 +201,12 @@ def run_pipeline(
         on_frame,
     )
     start = start_position(gnss, obs, inputs.enu)
-    trajectories = correct_all(inputs, table, vo.trajectory, speed, start, config, initial_yaw)
+    conventional_sigma = velocity_heading_sigma(
+        gnss.velocity.velocity_enu, gnss.velocity.covariance, inputs.enu.rotation
+    )
+    trajectories = correct_all(
+        inputs, table, vo.trajectory, speed, start, config, initial_yaw, conventional_sigma
+    )
     usable = usable_tight_heading(table, config)
     return PipelineResult(gnss, table, vo, speed, trajectories, start, usable)
 
@@ -214,6 +219,7 @@ def correct_all(
     start: np.ndarray,
     config: PipelineConfig,
     initial_yaw: float | None = None,
+    conventional_sigma: np.ndarray | None = None,
 ) -> dict[str, Trajectory]:
     """The VO alone, the VO corrected by the conventional and by the tightly coupled heading,
     and dead reckoning corrected by the tightly coupled heading (vehicle poses, ENU).
@@ -221,6 +227,8 @@ def correct_all(
     Every trajectory starts at ``start`` with yaw ``initial_yaw``; by default that is the
     first absolute heading (tightly coupled, else conventional), matched at its own time.
     Only reliable tightly coupled headings correct (the 10-epoch gyro-consistency test).
+    ``conventional_sigma`` (rad, per epoch) is the conventional heading's standard deviation
+    for the Kalman blend (see :func:`~vo_doppler.fusion.heading_blend.velocity_heading_sigma`).
     """
     tc_valid = usable_tight_heading(table, config)
     vo_vehicle = vehicle_poses(camera_trajectory, inputs.camera.T_vehicle_camera)
@@ -248,7 +256,7 @@ def correct_all(
     tight = AbsoluteHeading(
         table.t, table.yaw_tc, tc_valid, table.sigma_tc, config.heading.tight.window_s
     )
-    conventional = AbsoluteHeading(table.t, table.yaw_conv, table.conv_valid)
+    conventional = AbsoluteHeading(table.t, table.yaw_conv, table.conv_valid, conventional_sigma)
     trajectories["vo_gps_conv"] = corrected_level(vo_level, conventional, config)
     trajectories["vo_gps_tc"] = corrected_level(vo_level, tight, config)
     if dr is not None:
