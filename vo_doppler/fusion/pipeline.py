@@ -201,14 +201,25 @@ def run_pipeline(
         on_frame,
     )
     start = start_position(gnss, obs, inputs.enu)
-    conventional_sigma = velocity_heading_sigma(
-        gnss.velocity.velocity_enu, gnss.velocity.covariance, inputs.enu.rotation
-    )
     trajectories = correct_all(
-        inputs, table, vo.trajectory, speed, start, config, initial_yaw, conventional_sigma
+        inputs,
+        table,
+        vo.trajectory,
+        speed,
+        start,
+        config,
+        initial_yaw,
+        conventional_heading_sigma(gnss, inputs.enu),
     )
     usable = usable_tight_heading(table, config)
     return PipelineResult(gnss, table, vo, speed, trajectories, start, usable)
+
+
+def conventional_heading_sigma(gnss: GnssVelocityResult, enu: EnuFrame) -> np.ndarray:
+    """Standard deviation (rad) of each epoch's conventional heading, from its Doppler velocity
+    covariance (:func:`~vo_doppler.fusion.heading_blend.velocity_heading_sigma`)."""
+    velocity = gnss.velocity
+    return velocity_heading_sigma(velocity.velocity_enu, velocity.covariance, enu.rotation)
 
 
 def correct_all(
