@@ -3,6 +3,7 @@ window/kalman choice in the pipeline and the CLI."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -268,7 +269,7 @@ def test_pipeline_dispatches_on_the_method():
 
 
 @pytest.mark.parametrize("extra", [[], ["--causal"]])
-def test_correct_cli_kalman_recovers_the_enu_trajectory(tmp_path, extra):
+def test_correct_cli_kalman_recovers_the_enu_trajectory(tmp_path, capsys, extra):
     t, yaw, gt = _ground_truth(n=80)
     write_tum(tmp_path / "vo.tum", _vo_output(gt))
     table = _table(t, yaw, np.ones(len(t), bool), np.ones(len(t), bool))
@@ -280,6 +281,10 @@ def test_correct_cli_kalman_recovers_the_enu_trajectory(tmp_path, extra):
     corrected = read_tum(out)
     # Headings are rounded to 1e-4° in the CSV: 2e-6 rad over 80 m.
     np.testing.assert_allclose(corrected.positions, gt.positions - gt.positions[0], atol=1e-3)
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["correction"] == "kalman" and summary["final_correction_deg"] == pytest.approx(
+        np.degrees(2.5), abs=1e-3
+    )
 
 
 def test_velocity_heading_sigma_is_the_cross_track_sigma_over_the_speed():
@@ -295,3 +300,28 @@ def test_velocity_heading_sigma_is_the_cross_track_sigma_over_the_speed():
     sigma = velocity_heading_sigma(velocity, ecef, rotation)
     np.testing.assert_allclose(sigma[:2], [0.2 / 5.0, 0.01 / 10.0], rtol=1e-9)
     assert np.isnan(sigma[2])
+
+
+def test_without_any_absolute_heading_the_vo_is_left_as_it_is():
+    t, yaw, gt = _ground_truth(n=50)
+    vo = _turned_vo(gt, 0.3)
+    level = dict(world="level", camera_to_vehicle=np.eye(4))
+    for smooth in (True, False):
+        result = blend_heading(
+            vo, t, yaw, 0.01, np.zeros(len(t), bool), config=BlendConfig(smooth=smooth), **level
+        )
+        assert result.measurements == 0 and not result.noise.fitted
+        np.testing.assert_allclose(result.offset, 0.0)
+        expected = vo.matrices
+        expected[:, :3, 3] -= vo.positions[0]
+        np.testing.assert_allclose(result.vehicle.matrices, expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("command", ["run", "correct"])
+def test_unknown_correction_method_is_a_usage_error(tmp_path, command):
+    args = [command, str(tmp_path), "-o", str(tmp_path / "out"), "--correction", "median"]
+    if command == "correct":
+        args += ["--heading", str(tmp_path / "h.csv")]
+    with pytest.raises(SystemExit) as exit_info:
+        main(args)
+    assert exit_info.value.code == 2

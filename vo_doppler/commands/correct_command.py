@@ -128,8 +128,16 @@ def run(args: argparse.Namespace) -> int:
         "poses": len(out),
         "poses_with_absolute_heading": int(result.has_absolute.sum()),
         "final_correction_deg": float(np.degrees(result.total_correction[-1])),
+        "correction": args.correction,
         "output": str(output),
     }
+    if args.correction == "kalman":
+        summary["fitted_noise"] = result.noise.fitted
+        summary["sigma_distance_deg_per_sqrt_100m"] = float(
+            np.degrees(result.noise.sigma_distance) * 10.0
+        )
+        summary["sigma_turn"] = result.noise.sigma_turn
+        summary["heading_sigma_scale"] = result.noise.scale
     log.info("correct: %s", json.dumps(summary))
     print(json.dumps(summary))
     return 0
