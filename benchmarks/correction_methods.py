@@ -76,7 +76,7 @@ def print_sequence(console: Console, name: str, figures: dict) -> None:
     table = Table(title=f"{name}: {figures['path_length_m']:.0f} m")
     table.add_column("method")
     for label in ("VO", "VO + conv", "VO + TC", "DR + TC"):
-        table.add_column(f"{label} [m/100 m] (heading RMSE)", justify="right")
+        table.add_column(f"{label}: m per 100 m (heading RMSE)", justify="right")
     table.add_column("issue-5 acceptance")
     for method, rows in figures["methods"].items():
         cells = [
