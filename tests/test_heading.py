@@ -143,7 +143,7 @@ def test_outlier_is_down_weighted():
         scenario.t_epoch,
         scenario.speed,
         scenario.yaw_angle,
-        TightHeadingConfig(robust_passes=0),
+        TightHeadingConfig(robust_passes=0, outlier_passes=0),  # neither Huber nor rejection
     )
     affected = np.abs(scenario.t_epoch - T[len(T) // 2]) < 1.9
     robust_error = np.max(np.abs(wrap_angle(robust.yaw - scenario.yaw)[affected]))

@@ -74,6 +74,18 @@ class HeadingTable:
     conv_valid: np.ndarray
     gyro_bias: np.ndarray
     wheel_scale: np.ndarray
+    rejected_rows: np.ndarray | None = None
+    """Doppler rows of the window rejected as biased (NLOS) by the tightly coupled solver."""
+    tc_verifiable: np.ndarray | None = None
+    """A bias on any satellite the tightly coupled heading used would have shown in the
+    residuals (False where it could hide, and where the heading is unavailable)."""
+
+    def __post_init__(self) -> None:
+        n = len(self.t)
+        if self.rejected_rows is None:
+            self.rejected_rows = np.zeros(n, dtype=int)
+        if self.tc_verifiable is None:
+            self.tc_verifiable = np.zeros(n, dtype=bool)
 
     def __len__(self) -> int:
         return len(self.t)
@@ -234,4 +246,6 @@ def heading_pipeline(
         conv_valid=conv_ok,
         gyro_bias=cal.bias,
         wheel_scale=cal.scale,
+        rejected_rows=result.n_rejected,
+        tc_verifiable=result.verifiable,
     )

@@ -40,7 +40,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.geo import wrap_angle, yaw_to_course
+from vo_doppler.heading.profile import (
+    dz_of,
+    gauss_newton,
+    grid_minima,
+    projected_normal_matrix,
+    quadratic,
+    z_of,
+)
 from vo_doppler.heading.rows import DopplerRows
+from vo_doppler.heading.snooping import snoop_satellites
 
 
 @dataclass(frozen=True)
@@ -70,6 +79,17 @@ class TightHeadingConfig:
     profile_max_rad: float = np.radians(30.0)
     clock_drift_walk_mps: float = 0.01
     """Random walk of the receiver clock drift (m/s per √s) that the linear model leaves out."""
+    outlier_passes: int = 4
+    """Satellites that data snooping may reject per window (0: no NLOS rejection)."""
+    outlier_alpha: float = 0.001
+    """False-alarm probability of the bias tests per window (Baarda's α₀ = 0.001 of data
+    snooping, shared among the window's satellites)."""
+    identification_odds: float = 100.0
+    """The satellite with the largest w-test is named biased only when that hypothesis is this
+    many times likelier than any other satellite's (generalised likelihood ratio)."""
+    testable_redundancy: float = 0.05
+    """Satellites whose redundancy number (the share of a bias that shows in the residuals) is
+    below this are not tested; a window using such a satellite is not verifiable."""
 
 
 @dataclass
@@ -86,6 +106,14 @@ class TightHeadingResult:
     ambiguous: np.ndarray
     clock_drift: np.ndarray
     clock_drift_rate: np.ndarray
+    n_rejected: np.ndarray
+    """Rows of the window rejected as biased (satellites failing the w-test)."""
+    verifiable: np.ndarray
+    """Every satellite used could have been tested: a bias on any would show in the residuals
+    (redundancy number ≥ ``testable_redundancy``); False where it could hide, e.g. as many
+    independent rows as unknowns. Unavailable epochs are False."""
+    inconsistent: np.ndarray
+    """The w-test found a biased satellite it could not name (or too many): no heading."""
 
     @property
     def course(self) -> np.ndarray:
@@ -105,112 +133,154 @@ class _WindowSolution:
     rho0: np.ndarray
     alpha: np.ndarray
     n_obs: np.ndarray
+    n_rejected: np.ndarray
+    inconsistent: np.ndarray
+    min_redundancy: np.ndarray
     profile_sigma: np.ndarray
     scale_gain: np.ndarray
     bias_gain: np.ndarray
     clock_walk_gain: np.ndarray
 
 
-def _projected_normal_matrix(X, T, w):
-    """Q = XᵀWX − XᵀWT (TᵀWT)⁺ TᵀWX per window, with XᵀWX, XᵀWT, (TᵀWT)⁺ and rank(TᵀWT)."""
-    XtWX = np.einsum("kri,kr,krj->kij", X, w, X)
-    XtWT = np.einsum("kri,kr,krj->kij", X, w, T)
-    TtWT = np.einsum("kri,kr,krj->kij", T, w, T)
-    TtWT_pinv = np.linalg.pinv(TtWT, hermitian=True)
-    Q = XtWX - XtWT @ TtWT_pinv @ XtWT.transpose(0, 2, 1)
-    return Q, XtWX, XtWT, TtWT_pinv, np.linalg.matrix_rank(TtWT, hermitian=True)
+def _fit(X, T, w, config):
+    """Huber-weighted fit of padded windows (observation matrix ``X``, clock design ``T``,
+    a-priori weights ``w``): the robust weights, both minima of the final profiled cost and the
+    clock parameters at the best one."""
+    weights = np.array(w)
+    for _ in range(config.robust_passes):
+        Q, _, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, weights)
+        theta = gauss_newton(Q, grid_minima(Q, config.grid_size)[0], config.gauss_newton_iterations)
+        normalised = np.abs(_residual(X, T, XtWT, TtWT_pinv, theta)) * np.sqrt(w)
+        ratio = normalised / _robust_scale(normalised, w, config)[:, None]
+        weights = w * np.minimum(1.0, config.huber_k / np.maximum(ratio, 1e-300))
+    Q, XtWX, XtWT, TtWT_pinv, rank_t = projected_normal_matrix(X, T, weights)
+    first, second = grid_minima(Q, config.grid_size)
+    theta = gauss_newton(Q, first, config.gauss_newton_iterations)
+    has_second = np.isfinite(second)
+    theta2 = gauss_newton(Q, np.where(has_second, second, theta), config.gauss_newton_iterations)
+    cost = quadratic(Q, z_of(theta), z_of(theta))
+    cost2 = np.where(has_second, quadratic(Q, z_of(theta2), z_of(theta2)), np.inf)
+    swap = cost2 < cost
+    return {
+        "weights": weights,
+        "Q": Q,
+        "XtWX": XtWX,
+        "XtWT": XtWT,
+        "TtWT_pinv": TtWT_pinv,
+        "rank_t": rank_t,
+        "theta": np.where(swap, theta2, theta),
+        "theta2": np.where(swap, theta, theta2),
+        "cost": np.where(swap, cost2, cost),
+        "cost2": np.where(swap, cost, cost2),
+    }
 
 
-def _quadratic(Q, u, v):
-    """uᵀQv per window for vectors u, v of shape (K, 3)."""
-    return np.einsum("ki,kij,kj->k", u, Q, v)
+def _residual(X, T, XtWT, TtWT_pinv, theta):
+    """Observation − model per row at θ₀, with (ρ₀, α) at their conditional optimum."""
+    z = z_of(theta)
+    params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
+    return (X @ z[:, :, None])[:, :, 0] - np.einsum("krj,kj->kr", T, params)
 
 
-def _z(theta):
-    return np.stack([np.cos(theta), np.sin(theta), np.ones_like(theta)], axis=-1)
-
-
-def _dz(theta):
-    return np.stack([-np.sin(theta), np.cos(theta), np.zeros_like(theta)], axis=-1)
-
-
-def _gauss_newton(Q, theta, iterations):
-    for _ in range(iterations):
-        dz = _dz(theta)
-        hessian = _quadratic(Q, dz, dz)
-        step = np.where(
-            hessian > 0, _quadratic(Q, dz, _z(theta)) / np.where(hessian > 0, hessian, 1), 0
-        )
-        theta = theta - step
-    return wrap_angle(theta)
-
-
-def _grid_minima(Q, grid_size):
-    """Best and second-best local minima of zᵀQz on a circular grid (second NaN if none)."""
-    grid = np.linspace(-np.pi, np.pi, grid_size, endpoint=False)
-    Z = _z(grid)
-    cost = np.einsum("gi,kij,gj->kg", Z, Q, Z)
-    is_min = (cost <= np.roll(cost, 1, axis=1)) & (cost < np.roll(cost, -1, axis=1))
-    candidate = np.where(is_min, cost, np.inf)
-    first = np.argmin(np.where(is_min.any(axis=1, keepdims=True), candidate, cost), axis=1)
-    rows = np.arange(len(Q))
-    candidate[rows, first] = np.inf
-    second = np.argmin(candidate, axis=1)
-    has_second = np.isfinite(candidate[rows, second])
-    return grid[first], np.where(has_second, grid[second], np.nan)
-
-
-def solve_windows(y, a, b, tau, w, config: TightHeadingConfig = TightHeadingConfig()):
+def solve_windows(
+    y,
+    a,
+    b,
+    tau,
+    w,
+    config: TightHeadingConfig = TightHeadingConfig(),
+    group=None,
+    scale_sigma=0.0,
+    bias_sigma=0.0,
+):
     """Solve padded windows at once: arrays (K, R) of reduced observations ``y``, coefficients
     ``a``, ``b`` (model a·cos θ₀ + b·sin θ₀ + ρ₀ − α·τ), row times ``tau`` relative to the
-    window end and weights ``w`` (0 on padding). Returns a :class:`_WindowSolution`."""
+    window end and weights ``w`` (0 on padding). Returns a :class:`_WindowSolution`.
+
+    ``group`` (K, R) numbers the satellite of each row (default: every row its own), the unit
+    of NLOS rejection: after the robust fit, data snooping (:mod:`vo_doppler.heading.snooping`)
+    rejects the biased satellite (or row, or pair of satellites) it identifies and tests again,
+    up to ``config.outlier_passes`` times per window; the robust fit then uses the rows left. A
+    significant test that cannot name its satellite, one that still fails after the last pass,
+    or a repair that leaves a verifiable window unverifiable (a satellite whose bias could no
+    longer show), makes the window inconsistent.
+    ``scale_sigma`` and ``bias_sigma`` (per window or scalars) are the calibration
+    uncertainties the tests allow for.
+    """
+    K, R = w.shape
     X = np.stack([-a, -b, y], axis=-1)
     T = np.stack([np.ones_like(tau), -tau], axis=-1)
-    n_obs = np.count_nonzero(w > 0, axis=1)
-    weights = w.copy()
-    for _ in range(config.robust_passes):
-        Q, XtWX, XtWT, TtWT_pinv, rank_t = _projected_normal_matrix(X, T, weights)
-        theta = _gauss_newton(
-            Q, _grid_minima(Q, config.grid_size)[0], config.gauss_newton_iterations
+    if group is None:
+        group = np.broadcast_to(np.arange(R), (K, R))
+    n_groups = int(np.max(group, initial=0)) + 1
+    scale_sigma = np.broadcast_to(np.asarray(scale_sigma, dtype=float), (K,))
+    bias_sigma = np.broadcast_to(np.asarray(bias_sigma, dtype=float), (K,))
+    accepted = w > 0
+    inconsistent = np.zeros(K, dtype=bool)
+    min_redundancy = np.ones(K)
+    todo = np.arange(K)
+    verifiable_before = np.zeros(K, dtype=bool)
+    for rejection in range(config.outlier_passes + 1):
+        if not (todo.size and config.outlier_passes):
+            break
+        tests = snoop_satellites(
+            a[todo],
+            b[todo],
+            y[todo],
+            tau[todo],
+            w[todo] * accepted[todo],
+            group[todo],
+            n_groups,
+            (scale_sigma[todo], bias_sigma[todo]),
+            config.grid_size,
+            config.gauss_newton_iterations,
+            config.outlier_alpha,
+            config.identification_odds,
+            config.testable_redundancy,
         )
-        z = _z(theta)
-        params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
-        residual = X @ z[:, :, None]
-        residual = residual[:, :, 0] - np.einsum("krj,kj->kr", T, params)
-        normalised = np.abs(residual) * np.sqrt(w)
-        scale = _robust_scale(normalised, w, config)
-        ratio = normalised / scale[:, None]
-        weights = w * np.minimum(1.0, config.huber_k / np.maximum(ratio, 1e-300))
-    Q, XtWX, XtWT, TtWT_pinv, rank_t = _projected_normal_matrix(X, T, weights)
-    first, second = _grid_minima(Q, config.grid_size)
-    theta = _gauss_newton(Q, first, config.gauss_newton_iterations)
-    has_second = np.isfinite(second)
-    theta2 = _gauss_newton(Q, np.where(has_second, second, theta), config.gauss_newton_iterations)
-    cost = _quadratic(Q, _z(theta), _z(theta))
-    cost2 = np.where(has_second, _quadratic(Q, _z(theta2), _z(theta2)), np.inf)
-    swap = cost2 < cost
-    theta, theta2 = np.where(swap, theta2, theta), np.where(swap, theta, theta2)
-    cost, cost2 = np.where(swap, cost2, cost), np.where(swap, cost, cost2)
-    z, dz = _z(theta), _dz(theta)
-    params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
-    n_params = 1 + rank_t
-    dof = n_obs - n_params
-    mean_w = np.sum(w, axis=1) / np.maximum(n_obs, 1)
+        if rejection == 0:
+            verifiable_before = tests.min_redundancy >= config.testable_redundancy
+        min_redundancy[todo] = tests.min_redundancy
+        detected = tests.detected
+        if rejection == config.outlier_passes:
+            inconsistent[todo[detected]] = True
+            break
+        inconsistent[todo[detected & ~tests.identified]] = True
+        repair = detected & tests.identified
+        todo = todo[repair]
+        accepted[todo] &= ~tests.reject[repair]
+    fit = _fit(X, T, w * accepted, config)
+    weights, theta, cost = fit["weights"], fit["theta"], fit["cost"]
+    z, dz = z_of(theta), dz_of(theta)
+    params = (fit["TtWT_pinv"] @ (fit["XtWT"].transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
+    n_obs = np.count_nonzero(w > 0, axis=1)
+    n_used = np.count_nonzero(accepted, axis=1)
+    # A repair must not leave a window unverifiable that was verifiable: what remains has to be
+    # able to reveal a bias (exclusion, then detection).
+    lost = verifiable_before & (min_redundancy < config.testable_redundancy)
+    inconsistent |= (n_used < n_obs) & lost
+    dof = n_used - (1 + fit["rank_t"])
+    used_w = np.where(accepted, w, 0.0)
+    mean_w = np.sum(used_w, axis=1) / np.maximum(n_used, 1)
     floor = config.sigma_floor_mps**2 * mean_w
     posterior = np.where(dof > 0, np.maximum(cost, 0) / np.maximum(dof, 1), 1.0)
     variance_factor = np.maximum(posterior, floor)
+    Q = fit["Q"]
     return _WindowSolution(
         theta=theta,
-        theta_second=np.where(np.isfinite(cost2), theta2, np.nan),
+        theta_second=np.where(np.isfinite(fit["cost2"]), fit["theta2"], np.nan),
         cost=cost,
-        cost_second=cost2,
-        info=_quadratic(Q, dz, dz),
-        info_raw=_quadratic(XtWX, dz, dz),
+        cost_second=fit["cost2"],
+        info=quadratic(Q, dz, dz),
+        info_raw=quadratic(fit["XtWX"], dz, dz),
         variance_factor=variance_factor,
         profile_sigma=_profile_sigma(Q, theta, cost, variance_factor, config),
         rho0=params[:, 0],
         alpha=params[:, 1],
         n_obs=n_obs,
+        n_rejected=n_obs - n_used,
+        inconsistent=inconsistent,
+        min_redundancy=min_redundancy,
         **_error_gains(a, b, tau, weights, theta),
     )
 
@@ -232,7 +302,7 @@ def _profile_sigma(Q, theta, cost, variance_factor, config):
     rows = np.arange(len(Q))
     width = np.zeros(len(Q))
     for side in (-1.0, 1.0):
-        Z = _z(np.nan_to_num(theta)[:, None] + side * offsets[None, :])
+        Z = z_of(np.nan_to_num(theta)[:, None] + side * offsets[None, :])
         rise = (np.einsum("kgi,kij,kgj->kg", Z, Q, Z) - cost[:, None]) / variance_factor[:, None]
         rise[:, 0] = 0.0
         for n in (1.0, 2.0, 3.0):
@@ -331,6 +401,7 @@ def tight_heading_series(
     index = np.flatnonzero(usable)
     if len(index) == 0:
         return _unavailable(t_epoch)
+    row_group = np.unique(rows.sat_id, return_inverse=True)[1].reshape(-1)
     row_epoch = epoch_of_row[index]
     n_sat_epoch = np.bincount(row_epoch, minlength=m)[:m]
     lo = np.searchsorted(t_epoch[row_epoch], t_epoch - config.window_s, side="right")
@@ -341,7 +412,15 @@ def tight_heading_series(
         k = np.arange(start, min(start + config.chunk_windows, m))
         solutions.append(
             _solve_chunk(
-                rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_angle, config
+                rows,
+                (y_all, row_group),
+                index,
+                row_epoch,
+                k,
+                (lo, hi),
+                (t_epoch, speed, yaw_angle),
+                (scale_sigma, bias_sigma),
+                config,
             )
         )
     solution = _concatenate(solutions)
@@ -353,7 +432,9 @@ def tight_heading_series(
     return _decide(solution, model_variance, t_epoch, speed, yaw_angle, n_sat_epoch, config)
 
 
-def _solve_chunk(rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_angle, config):
+def _solve_chunk(rows, per_row, index, row_epoch, k, bounds, per_epoch, calibration, config):
+    (y_all, row_group), (lo, hi) = per_row, bounds
+    (t_epoch, speed, yaw_angle), (scale_sigma, bias_sigma) = per_epoch, calibration
     width = max(int(np.max(hi[k] - lo[k], initial=0)), 1)
     slot = lo[k][:, None] + np.arange(width)[None, :]
     inside = slot < hi[k][:, None]
@@ -370,14 +451,17 @@ def _solve_chunk(rows, y_all, index, row_epoch, k, lo, hi, t_epoch, speed, yaw_a
     w = np.where(inside, rows.weight[row], 0.0)
     y = np.where(w > 0, y_all[row], 0.0)
     a, b, tau = np.where(w > 0, a, 0.0), np.where(w > 0, b, 0.0), np.where(w > 0, tau, 0.0)
-    return solve_windows(y, a, b, tau, w, config)
+    group = np.where(w > 0, row_group[row], 0)
+    return solve_windows(y, a, b, tau, w, config, group, scale_sigma[k], bias_sigma[k])
 
 
 def _unavailable(t_epoch) -> TightHeadingResult:
     """Every epoch unavailable (no epochs, or no usable Doppler row at all)."""
     m = len(t_epoch)
     nan, flags, counts = np.full(m, np.nan), np.zeros(m, dtype=bool), np.zeros(m, dtype=int)
-    return TightHeadingResult(t_epoch, nan, nan, counts, counts, flags, flags, flags, nan, nan)
+    return TightHeadingResult(
+        t_epoch, nan, nan, counts, counts, flags, flags, flags, nan, nan, counts, flags, flags
+    )
 
 
 def _concatenate(solutions):
@@ -408,6 +492,7 @@ def _decide(
         & observable
         & np.isfinite(sol.theta)
         & (sigma <= config.max_sigma_rad)
+        & ~sol.inconsistent
     )
     yaw = np.where(candidate & ~ambiguous, sol.theta, np.nan)
     available = candidate & ~ambiguous
@@ -433,6 +518,9 @@ def _decide(
         ambiguous=ambiguous & candidate,
         clock_drift=np.where(available, sol.rho0, np.nan),
         clock_drift_rate=np.where(available, sol.alpha, np.nan),
+        n_rejected=sol.n_rejected.astype(int),
+        verifiable=available & (sol.min_redundancy >= config.testable_redundancy),
+        inconsistent=sol.inconsistent & (sol.n_obs >= config.min_obs),
     )
 
 

@@ -1,0 +1,272 @@
+"""Data snooping for the tightly coupled heading: is one satellite's Doppler biased (NLOS)?
+
+A reflected (non-line-of-sight) signal adds to its range rate the rate of the extra path,
+−2·(v·m)·|u_n| for a facade with unit normal u_n towards direction m: a bias that stays nearly
+constant over a window of a few seconds. The fault hypothesis H_j is therefore "satellite j is
+biased by an unknown ∇ over the window": the model gets ∇·c_j, c_j the indicator of the
+window's rows of satellite j. A satellite seen at one epoch only is a single row, so the same
+hypothesis covers single-row blunders.
+
+Test statistic (generalised likelihood ratio, Baarda's w-test squared when the model is linear):
+the drop of the weighted residual sum of squares when ∇ is added to the linear parameters,
+
+    λ_j = min_θ₀ zᵀQ₀z − min_θ₀ zᵀQ_jz,       λ_j ~ χ²(1) when no satellite is biased,
+
+with Q the profiled cost of :mod:`vo_doppler.heading.profile` (Q_j has c_j as a third column of
+T). θ₀ is re-estimated under each hypothesis over the whole circle, so a biased satellite that
+pulled the fit into a wrong minimum is still found. Every quantity is a per-satellite partial
+sum of the window's normal equations, so all hypotheses of all windows are solved at once.
+
+Redundancy number (linearised at the fit, design J = ∂model/∂(θ₀, ρ₀, α), N = JᵀWJ): the share
+of a bias on j that shows in the residuals, r_j = (Σ_j w − A_j N⁻¹ A_jᵀ)/Σ_j w with
+A_j = Σ_j w·J. Near zero (as many independent constraints as unknowns, or two satellites on a
+straight road) a bias cannot be detected, and the window is *unverifiable*.
+
+Errors the noise model leaves out — a speed-scale error ε and a gyro-bias error δb of the
+calibration — move every row coherently (model error m_ε = a·cos θ₀ + b·sin θ₀ per unit ε,
+m_b = −τ·J_θ per unit δb) and look like satellite biases: they add (c_jᵀ W Q_r W m)²·σ² to the
+variance of c_jᵀWr (Q_r the residuals' cofactor matrix), whose noise part is
+σ₀²·(Σ_j w − A_j N⁻¹ A_jᵀ); σ₀ = max(1, MAD scale of the normalised residuals) guards against
+optimistic a-priori σ. λ_j is divided by the ratio of that variance to its noise-only value.
+
+Identification: the largest statistic names its satellite only when H_j is at least
+``identification_odds`` times likelier than every other H_i, i.e. λ_j − λ_i ≥ 2 ln(odds)
+(likelihood ratio exp((λ_j − λ_i)/2)). Hypotheses that explain the residuals equally well
+(redundancy one at satellite level, e.g. three satellites on a straight road, give λ_i = λ_j)
+leave the window inconsistent rather than repaired.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from vo_doppler.heading.profile import (
+    minimum_cost,
+    project_out,
+    projected_normal_matrix,
+    z_of,
+)
+
+MAX_PAIR_SATELLITES = 12
+"""Two-satellite hypotheses are formed among this many satellites of largest statistic."""
+
+
+@dataclass
+class SnoopingResult:
+    """Per window: the rows to reject (K, R), whether a bias was detected, whether its
+    satellite (or row) was identified, and the smallest redundancy number of the satellites
+    present (1 if none)."""
+
+    reject: np.ndarray
+    detected: np.ndarray
+    identified: np.ndarray
+    min_redundancy: np.ndarray
+
+
+def _group_sums(values, flat, shape):
+    """Σ per (window, group) of ``values`` (K, R) or (K, R, C), flattened index ``flat``."""
+    size = shape[0] * shape[1]
+    if values.ndim == 2:
+        return np.bincount(flat, values.ravel(), size).reshape(shape)
+    columns = [np.bincount(flat, values[..., c].ravel(), size) for c in range(values.shape[-1])]
+    return np.stack(columns, -1).reshape(*shape, values.shape[-1])
+
+
+def _cost_with_biases(normal, S_X, S_T, S_w, grid_size, iterations):
+    """Minimum profiled cost when each window (leading axis) also fits one constant bias per
+    selected satellite: sums (K, H, n, ·) of the n disjoint satellites of H hypotheses."""
+    XtWX, XtWT, TtWT = (m[:, None] for m in normal)
+    lead = S_w.shape[:2]
+    XtWT_h = np.concatenate(
+        [np.broadcast_to(XtWT, (*lead, 3, 2)), np.swapaxes(S_X, -1, -2)], axis=-1
+    )
+    top = np.concatenate([np.broadcast_to(TtWT, (*lead, 2, 2)), np.swapaxes(S_T, -1, -2)], -1)
+    bottom = np.concatenate([S_T, S_w[..., None] * np.eye(S_w.shape[-1])], axis=-1)
+    Q = project_out(XtWX, XtWT_h, np.concatenate([top, bottom], axis=-2))[0]
+    return minimum_cost(Q, grid_size, iterations)[1]
+
+
+@dataclass
+class _Linearised:
+    """The least-squares fit linearised at its θ₀ (module docstring): per row the weighted
+    residual w·r, the noise-only variance of w·r with unit σ₀ (w − w²·J N⁻¹ Jᵀ) and w·(I − H)·m
+    of each calibration error m scaled by its σ; per window σ₀²; A_j N⁻¹ per satellite."""
+
+    weighted_residual: np.ndarray
+    row_seen: np.ndarray
+    model_rows: list[np.ndarray]
+    sigma0_sq: np.ndarray
+    J: np.ndarray
+    N_inv: np.ndarray
+
+
+def _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma):
+    cos_t, sin_t = np.cos(theta)[:, None], np.sin(theta)[:, None]
+    j_theta = -a * sin_t + b * cos_t
+    J = np.stack([j_theta, np.ones_like(tau), -tau], axis=-1)
+    z = z_of(theta)
+    params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
+    residual = (X @ z[:, :, None])[:, :, 0] - np.einsum("krj,kj->kr", T, params)
+    normalised = np.where(w > 0, np.abs(residual) * np.sqrt(w), np.nan)
+    with warnings.catch_warnings():  # windows without rows give NaN: no scale-up
+        warnings.simplefilter("ignore", RuntimeWarning)
+        mad = 1.4826 * np.nan_to_num(np.nanmedian(normalised, axis=1))
+    N_inv = np.linalg.pinv(np.einsum("kri,kr,krj->kij", J, w, J), hermitian=True)
+    leverage = np.einsum("kri,kij,krj->kr", J, N_inv, J) * w
+    model_rows = []
+    for m, sigma in zip((a * cos_t + b * sin_t, -tau * j_theta), calibration_sigma, strict=True):
+        fitted = np.einsum("kri,kij,krj,kr,kr->kr", J, N_inv, J, w, m)
+        model_rows.append(w * (m - fitted) * sigma[:, None])
+    return _Linearised(
+        weighted_residual=w * residual,
+        row_seen=np.clip(w * (1.0 - leverage), 0.0, None),
+        model_rows=model_rows,
+        sigma0_sq=np.maximum(1.0, mad) ** 2,
+        J=J,
+        N_inv=N_inv,
+    )
+
+
+def snoop_satellites(
+    a: np.ndarray,
+    b: np.ndarray,
+    y: np.ndarray,
+    tau: np.ndarray,
+    w: np.ndarray,
+    group: np.ndarray,
+    n_groups: int,
+    calibration_sigma: tuple[np.ndarray, np.ndarray],
+    grid_size: int,
+    iterations: int,
+    alpha: float,
+    identification_odds: float,
+    min_redundancy: float,
+) -> SnoopingResult:
+    """Bias tests of every satellite and every row of every window (module docstring).
+
+    Arrays (K, R) as in :func:`vo_doppler.heading.tight_heading.solve_windows`: coefficients
+    ``a``, ``b``, reduced observations ``y``, row times ``tau``, a-priori weights ``w`` of the
+    rows in the fit (0 elsewhere) and ``group`` the satellite index in [0, n_groups).
+    ``calibration_sigma``: relative speed-scale and gyro-bias (rad/s) standard deviations (K,).
+    ``alpha`` is the false-alarm probability per window, half for the satellite tests and
+    half for the row tests, each half shared among the n tests (Bonferroni: α/(2n)).
+    Satellites and rows whose redundancy number is below ``min_redundancy`` are not tested:
+    so little of a bias would show that the statistic would measure the model's small
+    unmodelled errors rather than the observation.
+    """
+    a, b = np.nan_to_num(a), np.nan_to_num(b)
+    K = len(w)
+    shape = (K, n_groups)
+    X = np.stack([-a, -b, y], axis=-1)
+    T = np.stack([np.ones_like(tau), -tau], axis=-1)
+    Q0, XtWX, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, w)
+    theta, cost0 = minimum_cost(Q0, grid_size, iterations)
+    flat = (np.arange(K)[:, None] * n_groups + group).ravel()
+    S_w = _group_sums(w, flat, shape)
+    S_X = _group_sums(w[..., None] * X, flat, shape)
+    S_T = _group_sums(w[..., None] * T, flat, shape)
+    normal = (XtWX, XtWT, np.einsum("kri,kr,krj->kij", T, w, T))
+    single = _cost_with_biases(
+        normal, S_X[:, :, None], S_T[:, :, None], S_w[:, :, None], grid_size, iterations
+    )
+    lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma)
+
+    A = _group_sums(w[..., None] * lin.J, flat, shape)
+    seen = np.clip(S_w - np.einsum("kgi,kij,kgj->kg", A, lin.N_inv, A), 0.0, None)
+    variance = lin.sigma0_sq[:, None] * seen
+    row_variance = lin.sigma0_sq[:, None] * lin.row_seen
+    for model in lin.model_rows:
+        variance += _group_sums(model, flat, shape) ** 2
+        row_variance += model**2
+    present = S_w > 0
+    redundancy = np.where(present, seen / np.where(present, S_w, 1.0), 1.0)
+    sat_ok = present & (redundancy >= min_redundancy)
+    row_ok = (w > 0) & (lin.row_seen >= min_redundancy * w)
+    drop = np.clip(cost0[:, None] - single, 0.0, None)
+    sat_stat = np.where(sat_ok, drop * seen / np.where(sat_ok, variance, 1.0), 0.0)
+    row_stat = np.where(row_ok, lin.weighted_residual**2 / np.where(row_ok, row_variance, 1.0), 0.0)
+    n_sat, n_row = np.count_nonzero(sat_ok, axis=1), np.count_nonzero(row_ok, axis=1)
+    best_sat, best_row = np.argmax(sat_stat, axis=1), np.argmax(row_stat, axis=1)
+    k = np.arange(K)
+    sat_max, row_max = sat_stat[k, best_sat], row_stat[k, best_row]
+    detected = (sat_max > chi2.isf(alpha / (2 * np.maximum(n_sat, 1)), 1)) | (
+        row_max > chi2.isf(alpha / (2 * np.maximum(n_row, 1)), 1)
+    )
+    by_row = row_max > sat_max
+    largest = np.maximum(sat_max, row_max)
+    runner_up = np.maximum(
+        _second(sat_stat, sat_ok, np.where(by_row, -1, best_sat)),
+        _second(row_stat, row_ok, np.where(by_row, best_row, -1)),
+    )
+    margin = 2.0 * np.log(identification_odds)
+    identified = largest - runner_up >= margin
+    reject = np.where(
+        by_row[:, None],
+        np.arange(w.shape[1])[None, :] == best_row[:, None],
+        group == best_sat[:, None],
+    )
+    two = np.flatnonzero(detected & ~by_row & (n_sat >= 2))
+    if two.size:
+        pair, pair_identified, pair_wins = _pairs(
+            two,
+            (S_X, S_T, S_w, seen / np.where(sat_ok, variance, 1.0), sat_stat, sat_ok),
+            normal,
+            single[two, best_sat[two]],
+            (grid_size, iterations),
+            alpha,
+            margin,
+        )
+        windows = two[pair_wins]
+        chosen = pair[pair_wins]
+        reject[windows] = (group[windows] == chosen[:, :1]) | (group[windows] == chosen[:, 1:])
+        identified[windows] = pair_identified[pair_wins]
+    return SnoopingResult(
+        reject=reject & (w > 0) & (detected & identified)[:, None],
+        detected=detected,
+        identified=identified,
+        min_redundancy=np.min(redundancy, axis=1, initial=1.0),
+    )
+
+
+def _second(statistic, ok, best):
+    """Largest statistic per window other than column ``best`` (−1: none excluded); 0 if none."""
+    masked = np.where(ok, statistic, 0.0)
+    k = np.flatnonzero(best >= 0)
+    masked[k, best[k]] = 0.0
+    return np.max(masked, axis=1, initial=0.0)
+
+
+def _pairs(windows, sums, normal, cost_bound, solver, alpha, margin):
+    """Two-satellite hypotheses in ``windows`` (module docstring): the best pair, whether it is
+    identified, and whether its second bias is significant — the pair then replaces the best
+    single hypothesis, which a second biased satellite can mask. ``cost_bound`` is the
+    cost under the best single-satellite hypothesis."""
+    S_X, S_T, S_w, scale, statistic, testable = (x[windows] for x in sums)
+    normal = tuple(m[windows] for m in normal)
+    n_tests = np.count_nonzero(testable, axis=1)
+    order = np.argsort(np.where(testable, -statistic, np.inf), axis=1, kind="stable")
+    ids = order[:, : min(int(n_tests.max()), MAX_PAIR_SATELLITES)]
+    u, v = np.triu_indices(ids.shape[1], 1)
+    g1, g2 = ids[:, u], ids[:, v]
+    k = np.arange(len(windows))[:, None]
+    cost = _cost_with_biases(
+        normal,
+        np.stack([S_X[k, g1], S_X[k, g2]], axis=-2),
+        np.stack([S_T[k, g1], S_T[k, g2]], axis=-2),
+        np.stack([S_w[k, g1], S_w[k, g2]], axis=-1),
+        *solver,
+    )
+    gain = np.clip(cost_bound[:, None] - cost, 0.0, None) * np.minimum(scale[k, g1], scale[k, g2])
+    valid = v[None, :] < n_tests[:, None]
+    gain = np.where(valid, gain, -np.inf)
+    best = np.argmax(gain, axis=1)
+    rows = np.arange(len(windows))
+    largest = gain[rows, best]
+    gain[rows, best] = -np.inf
+    identified = largest - np.max(gain, axis=1) >= margin
+    wins = largest > chi2.isf(alpha / np.maximum(n_tests - 1, 1), 1)
+    return np.stack([g1[rows, best], g2[rows, best]], axis=1), identified, wins
