@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -74,6 +75,11 @@ def register(subparsers) -> None:
         help="extra seconds added to the speed times",
     )
     parser.add_argument("--window-s", type=float, default=2.0, help="heading window (s)")
+    parser.add_argument(
+        "--no-nlos-rejection",
+        action="store_true",
+        help="keep every Doppler row: no data snooping for reflected (NLOS) satellites",
+    )
     parser.add_argument("--calibration", choices=CALIBRATION_METHODS, default="ls")
     parser.add_argument("--gyro-bias", type=float, help="fixed gyro bias (deg/s) instead")
     parser.add_argument("--wheel-scale", type=float, help="fixed wheel scale instead")
@@ -136,9 +142,12 @@ def run(args: argparse.Namespace) -> int:
             f"sensor times ({speed.t[:1]}..{speed.t[-1:]}) do not overlap the GNSS epochs "
             f"({obs.epoch_time[0]:.1f}..{obs.epoch_time[-1]:.1f} GPS s); use --time-offset-*"
         )
+    tight = TightHeadingConfig(window_s=args.window_s)
+    if args.no_nlos_rejection:
+        tight = replace(tight, outlier_passes=0)
     config = HeadingPipelineConfig(
         calibration=args.calibration,
-        tight=TightHeadingConfig(window_s=args.window_s),
+        tight=tight,
         fixed_gyro_bias=None if args.gyro_bias is None else np.radians(args.gyro_bias),
         fixed_wheel_scale=args.wheel_scale,
     )
@@ -162,6 +171,9 @@ def run(args: argparse.Namespace) -> int:
         "tc_available": float(table.tc_available.mean()),
         "tc_reliable": float(table.tc_reliable.mean()),
         "conv_valid": float(table.conv_valid.mean()),
+        "rejected_rows": int(table.rejected_rows.sum()),
+        "epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
+        "tc_verifiable": float(table.tc_verifiable.mean()),
         "gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
         "wheel_scale": float(table.wheel_scale[-1]),
         "output": str(args.output),

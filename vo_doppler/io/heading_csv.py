@@ -1,8 +1,11 @@
 """``heading.csv``: one row per GNSS epoch, headings as course in degrees clockwise from north.
 
 Columns: gps_time_s, heading_tc_deg, heading_tc_sigma_deg, tc_reliable, n_obs_window,
-n_sat_epoch, heading_conv_deg, conv_valid, gyro_bias_dps, wheel_scale. Unavailable headings are
-written as ``nan``; flags as 0/1. Reading converts back to yaw (rad, counter-clockwise from east).
+n_sat_epoch, heading_conv_deg, conv_valid, gyro_bias_dps, wheel_scale, then rejected_rows (rows
+of the window rejected as biased, NLOS) and tc_verifiable (a bias on any satellite used would
+have shown). Unavailable headings are written as ``nan``; flags as 0/1. Reading converts back to
+yaw (rad, counter-clockwise from east); the last two columns are optional (files written before
+they existed read as zero).
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ COLUMNS = (
     "gyro_bias_dps",
     "wheel_scale",
 )
+OPTIONAL_COLUMNS = ("rejected_rows", "tc_verifiable")
 
 
 def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
@@ -42,6 +46,8 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         table.conv_valid.astype(int),
         np.degrees(table.gyro_bias),
         table.wheel_scale,
+        table.rejected_rows.astype(int),
+        table.tc_verifiable.astype(int),
     ]
     formats = (
         "{:.3f}",
@@ -54,9 +60,11 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         "{:d}",
         "{:.5f}",
         "{:.6f}",
+        "{:d}",
+        "{:d}",
     )
     with Path(path).open("w", newline="") as handle:
-        handle.write(",".join(COLUMNS) + "\n")
+        handle.write(",".join(COLUMNS + OPTIONAL_COLUMNS) + "\n")
         for values in zip(*columns, strict=True):
             handle.write(",".join(f.format(v) for f, v in zip(formats, values, strict=True)) + "\n")
 
@@ -74,7 +82,7 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
     missing = [c for c in COLUMNS if c not in header]
     if missing:
         raise InputError(f"heading CSV lacks columns {missing}", path, 1)
-    index = [header.index(c) for c in COLUMNS]
+    index = [header.index(c) for c in COLUMNS + OPTIONAL_COLUMNS if c in header]
     rows = []
     for number, line in enumerate(lines[1:], start=2):
         if not line.strip():
@@ -84,7 +92,11 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
             rows.append([float(fields[i]) for i in index])
         except (ValueError, IndexError) as exc:
             raise InputError(f"bad heading row ({exc})", path, number) from exc
-    data = np.array(rows, dtype=float).reshape(-1, len(COLUMNS))
+    data = np.array(rows, dtype=float).reshape(-1, len(index))
+    optional = {
+        c: data[:, len(COLUMNS) + i]
+        for i, c in enumerate(c for c in OPTIONAL_COLUMNS if c in header)
+    }
     tc_deg, conv_deg = data[:, 1], data[:, 6]
     return HeadingTable(
         t=data[:, 0],
@@ -97,4 +109,6 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
         conv_valid=(data[:, 7] > 0.5) & np.isfinite(conv_deg),
         gyro_bias=np.radians(data[:, 8]),
         wheel_scale=data[:, 9],
+        rejected_rows=optional.get("rejected_rows", np.zeros(len(data))).astype(int),
+        tc_verifiable=optional.get("tc_verifiable", np.zeros(len(data))) > 0.5,
     )
