@@ -22,12 +22,17 @@ def project_out(XtWX, XtWT, TtWT):
     return Q, TtWT_pinv, np.linalg.matrix_rank(TtWT, hermitian=True)
 
 
+def weighted_gram(U, w, V):
+    """UᵀWV per window for rows U (K, R, m), V (K, R, n) and weights w (K, R)."""
+    return np.swapaxes(U * w[..., None], -1, -2) @ V
+
+
 def projected_normal_matrix(X, T, w):
     """Q per window from rows (K, R, ·) with weights (K, R), plus XᵀWX, XᵀWT, (TᵀWT)⁺ and
     rank(TᵀWT)."""
-    XtWX = np.einsum("kri,kr,krj->kij", X, w, X)
-    XtWT = np.einsum("kri,kr,krj->kij", X, w, T)
-    TtWT = np.einsum("kri,kr,krj->kij", T, w, T)
+    XtW = np.swapaxes(X * w[..., None], -1, -2)
+    XtWX, XtWT = XtW @ X, XtW @ T
+    TtWT = weighted_gram(T, w, T)
     Q, TtWT_pinv, rank = project_out(XtWX, XtWT, TtWT)
     return Q, XtWX, XtWT, TtWT_pinv, rank
 

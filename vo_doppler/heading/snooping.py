@@ -48,6 +48,7 @@ from vo_doppler.heading.profile import (
     minimum_cost,
     project_out,
     projected_normal_matrix,
+    weighted_gram,
     z_of,
 )
 
@@ -115,11 +116,11 @@ def _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma):
     with warnings.catch_warnings():  # windows without rows give NaN: no scale-up
         warnings.simplefilter("ignore", RuntimeWarning)
         mad = 1.4826 * np.nan_to_num(np.nanmedian(normalised, axis=1))
-    N_inv = np.linalg.pinv(np.einsum("kri,kr,krj->kij", J, w, J), hermitian=True)
-    leverage = np.einsum("kri,kij,krj->kr", J, N_inv, J) * w
+    N_inv = np.linalg.pinv(weighted_gram(J, w, J), hermitian=True)
+    leverage = np.sum((J @ N_inv) * J, axis=-1) * w
     model_rows = []
     for m, sigma in zip((a * cos_t + b * sin_t, -tau * j_theta), calibration_sigma, strict=True):
-        fitted = np.einsum("kri,kij,krj,kr,kr->kr", J, N_inv, J, w, m)
+        fitted = (J @ (N_inv @ weighted_gram(J, w * m, np.ones_like(m)[..., None])))[..., 0]
         model_rows.append(w * (m - fitted) * sigma[:, None])
     return _Linearised(
         weighted_residual=w * residual,
@@ -169,14 +170,14 @@ def snoop_satellites(
     S_w = _group_sums(w, flat, shape)
     S_X = _group_sums(w[..., None] * X, flat, shape)
     S_T = _group_sums(w[..., None] * T, flat, shape)
-    normal = (XtWX, XtWT, np.einsum("kri,kr,krj->kij", T, w, T))
+    normal = (XtWX, XtWT, weighted_gram(T, w, T))
     single = _cost_with_biases(
         normal, S_X[:, :, None], S_T[:, :, None], S_w[:, :, None], grid_size, iterations
     )
     lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma)
 
     A = _group_sums(w[..., None] * lin.J, flat, shape)
-    seen = np.clip(S_w - np.einsum("kgi,kij,kgj->kg", A, lin.N_inv, A), 0.0, None)
+    seen = np.clip(S_w - np.sum((A @ lin.N_inv) * A, axis=-1), 0.0, None)
     variance = lin.sigma0_sq[:, None] * seen
     row_variance = lin.sigma0_sq[:, None] * lin.row_seen
     for model in lin.model_rows:
@@ -193,22 +194,22 @@ def snoop_satellites(
     best_sat, best_row = np.argmax(sat_stat, axis=1), np.argmax(row_stat, axis=1)
     k = np.arange(K)
     sat_max, row_max = sat_stat[k, best_sat], row_stat[k, best_row]
+    row_critical = chi2.isf(alpha / (2 * np.maximum(n_row, 1)), 1)
     detected = (sat_max > chi2.isf(alpha / (2 * np.maximum(n_sat, 1)), 1)) | (
-        row_max > chi2.isf(alpha / (2 * np.maximum(n_row, 1)), 1)
+        row_max > row_critical
     )
     by_row = row_max > sat_max
+    suspect = np.where(by_row, group[k, best_row], best_sat)
+    own = group == suspect[:, None]
     largest = np.maximum(sat_max, row_max)
-    runner_up = np.maximum(
-        _second(sat_stat, sat_ok, np.where(by_row, -1, best_sat)),
-        _second(row_stat, row_ok, np.where(by_row, best_row, -1)),
-    )
+    other_sat = np.where(sat_ok & (np.arange(n_groups) != suspect[:, None]), sat_stat, 0.0)
+    other_row = np.where(row_ok & ~own, row_stat, 0.0)
+    runner_up = np.maximum(np.max(other_sat, axis=1), np.max(other_row, axis=1, initial=0.0))
     margin = 2.0 * np.log(identification_odds)
     identified = largest - runner_up >= margin
-    reject = np.where(
-        by_row[:, None],
-        np.arange(w.shape[1])[None, :] == best_row[:, None],
-        group == best_sat[:, None],
-    )
+    significant_rows = own & (row_stat > row_critical[:, None])
+    significant_rows[k, best_row] = True
+    reject = np.where(by_row[:, None], significant_rows, own)
     two = np.flatnonzero(detected & ~by_row & (n_sat >= 2))
     if two.size:
         pair, pair_identified, pair_wins = _pairs(
@@ -230,14 +231,6 @@ def snoop_satellites(
         identified=identified,
         min_redundancy=np.min(redundancy, axis=1, initial=1.0),
     )
-
-
-def _second(statistic, ok, best):
-    """Largest statistic per window other than column ``best`` (−1: none excluded); 0 if none."""
-    masked = np.where(ok, statistic, 0.0)
-    k = np.flatnonzero(best >= 0)
-    masked[k, best[k]] = 0.0
-    return np.max(masked, axis=1, initial=0.0)
 
 
 def _pairs(windows, sums, normal, cost_bound, solver, alpha, margin):

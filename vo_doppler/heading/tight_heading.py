@@ -46,6 +46,7 @@ from vo_doppler.heading.profile import (
     grid_minima,
     projected_normal_matrix,
     quadratic,
+    weighted_gram,
     z_of,
 )
 from vo_doppler.heading.rows import DopplerRows
@@ -330,7 +331,7 @@ def _error_gains(a, b, tau, weights, theta):
     cos_t, sin_t = np.cos(theta)[:, None], np.sin(theta)[:, None]
     j_theta = -a * sin_t + b * cos_t
     J = np.stack([j_theta, np.ones_like(tau), -tau], axis=-1)
-    normal_inv = np.linalg.pinv(np.einsum("kri,kr,krj->kij", J, weights, J), hermitian=True)
+    normal_inv = np.linalg.pinv(weighted_gram(J, weights, J), hermitian=True)
     g = np.einsum("kj,krj,kr->kr", normal_inv[:, 0, :], J, weights)
     tail = np.cumsum(g[:, ::-1], axis=1)[:, ::-1]
     step = np.diff(tau, axis=1, prepend=tau[:, :1])
