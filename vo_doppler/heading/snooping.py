@@ -1,39 +1,59 @@
-"""Data snooping for the tightly coupled heading: is one satellite's Doppler biased (NLOS)?
+"""Data snooping for the tightly coupled heading: which satellite's Doppler is biased (NLOS)?
 
 A reflected (non-line-of-sight) signal adds to its range rate the rate of the extra path,
-−2·(v·m)·|u_n| for a facade with unit normal u_n towards direction m: a bias that stays nearly
-constant over a window of a few seconds. The fault hypothesis H_j is therefore "satellite j is
-biased by an unknown ∇ over the window": the model gets ∇·c_j, c_j the indicator of the
-window's rows of satellite j. A satellite seen at one epoch only is a single row, so the same
-hypothesis covers single-row blunders.
+−2·(v·m)·|u_n| for a facade with unit normal u_n, m the unit vector towards it: a bias that
+stays nearly constant over a window of a few seconds on a straight road, ramps in a turn, and
+starts or stops where the reflecting facade does. Three families of fault hypotheses cover it:
 
-Test statistic (generalised likelihood ratio, Baarda's w-test squared when the model is linear):
-the drop of the weighted residual sum of squares when ∇ is added to the linear parameters,
+* satellite H_j: "satellite j is biased by an unknown constant ∇ over the window" (the model
+  gets ∇·c_j, c_j the indicator of the window's rows of satellite j);
+* row H_i: "row i alone is biased" (a blunder, or the part of a reflection that is not
+  constant over the window);
+* pair H_jk: two satellites biased at once, which one satellite test can mask (a second bias
+  drags the fit so that a clean satellite looks worst).
+
+Satellite statistic (generalised likelihood ratio; Baarda's w-test squared when the model is
+linear): the drop of the weighted residual sum of squares when ∇ joins the linear parameters,
 
     λ_j = min_θ₀ zᵀQ₀z − min_θ₀ zᵀQ_jz,       λ_j ~ χ²(1) when no satellite is biased,
 
-with Q the profiled cost of :mod:`vo_doppler.heading.profile` (Q_j has c_j as a third column of
-T). θ₀ is re-estimated under each hypothesis over the whole circle, so a biased satellite that
-pulled the fit into a wrong minimum is still found. Every quantity is a per-satellite partial
-sum of the window's normal equations, so all hypotheses of all windows are solved at once.
+with Q the profiled cost of :mod:`vo_doppler.heading.profile` (Q_j has c_j as a further column
+of T). θ₀ is re-estimated under each hypothesis over the whole circle, so a biased satellite
+that pulled the fit into a wrong minimum is still found. Every quantity is a per-satellite
+partial sum of the window's normal equations, so all hypotheses of all windows are solved at
+once; pairs (λ_jk ~ χ²(2)) only where a bias was detected. Row statistic: the w-test
+(w_i r_i)² / var(w_i r_i) of the least-squares fit linearised at its θ₀ (design
+J = ∂model/∂(θ₀, ρ₀, α), N = JᵀWJ, var = w_i − w_i² J_i N⁻¹ J_iᵀ).
 
-Redundancy number (linearised at the fit, design J = ∂model/∂(θ₀, ρ₀, α), N = JᵀWJ): the share
-of a bias on j that shows in the residuals, r_j = (Σ_j w − A_j N⁻¹ A_jᵀ)/Σ_j w with
-A_j = Σ_j w·J. Near zero (as many independent constraints as unknowns, or two satellites on a
-straight road) a bias cannot be detected, and the window is *unverifiable*.
+Redundancy number: the share of a bias on satellite j that shows in the residuals,
+r_j = (Σ_j w − A_j N⁻¹ A_jᵀ)/Σ_j w with A_j = Σ_j w·J (rows alike). Near zero (as many
+independent constraints as unknowns; one satellite, whose bias is a clock drift; two
+satellites on a straight road) a bias cannot be detected: such satellites and rows are not
+tested, and a window using one is *unverifiable*.
 
 Errors the noise model leaves out — a speed-scale error ε and a gyro-bias error δb of the
 calibration — move every row coherently (model error m_ε = a·cos θ₀ + b·sin θ₀ per unit ε,
 m_b = −τ·J_θ per unit δb) and look like satellite biases: they add (c_jᵀ W Q_r W m)²·σ² to the
 variance of c_jᵀWr (Q_r the residuals' cofactor matrix), whose noise part is
-σ₀²·(Σ_j w − A_j N⁻¹ A_jᵀ); σ₀ = max(1, MAD scale of the normalised residuals) guards against
-optimistic a-priori σ. λ_j is divided by the ratio of that variance to its noise-only value.
+σ₀²·(Σ_j w − A_j N⁻¹ A_jᵀ); σ₀ ≥ 1, a robust scale of the normalised residuals over all
+windows (:func:`receiver_noise_scale`), guards against optimistic a-priori σ. Each
+statistic is divided by the ratio of that variance to its noise-only value.
 
-Identification: the largest statistic names its satellite only when H_j is at least
-``identification_odds`` times likelier than every other H_i, i.e. λ_j − λ_i ≥ 2 ln(odds)
-(likelihood ratio exp((λ_j − λ_i)/2)). Hypotheses that explain the residuals equally well
-(redundancy one at satellite level, e.g. three satellites on a straight road, give λ_i = λ_j)
-leave the window inconsistent rather than repaired.
+Decision: the false-alarm probability α of a window is split between the satellite and the row
+family and Bonferroni-shared among their tests. The largest statistic names a satellite only
+when that hypothesis is at least ``identification_odds`` times likelier than every hypothesis
+on another satellite, i.e. λ − λ_other ≥ 2 ln(odds) (likelihood ratio exp(Δλ/2)); hypotheses
+that explain the residuals equally well (redundancy one at satellite level, e.g. three
+satellites on a straight road, give equal λ) leave the window inconsistent rather than
+repaired. A named satellite loses all its rows (satellite hypothesis) or all its rows whose
+own test is significant (row hypothesis); the best pair replaces the best single satellite when
+its second bias is significant (λ_jk − λ_j beyond the χ²(1) critical value).
+
+Heading variance after a repair: a window that had to reject a reflected satellite may hold
+another whose bias stayed below detection. Giving satellite j its own bias parameter adds
+g_j²·var(∇̂_j) to var θ₀ (Schur complement; g_j = (N⁻¹A_jᵀ)_θ, var(∇̂_j) the variance of
+c_jᵀWr over (Σ_j w − A_j N⁻¹ A_jᵀ)²); the largest such term over the tested satellites is
+``bias_variance``.
 """
 
 from __future__ import annotations
@@ -52,6 +72,8 @@ from vo_doppler.heading.profile import (
     z_of,
 )
 
+MIN_SCALE_DOF = 10
+"""Windows with fewer degrees of freedom do not estimate the scale of the a-priori σ."""
 MAX_PAIR_SATELLITES = 12
 """Two-satellite hypotheses are formed among this many satellites of largest statistic."""
 
@@ -66,6 +88,9 @@ class SnoopingResult:
     detected: np.ndarray
     identified: np.ndarray
     min_redundancy: np.ndarray
+    bias_variance: np.ndarray
+    """Largest increase of var θ₀ (rad²) if one tested satellite had its own unknown bias."""
+    noise_scale: float
 
 
 def _group_sums(values, flat, shape):
@@ -95,12 +120,14 @@ def _cost_with_biases(normal, S_X, S_T, S_w, grid_size, iterations):
 class _Linearised:
     """The least-squares fit linearised at its θ₀ (module docstring): per row the weighted
     residual w·r, the noise-only variance of w·r with unit σ₀ (w − w²·J N⁻¹ Jᵀ) and w·(I − H)·m
-    of each calibration error m scaled by its σ; per window σ₀²; A_j N⁻¹ per satellite."""
+    of each calibration error m scaled by its σ; per window the MAD scale of the normalised
+    residuals and the degrees of freedom."""
 
     weighted_residual: np.ndarray
     row_seen: np.ndarray
     model_rows: list[np.ndarray]
-    sigma0_sq: np.ndarray
+    mad: np.ndarray
+    dof: np.ndarray
     J: np.ndarray
     N_inv: np.ndarray
 
@@ -126,7 +153,8 @@ def _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma):
         weighted_residual=w * residual,
         row_seen=np.clip(w * (1.0 - leverage), 0.0, None),
         model_rows=model_rows,
-        sigma0_sq=np.maximum(1.0, mad) ** 2,
+        mad=mad,
+        dof=np.count_nonzero(w > 0, axis=1) - np.linalg.matrix_rank(weighted_gram(J, w, J)),
         J=J,
         N_inv=N_inv,
     )
@@ -146,6 +174,7 @@ def snoop_satellites(
     alpha: float,
     identification_odds: float,
     min_redundancy: float,
+    noise_scale: float | None = None,
 ) -> SnoopingResult:
     """Bias tests of every satellite and every row of every window (module docstring).
 
@@ -157,7 +186,8 @@ def snoop_satellites(
     half for the row tests, each half shared among the n tests (Bonferroni: α/(2n)).
     Satellites and rows whose redundancy number is below ``min_redundancy`` are not tested:
     so little of a bias would show that the statistic would measure the model's small
-    unmodelled errors rather than the observation.
+    unmodelled errors rather than the observation. ``noise_scale`` σ₀ multiplies the a-priori
+    σ (default: :func:`receiver_noise_scale` of these windows).
     """
     a, b = np.nan_to_num(a), np.nan_to_num(b)
     K = len(w)
@@ -178,8 +208,10 @@ def snoop_satellites(
 
     A = _group_sums(w[..., None] * lin.J, flat, shape)
     seen = np.clip(S_w - np.sum((A @ lin.N_inv) * A, axis=-1), 0.0, None)
-    variance = lin.sigma0_sq[:, None] * seen
-    row_variance = lin.sigma0_sq[:, None] * lin.row_seen
+    if noise_scale is None:
+        noise_scale = receiver_noise_scale(lin.mad, lin.dof)
+    variance = noise_scale**2 * seen
+    row_variance = noise_scale**2 * lin.row_seen
     for model in lin.model_rows:
         variance += _group_sums(model, flat, shape) ** 2
         row_variance += model**2
@@ -229,8 +261,26 @@ def snoop_satellites(
         reject=reject & (w > 0) & (detected & identified)[:, None],
         detected=detected,
         identified=identified,
+        bias_variance=np.max(
+            np.where(sat_ok, (A @ lin.N_inv)[..., 0] ** 2 * variance, 0.0)
+            / np.where(sat_ok, seen, 1.0) ** 2,
+            axis=1,
+            initial=0.0,
+        ),
         min_redundancy=np.min(redundancy, axis=1, initial=1.0),
+        noise_scale=noise_scale,
     )
+
+
+def receiver_noise_scale(mad: np.ndarray, dof: np.ndarray) -> float:
+    """σ₀ ≥ 1 of the a-priori σ: the median over windows of the MAD scale of their normalised
+    residuals, from windows with at least ``MIN_SCALE_DOF`` degrees of freedom (1 if none).
+
+    One value for the receiver's noise model, not one per window: in a window with little
+    redundancy a biased row smears into every residual and its own MAD would hide the bias.
+    """
+    usable = mad[dof >= MIN_SCALE_DOF]
+    return max(1.0, float(np.median(usable))) if usable.size else 1.0
 
 
 def _pairs(windows, sums, normal, cost_bound, solver, alpha, margin):

@@ -137,6 +137,7 @@ class _WindowSolution:
     n_rejected: np.ndarray
     inconsistent: np.ndarray
     min_redundancy: np.ndarray
+    repair_variance: np.ndarray
     profile_sigma: np.ndarray
     scale_gain: np.ndarray
     bias_gain: np.ndarray
@@ -204,7 +205,9 @@ def solve_windows(
     up to ``config.outlier_passes`` times per window; the robust fit then uses the rows left. A
     significant test that cannot name its satellite, one that still fails after the last pass,
     or a repair that leaves a verifiable window unverifiable (a satellite whose bias could no
-    longer show), makes the window inconsistent.
+    longer show), makes the window inconsistent. After rejecting more than one row at once (a
+    reflection lasts; a lone row is a blunder) the θ₀ variance allows for one more biased
+    satellite (``bias_variance`` of :mod:`vo_doppler.heading.snooping`).
     ``scale_sigma`` and ``bias_sigma`` (per window or scalars) are the calibration
     uncertainties the tests allow for.
     """
@@ -221,6 +224,9 @@ def solve_windows(
     min_redundancy = np.ones(K)
     todo = np.arange(K)
     verifiable_before = np.zeros(K, dtype=bool)
+    noise_scale = None
+    bias_variance = np.zeros(K)
+    reflection = np.zeros(K, dtype=bool)
     for rejection in range(config.outlier_passes + 1):
         if not (todo.size and config.outlier_passes):
             break
@@ -238,10 +244,13 @@ def solve_windows(
             config.outlier_alpha,
             config.identification_odds,
             config.testable_redundancy,
+            noise_scale,
         )
+        noise_scale = tests.noise_scale
         if rejection == 0:
             verifiable_before = tests.min_redundancy >= config.testable_redundancy
         min_redundancy[todo] = tests.min_redundancy
+        bias_variance[todo] = tests.bias_variance
         detected = tests.detected
         if rejection == config.outlier_passes:
             inconsistent[todo[detected]] = True
@@ -250,6 +259,7 @@ def solve_windows(
         repair = detected & tests.identified
         todo = todo[repair]
         accepted[todo] &= ~tests.reject[repair]
+        reflection[todo] |= np.count_nonzero(tests.reject[repair], axis=1) > 1
     fit = _fit(X, T, w * accepted, config)
     weights, theta, cost = fit["weights"], fit["theta"], fit["cost"]
     z, dz = z_of(theta), dz_of(theta)
@@ -282,6 +292,7 @@ def solve_windows(
         n_rejected=n_obs - n_used,
         inconsistent=inconsistent,
         min_redundancy=min_redundancy,
+        repair_variance=np.where(reflection, bias_variance, 0.0),
         **_error_gains(a, b, tau, weights, theta),
     )
 
@@ -429,6 +440,7 @@ def tight_heading_series(
         (solution.scale_gain * scale_sigma) ** 2
         + (solution.bias_gain * bias_sigma) ** 2
         + solution.clock_walk_gain * config.clock_drift_walk_mps**2
+        + solution.repair_variance
     )
     return _decide(solution, model_variance, t_epoch, speed, yaw_angle, n_sat_epoch, config)
 
