@@ -104,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
             write_tum(out / f"trajectory_{name}.tum", result.trajectories[name])
     write_heading_csv(out / "heading.csv", result.heading)
     summary = summarise(result)
+    summary["heading_correction"] = args.correction + (" (causal)" if args.causal else "")
     figures = [out / "trajectories.png", out / "heading.png"]
     truth = inputs.truth
     errors = {}
