@@ -113,6 +113,8 @@ class BlendConfig:
     max_gap_s: float = 1.5
     """Longest gap across which the VO course (or yaw) is interpolated to an epoch."""
     min_fit_measurements: int = 20
+    """Fewest measurements (after decimation to one per T_c) for the maximum-likelihood fit
+    of the three noise parameters; below it the defaults hold."""
 
     def __post_init__(self) -> None:
         if self.reference not in ("course", "orientation"):
