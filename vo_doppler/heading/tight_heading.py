@@ -112,7 +112,8 @@ class TightHeadingResult:
     verifiable: np.ndarray
     """Every satellite used could have been tested: a bias on any would show in the residuals
     (redundancy number ≥ ``testable_redundancy``); False where it could hide, e.g. as many
-    independent rows as unknowns. Unavailable epochs are False."""
+    independent rows as unknowns. Unavailable epochs, and all without NLOS rejection
+    (``outlier_passes`` 0), are False."""
     inconsistent: np.ndarray
     """The w-test found a biased satellite it could not name (or too many): no heading."""
 
@@ -221,7 +222,7 @@ def solve_windows(
     bias_sigma = np.broadcast_to(np.asarray(bias_sigma, dtype=float), (K,))
     accepted = w > 0
     inconsistent = np.zeros(K, dtype=bool)
-    min_redundancy = np.ones(K)
+    min_redundancy = np.zeros(K)  # untested windows are not verifiable
     todo = np.arange(K)
     verifiable_before = np.zeros(K, dtype=bool)
     noise_scale = None
