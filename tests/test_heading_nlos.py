@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.test_heading import AZIMUTH, ELEVATION, T, sharp_turn, straight, turning
+from tests.test_heading import constant_speed as speed
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.pipeline import heading_pipeline
 from vo_doppler.heading.rows import DopplerRows
@@ -19,26 +21,7 @@ from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
 from vo_doppler.io.sensor_csv import SensorSeries
 from vo_doppler.sim.doppler_rows import simulate_doppler
 
-AZIMUTH = [30.0, 110.0, 200.0, 280.0, 330.0, 160.0]
-ELEVATION = [60.0, 30.0, 45.0, 20.0, 70.0, 15.0]
-T = np.arange(0.0, 6.0, 0.05)
 NO_REJECTION = TightHeadingConfig(outlier_passes=0)
-
-
-def straight(t):
-    return 0.7 + 0.0 * t
-
-
-def turning(t):
-    return 0.7 + 0.3 * t
-
-
-def sharp_turn(t):
-    return 0.7 + 0.8 * t
-
-
-def speed(t):
-    return 10.0 + 0.0 * t
 
 
 def facade_excess_rate(scenario, facade_normal):
@@ -142,9 +125,10 @@ def test_minimal_rows_are_flagged_not_rejected():
     assert np.max(_error(single, result)[late]) < 1e-6
 
 
-def test_noise_only_rows_are_kept():
-    scenario = simulate_doppler(
-        np.arange(0.0, 60.0, 0.05),
+def _noisy_drive(duration_s):
+    """Six satellites, 20 Hz, Doppler noise exactly as the weights say (5 cm/s), seed fixed."""
+    return simulate_doppler(
+        np.arange(0.0, duration_s, 0.05),
         lambda t: 0.7 + 0.2 * np.sin(0.5 * t),
         lambda t: 12.0 + 0.0 * t,
         AZIMUTH,
@@ -153,6 +137,10 @@ def test_noise_only_rows_are_kept():
         noise_mps=0.05,
         seed=3,
     )
+
+
+def test_noise_only_rows_are_kept():
+    scenario = _noisy_drive(60.0)
     result = _solve(scenario)
     assert not result.n_rejected.any()
     assert not result.inconsistent.any()
@@ -164,16 +152,7 @@ def test_false_alarm_rate_is_near_the_nominal_level():
     In a one-epoch window each satellite is one row, so the satellite and row families (α/2
     each, Bonferroni within) test the same hypotheses: the window false-alarm rate is ≈ α/2.
     A false alarm is seldom attributed clearly enough to reject a row (odds 100:1)."""
-    scenario = simulate_doppler(
-        np.arange(0.0, 200.0, 0.05),
-        lambda t: 0.7 + 0.2 * np.sin(0.5 * t),
-        lambda t: 12.0 + 0.0 * t,
-        AZIMUTH,
-        ELEVATION,
-        6,
-        noise_mps=0.05,
-        seed=3,
-    )
+    scenario = _noisy_drive(200.0)
     alpha = 0.05
     result = _solve(scenario, config=TightHeadingConfig(window_s=0.01, outlier_alpha=alpha))
     alarms = np.mean(result.inconsistent | (result.n_rejected > 0))
