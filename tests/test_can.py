@@ -148,16 +148,36 @@ def test_wheels_in_different_messages_are_interpolated(dbc_path):
     assert motion.yaw_rate is None
 
 
-def test_short_frames_are_padded_and_counted(dbc_path):
+def test_short_frames_are_skipped_and_named_by_default(dbc_path, caplog):
+    db = load_dbc(dbc_path)
+    wheels = db.get_message_by_name("WHEELS")
+    full = wheels.encode({"WL": 36.0, "WR": 18.0})
+    frames = frames_from_arrays(
+        [1.0, 2.0, 3.0], [170, 170, 170], [full, full[:3], full], source="bus.log"
+    )
+    report = CanDecodeReport()
+    out = decode_signals(frames, db, parse_signal_list("WHEELS.WL,WHEELS.WR"), report=report)
+    assert report.n_short_skipped == 1 and report.n_padded == 0 and report.n_decoded == 2
+    np.testing.assert_allclose(out[SignalRef("WHEELS", "WR")].t, [1.0, 3.0])
+    np.testing.assert_allclose(out[SignalRef("WHEELS", "WR")].value, [5.0, 5.0])
+    message = caplog.text
+    assert "bus.log" in message and "0xAA" in message and "3 of 8 bytes" in message
+    assert "t = 2.000000 s" in message
+
+
+def test_short_frames_are_padded_and_counted_on_request(dbc_path):
     db = load_dbc(dbc_path)
     wheels = db.get_message_by_name("WHEELS")
     full = wheels.encode({"WL": 36.0, "WR": 0.0})  # WR bytes and the tail are zero
     frames = frames_from_arrays([1.0, 2.0], [170, 170], [full, full.rstrip(b"\0")])
     report = CanDecodeReport()
-    out = decode_signals(frames, db, parse_signal_list("WHEELS.WL,WHEELS.WR"), report=report)
-    assert report.n_padded == 1 and report.n_decoded == 2
+    refs = parse_signal_list("WHEELS.WL,WHEELS.WR")
+    out = decode_signals(frames, db, refs, report=report, short_frames="pad")
+    assert report.n_padded == 1 and report.n_short_skipped == 0 and report.n_decoded == 2
     np.testing.assert_allclose(out[SignalRef("WHEELS", "WL")].value, [10.0, 10.0])
     np.testing.assert_allclose(out[SignalRef("WHEELS", "WR")].value, [0.0, 0.0])
+    with pytest.raises(ValueError, match="short_frames"):
+        decode_signals(frames, db, refs, short_frames="guess")
 
 
 def test_undecodable_frames_are_counted_not_fatal(dbc_path):
@@ -272,7 +292,12 @@ def test_comma_raw_can_truncated_payloads():
     )
     report = CanDecodeReport()
     decoded = decode_signals(
-        frames, load_dbc(dbc), parse_signal_list(FOUR_WHEELS), channel="0", report=report
+        frames,
+        load_dbc(dbc),
+        parse_signal_list(FOUR_WHEELS),
+        channel="0",
+        report=report,
+        short_frames="pad",  # numpy S8 dropped the payloads' trailing zero bytes
     )
     assert report.n_padded > 0 and report.n_undecodable == 0
     for k, ref in enumerate(parse_signal_list(FOUR_WHEELS)):

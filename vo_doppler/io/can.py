@@ -6,9 +6,11 @@ several wheel-speed signals are averaged. Values are converted from the DBC unit
 (km/h → m/s, deg/s → rad/s). The yaw rate leaves this module counter-clockwise positive
 (DESIGN.md): ``yaw_rate_sign=-1`` flips a bus that reports clockwise-positive yaw rate.
 
-Frames shorter than their DBC length are zero-padded and counted (logs that dropped trailing
-zero bytes); frames that cannot be decoded, and log lines that cannot be read, are counted,
-logged and skipped — the result keeps every frame that could be decoded.
+Frames shorter than their DBC length are skipped, counted and named in a warning (their
+missing bytes would decode as made-up values); ``short_frames="pad"`` zero-pads them instead,
+for sources known to drop trailing zero bytes (comma2k19's ``raw_can`` arrays). Frames that
+cannot be decoded, and log lines that cannot be read, are counted, logged and skipped — the
+result keeps every frame that could be decoded.
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ class CanFrames:
     data: list[bytes]
     channel: np.ndarray
     n_unreadable: int = 0
+    source: str = "CAN frames"
 
     def __len__(self) -> int:
         return len(self.t)
@@ -62,10 +65,12 @@ class CanFrames:
 
 @dataclass
 class CanDecodeReport:
-    """What happened to the frames: used, zero-padded, undecodable (by id), ignored."""
+    """What happened to the frames: used, short (skipped or zero-padded), undecodable (by id),
+    ignored."""
 
     n_frames: int = 0
     n_decoded: int = 0
+    n_short_skipped: int = 0
     n_padded: int = 0
     n_undecodable: int = 0
     n_unreadable_lines: int = 0
@@ -74,7 +79,8 @@ class CanDecodeReport:
     def summary(self) -> str:
         ids = ", ".join(f"0x{k:X}×{v}" for k, v in sorted(self.undecodable_by_id.items()))
         return (
-            f"{self.n_frames} frames, {self.n_decoded} decoded, {self.n_padded} zero-padded, "
+            f"{self.n_frames} frames, {self.n_decoded} decoded, "
+            f"{self.n_short_skipped} short skipped, {self.n_padded} short zero-padded, "
             f"{self.n_undecodable} undecodable{f' ({ids})' if ids else ''}, "
             f"{self.n_unreadable_lines} unreadable log lines"
         )
@@ -176,15 +182,18 @@ def read_can_log(path: str | Path) -> CanFrames:
         data=[bytes(m.data) for m in frames],
         channel=np.array([str(m.channel) if m.channel is not None else "" for m in frames]),
         n_unreadable=unreadable,
+        source=str(path),
     )
 
 
-def frames_from_arrays(t, address, data, channel=None) -> CanFrames:
+def frames_from_arrays(t, address, data, channel=None, source: str = "CAN arrays") -> CanFrames:
     """Frames from columns such as comma2k19's ``raw_can`` (``data`` may be numpy ``S8``)."""
     address = np.asarray(address, dtype=np.int64)
     payloads = [bytes(d) for d in np.asarray(data, dtype=object)]
     channels = np.zeros(len(address), dtype=int) if channel is None else np.asarray(channel)
-    return CanFrames(np.asarray(t, dtype=float), address, payloads, channels.astype(str))
+    return CanFrames(
+        np.asarray(t, dtype=float), address, payloads, channels.astype(str), source=source
+    )
 
 
 def load_dbc(path: str | Path) -> cantools.database.can.Database:
@@ -209,9 +218,15 @@ def decode_signals(
     refs: list[SignalRef],
     channel: str | None = None,
     report: CanDecodeReport | None = None,
+    short_frames: str = "skip",
 ) -> dict[SignalRef, SensorSeries]:
-    """Decode the referenced signals to SI units; one series per reference, sorted by time."""
+    """Decode the referenced signals to SI units; one series per reference, sorted by time.
+
+    ``short_frames``: ``"skip"`` (default) or ``"pad"`` frames shorter than the DBC length."""
+    if short_frames not in ("skip", "pad"):
+        raise ValueError(f"short_frames must be 'skip' or 'pad', not {short_frames!r}")
     report = report if report is not None else CanDecodeReport()
+    first_short: tuple[float, int, int, int] | None = None
     by_message: dict[str, list[SignalRef]] = {}
     for ref in refs:
         by_message.setdefault(ref.message, []).append(ref)
@@ -240,6 +255,11 @@ def decode_signals(
         for row in rows:
             payload = frames.data[row]
             if len(payload) < message.length:
+                if first_short is None:
+                    first_short = (frames.t[row], message.frame_id, len(payload), message.length)
+                if short_frames == "skip":
+                    report.n_short_skipped += 1
+                    continue
                 payload = payload + bytes(message.length - len(payload))
                 report.n_padded += 1
             try:
@@ -258,6 +278,23 @@ def decode_signals(
             factor, unit = factors[ref]
             out[ref] = SensorSeries(np.asarray(times)[order], table[:, k] * factor, str(ref), unit)
     report.undecodable_by_id = dict(undecodable)
+    if first_short is not None:
+        t, frame_id, length, expected = first_short
+        action = "skipped" if short_frames == "skip" else "zero-padded"
+        log.warning(
+            "%s: %d frames shorter than their DBC length %s (first at t = %.6f s: id 0x%X, "
+            "%d of %d bytes)%s",
+            frames.source,
+            report.n_short_skipped if short_frames == "skip" else report.n_padded,
+            action,
+            t,
+            frame_id,
+            length,
+            expected,
+            "; short_frames='pad' if the log drops trailing zero bytes"
+            if short_frames == "skip"
+            else "",
+        )
     if report.n_undecodable:
         log.warning("CAN decoding: %s", report.summary())
     return out
@@ -289,6 +326,7 @@ def decode_motion(
     yaw_rate_offset_s: float = 0.0,
     speed_offset_s: float = 0.0,
     channel: str | None = None,
+    short_frames: str = "skip",
 ) -> CanMotion:
     """Yaw rate and speed from decoded frames, in SI, time-shifted by per-sensor offsets.
 
@@ -300,7 +338,7 @@ def decode_motion(
     wheels = list(wheel_speed or [])
     refs = ([yaw_rate] if yaw_rate else []) + wheels
     report = CanDecodeReport()
-    decoded = decode_signals(frames, db, refs, channel, report)
+    decoded = decode_signals(frames, db, refs, channel, report, short_frames)
     yaw_series = None
     if yaw_rate is not None:
         raw = decoded[yaw_rate]
@@ -328,6 +366,7 @@ def read_can_motion(
     yaw_rate_offset_s: float = 0.0,
     speed_offset_s: float = 0.0,
     channel: str | None = None,
+    short_frames: str = "skip",
 ) -> CanMotion:
     """Read a CAN log and decode yaw rate (``MSG.SIG``) and mean wheel speed (``MSG.A,MSG.B``)."""
     frames = read_can_log(log_path)
@@ -341,6 +380,7 @@ def read_can_motion(
         yaw_rate_offset_s,
         speed_offset_s,
         channel,
+        short_frames,
     )
     log.info("%s: %s", log_path, motion.report.summary())
     return motion

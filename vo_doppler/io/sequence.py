@@ -79,6 +79,9 @@ def read_sequence(folder: str | Path) -> SequenceInputs:
     if float(gnss_cfg.get("time_offset_s", 0.0)) != 0.0:
         raise InputError("GNSS observations must be on GPS time (time_offset_s 0)", root)
     can_offset = float(can_cfg.get("time_offset_s", 0.0))
+    short_frames = str(can_cfg.get("short_frames", "skip"))
+    if short_frames not in ("skip", "pad"):
+        raise InputError(f"can.short_frames is {short_frames!r}, not skip or pad", root)
     motion = read_can_motion(
         root / _entry(can_cfg, "log", manifest, "can"),
         root / _entry(can_cfg, "dbc", manifest, "can"),
@@ -87,6 +90,7 @@ def read_sequence(folder: str | Path) -> SequenceInputs:
         float(can_cfg.get("yaw_rate_sign", 1.0)),
         can_offset,
         can_offset,
+        short_frames=short_frames,
     )
     if motion.yaw_rate is None or motion.speed is None or not len(motion.speed):
         raise InputError("CAN log gave no yaw rate or wheel speed", root / can_cfg["log"])
