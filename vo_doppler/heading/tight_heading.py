@@ -27,6 +27,13 @@ correlated over the window (one scale, one bias, one clock path), so the residua
 reveal them, and with one or two satellites they dominate. Every window is solved at once
 with numpy.
 
+Reflected (NLOS) Doppler: before the robust fit, data snooping on the least-squares fit
+(:mod:`vo_doppler.heading.snooping`) tests every satellite of the window for a bias, every row
+for a blunder and, where a bias is found, every pair of satellites; it rejects what it can
+name and tests again. What it detects but cannot name makes the window *inconsistent* (no
+heading); a window where a bias on some satellite would not show is flagged *unverifiable*;
+after a rejected reflection the θ₀ variance allows for one more, undetected, biased satellite.
+
 Reliability (sec. 3.5): the heading at epoch k is compared with the headings of the previous
 epochs of the last ``reliability_epochs`` propagated by the gyro; it is reliable when enough of
 them exist and all agree within the gate.
@@ -81,13 +88,14 @@ class TightHeadingConfig:
     clock_drift_walk_mps: float = 0.01
     """Random walk of the receiver clock drift (m/s per √s) that the linear model leaves out."""
     outlier_passes: int = 4
-    """Satellites that data snooping may reject per window (0: no NLOS rejection)."""
+    """Rejection rounds of data snooping per window, each removing one satellite, a pair, or a
+    satellite's significant rows (0: no NLOS rejection)."""
     outlier_alpha: float = 0.001
     """False-alarm probability of the bias tests per window (Baarda's α₀ = 0.001 of data
     snooping, shared among the window's satellites)."""
     identification_odds: float = 100.0
-    """The satellite with the largest w-test is named biased only when that hypothesis is this
-    many times likelier than any other satellite's (generalised likelihood ratio)."""
+    """The satellite with the largest test statistic is named biased only when that hypothesis
+    is this many times likelier than any on another satellite (generalised likelihood ratio)."""
     testable_redundancy: float = 0.05
     """Satellites whose redundancy number (the share of a bias that shows in the residuals) is
     below this are not tested; a window using such a satellite is not verifiable."""
@@ -108,14 +116,15 @@ class TightHeadingResult:
     clock_drift: np.ndarray
     clock_drift_rate: np.ndarray
     n_rejected: np.ndarray
-    """Rows of the window rejected as biased (satellites failing the w-test)."""
+    """Rows of the window rejected as biased by data snooping (reflections, blunders)."""
     verifiable: np.ndarray
     """Every satellite used could have been tested: a bias on any would show in the residuals
     (redundancy number ≥ ``testable_redundancy``); False where it could hide, e.g. as many
     independent rows as unknowns. Unavailable epochs, and all without NLOS rejection
     (``outlier_passes`` 0), are False."""
     inconsistent: np.ndarray
-    """The w-test found a biased satellite it could not name (or too many): no heading."""
+    """Data snooping found a bias it could not attribute (or too many, or a repair that left
+    the window unverifiable): no heading."""
 
     @property
     def course(self) -> np.ndarray:
@@ -201,8 +210,8 @@ def solve_windows(
     window end and weights ``w`` (0 on padding). Returns a :class:`_WindowSolution`.
 
     ``group`` (K, R) numbers the satellite of each row (default: every row its own), the unit
-    of NLOS rejection: after the robust fit, data snooping (:mod:`vo_doppler.heading.snooping`)
-    rejects the biased satellite (or row, or pair of satellites) it identifies and tests again,
+    of NLOS rejection: data snooping on the least-squares fit (:mod:`vo_doppler.heading.snooping`)
+    rejects the biased satellite (or rows, or pair of satellites) it identifies and tests again,
     up to ``config.outlier_passes`` times per window; the robust fit then uses the rows left. A
     significant test that cannot name its satellite, one that still fails after the last pass,
     or a repair that leaves a verifiable window unverifiable (a satellite whose bias could no
