@@ -418,14 +418,14 @@ def tight_heading_series(
         & np.all(np.isfinite(rows.los), axis=1)
         & (rows.weight > 0)
     )
+    n_sat_epoch = np.bincount(epoch_of_row[usable], minlength=m)[:m]
     epoch_safe = np.maximum(epoch_of_row, 0)
     usable &= np.isfinite(speed[epoch_safe]) & np.isfinite(yaw_angle[epoch_safe])
     index = np.flatnonzero(usable)
     if len(index) == 0:
-        return _unavailable(t_epoch)
+        return _unavailable(t_epoch, n_sat_epoch)
     row_group = np.unique(rows.sat_id, return_inverse=True)[1].reshape(-1)
     row_epoch = epoch_of_row[index]
-    n_sat_epoch = np.bincount(row_epoch, minlength=m)[:m]
     lo = np.searchsorted(t_epoch[row_epoch], t_epoch - config.window_s, side="right")
     hi = np.searchsorted(t_epoch[row_epoch], t_epoch, side="right")
 
@@ -478,12 +478,14 @@ def _solve_chunk(rows, per_row, index, row_epoch, k, bounds, per_epoch, calibrat
     return solve_windows(y, a, b, tau, w, config, group, scale_sigma[k], bias_sigma[k])
 
 
-def _unavailable(t_epoch) -> TightHeadingResult:
-    """Every epoch unavailable (no epochs, or no usable Doppler row at all)."""
+def _unavailable(t_epoch, n_sat_epoch=None) -> TightHeadingResult:
+    """Every epoch unavailable (no epochs, or no Doppler row with sensor data at all), with the
+    satellites observed at each epoch when known."""
     m = len(t_epoch)
     nan, flags, counts = np.full(m, np.nan), np.zeros(m, dtype=bool), np.zeros(m, dtype=int)
+    observed = counts if n_sat_epoch is None else np.asarray(n_sat_epoch, dtype=int)
     return TightHeadingResult(
-        t_epoch, nan, nan, counts, counts, flags, flags, flags, nan, nan, counts, flags, flags
+        t_epoch, nan, nan, counts, observed, flags, flags, flags, nan, nan, counts, flags, flags
     )
 
 
