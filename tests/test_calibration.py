@@ -278,3 +278,18 @@ def test_standstill_runs_give_the_bias_without_a_course():
         config=GateConfig(stationary_speed_mps=0.0),
     )
     assert not disabled.valid
+
+
+def test_kalman_calibration_starts_from_the_configured_prior():
+    m = 5
+    t = np.arange(m, dtype=float)
+    config = HeadingPipelineConfig(
+        calibration="kalman", prior_gyro_bias_sigma=np.radians(0.2), prior_wheel_scale_sigma=0.01
+    )
+    out = causal_calibration(
+        t, np.full(m, 10.0), np.zeros(m), np.zeros(m, bool), np.full(m, 10.0), np.zeros(m), config
+    )
+    np.testing.assert_allclose(out.bias, 0.0)
+    np.testing.assert_allclose(out.scale, 1.0)
+    np.testing.assert_allclose(out.bias_sigma, np.radians(0.2))
+    np.testing.assert_allclose(out.scale_sigma, 0.01)

@@ -21,6 +21,8 @@ import numpy as np
 
 from vo_doppler.geo import yaw_to_course
 from vo_doppler.heading.calibration import (
+    PRIOR_GYRO_BIAS_SIGMA,
+    PRIOR_WHEEL_SCALE_SIGMA,
     GateConfig,
     GyroBiasCalibrator,
     GyroBiasKalman,
@@ -52,9 +54,9 @@ class HeadingPipelineConfig:
     """A conventional speed further than max(these, as m/s and as a fraction) from the raw wheel
     speed does not calibrate: wheel scale errors are a few per cent, a reflected (NLOS) Doppler
     is often far more."""
-    prior_gyro_bias_sigma: float = np.radians(0.5)
+    prior_gyro_bias_sigma: float = PRIOR_GYRO_BIAS_SIGMA
     """Spread of an uncalibrated gyro bias about zero (rad/s)."""
-    prior_wheel_scale_sigma: float = 0.03
+    prior_wheel_scale_sigma: float = PRIOR_WHEEL_SCALE_SIGMA
     """Spread of an uncalibrated wheel scale about one."""
     fixed_gyro_bias: float | None = None
     fixed_wheel_scale: float | None = None
@@ -123,7 +125,10 @@ def _calibrators(config: HeadingPipelineConfig):
     if config.calibration == "ls":
         return GyroBiasCalibrator(config.gate), WheelScaleCalibrator(config.gate)
     if config.calibration == "kalman":
-        return GyroBiasKalman(config=config.gate), WheelScaleKalman(config=config.gate)
+        return (
+            GyroBiasKalman(config=config.gate, prior_sigma=config.prior_gyro_bias_sigma),
+            WheelScaleKalman(config=config.gate, prior_sigma=config.prior_wheel_scale_sigma),
+        )
     if config.calibration == "none":
         return None, None
     raise ValueError(f"unknown calibration {config.calibration!r} ({CALIBRATION_METHODS})")
