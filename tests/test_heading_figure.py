@@ -48,25 +48,26 @@ def test_satellite_curve_is_the_table_count_at_every_epoch(tmp_path):
     assert (tmp_path / "h.png").stat().st_size > 10_000
 
 
+def _table_at_10_mps(t, yaw_rate, n_sat, speed_t, gyro: SensorSeries) -> HeadingTable:
+    """Heading table of a 10 m/s drive seen by ``n_sat`` satellites, with the wheel speed
+    recorded at ``speed_t`` and the given gyro."""
+    scenario = simulate_doppler(
+        t, lambda t: 0.3 + yaw_rate * t, lambda t: np.full_like(t, 10.0), AZIMUTH, ELEVATION, n_sat
+    )
+    velocity = 10.0 * np.stack([np.cos(scenario.yaw), np.sin(scenario.yaw), 0 * t], axis=1)
+    speed = SensorSeries(speed_t, np.full(len(speed_t), 10.0))
+    return heading_pipeline(t, scenario.rows, velocity, np.ones(len(t), bool), speed, gyro)
+
+
 def test_satellites_are_counted_where_the_sensors_have_ended():
     """The urban_canyon_small case: the CAN log ends 2 ms before the last GNSS epoch (and starts
     0.09 ms after the first); the satellites are still observed at those epochs."""
     t = np.arange(0.0, 10.0, 0.1)
-    scenario = simulate_doppler(
-        t, lambda t: 0.3 + 0.05 * t, lambda t: np.full_like(t, 10.0), AZIMUTH, ELEVATION, 3
-    )
-    t_gyro, rate = gyro_from_heading(t, scenario.yaw, np.ones(len(t), bool), 0.0, 0.0, 50.0)
+    yaw = 0.3 + 0.05 * t
+    t_gyro, rate = gyro_from_heading(t, yaw, np.ones(len(t), bool), 0.0, 0.0, 50.0)
     inside = (t_gyro > t[0] + 1e-4) & (t_gyro < t[-1] - 2e-3)
     t_speed = np.arange(1e-4, t[-1] - 2e-3, 0.01)
-    velocity = 10.0 * np.stack([np.cos(scenario.yaw), np.sin(scenario.yaw), 0 * t], axis=1)
-    table = heading_pipeline(
-        t,
-        scenario.rows,
-        velocity,
-        np.ones(len(t), bool),
-        SensorSeries(t_speed, np.full(len(t_speed), 10.0)),
-        SensorSeries(t_gyro[inside], rate[inside]),
-    )
+    table = _table_at_10_mps(t, 0.05, 3, t_speed, SensorSeries(t_gyro[inside], rate[inside]))
     assert np.isnan(table.yaw_tc[[0, -1]]).all()  # no sensor data: no tightly coupled heading
     np.testing.assert_array_equal(table.n_sat_epoch, np.full(len(t), 3))
     line = _satellite_line(build_heading_figure(table))
@@ -75,18 +76,7 @@ def test_satellites_are_counted_where_the_sensors_have_ended():
 
 def test_satellites_are_counted_when_no_epoch_has_sensor_data():
     t = np.arange(0.0, 5.0, 0.1)
-    scenario = simulate_doppler(
-        t, lambda t: 0.3 + 0.0 * t, lambda t: np.full_like(t, 10.0), AZIMUTH, ELEVATION, 2
-    )
     later = np.arange(100.0, 110.0, 0.01)  # sensors recorded over another interval entirely
-    velocity = 10.0 * np.stack([np.cos(scenario.yaw), np.sin(scenario.yaw), 0 * t], axis=1)
-    table = heading_pipeline(
-        t,
-        scenario.rows,
-        velocity,
-        np.ones(len(t), bool),
-        SensorSeries(later, np.full(len(later), 10.0)),
-        SensorSeries(later, np.zeros(len(later))),
-    )
+    table = _table_at_10_mps(t, 0.0, 2, later, SensorSeries(later, np.zeros(len(later))))
     assert not np.any(table.tc_available)
     np.testing.assert_array_equal(table.n_sat_epoch, np.full(len(t), 2))
