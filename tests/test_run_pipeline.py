@@ -54,6 +54,7 @@ def test_run_recovers_calibration_and_heading(sequence, run_output):
     assert summary["final_wheel_scale"] == pytest.approx(1 / 1.02, abs=0.01)
     table = read_heading_csv(run_output / "heading.csv")
     assert np.all(np.diff(table.t) > 0)
+    assert summary["tight_heading_rejected_rows"] == int(table.rejected_rows.sum())
     evaluation = summary["evaluation"]
     tc = evaluation["vo_gps_tc"]
     assert tc["heading_rmse_deg"] < 3.0
@@ -70,3 +71,9 @@ def test_corrected_trajectory_is_finite_and_covers_every_image(sequence, run_out
 def test_missing_manifest_is_a_clear_error(tmp_path, capsys):
     assert main(["run", str(tmp_path), "-o", str(tmp_path / "out")]) == 1
     assert "sequence.yaml" in capsys.readouterr().err
+
+
+def test_heading_short_frame_policy_is_checked_by_the_parser(tmp_path):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["heading", "x.obs", "--nav", "x.nav", "--can-short-frames", "guess", "-o", "h.csv"])
+    assert exit_info.value.code == 2

@@ -54,6 +54,13 @@ def register(subparsers) -> None:
         help="-1 when the bus reports clockwise-positive yaw rate",
     )
     sensors.add_argument("--can-channel", help="only frames of this channel/bus")
+    sensors.add_argument(
+        "--can-short-frames",
+        choices=("skip", "pad"),
+        default="skip",
+        help="frames shorter than their DBC length: skip them (default) or zero-pad them, for "
+        "logs that drop trailing zero bytes",
+    )
     sensors.add_argument("--yaw-rate-csv", type=Path, help="CSV t,yaw_rate_rad_s (ccw +)")
     sensors.add_argument("--speed-csv", type=Path, help="CSV t,speed_mps")
     sensors.add_argument(
@@ -109,6 +116,7 @@ def _sensors(args):
             args.time_offset_can + args.time_offset_yaw,
             args.time_offset_can + args.time_offset_speed,
             args.can_channel,
+            args.can_short_frames,
         )
         return motion.speed, motion.yaw_rate
     if args.yaw_rate_csv is None or args.speed_csv is None:

@@ -143,6 +143,8 @@ def summarise(result: PipelineResult) -> dict:
         "tight_heading_availability": float(np.mean(table.tc_available)),
         "tight_heading_reliable": float(np.mean(table.tc_reliable)),
         "tight_heading_used": float(np.mean(result.tc_usable)),
+        "tight_heading_rejected_rows": int(table.rejected_rows.sum()),
+        "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "final_wheel_scale": float(table.wheel_scale[-1]),
         "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
         "vo_frames": result.vo.stats.frames,
@@ -155,7 +157,9 @@ def print_summary(console: Console, summary: dict, errors: dict) -> None:
     console.print(
         f"heading available: conventional {summary['conventional_heading_availability']:.0%}, "
         f"tightly coupled {summary['tight_heading_availability']:.0%} of "
-        f"{summary['gnss_epochs']} epochs; wheel scale {summary['final_wheel_scale']:.4f}, "
+        f"{summary['gnss_epochs']} epochs ({summary['tight_heading_rejected_rows']} Doppler rows "
+        "rejected as reflections or blunders); "
+        f"wheel scale {summary['final_wheel_scale']:.4f}, "
         f"gyro bias {summary['final_gyro_bias_dps']:+.3f} deg/s; VO {summary['vo_frames']} "
         f"frames ({summary['vo_flagged_frames']} flagged)"
     )
