@@ -158,7 +158,7 @@ def print_summary(console: Console, summary: dict, errors: dict) -> None:
         f"heading available: conventional {summary['conventional_heading_availability']:.0%}, "
         f"tightly coupled {summary['tight_heading_availability']:.0%} of "
         f"{summary['gnss_epochs']} epochs ({summary['tight_heading_rejected_rows']} Doppler rows "
-        "rejected as reflections or blunders); "
+        "rejected by the NLOS tests); "
         f"wheel scale {summary['final_wheel_scale']:.4f}, "
         f"gyro bias {summary['final_gyro_bias_dps']:+.3f} deg/s; VO {summary['vo_frames']} "
         f"frames ({summary['vo_flagged_frames']} flagged)"
