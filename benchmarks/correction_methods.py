@@ -24,7 +24,6 @@ from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.fusion.pipeline import (
     PipelineConfig,
-    conventional_heading_sigma,
     correct_all,
     run_pipeline,
 )
@@ -46,7 +45,6 @@ def evaluate_sequence(folder: Path, console: Console) -> dict:
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task(f"{inputs.name}: VO", total=len(inputs.image_paths))
         result = run_pipeline(inputs, on_frame=lambda _: progress.advance(task))
-    sigma = conventional_heading_sigma(result.gnss, inputs.enu)
     methods = {}
     for name, config in METHODS.items():
         trajectories = correct_all(
@@ -56,7 +54,6 @@ def evaluate_sequence(folder: Path, console: Console) -> dict:
             result.calibrated_speed,
             result.start_enu,
             config,
-            conventional_sigma=sigma,
         )
         errors, _, _ = evaluate_pipelines(
             trajectories, result.heading, result.tc_usable, inputs.truth

@@ -20,7 +20,6 @@ from vo_doppler.fusion.heading_blend import (
     fit_process_noise,
     forward_filter,
     rts_smooth,
-    velocity_heading_sigma,
 )
 from vo_doppler.fusion.heading_correction import (
     FORWARD_CAMERA_TO_VEHICLE,
@@ -29,7 +28,8 @@ from vo_doppler.fusion.heading_correction import (
 )
 from vo_doppler.fusion.pipeline import AbsoluteHeading, PipelineConfig, corrected_level
 from vo_doppler.geo import wrap_angle
-from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.heading.conventional import velocity_heading_sigma
+from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
 from vo_doppler.trajectory import Trajectory, read_tum, write_tum
 
 FIXED = BlendConfig(sigma_distance=1e-3, sigma_turn=1e-3, measurement_scale=1.0)
@@ -325,3 +325,32 @@ def test_unknown_correction_method_is_a_usage_error(tmp_path, command):
     with pytest.raises(SystemExit) as exit_info:
         main(args)
     assert exit_info.value.code == 2
+
+
+def test_correct_cli_kalman_weighs_conventional_headings_by_their_sigma(tmp_path):
+    """Conventional headings alternate, 10 epochs each, between the truth (σ 0.1°) and 3° off
+    (σ 10°): with the σ column the blend follows the precise ones; without it (old files) it
+    averages them."""
+    t, yaw, gt = _ground_truth(n=80)
+    write_tum(tmp_path / "vo.tum", _vo_output(gt))
+    precise = (np.arange(len(t)) // 10) % 2 == 0
+    table = _table(t, yaw, np.zeros(len(t), bool), np.ones(len(t), bool))
+    table.yaw_conv = np.where(precise, yaw, yaw + np.radians(3.0))
+    table.sigma_conv = np.radians(np.where(precise, 0.1, 10.0))
+    errors = {}
+    for name, keep_sigma in (("with", True), ("without", False)):
+        path = tmp_path / f"heading_{name}.csv"
+        write_heading_csv(path, table)
+        if not keep_sigma:
+            lines = [line.rsplit(",", 1)[0] for line in path.read_text().splitlines()]
+            path.write_text("\n".join(lines) + "\n")
+            assert np.isnan(read_heading_csv(path).sigma_conv).all()
+        else:
+            np.testing.assert_allclose(read_heading_csv(path).sigma_conv, table.sigma_conv)
+        out = tmp_path / f"corrected_{name}.tum"
+        args = ["correct", str(tmp_path / "vo.tum"), "--heading", str(path)]
+        assert main([*args, "--correction", "kalman", "--source", "conv", "-o", str(out)]) == 0
+        corrected = read_tum(out)
+        errors[name] = np.abs(wrap_angle(yaw_of(corrected.orientations.as_matrix()) - yaw))
+    assert np.degrees(np.median(errors["with"])) < 0.1
+    assert np.degrees(np.median(errors["without"])) > 1.0

@@ -93,12 +93,12 @@ def run(args: argparse.Namespace) -> int:
             args.trajectory,
         )
     if args.correction == "kalman":
-        tight = table.tc_reliable & table.tc_available
+        tight = table.tc_reliable & table.tc_available & (args.source != "conv")
         result = blend_heading(
             trajectory,
             table.t,
             yaw,
-            np.where(tight, table.sigma_tc, np.nan),
+            np.where(tight, table.sigma_tc, table.sigma_conv),
             valid,
             np.where(tight, TightHeadingConfig().window_s, 0.0),
             extrinsic,

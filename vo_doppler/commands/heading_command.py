@@ -12,7 +12,9 @@ import numpy as np
 
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.fusion.heading_correction import yaw_of
+from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.pipeline import gnss_velocity
+from vo_doppler.heading.conventional import velocity_heading_sigma
 from vo_doppler.heading.from_gnss import emulated_canyon, heading_rows
 from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.sensors import sample_at
@@ -133,6 +135,17 @@ def _truth_yaw(path: Path, t: np.ndarray) -> np.ndarray:
     return sample_at(truth.t, yaw, t)
 
 
+def _conventional_yaw_sigma(velocity, receiver_ecef: np.ndarray) -> np.ndarray | None:
+    """The conventional headings' standard deviations, with the covariances turned to ENU at
+    the first receiver position (None without one)."""
+    finite = np.flatnonzero(np.all(np.isfinite(receiver_ecef), axis=1))
+    if finite.size == 0:
+        return None
+    lat, lon, _ = ecef_to_geodetic(receiver_ecef[finite[0]])
+    rotation = ecef_to_enu_rotation(float(lat), float(lon))
+    return velocity_heading_sigma(velocity.velocity_enu, velocity.covariance, rotation)
+
+
 def run(args: argparse.Namespace) -> int:
     speed, yaw_rate = _sensors(args)
     obs = read_obs(args.obs)
@@ -168,6 +181,7 @@ def run(args: argparse.Namespace) -> int:
         yaw_rate,
         config,
         conventional_sigma_mps=conventional.sigma_mps,
+        conventional_yaw_sigma=_conventional_yaw_sigma(conventional, rows.receiver_ecef),
     )
     args.output.parent.mkdir(parents=True, exist_ok=True)
     write_heading_csv(args.output, table)

@@ -26,10 +26,11 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading, velocity_heading_sigma
+from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading
 from vo_doppler.fusion.heading_correction import correct_heading, vehicle_poses, yaw_of
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
+from vo_doppler.heading.conventional import velocity_heading_sigma
 from vo_doppler.heading.from_gnss import heading_rows
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, HeadingTable, heading_pipeline
 from vo_doppler.io.images import read_image
@@ -190,6 +191,7 @@ def run_pipeline(
         inputs.yaw_rate,
         config.heading,
         conventional_sigma_mps=gnss.velocity.sigma_mps,
+        conventional_yaw_sigma=conventional_heading_sigma(gnss, inputs.enu),
     )
     speed = calibrated_speed(inputs.wheel_speed, table)
     vo = run_visual_odometry(
@@ -209,7 +211,6 @@ def run_pipeline(
         start,
         config,
         initial_yaw,
-        conventional_heading_sigma(gnss, inputs.enu),
     )
     usable = usable_tight_heading(table, config)
     return PipelineResult(gnss, table, vo, speed, trajectories, start, usable)
@@ -217,7 +218,7 @@ def run_pipeline(
 
 def conventional_heading_sigma(gnss: GnssVelocityResult, enu: EnuFrame) -> np.ndarray:
     """Standard deviation (rad) of each epoch's conventional heading, from its Doppler velocity
-    covariance (:func:`~vo_doppler.fusion.heading_blend.velocity_heading_sigma`)."""
+    covariance (:func:`~vo_doppler.heading.conventional.velocity_heading_sigma`)."""
     velocity = gnss.velocity
     return velocity_heading_sigma(velocity.velocity_enu, velocity.covariance, enu.rotation)
 
@@ -230,7 +231,6 @@ def correct_all(
     start: np.ndarray,
     config: PipelineConfig,
     initial_yaw: float | None = None,
-    conventional_sigma: np.ndarray | None = None,
 ) -> dict[str, Trajectory]:
     """The VO alone, the VO corrected by the conventional and by the tightly coupled heading,
     and dead reckoning corrected by the tightly coupled heading (vehicle poses, ENU).
@@ -238,8 +238,6 @@ def correct_all(
     Every trajectory starts at ``start`` with yaw ``initial_yaw``; by default that is the
     first absolute heading (tightly coupled, else conventional), matched at its own time.
     Only reliable tightly coupled headings correct (the 10-epoch gyro-consistency test).
-    ``conventional_sigma`` (rad, per epoch) is the conventional heading's standard deviation
-    for the Kalman blend (see :func:`~vo_doppler.fusion.heading_blend.velocity_heading_sigma`).
     """
     tc_valid = usable_tight_heading(table, config)
     vo_vehicle = vehicle_poses(camera_trajectory, inputs.camera.T_vehicle_camera)
@@ -267,7 +265,7 @@ def correct_all(
     tight = AbsoluteHeading(
         table.t, table.yaw_tc, tc_valid, table.sigma_tc, config.heading.tight.window_s
     )
-    conventional = AbsoluteHeading(table.t, table.yaw_conv, table.conv_valid, conventional_sigma)
+    conventional = AbsoluteHeading(table.t, table.yaw_conv, table.conv_valid, table.sigma_conv)
     trajectories["vo_gps_conv"] = corrected_level(vo_level, conventional, config)
     trajectories["vo_gps_tc"] = corrected_level(vo_level, tight, config)
     if dr is not None:

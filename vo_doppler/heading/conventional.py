@@ -1,4 +1,5 @@
-"""Conventional heading (sec. 3.2): the direction of a Doppler velocity solution."""
+"""Conventional heading (sec. 3.2): the direction of a Doppler velocity solution, and its
+standard deviation from the velocity covariance."""
 
 from __future__ import annotations
 
@@ -30,3 +31,23 @@ def course_from_velocity(
     """Course (rad, clockwise from north, [0, 2π)) of ENU velocities and its validity."""
     yaw, ok = heading_from_velocity(velocity_enu, valid, min_speed_mps)
     return np.where(ok, yaw_to_course(np.nan_to_num(yaw)), np.nan), ok
+
+
+def velocity_heading_sigma(
+    velocity_enu: np.ndarray, covariance_ecef: np.ndarray, ecef_to_enu: np.ndarray
+) -> np.ndarray:
+    """Standard deviation (rad) of the yaw atan2(v_n, v_e) of GNSS velocities (N, 3) with
+    their ECEF covariances (N, ≥3, ≥3), to first order: the cross-track velocity's standard
+    deviation over the horizontal speed, √(uᵀ·C_EN·u)/|v_EN| with u = (−sin ψ, cos ψ) and
+    C_EN the east-north block of R·C·Rᵀ (R: ECEF→ENU). NaN where the speed is zero or the
+    velocity is not finite."""
+    v = np.asarray(velocity_enu, dtype=float)
+    rotation = np.asarray(ecef_to_enu, dtype=float)
+    enu = rotation @ np.asarray(covariance_ecef, dtype=float)[:, :3, :3] @ rotation.T
+    speed = np.hypot(v[:, 0], v[:, 1])
+    yaw = np.arctan2(v[:, 1], v[:, 0])
+    across = np.stack([-np.sin(yaw), np.cos(yaw)], axis=1)
+    variance = np.einsum("ni,nij,nj->n", across, enu[:, :2, :2], across)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sigma = np.sqrt(variance) / speed
+    return np.where(np.isfinite(sigma) & (speed > 0), sigma, np.nan)

@@ -81,6 +81,8 @@ class HeadingTable:
     tc_verifiable: np.ndarray | None = None
     """A bias on any satellite the tightly coupled heading used would have shown in the
     residuals (False where it could hide, and where the heading is unavailable)."""
+    sigma_conv: np.ndarray | None = None
+    """Standard deviation (rad) of the conventional heading, NaN where unknown or invalid."""
 
     def __post_init__(self) -> None:
         n = len(self.t)
@@ -88,6 +90,8 @@ class HeadingTable:
             self.rejected_rows = np.zeros(n, dtype=int)
         if self.tc_verifiable is None:
             self.tc_verifiable = np.zeros(n, dtype=bool)
+        if self.sigma_conv is None:
+            self.sigma_conv = np.full(n, np.nan)
 
     def __len__(self) -> int:
         return len(self.t)
@@ -201,12 +205,15 @@ def heading_pipeline(
     yaw_rate: SensorSeries,
     config: HeadingPipelineConfig = HeadingPipelineConfig(),
     conventional_sigma_mps: np.ndarray | None = None,
+    conventional_yaw_sigma: np.ndarray | None = None,
 ) -> HeadingTable:
     """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise).
 
     ``conventional_sigma_mps``: standard deviation of each conventional velocity (√trace of
     its covariance); when given, only velocities within ``calibration_max_velocity_sigma_mps``
-    calibrate the sensors.
+    calibrate the sensors. ``conventional_yaw_sigma`` (rad): standard deviation of each
+    conventional heading (:func:`~vo_doppler.heading.conventional.velocity_heading_sigma`),
+    kept in the table for the heading correction.
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     velocity = np.asarray(conventional_velocity_enu, dtype=float).reshape(-1, 3)
@@ -253,4 +260,7 @@ def heading_pipeline(
         wheel_scale=cal.scale,
         rejected_rows=result.n_rejected,
         tc_verifiable=result.verifiable,
+        sigma_conv=None
+        if conventional_yaw_sigma is None
+        else np.where(conv_ok, np.asarray(conventional_yaw_sigma, dtype=float), np.nan),
     )

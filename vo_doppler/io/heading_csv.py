@@ -3,9 +3,10 @@
 Columns: gps_time_s, heading_tc_deg, heading_tc_sigma_deg, tc_reliable, n_obs_window,
 n_sat_epoch, heading_conv_deg, conv_valid, gyro_bias_dps, wheel_scale, then rejected_rows (rows
 of the window rejected as biased, NLOS) and tc_verifiable (a bias on any satellite used would
-have shown). Unavailable headings are written as ``nan``; flags as 0/1. Reading converts back to
-yaw (rad, counter-clockwise from east); the last two columns are optional (files written before
-they existed read as zero).
+have shown) and heading_conv_sigma_deg (the conventional heading's standard deviation).
+Unavailable headings are written as ``nan``; flags as 0/1. Reading converts back to yaw (rad,
+counter-clockwise from east); the last three columns are optional (files written before they
+existed read as zero, or NaN for the standard deviation).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ COLUMNS = (
     "gyro_bias_dps",
     "wheel_scale",
 )
-OPTIONAL_COLUMNS = ("rejected_rows", "tc_verifiable")
+OPTIONAL_COLUMNS = ("rejected_rows", "tc_verifiable", "heading_conv_sigma_deg")
 
 
 def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
@@ -48,6 +49,7 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         table.wheel_scale,
         table.rejected_rows.astype(int),
         table.tc_verifiable.astype(int),
+        np.degrees(table.sigma_conv),
     ]
     formats = (
         "{:.3f}",
@@ -62,6 +64,7 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         "{:.6f}",
         "{:d}",
         "{:d}",
+        "{:.4f}",
     )
     with Path(path).open("w", newline="") as handle:
         handle.write(",".join(COLUMNS + OPTIONAL_COLUMNS) + "\n")
@@ -111,4 +114,5 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
         wheel_scale=data[:, 9],
         rejected_rows=optional.get("rejected_rows", np.zeros(len(data))).astype(int),
         tc_verifiable=optional.get("tc_verifiable", np.zeros(len(data))) > 0.5,
+        sigma_conv=np.radians(optional.get("heading_conv_sigma_deg", np.full(len(data), np.nan))),
     )
