@@ -44,6 +44,9 @@ def test_run_writes_every_output(run_output):
         assert (run_output / name).stat().st_size > 0, name
     report = (run_output / "report.html").read_text()
     assert "VO + GPS (tightly coupled)" in report and "<img src='trajectories.png'" in report
+    summary = json.loads((run_output / "summary.json").read_text())
+    available = f"{summary['tight_heading_availability']:.1%}"
+    assert f"<b>tightly coupled heading available</b>: {available}" in report
 
 
 def test_run_recovers_calibration_and_heading(sequence, run_output):

@@ -124,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
     trajectories_figure(figures[0], shown, truth, inputs.name)
     heading_figure(figures[1], result.heading, truth_yaw, inputs.name)
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
-    facts = {key: str(value) for key, value in summary.items() if key != "evaluation"}
+    facts = readable_facts(summary)
     write_html_report(out / "report.html", f"vo-doppler run: {inputs.name}", facts, errors, figures)
     print_summary(console, summary, errors)
     console.print(f"wrote {out}/report.html and the trajectories, heading.csv, figures")
@@ -133,6 +133,34 @@ def run(args: argparse.Namespace) -> int:
             "the tightly coupled heading was unavailable at every epoch", args.sequence
         )
     return 0
+
+
+FACT_FORMATS = {
+    "gnss_epochs": ("GNSS epochs", "{:d}"),
+    "conventional_heading_availability": ("conventional heading available", "{:.1%}"),
+    "tight_heading_availability": ("tightly coupled heading available", "{:.1%}"),
+    "tight_heading_reliable": ("tightly coupled heading reliable (gyro-consistent)", "{:.1%}"),
+    "tight_heading_used": ("tightly coupled heading used by the correction", "{:.1%}"),
+    "tight_heading_rejected_rows": ("Doppler rows rejected by the NLOS tests", "{:d}"),
+    "tight_heading_epochs_with_rejection": ("epochs with a rejection", "{:d}"),
+    "final_wheel_scale": ("wheel scale at the end", "{:.4f}"),
+    "final_gyro_bias_dps": ("gyro bias at the end", "{:+.3f} deg/s"),
+    "vo_frames": ("VO frames", "{:d}"),
+    "vo_flagged_frames": ("VO frames flagged", "{:d}"),
+    "vo_fps": ("VO speed", "{:.1f} frames/s"),
+    "heading_correction": ("heading correction", "{}"),
+}
+
+
+def readable_facts(summary: dict) -> dict[str, str]:
+    """The summary's scalars with labels and units for people (the report's list)."""
+    facts = {}
+    for key, value in summary.items():
+        if key == "evaluation":
+            continue
+        label, fmt = FACT_FORMATS.get(key, (key, "{}"))
+        facts[label] = fmt.format(value)
+    return facts
 
 
 def summarise(result: PipelineResult) -> dict:
