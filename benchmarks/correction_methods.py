@@ -11,8 +11,6 @@ acceptance (VO + TC ≤ 0.5 m per 100 m and ≤ 0.25 × VO + conventional), and 
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -20,6 +18,7 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
+from benchmarks.sequence_runs import run_sequences
 from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.fusion.pipeline import (
@@ -87,22 +86,14 @@ def print_sequence(console: Console, name: str, figures: dict) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("sequences", nargs="+", type=Path)
-    parser.add_argument(
-        "--json", type=Path, default=ROOT / "benchmarks/results/correction_methods.json"
+    return run_sequences(
+        __doc__.splitlines()[0],
+        ROOT / "benchmarks/results/correction_methods.json",
+        lambda folder, _, console: evaluate_sequence(folder, console),
+        print_sequence,
+        argv,
+        width=170,
     )
-    args = parser.parse_args(argv)
-    console = Console(width=170)
-    results = {}
-    for folder in args.sequences:
-        name = folder.resolve().name
-        results[name] = evaluate_sequence(folder, console)
-        print_sequence(console, name, results[name])
-    args.json.parent.mkdir(parents=True, exist_ok=True)
-    args.json.write_text(json.dumps({"sequences": results}, indent=2))
-    console.print(f"wrote {args.json}")
-    return 0
 
 
 if __name__ == "__main__":

@@ -11,8 +11,6 @@ error per 100 m) next to it.
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -21,6 +19,7 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
+from benchmarks.sequence_runs import run_sequences
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
 from vo_doppler.eval.report import error_per_100m_figure, trajectories_figure
 from vo_doppler.fusion.heading_correction import yaw_of
@@ -98,23 +97,13 @@ def print_sequence(console: Console, name: str, figures: dict) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("sequences", nargs="+", type=Path)
-    parser.add_argument(
-        "--json", type=Path, default=ROOT / "benchmarks/results/error_per_100m.json"
+    return run_sequences(
+        __doc__.splitlines()[0],
+        ROOT / "benchmarks/results/error_per_100m.json",
+        evaluate_sequence,
+        print_sequence,
+        argv,
     )
-    args = parser.parse_args(argv)
-    console = Console(width=160)
-    figures = args.json.parent
-    results = {}
-    for folder in args.sequences:
-        name = folder.resolve().name
-        results[name] = evaluate_sequence(folder, figures, console)
-        print_sequence(console, name, results[name])
-    args.json.parent.mkdir(parents=True, exist_ok=True)
-    args.json.write_text(json.dumps({"sequences": results}, indent=2))
-    console.print(f"wrote {args.json} and figures in {figures}")
-    return 0
 
 
 if __name__ == "__main__":

@@ -20,9 +20,7 @@ Errors are |heading − ground-truth yaw| in degrees.
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
-import json
 import time
 from pathlib import Path
 
@@ -30,6 +28,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from benchmarks.sequence_runs import run_sequences
 from vo_doppler.fusion.heading_correction import yaw_of
 from vo_doppler.fusion.pipeline import PipelineConfig, usable_tight_heading
 from vo_doppler.geo import wrap_angle
@@ -149,21 +148,14 @@ def print_sequence(console: Console, name: str, figures: dict) -> None:
     console.print(table)
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("sequences", nargs="+", type=Path)
-    parser.add_argument("--json", default=ROOT / "benchmarks" / "results" / "heading_nlos.json")
-    args = parser.parse_args()
-    console = Console(width=160)
-    results = {}
-    for folder in args.sequences:
-        results[folder.name] = figures = evaluate(folder)
-        print_sequence(console, folder.name, figures)
-    out = Path(args.json)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(results, indent=2))
-    console.print(f"wrote {out}")
-    return 0
+def main(argv: list[str] | None = None) -> int:
+    return run_sequences(
+        __doc__.splitlines()[0],
+        ROOT / "benchmarks" / "results" / "heading_nlos.json",
+        lambda folder, _, console: evaluate(folder),
+        print_sequence,
+        argv,
+    )
 
 
 if __name__ == "__main__":
