@@ -106,6 +106,13 @@ def register(subparsers) -> None:
         help="GPS start time YYYY-MM-DDTHH:MM:SS (default 2025-03-14T02:10)",
     )
     parser.add_argument("--origin", type=_triple, default=defaults.origin, help="LAT,LON,H")
+    parser.add_argument(
+        "--antenna-lever-arm",
+        type=_triple,
+        default=defaults.antenna_lever_arm_m,
+        help="GNSS antenna X,Y,Z m in the vehicle frame (x forward, y left, z up) from the "
+        "rear-axle centre on the ground",
+    )
     parser.set_defaults(func=run)
 
 
@@ -141,6 +148,8 @@ def _command_line(args: argparse.Namespace) -> str:
     words += ["--gnss-rate", f"{args.gnss_rate:g}", "--systems", args.systems]
     words += ["--wheel-scale-error", f"{args.wheel_scale_error:g}"]
     words += ["--yaw-bias", f"{args.yaw_bias:g}", "--origin", joined(args.origin)]
+    if tuple(args.antenna_lever_arm) != UrbanCanyonConfig().antenna_lever_arm_m:
+        words += ["--antenna-lever-arm", joined(args.antenna_lever_arm)]
     if args.start is not None:
         words += ["--start", args.start]
     for flag in ("no_images", "nlos", "no_noise"):
@@ -178,6 +187,7 @@ def run(args: argparse.Namespace) -> int:
         calib_principal_offset_px=args.calib_error[1:],
         start_gps_s=_start_gps(args.start, defaults.start_gps_s),
         origin=args.origin,
+        antenna_lever_arm_m=args.antenna_lever_arm,
         gnss=replace(
             defaults.gnss,
             rate_hz=args.gnss_rate,

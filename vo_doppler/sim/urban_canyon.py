@@ -28,7 +28,7 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     origin: {lat_deg, lon_deg, height_m}          ENU origin (WGS-84, ellipsoidal height)
     start_gps_s                                   GPS time of the drive start
     camera: {images, image_format, times, calib, fps, width, height, time_offset_s}
-    gnss: {obs, nav: [..], rate_hz, systems, time_offset_s, antenna_lever_arm_m,
+    gnss: {obs, nav: [..], rate_hz, systems, time_offset_s, antenna_lever_arm_m (x, y, z m),
            doppler_sign: "range_rate = -wavelength * doppler", visibility}
     can: {log, dbc, period_s, time_offset_s, yaw_rate, yaw_rate_sign, wheel_speed}
          yaw_rate / wheel_speed are MESSAGE.SIGNAL names as ``vo-doppler heading`` takes them
@@ -139,7 +139,8 @@ class UrbanCanyonConfig:
     render: bool = True
     start_gps_s: float = DEFAULT_START_GPS_S
     origin: tuple[float, float, float] = SHINJUKU
-    antenna_height_m: float = 1.6
+    antenna_lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 1.6)
+    """GNSS antenna in the vehicle frame (x forward, y left, z up) from the rear-axle centre."""
     leap_seconds: int = 18
     gnss: GnssSimConfig = field(default_factory=GnssSimConfig)
     can: CanSimConfig = field(default_factory=CanSimConfig)
@@ -240,10 +241,7 @@ def simulate_urban_canyon(
     write_nav(out / "gnss" / "brdc.nav", records, config.leap_seconds, KLOBUCHAR)
 
     def antenna(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        motion = vehicle(t)
-        position = np.column_stack([motion.xy, np.full(len(motion.t), config.antenna_height_m)])
-        heading = np.column_stack([np.cos(motion.yaw), np.sin(motion.yaw), np.zeros(len(t))])
-        return position, motion.speed[:, None] * heading
+        return antenna_motion(vehicle(t), config.antenna_lever_arm_m)
 
     n_epochs = int(np.floor(config.duration_s * config.gnss.rate_hz + 1e-9)) + 1
     epoch_time = t0 + np.arange(n_epochs) / config.gnss.rate_hz
@@ -263,7 +261,7 @@ def simulate_urban_canyon(
         start_ecef,
         1.0 / config.gnss.rate_hz,
         marker_name=f"URBAN_CANYON_{config.seed}",
-        antenna_height_m=config.antenna_height_m,
+        antenna_height_m=config.antenna_lever_arm_m[2],
     )
     np.savetxt(
         out / "gnss" / "visibility.csv",
@@ -301,6 +299,33 @@ def simulate_urban_canyon(
     files = _write_manifest(out, config, command, camera, camera_offset, stats)
     log.info("wrote %s in %.1f s", out, sum(seconds.values()))
     return UrbanCanyonSimulation(config, frame, vehicle, gnss, can, stats, files)
+
+
+def antenna_motion(
+    motion: VehicleMotion, lever_arm_m: tuple[float, float, float]
+) -> tuple[np.ndarray, np.ndarray]:
+    """ENU position and velocity (N, 3) of an antenna at ``lever_arm_m`` (vehicle frame) on the
+    vehicle: p = p_v + R(ψ)·r and v = v_v + ω × r, ω = (0, 0, ψ̇) (the vehicle stays level), so
+    in the vehicle frame the antenna moves at (s − ψ̇·r_y, ψ̇·r_x, 0)."""
+    rx, ry, rz = lever_arm_m
+    cos_yaw, sin_yaw = np.cos(motion.yaw), np.sin(motion.yaw)
+    position = np.column_stack(
+        [
+            motion.xy[:, 0] + cos_yaw * rx - sin_yaw * ry,
+            motion.xy[:, 1] + sin_yaw * rx + cos_yaw * ry,
+            np.full(len(motion.t), rz),
+        ]
+    )
+    along = motion.speed - motion.yaw_rate * ry
+    across = motion.yaw_rate * rx
+    velocity = np.column_stack(
+        [
+            cos_yaw * along - sin_yaw * across,
+            sin_yaw * along + cos_yaw * across,
+            np.zeros(len(motion.t)),
+        ]
+    )
+    return position, velocity
 
 
 def written_camera(camera: Camera, config: UrbanCanyonConfig) -> Camera:
@@ -411,7 +436,7 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
             "rate_hz": config.gnss.rate_hz,
             "systems": config.gnss.systems,
             "time_offset_s": 0.0,
-            "antenna_lever_arm_m": [0.0, 0.0, config.antenna_height_m],
+            "antenna_lever_arm_m": [float(v) for v in config.antenna_lever_arm_m],
             "doppler_sign": "range_rate = -wavelength * doppler",
             "visibility": files["visibility"],
         },
