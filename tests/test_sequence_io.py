@@ -7,6 +7,7 @@ import yaml
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.sequence import read_manifest, read_sequence
+from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
 
 def write_manifest(folder, data) -> None:
@@ -43,3 +44,20 @@ def test_missing_section_and_key_are_named(tmp_path):
     )
     with pytest.raises(InputError, match="section 'camera' lacks 'images'"):
         read_sequence(tmp_path)
+
+
+def test_antenna_lever_arm_is_read_and_defaults_to_zero(tmp_path):
+    config = UrbanCanyonConfig(
+        duration_s=1.0, seed=1, image_size=(64, 36), antenna_lever_arm_m=(1.2, -0.3, 1.5)
+    )
+    simulate_urban_canyon(tmp_path, config)
+    assert read_sequence(tmp_path).antenna_lever_arm_m == (1.2, -0.3, 1.5)
+    manifest = yaml.safe_load((tmp_path / "sequence.yaml").read_text())
+    del manifest["gnss"]["antenna_lever_arm_m"]
+    write_manifest(tmp_path, manifest)
+    assert read_sequence(tmp_path).antenna_lever_arm_m == (0.0, 0.0, 0.0)
+    for bad in ([1.0, 2.0], "1,2,3", [1.0, None, 2.0]):
+        manifest["gnss"]["antenna_lever_arm_m"] = bad
+        write_manifest(tmp_path, manifest)
+        with pytest.raises(InputError, match=r"gnss\.antenna_lever_arm_m .* not three numbers"):
+            read_sequence(tmp_path)

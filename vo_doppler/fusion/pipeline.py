@@ -65,6 +65,8 @@ class SequenceInputs:
     enu: EnuFrame
     truth: Trajectory | None = None
     """Vehicle poses in the ENU frame, if known."""
+    antenna_lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """GNSS antenna in the vehicle frame (x forward, y left, z up) from the vehicle origin (m)."""
 
 
 @dataclass

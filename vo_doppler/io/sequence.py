@@ -99,6 +99,7 @@ def read_sequence(folder: str | Path) -> SequenceInputs:
         np.radians(float(_entry(origin, "lon_deg", manifest, "origin"))),
         float(origin.get("height_m", 0.0)),
     )
+    lever_arm = _lever_arm(gnss_cfg.get("antenna_lever_arm_m", (0.0, 0.0, 0.0)), root)
     truth = None
     truth_cfg = manifest.get("ground_truth")
     if isinstance(truth_cfg, dict) and (root / truth_cfg.get("trajectory", "")).is_file():
@@ -114,4 +115,16 @@ def read_sequence(folder: str | Path) -> SequenceInputs:
         wheel_speed=motion.speed,
         enu=enu,
         truth=truth,
+        antenna_lever_arm_m=lever_arm,
     )
+
+
+def _lever_arm(value, root: Path) -> tuple[float, float, float]:
+    """``gnss.antenna_lever_arm_m``: three numbers (x forward, y left, z up, m)."""
+    try:
+        arm = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        arm = ()
+    if len(arm) != 3 or not all(np.isfinite(arm)):
+        raise InputError(f"gnss.antenna_lever_arm_m is {value!r}, not three numbers (m)", root)
+    return arm
