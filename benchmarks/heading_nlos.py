@@ -53,7 +53,9 @@ def _errors(error_deg: np.ndarray, mask: np.ndarray) -> dict:
     }
 
 
-def evaluate(folder: Path) -> dict:
+def sequence_with_truth(folder: Path):
+    """The sequence's inputs, its GNSS velocity result with the run's settings and the
+    ground-truth yaw (unwrapped) at its GNSS epochs."""
     inputs = read_sequence(folder)
     if inputs.truth is None:
         raise SystemExit(f"{folder}: no ground truth; the benchmark needs one")
@@ -62,11 +64,18 @@ def evaluate(folder: Path) -> dict:
     gnss = gnss_velocity(
         obs, inputs.navigation, config.systems, np.radians(config.elevation_mask_deg)
     )
-    rows = heading_rows(gnss.rows)
     truth = inputs.truth
     truth_yaw = sample_at(
         truth.t, np.unwrap(yaw_of(truth.orientations.as_matrix())), obs.epoch_time
     )
+    return inputs, gnss, truth_yaw
+
+
+def evaluate(folder: Path) -> dict:
+    inputs, gnss, truth_yaw = sequence_with_truth(folder)
+    config = PipelineConfig()
+    obs = inputs.observations
+    rows = heading_rows(gnss.rows)
     variants = {
         "off": dataclasses.replace(config.heading.tight, outlier_passes=0),
         "on": config.heading.tight,

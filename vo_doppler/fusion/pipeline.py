@@ -171,6 +171,30 @@ def dead_reckoning_track(
     return Trajectory(t, positions, Rotation.from_euler("z", track.yaw[:, None]))
 
 
+def heading_stage(
+    inputs: SequenceInputs,
+    gnss: GnssVelocityResult,
+    config: HeadingPipelineConfig,
+    antenna_lever_arm_m: tuple[float, ...] | None = None,
+) -> HeadingTable:
+    """The heading table of :func:`run_pipeline` (sec. 3.3–3.5) from the GNSS velocity result,
+    with the sequence's antenna lever arm unless ``antenna_lever_arm_m`` replaces it."""
+    return heading_pipeline(
+        inputs.observations.epoch_time,
+        heading_rows(gnss.rows),
+        gnss.velocity.velocity_enu,
+        gnss.velocity.valid,
+        inputs.wheel_speed,
+        inputs.yaw_rate,
+        config,
+        conventional_sigma_mps=gnss.velocity.sigma_mps,
+        conventional_yaw_sigma=conventional_heading_sigma(gnss, inputs.enu),
+        antenna_lever_arm_m=inputs.antenna_lever_arm_m
+        if antenna_lever_arm_m is None
+        else antenna_lever_arm_m,
+    )
+
+
 def run_pipeline(
     inputs: SequenceInputs,
     config: PipelineConfig | None = None,
@@ -184,17 +208,7 @@ def run_pipeline(
     gnss = gnss_velocity(
         obs, inputs.navigation, config.systems, np.radians(config.elevation_mask_deg)
     )
-    table = heading_pipeline(
-        obs.epoch_time,
-        heading_rows(gnss.rows),
-        gnss.velocity.velocity_enu,
-        gnss.velocity.valid,
-        inputs.wheel_speed,
-        inputs.yaw_rate,
-        config.heading,
-        conventional_sigma_mps=gnss.velocity.sigma_mps,
-        conventional_yaw_sigma=conventional_heading_sigma(gnss, inputs.enu),
-    )
+    table = heading_stage(inputs, gnss, config.heading)
     speed = calibrated_speed(inputs.wheel_speed, table)
     vo = run_visual_odometry(
         (read_image(p) for p in inputs.image_paths),

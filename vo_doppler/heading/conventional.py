@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vo_doppler.geo import yaw_to_course
+from vo_doppler.geo import wrap_angle, yaw_to_course
 
 
 def heading_from_velocity(
@@ -51,3 +51,20 @@ def velocity_heading_sigma(
     with np.errstate(divide="ignore", invalid="ignore"):
         sigma = np.sqrt(variance) / speed
     return np.where(np.isfinite(sigma) & (speed > 0), sigma, np.nan)
+
+
+def vehicle_heading_from_antenna(
+    yaw: np.ndarray, speed: np.ndarray, wheel_speed: np.ndarray, offset_velocity: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Yaw and forward speed of the vehicle from the yaw and horizontal speed of its GNSS
+    antenna's velocity, which moves at ``offset_velocity`` (N, 2) = ω × r (along, across)
+    relative to the vehicle origin (``antenna_offset_velocity`` of the tight heading).
+
+    In the vehicle frame the antenna moves at (s − ω·r_y, ω·r_x), at the angle
+    δ = atan2(ω·r_x, s − ω·r_y) (s: the wheel speed) to the vehicle's x axis, so the vehicle's
+    yaw is the antenna's minus δ and its speed the antenna velocity's forward component
+    |v|·cos δ plus ω·r_y.
+    """
+    offset = np.asarray(offset_velocity, dtype=float)
+    delta = np.arctan2(offset[:, 1], np.asarray(wheel_speed, dtype=float) + offset[:, 0])
+    return wrap_angle(yaw - delta), speed * np.cos(delta) - offset[:, 0]

@@ -15,6 +15,7 @@ solver, which propagates them into each heading's standard deviation.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,10 +30,14 @@ from vo_doppler.heading.calibration import (
     WheelScaleCalibrator,
     WheelScaleKalman,
 )
-from vo_doppler.heading.conventional import heading_from_velocity
+from vo_doppler.heading.conventional import heading_from_velocity, vehicle_heading_from_antenna
 from vo_doppler.heading.rows import DopplerRows
 from vo_doppler.heading.sensors import integrate_rate, sample_at
-from vo_doppler.heading.tight_heading import TightHeadingConfig, tight_heading_series
+from vo_doppler.heading.tight_heading import (
+    TightHeadingConfig,
+    antenna_offset_velocity,
+    tight_heading_series,
+)
 from vo_doppler.io.sensor_csv import SensorSeries
 
 CALIBRATION_METHODS = ("ls", "kalman", "none")
@@ -206,6 +211,7 @@ def heading_pipeline(
     config: HeadingPipelineConfig = HeadingPipelineConfig(),
     conventional_sigma_mps: np.ndarray | None = None,
     conventional_yaw_sigma: np.ndarray | None = None,
+    antenna_lever_arm_m: Sequence[float] = (0.0, 0.0),
 ) -> HeadingTable:
     """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise).
 
@@ -214,6 +220,13 @@ def heading_pipeline(
     calibrate the sensors. ``conventional_yaw_sigma`` (rad): standard deviation of each
     conventional heading (:func:`~vo_doppler.heading.conventional.velocity_heading_sigma`),
     kept in the table for the heading correction.
+
+    ``antenna_lever_arm_m``: the GNSS antenna (x forward, y left[, z up], m) from the vehicle
+    origin. In turns the antenna moves at ω × r relative to the vehicle, so the Doppler
+    velocity is not the vehicle's: the tightly coupled model adds ω × r (ω the calibrated yaw
+    rate at each epoch) and the conventional heading and speed are turned into the vehicle's
+    (:func:`~vo_doppler.heading.conventional.vehicle_heading_from_antenna`), with the raw yaw
+    rate for the calibration (the bias is not known yet) and the calibrated one in the table.
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     velocity = np.asarray(conventional_velocity_enu, dtype=float).reshape(-1, 3)
@@ -223,11 +236,19 @@ def heading_pipeline(
     # Horizontal speed: the tightly coupled model's velocity is horizontal, and the vertical
     # component of a canyon fix is noisy (large VDOP), which would bias |v| and the scale up.
     conv_speed = np.where(conventional_valid, np.hypot(velocity[:, 0], velocity[:, 1]), np.nan)
+    wheel = sample_at(speed.t, speed.value, t_epoch)
+    raw_rate = sample_at(yaw_rate.t, yaw_rate.value, t_epoch)
+    lever = any(float(v) != 0.0 for v in tuple(antenna_lever_arm_m)[:2])
+    antenna_yaw, antenna_speed = conv_yaw, conv_speed
+    if lever:
+        offset = antenna_offset_velocity(raw_rate, antenna_lever_arm_m)
+        conv_yaw, conv_speed = vehicle_heading_from_antenna(
+            antenna_yaw, antenna_speed, wheel, offset
+        )
     calibrating = np.asarray(conventional_valid, bool).copy()
     if conventional_sigma_mps is not None:
         sigma = np.nan_to_num(np.asarray(conventional_sigma_mps, dtype=float), nan=np.inf)
         calibrating &= sigma <= config.calibration_max_velocity_sigma_mps
-    wheel = sample_at(speed.t, speed.value, t_epoch)
     tolerance = np.maximum(
         config.calibration_max_speed_mismatch_mps,
         config.calibration_max_speed_mismatch_ratio * np.abs(wheel),
@@ -238,6 +259,11 @@ def heading_pipeline(
     # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
     steps = cal.bias[:-1] * np.diff(t_epoch)
     yaw_angle = raw_angle - np.concatenate([[0.0], np.cumsum(steps)])[: len(t_epoch)]
+    offset = antenna_offset_velocity(raw_rate - cal.bias, antenna_lever_arm_m)
+    if lever:
+        conv_yaw, _ = vehicle_heading_from_antenna(
+            antenna_yaw, antenna_speed, cal.scale * wheel, offset
+        )
     result = tight_heading_series(
         rows,
         t_epoch,
@@ -246,6 +272,7 @@ def heading_pipeline(
         config.tight,
         speed_scale_sigma=cal.scale_sigma / cal.scale,
         gyro_bias_sigma=cal.bias_sigma,
+        lever_velocity=np.nan_to_num(offset),
     )
     return HeadingTable(
         t=t_epoch,

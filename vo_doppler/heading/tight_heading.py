@@ -391,6 +391,7 @@ def tight_heading_series(
     config: TightHeadingConfig = TightHeadingConfig(),
     speed_scale_sigma: np.ndarray | float = 0.0,
     gyro_bias_sigma: np.ndarray | float = 0.0,
+    lever_velocity: np.ndarray | float = 0.0,
 ) -> TightHeadingResult:
     """Heading at every epoch from the window of Doppler rows ending there (sec. 3.5).
 
@@ -399,6 +400,11 @@ def tight_heading_series(
     (relative) and ``gyro_bias_sigma`` (rad/s), per epoch or scalars, are the uncertainties of
     the calibration behind them; they enter the heading's standard deviation together with
     the Doppler noise and the clock-drift random walk (``config.clock_drift_walk_mps``).
+
+    ``lever_velocity`` (m, 2) or a scalar: the antenna's velocity relative to the vehicle
+    origin in the vehicle frame (along, across) = ω × r = (−ω·r_y, ω·r_x) for an antenna at
+    (r_x, r_y) turning at ω (:func:`antenna_offset_velocity`); the Doppler rows then see
+    v_t = R(θ_t)·[s_t + along_t, across_t] instead of s_t·[cos θ_t, sin θ_t].
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     speed = np.asarray(speed, dtype=float)
@@ -406,6 +412,7 @@ def tight_heading_series(
     m = len(t_epoch)
     scale_sigma = np.broadcast_to(np.asarray(speed_scale_sigma, dtype=float), (m,))
     bias_sigma = np.broadcast_to(np.asarray(gyro_bias_sigma, dtype=float), (m,))
+    lever = np.broadcast_to(np.asarray(lever_velocity, dtype=float), (m, 2))
     if np.any(np.diff(t_epoch) <= 0):
         raise ValueError("epoch times must be strictly increasing")
     if m == 0:
@@ -440,7 +447,7 @@ def tight_heading_series(
                 row_epoch,
                 k,
                 (lo, hi),
-                (t_epoch, speed, yaw_angle),
+                (t_epoch, speed, yaw_angle, lever),
                 (scale_sigma, bias_sigma),
                 config,
             )
@@ -457,7 +464,7 @@ def tight_heading_series(
 
 def _solve_chunk(rows, per_row, index, row_epoch, k, bounds, per_epoch, calibration, config):
     (y_all, row_group), (lo, hi) = per_row, bounds
-    (t_epoch, speed, yaw_angle), (scale_sigma, bias_sigma) = per_epoch, calibration
+    (t_epoch, speed, yaw_angle, lever), (scale_sigma, bias_sigma) = per_epoch, calibration
     width = max(int(np.max(hi[k] - lo[k], initial=0)), 1)
     slot = lo[k][:, None] + np.arange(width)[None, :]
     inside = slot < hi[k][:, None]
@@ -466,16 +473,27 @@ def _solve_chunk(rows, per_row, index, row_epoch, k, bounds, per_epoch, calibrat
     epoch = row_epoch[slot]
     delta = yaw_angle[epoch] - yaw_angle[k][:, None]
     tau = t_epoch[epoch] - t_epoch[k][:, None]
-    s = speed[epoch]
+    along, across = speed[epoch] + lever[epoch, 0], lever[epoch, 1]
     ge, gn = rows.los[row, 0], rows.los[row, 1]
     cos_d, sin_d = np.cos(delta), np.sin(delta)
-    a = -s * (ge * cos_d + gn * sin_d)
-    b = -s * (gn * cos_d - ge * sin_d)
+    # The LOS turned by −δ, so that −G·R(θ₀ + δ)·[along, across] = a·cos θ₀ + b·sin θ₀.
+    forward, left = ge * cos_d + gn * sin_d, gn * cos_d - ge * sin_d
+    a = -along * forward - across * left
+    b = -along * left + across * forward
     w = np.where(inside, rows.weight[row], 0.0)
     y = np.where(w > 0, y_all[row], 0.0)
     a, b, tau = np.where(w > 0, a, 0.0), np.where(w > 0, b, 0.0), np.where(w > 0, tau, 0.0)
     group = np.where(w > 0, row_group[row], 0)
     return solve_windows(y, a, b, tau, w, config, group, scale_sigma[k], bias_sigma[k])
+
+
+def antenna_offset_velocity(yaw_rate: np.ndarray, lever_arm_m) -> np.ndarray:
+    """Velocity (N, 2) of an antenna at ``lever_arm_m`` = (r_x forward, r_y left, …) relative
+    to the vehicle origin, in the vehicle frame: ω × r = (−ω·r_y, ω·r_x) for yaw rates ω
+    (rad/s, counter-clockwise; the vehicle stays level, so r_z does not move the antenna)."""
+    rx, ry = (float(v) for v in tuple(lever_arm_m)[:2])
+    omega = np.asarray(yaw_rate, dtype=float)
+    return np.stack([-omega * ry, omega * rx], axis=-1)
 
 
 def _unavailable(t_epoch, n_sat_epoch=None) -> TightHeadingResult:
