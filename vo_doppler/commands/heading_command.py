@@ -83,6 +83,13 @@ def register(subparsers) -> None:
         default=0.0,
         help="extra seconds added to the speed times",
     )
+    parser.add_argument(
+        "--antenna-lever-arm",
+        type=_lever_arm,
+        default=(0.0, 0.0),
+        help="GNSS antenna X,Y[,Z] m in the vehicle frame (x forward, y left) from the point "
+        "whose heading is wanted (default 0,0); the Doppler is then the antenna's in turns",
+    )
     parser.add_argument("--window-s", type=float, default=2.0, help="heading window (s)")
     parser.add_argument(
         "--no-nlos-rejection",
@@ -103,6 +110,16 @@ def register(subparsers) -> None:
     parser.add_argument("-o", "--output", type=Path, required=True, help="heading CSV")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
     parser.set_defaults(func=run)
+
+
+def _lever_arm(text: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected X,Y or X,Y,Z (m)") from exc
+    if len(values) not in (2, 3) or not all(np.isfinite(values)):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected X,Y or X,Y,Z (m)")
+    return values
 
 
 def _sensors(args):
@@ -182,6 +199,7 @@ def run(args: argparse.Namespace) -> int:
         config,
         conventional_sigma_mps=conventional.sigma_mps,
         conventional_yaw_sigma=_conventional_yaw_sigma(conventional, rows.receiver_ecef),
+        antenna_lever_arm_m=args.antenna_lever_arm,
     )
     args.output.parent.mkdir(parents=True, exist_ok=True)
     write_heading_csv(args.output, table)
