@@ -93,6 +93,7 @@ def evaluate(folder: Path) -> dict:
             inputs.yaw_rate,
             heading,
             conventional_sigma_mps=gnss.velocity.sigma_mps,
+            antenna_lever_arm_m=inputs.antenna_lever_arm_m,
         )
         seconds = time.perf_counter() - start
         error = np.degrees(np.abs(wrap_angle(table.yaw_tc - truth_yaw)))
