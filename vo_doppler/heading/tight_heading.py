@@ -9,7 +9,9 @@ For the window of epochs t ∈ (t_k − W, t_k] ending at epoch k, every Doppler
 with s_t the calibrated speed, Φ the integrated calibrated yaw rate (counter-clockwise
 positive, so Φ_t − Φ_k = −∫_t^{t_k} ω dτ: "θ₀ minus the integrated yaw rate since t"), θ the
 yaw counter-clockwise from east, ρ the receiver clock drift (m/s) and α its rate. Vertical
-velocity is taken as zero (land vehicle). θ₀ is the heading at the newest epoch.
+velocity is taken as zero (land vehicle). θ₀ is the heading at the newest epoch. An antenna at
+(r_x, r_y) off the vehicle origin moves at v_t = R(θ_t)·[s_t − ω_t·r_y, ω_t·r_x] (v + ω × r,
+ω_t the calibrated yaw rate), which is still a·cos θ₀ + b·sin θ₀ (``lever_velocity``).
 
 Given θ₀ the model is linear in (ρ₀, α), so they are projected out (variable projection): with
 z = [cos θ₀, sin θ₀, 1] the weighted residual sum of squares is zᵀQz for a 3×3 matrix Q per
