@@ -13,6 +13,7 @@ from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.heading_correction import (
     FORWARD_CAMERA_TO_VEHICLE,
+    chord_starts,
     correct_heading,
     headings_at,
     vehicle_poses,
@@ -314,3 +315,56 @@ def test_course_reference_is_immune_to_an_extrinsic_yaw_error():
     assert error.max() > 1.0
     with pytest.raises(ValueError, match="reference must be"):
         correct_heading(vo, t, yaw, reference="sideways")
+
+
+def test_chord_starts_group_short_steps_until_the_chord_is_long_enough():
+    x = np.array([0.0, 0.6, 0.7, 0.8, 0.9, 1.6, 1.6, 3.0])
+    positions = np.column_stack([x, np.zeros_like(x), np.zeros_like(x)])
+    np.testing.assert_array_equal(chord_starts(positions, 0.5), [-1, 0, 0, 0, 0, 4, 4, 6])
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(5.0, 200.0), st.floats(0.5, 20.0), st.floats(0.5, 3.0))
+def test_chord_course_is_the_tangent_at_the_chord_middle_on_an_arc(radius, speed, chord_m):
+    t = np.arange(0.0, 20.0, 0.05)
+    angle = speed * t / radius
+    positions = np.column_stack([radius * np.sin(angle), radius * (1 - np.cos(angle)), 0 * t])
+    start = chord_starts(positions, chord_m)
+    has = np.flatnonzero(start >= 0)
+    chord = positions[has, :2] - positions[start[has], :2]
+    middle = 0.5 * (t[has] + t[start[has]])
+    np.testing.assert_allclose(
+        wrap_angle(np.arctan2(chord[:, 1], chord[:, 0]) - speed * middle / radius), 0.0, atol=1e-9
+    )
+
+
+def test_creeping_steps_at_a_stop_do_not_turn_the_course_corrected_trajectory():
+    """Stopped, a VO's position only jitters: two 6 cm steps 60° off the way the vehicle
+    faces are then the only courses in the window. Compared one by one with the absolute
+    heading they turned the corrected trajectory by 60°; the 0.5 m chord leaves them out."""
+    step = np.r_[np.full(40, 1.0), np.zeros(20), np.full(40, 1.0)]
+    direction = np.zeros(len(step))
+    step[[45, 52]] = 0.06
+    direction[[45, 52]] = np.radians([60.0, -120.0])
+    positions = np.zeros((len(step) + 1, 3))
+    positions[1:, 0] = np.cumsum(step * np.cos(direction))
+    positions[1:, 1] = np.cumsum(step * np.sin(direction))
+    t = np.arange(len(positions)) / RATE_HZ
+    vo = Trajectory(t, positions, Rotation.identity(len(t)))
+    worst = {}
+    for chord in (0.05, 0.5):
+        result = correct_heading(
+            vo,
+            t,
+            np.zeros(len(t)),
+            None,
+            2.0,
+            np.eye(4),
+            "level",
+            reference="course",
+            min_chord_m=chord,
+        )
+        yaw = yaw_of(result.vehicle.orientations.as_matrix())
+        worst[chord] = np.degrees(np.max(np.abs(wrap_angle(yaw))))
+    assert worst[0.5] < 2.0  # a chord leaving the stop still carries a creep's 5 cm offset
+    assert worst[0.05] > 50.0

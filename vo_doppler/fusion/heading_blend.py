@@ -20,8 +20,9 @@ State: the offset δ = (true course − VO course), a scalar in rad, held unwrap
 
       z_j = wrap(h_j − c_VO(t_j)) = δ(t_j) + v_j,   v_j ~ N(0, r_j),   r_j = (s·σ_j)²·κ_j   (B2)
 
-  at the middle time t_j of every VO step (of at least ``min_step_m``; at every pose for the
-  orientation reference), c_VO(t_j) the step's course (or the pose's yaw), h_j and its
+  at the middle time t_j of the VO chord ending at every pose (at least ``min_chord_m`` long,
+  :func:`~vo_doppler.fusion.heading_correction.chord_starts`; at every pose for the
+  orientation reference), c_VO(t_j) the chord's course (or the pose's yaw), h_j and its
   standard deviation σ_j interpolated between GNSS epochs, s a scale on σ_j and
   κ_j = max(1, T_c/Δt) the number of measurements within the heading's error-correlation time
   T_c: the tight heading of consecutive epochs comes from overlapping windows (T_c = its
@@ -67,6 +68,7 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.fusion.heading_correction import (
     FORWARD_CAMERA_TO_VEHICLE,
+    chord_starts,
     headings_at,
     vehicle_poses,
     yaw_of,
@@ -103,13 +105,13 @@ class BlendConfig:
     """Floor on σ_ψ: 0.01 % yaw-scale error."""
     default_measurement_sigma: float = np.radians(1.0)
     """σ_j of epochs whose heading carries no standard deviation (e.g. conventional headings
-    read from heading.csv, which has no column for theirs)."""
+    read from a heading.csv written before it had their column)."""
     smooth: bool = True
     """RTS smoother (B4, offline); False: forward filter only (causal)."""
     reference: str = "course"
     """Compare the absolute heading with the VO's 'course' or its 'orientation' yaw."""
-    min_step_m: float = 0.05
-    """VO steps shorter than this have no course."""
+    min_chord_m: float = 0.5
+    """Length of the VO chord whose direction is the course (shorter, slower motion has none)."""
     max_gap_s: float = 1.5
     """Longest gap across which the VO course (or yaw) is interpolated to an epoch."""
     min_fit_measurements: int = 20
@@ -176,16 +178,17 @@ class BlendResult:
 
 
 def vo_direction(
-    t: np.ndarray, positions: np.ndarray, rotations: np.ndarray, reference: str, min_step_m
+    t: np.ndarray, positions: np.ndarray, rotations: np.ndarray, reference: str, min_chord_m
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Times and yaw (rad) of the VO direction: the course of every step of at least
-    ``min_step_m`` at its middle time, or the orientation yaw at every pose."""
+    """Times and yaw (rad) of the VO direction: the course of the chord of at least
+    ``min_chord_m`` ending at each pose, at the chord's middle time, or the orientation yaw at
+    every pose."""
     if reference == "orientation":
         return t, yaw_of(rotations)
-    step = np.diff(positions[:, :2], axis=0)
-    moving = np.hypot(step[:, 0], step[:, 1]) >= min_step_m
-    middle = 0.5 * (t[1:] + t[:-1])
-    return middle[moving], np.arctan2(step[moving, 1], step[moving, 0])
+    start = chord_starts(positions, min_chord_m)
+    has = np.flatnonzero(start >= 0)
+    chord = positions[has, :2] - positions[start[has], :2]
+    return 0.5 * (t[has] + t[start[has]]), np.arctan2(chord[:, 1], chord[:, 0])
 
 
 def offset_measurements(
@@ -396,7 +399,7 @@ def blend_heading(
     positions = poses[:, :3, 3] - (poses[0, :3, 3] if len(poses) else 0.0)
     rotations = poses[:, :3, :3]
     t_direction, yaw_direction = vo_direction(
-        t, positions, rotations, config.reference, config.min_step_m
+        t, positions, rotations, config.reference, config.min_chord_m
     )
     measurements = offset_measurements(
         t_heading, yaw, sigma, correlation, t_direction, yaw_direction, config.max_gap_s

@@ -99,22 +99,39 @@ def _rz(angle: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def chord_starts(positions: np.ndarray, min_chord_m: float) -> np.ndarray:
+    """For every pose j, the latest earlier pose k with |p_j − p_k| ≥ ``min_chord_m``
+    (horizontal), or −1 when there is none. Its direction is the course at the chord's middle
+    time (exact on a circular arc, and independent of the frame rate)."""
+    n = len(positions)
+    starts = np.full(n, -1, dtype=int)
+    xy = positions[:, :2]
+    k = -1
+    for j in range(n):
+        while k + 1 < j and np.hypot(*(xy[j] - xy[k + 1])) >= min_chord_m:
+            k += 1
+        if k >= 0 and np.hypot(*(xy[j] - xy[k])) >= min_chord_m:
+            starts[j] = k
+    return starts
+
+
 def _window_yaw(
     positions: np.ndarray,
     rotations: np.ndarray,
     start: int,
     stop: int,
     reference: str,
-    min_step_m: float,
+    chord_start: np.ndarray,
 ) -> np.ndarray:
-    """VO yaw of poses start..stop−1: orientation yaw, or the course of the step into each pose
-    (NaN where the step is shorter than ``min_step_m`` or there is none)."""
+    """VO yaw of poses start..stop−1: orientation yaw, or the course of the chord ending at each
+    pose (NaN where the chord would begin before ``start`` or there is none)."""
     if reference == "orientation":
         return yaw_of(rotations[start:stop])
     index = np.arange(start, stop)
-    step = positions[index, :2] - positions[np.maximum(index - 1, 0), :2]
-    moving = np.hypot(step[:, 0], step[:, 1]) >= min_step_m
-    return np.where(moving, np.arctan2(step[:, 1], step[:, 0]), np.nan)
+    begin = chord_start[index]
+    inside = begin >= start
+    chord = positions[index, :2] - positions[np.where(inside, begin, index), :2]
+    return np.where(inside, np.arctan2(chord[:, 1], chord[:, 0]), np.nan)
 
 
 def correct_heading(
@@ -128,7 +145,7 @@ def correct_heading(
     max_gap_s: float = 1.5,
     gate_rad: float | None = None,
     reference: str = "orientation",
-    min_step_m: float = 0.05,
+    min_chord_m: float = 0.5,
 ) -> HeadingCorrectionResult:
     """Correct the VO heading with absolute headings (sec. 3.6, Eq. 11–13).
 
@@ -138,22 +155,25 @@ def correct_heading(
     (an innovation gate against wrong but self-consistent absolute solutions).
 
     ``reference`` is what Eq. (11) compares with the absolute heading: the VO's
-    ``"orientation"`` (vehicle yaw), or its ``"course"``, the direction of each step of at
-    least ``min_step_m`` compared with the absolute heading at the step's middle time. A
-    Doppler heading is a direction of travel, so "course" is immune to a yaw error of the
-    camera→vehicle extrinsic or to a VO whose motion is skewed against its optical axis.
+    ``"orientation"`` (vehicle yaw), or its ``"course"``, the direction of the chord of at least
+    ``min_chord_m`` ending at each pose (:func:`chord_starts`) compared with the absolute
+    heading at the chord's middle time. A Doppler heading is a direction of travel, so "course"
+    is immune to a yaw error of the camera→vehicle extrinsic or to a VO whose motion is skewed
+    against its optical axis; the chord keeps the tiny, noisy steps of a vehicle that is
+    slowing down or creeping out of the comparison.
     """
     if reference not in ("orientation", "course"):
         raise ValueError(f"reference must be 'orientation' or 'course', not {reference!r}")
     poses = vehicle_poses(camera, camera_to_vehicle, world)
     n = len(poses)
-    t_compare = camera.t
-    if reference == "course" and n:
-        t_compare = np.concatenate([[camera.t[0]], 0.5 * (camera.t[1:] + camera.t[:-1])])
-    absolute, has_absolute = headings_at(t_compare, t_heading, yaw_heading, valid, max_gap_s)
-    if reference == "course" and n:
-        has_absolute[0] = False
     vo_positions = poses[:, :3, 3] - (poses[0, :3, 3] if n else 0.0)
+    chord_start = chord_starts(vo_positions, min_chord_m)
+    t_compare = camera.t
+    if reference == "course":
+        t_compare = 0.5 * (camera.t + camera.t[np.maximum(chord_start, 0)])
+    absolute, has_absolute = headings_at(t_compare, t_heading, yaw_heading, valid, max_gap_s)
+    if reference == "course":
+        has_absolute &= chord_start >= 0
     vo_rotations = poses[:, :3, :3]
     positions = np.zeros((n, 3))
     rotations = np.zeros((n, 3, 3))
@@ -170,7 +190,7 @@ def correct_heading(
         while camera.t[oldest] <= camera.t[i] - window_s:
             oldest += 1
         window = slice(oldest, i + 1)
-        vo_yaw = _window_yaw(positions, rotations, oldest, i + 1, reference, min_step_m)
+        vo_yaw = _window_yaw(positions, rotations, oldest, i + 1, reference, chord_start)
         use = has_absolute[window] & np.isfinite(vo_yaw)
         if gate_rad is not None and established:
             innovation = wrap_angle(vo_yaw - absolute[window])
