@@ -15,18 +15,15 @@ import sys
 from pathlib import Path
 
 from rich.console import Console
-from rich.progress import Progress
 from rich.table import Table
 
-from benchmarks.sequence_runs import run_sequences
+from benchmarks.sequence_runs import read_with_truth, run_sequences, run_with_progress
 from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.fusion.pipeline import (
     PipelineConfig,
     correct_all,
-    run_pipeline,
 )
-from vo_doppler.io.sequence import read_sequence
 
 ROOT = Path(__file__).resolve().parents[1]
 METHODS = {
@@ -38,12 +35,8 @@ PIPELINES = ("vo", "vo_gps_conv", "vo_gps_tc", "dr_gps_tc")
 
 
 def evaluate_sequence(folder: Path, console: Console) -> dict:
-    inputs = read_sequence(folder)
-    if inputs.truth is None:
-        raise SystemExit(f"{folder}: no ground truth; the benchmark needs one")
-    with Progress(console=console, transient=True) as progress:
-        task = progress.add_task(f"{inputs.name}: VO", total=len(inputs.image_paths))
-        result = run_pipeline(inputs, on_frame=lambda _: progress.advance(task))
+    inputs = read_with_truth(folder)
+    result = run_with_progress(inputs, console)
     methods = {}
     for name, config in METHODS.items():
         trajectories = correct_all(

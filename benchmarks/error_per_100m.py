@@ -16,28 +16,21 @@ from pathlib import Path
 
 import numpy as np
 from rich.console import Console
-from rich.progress import Progress
 from rich.table import Table
 
-from benchmarks.sequence_runs import run_sequences
+from benchmarks.sequence_runs import read_with_truth, run_sequences, run_with_progress
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
 from vo_doppler.eval.report import error_per_100m_figure, trajectories_figure
 from vo_doppler.fusion.heading_correction import yaw_of
-from vo_doppler.fusion.pipeline import run_pipeline
 from vo_doppler.heading.sensors import sample_at
 from vo_doppler.io.heading_figure import heading_figure
-from vo_doppler.io.sequence import read_sequence
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def evaluate_sequence(folder: Path, figures: Path, console: Console) -> dict:
-    inputs = read_sequence(folder)
-    if inputs.truth is None:
-        raise SystemExit(f"{folder}: no ground truth; the benchmark needs one")
-    with Progress(console=console, transient=True) as progress:
-        task = progress.add_task(f"{inputs.name}: VO", total=len(inputs.image_paths))
-        result = run_pipeline(inputs, on_frame=lambda _: progress.advance(task))
+    inputs = read_with_truth(folder)
+    result = run_with_progress(inputs, console)
     errors, per_100m, shown = evaluate_pipelines(
         result.trajectories, result.heading, result.tc_usable, inputs.truth
     )

@@ -28,7 +28,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from benchmarks.sequence_runs import run_sequences
+from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.fusion.heading_correction import yaw_of
 from vo_doppler.fusion.pipeline import PipelineConfig, usable_tight_heading
 from vo_doppler.geo import wrap_angle
@@ -36,7 +36,6 @@ from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import heading_rows
 from vo_doppler.heading.pipeline import heading_pipeline
 from vo_doppler.heading.sensors import sample_at
-from vo_doppler.io.sequence import read_sequence
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -56,9 +55,7 @@ def _errors(error_deg: np.ndarray, mask: np.ndarray) -> dict:
 def sequence_with_truth(folder: Path):
     """The sequence's inputs, its GNSS velocity result with the run's settings and the
     ground-truth yaw (unwrapped) at its GNSS epochs."""
-    inputs = read_sequence(folder)
-    if inputs.truth is None:
-        raise SystemExit(f"{folder}: no ground truth; the benchmark needs one")
+    inputs = read_with_truth(folder)
     config = PipelineConfig()
     obs = inputs.observations
     gnss = gnss_velocity(

@@ -9,10 +9,29 @@ from collections.abc import Callable
 from pathlib import Path
 
 from rich.console import Console
+from rich.progress import Progress
+
+from vo_doppler.fusion.pipeline import PipelineResult, SequenceInputs, run_pipeline
+from vo_doppler.io.sequence import read_sequence
 
 Evaluate = Callable[[Path, Path, Console], dict]
 """(sequence folder, output folder of the JSON, console) → the sequence's figures."""
 Show = Callable[[Console, str, dict], None]
+
+
+def read_with_truth(folder: Path) -> SequenceInputs:
+    """The sequence's inputs; a benchmark without ground truth stops with the folder named."""
+    inputs = read_sequence(folder)
+    if inputs.truth is None:
+        raise SystemExit(f"{folder}: no ground truth; the benchmark needs one")
+    return inputs
+
+
+def run_with_progress(inputs: SequenceInputs, console: Console) -> PipelineResult:
+    """``run_pipeline`` with the default configuration and a progress bar over the images."""
+    with Progress(console=console, transient=True) as progress:
+        task = progress.add_task(f"{inputs.name}: VO", total=len(inputs.image_paths))
+        return run_pipeline(inputs, on_frame=lambda _: progress.advance(task))
 
 
 def run_sequences(
