@@ -19,17 +19,18 @@ from rich.table import Table
 
 from benchmarks.sequence_runs import read_with_truth, run_sequences, run_with_progress
 from vo_doppler.eval.pipelines import evaluate_pipelines
+from vo_doppler.fusion.correction import CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
-from vo_doppler.fusion.pipeline import (
-    PipelineConfig,
-    correct_all,
-)
+from vo_doppler.run import RunConfig, correct_all
+from vo_doppler.vo.frames import vehicle_trajectory
 
 ROOT = Path(__file__).resolve().parents[1]
 METHODS = {
-    "window": PipelineConfig(correction_method="window"),
-    "kalman": PipelineConfig(correction_method="kalman"),
-    "kalman causal": PipelineConfig(correction_method="kalman", blend=BlendConfig(smooth=False)),
+    "window": RunConfig(correction=CorrectionConfig(method="window")),
+    "kalman": RunConfig(correction=CorrectionConfig(method="kalman")),
+    "kalman causal": RunConfig(
+        correction=CorrectionConfig(method="kalman", blend=BlendConfig(smooth=False))
+    ),
 }
 PIPELINES = ("vo", "vo_gps_conv", "vo_gps_tc", "dr_gps_tc")
 
@@ -42,7 +43,7 @@ def evaluate_sequence(folder: Path, console: Console) -> dict:
         trajectories = correct_all(
             inputs,
             result.heading,
-            result.vo.trajectory,
+            vehicle_trajectory(result.vo.trajectory, inputs.camera.T_vehicle_camera),
             result.calibrated_speed,
             result.start_enu,
             config,

@@ -21,8 +21,6 @@ from rich.table import Table
 from benchmarks.sequence_runs import read_with_truth, run_sequences, run_with_progress
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
 from vo_doppler.eval.report import error_per_100m_figure, trajectories_figure
-from vo_doppler.fusion.heading_correction import yaw_of
-from vo_doppler.heading.sensors import sample_at
 from vo_doppler.io.heading_figure import heading_figure
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,7 +34,7 @@ def evaluate_sequence(folder: Path, figures: Path, console: Console) -> dict:
     )
     table = result.heading
     truth = inputs.truth
-    truth_yaw = sample_at(truth.t, np.unwrap(yaw_of(truth.orientations.as_matrix())), table.t)
+    truth_yaw = truth.yaw_at(table.t)
     figures.mkdir(parents=True, exist_ok=True)
     trajectories_figure(figures / f"{inputs.name}_trajectories.png", shown, truth, inputs.name)
     heading_figure(figures / f"{inputs.name}_heading.png", table, truth_yaw, inputs.name)

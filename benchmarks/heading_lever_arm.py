@@ -23,20 +23,21 @@ from rich.table import Table
 
 from benchmarks.heading_nlos import ROOT, _errors, _fmt, sequence_with_truth
 from benchmarks.sequence_runs import run_sequences
-from vo_doppler.fusion.heading_correction import yaw_of
-from vo_doppler.fusion.pipeline import PipelineConfig, heading_stage, usable_tight_heading
+from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
-from vo_doppler.heading.sensors import sample_at
+from vo_doppler.heading.from_gnss import heading_from_gnss
+from vo_doppler.model.timeseries import sample
+from vo_doppler.run import RunConfig
 
 TURN_RATE_DPS = 3.0
 
 
 def evaluate(folder, _results_dir=None, _console=None) -> dict:
     inputs, gnss, truth_yaw = sequence_with_truth(folder)
-    config = PipelineConfig()
+    config = RunConfig()
     obs, truth = inputs.observations, inputs.truth
-    rate = np.gradient(np.unwrap(yaw_of(truth.orientations.as_matrix())), truth.t)
-    turning = np.abs(np.degrees(np.nan_to_num(sample_at(truth.t, rate, obs.epoch_time))))
+    rate = np.gradient(truth.yaw(), truth.t)
+    turning = np.abs(np.degrees(np.nan_to_num(sample(truth.t, rate, obs.epoch_time))))
     turning = turning > TURN_RATE_DPS
     figures = {
         "epochs": len(obs.epoch_time),
@@ -45,10 +46,19 @@ def evaluate(folder, _results_dir=None, _console=None) -> dict:
         "variants": {},
     }
     for name, lever in (("ignored", (0.0, 0.0, 0.0)), ("applied", inputs.antenna_lever_arm_m)):
-        table = heading_stage(inputs, gnss, config.heading, lever)
+        table = heading_from_gnss(
+            obs.epoch_time,
+            gnss.rows,
+            gnss.velocity,
+            inputs.wheel_speed,
+            inputs.yaw_rate,
+            inputs.enu,
+            config.heading,
+            lever,
+        )
         tc = np.degrees(np.abs(wrap_angle(table.yaw_tc - truth_yaw)))
         conv = np.degrees(np.abs(wrap_angle(table.yaw_conv - truth_yaw)))
-        used = usable_tight_heading(table, config)
+        used = usable_tight_heading(table, config.correction.tc_max_sigma)
         figures["variants"][name] = {
             "tc_used": _errors(tc, used),
             "tc_used_turning": _errors(tc, used & turning),

@@ -29,13 +29,12 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmarks.sequence_runs import read_with_truth, run_sequences
-from vo_doppler.fusion.heading_correction import yaw_of
-from vo_doppler.fusion.pipeline import PipelineConfig, usable_tight_heading
+from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
 from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import heading_rows
 from vo_doppler.heading.pipeline import heading_pipeline
-from vo_doppler.heading.sensors import sample_at
+from vo_doppler.run import RunConfig
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -56,21 +55,17 @@ def sequence_with_truth(folder: Path):
     """The sequence's inputs, its GNSS velocity result with the run's settings and the
     ground-truth yaw (unwrapped) at its GNSS epochs."""
     inputs = read_with_truth(folder)
-    config = PipelineConfig()
+    config = RunConfig()
     obs = inputs.observations
-    gnss = gnss_velocity(
-        obs, inputs.navigation, config.systems, np.radians(config.elevation_mask_deg)
-    )
+    gnss = gnss_velocity(obs, inputs.navigation, config.systems, config.elevation_mask)
     truth = inputs.truth
-    truth_yaw = sample_at(
-        truth.t, np.unwrap(yaw_of(truth.orientations.as_matrix())), obs.epoch_time
-    )
+    truth_yaw = truth.yaw_at(obs.epoch_time)
     return inputs, gnss, truth_yaw
 
 
 def evaluate(folder: Path) -> dict:
     inputs, gnss, truth_yaw = sequence_with_truth(folder)
-    config = PipelineConfig()
+    config = RunConfig()
     obs = inputs.observations
     rows = heading_rows(gnss.rows)
     variants = {
@@ -94,7 +89,7 @@ def evaluate(folder: Path) -> dict:
         )
         seconds = time.perf_counter() - start
         error = np.degrees(np.abs(wrap_angle(table.yaw_tc - truth_yaw)))
-        used = usable_tight_heading(table, config)
+        used = usable_tight_heading(table, config.correction.tc_max_sigma)
         figures["variants"][name] = {
             "available": _errors(error, table.tc_available),
             "used": _errors(error, used),

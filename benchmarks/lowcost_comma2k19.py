@@ -33,9 +33,9 @@ from scipy.spatial import cKDTree
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.comma2k19 import read_ground_truth, read_gyro_yaw_rate, read_live_fixes
-from vo_doppler.lowcost.dead_reckoning import integrate_yaw_rate
 from vo_doppler.lowcost.gps_reconstruction import reconstruct_track
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, Reference, run_deadreckon
+from vo_doppler.model.timeseries import cumulative_integral
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_DATA = (
@@ -73,7 +73,7 @@ def heading_run(truth, fixes, gyro, can, window_s: float, k: float | None, body:
 def block_rate_errors(t_rate, rate, truth, block_s: float = 5.0) -> np.ndarray:
     """(sensor − truth) heading change per block divided by its length (rad/s): the error of a
     block-mean ε0 taken there."""
-    heading = integrate_yaw_rate(t_rate, rate)
+    heading = cumulative_integral(t_rate, rate)
     edges = np.arange(max(t_rate[0], truth.t[0]), min(t_rate[-1], truth.t[-1]) - block_s, block_s)
     return np.array(
         [

@@ -11,15 +11,16 @@ from pathlib import Path
 from rich.console import Console
 from rich.progress import Progress
 
-from vo_doppler.fusion.pipeline import PipelineResult, SequenceInputs, run_pipeline
 from vo_doppler.io.sequence import read_sequence
+from vo_doppler.model.sequence import Sequence
+from vo_doppler.run import RunResult, run_sequence
 
 Evaluate = Callable[[Path, Path, Console], dict]
 """(sequence folder, output folder of the JSON, console) → the sequence's figures."""
 Show = Callable[[Console, str, dict], None]
 
 
-def read_with_truth(folder: Path) -> SequenceInputs:
+def read_with_truth(folder: Path) -> Sequence:
     """The sequence's inputs; a benchmark without ground truth stops with the folder named."""
     inputs = read_sequence(folder)
     if inputs.truth is None:
@@ -27,11 +28,11 @@ def read_with_truth(folder: Path) -> SequenceInputs:
     return inputs
 
 
-def run_with_progress(inputs: SequenceInputs, console: Console) -> PipelineResult:
-    """``run_pipeline`` with the default configuration and a progress bar over the images."""
+def run_with_progress(inputs: Sequence, console: Console) -> RunResult:
+    """``run_sequence`` with the default configuration and a progress bar over the images."""
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task(f"{inputs.name}: VO", total=len(inputs.image_paths))
-        return run_pipeline(inputs, on_frame=lambda _: progress.advance(task))
+        return run_sequence(inputs, on_frame=lambda _: progress.advance(task))
 
 
 def run_sequences(

@@ -29,12 +29,13 @@ from rich.table import Table
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.eval.metrics import evaluate
+from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import list_images, read_image, read_times
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
-from vo_doppler.trajectory import Trajectory, read_kitti
+from vo_doppler.io.trajectory import read_kitti
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.vo.baseline import FrameToFrameVO
 from vo_doppler.vo.batch import run_visual_odometry
-from vo_doppler.vo.camera import read_camera
 from vo_doppler.vo.scale import metric_positions
 
 ROOT = Path(__file__).resolve().parents[1]

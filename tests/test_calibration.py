@@ -20,8 +20,8 @@ from vo_doppler.heading.calibration import (
     variation_gate,
 )
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, causal_calibration
-from vo_doppler.heading.sensors import integrate_rate, sample_at
 from vo_doppler.io.can import read_can_motion
+from vo_doppler.model.timeseries import integral_at, sample
 
 COMMA = "comma2k19_example1"
 GPS_MINUS_UTC_2018_S = 18.0
@@ -54,7 +54,7 @@ def test_exact_wheel_scale_and_spikes_rejected():
 def test_exact_gyro_bias_across_the_wrap():
     t, speed, yaw_rate, yaw = _drive()
     bias = np.radians(0.5)
-    phi = integrate_rate(t, yaw_rate + bias, t)  # trapezoid, same rule as the truth
+    phi = integral_at(t, yaw_rate + bias, t)  # trapezoid, same rule as the truth
     doppler_yaw = yaw.copy()
     doppler_yaw[[100, 250]] += np.radians([20.0, -15.0])
     estimate = estimate_gyro_bias(t, doppler_yaw, phi, speed)
@@ -65,7 +65,7 @@ def test_exact_gyro_bias_across_the_wrap():
 def test_low_speed_course_is_not_used_and_too_few_samples_is_unavailable():
     t, speed, yaw_rate, yaw = _drive(n=40)
     slow = np.full_like(speed, 0.5)
-    phi = integrate_rate(t, yaw_rate, t)
+    phi = integral_at(t, yaw_rate, t)
     assert not estimate_gyro_bias(t, yaw, phi, slow).valid
     assert not estimate_wheel_scale(t[:5], speed[:5], speed[:5]).valid
     valid = np.zeros(len(t), dtype=bool)
@@ -83,7 +83,7 @@ def test_streaming_least_squares_follows_a_change_after_one_window():
     config = GateConfig(window_s=20.0)
     t, speed, yaw_rate, yaw = _drive(n=800)
     bias = np.where(t < 40.0, np.radians(0.2), np.radians(-0.3))
-    phi = integrate_rate(t, yaw_rate + bias, t)
+    phi = integral_at(t, yaw_rate + bias, t)
     gyro = GyroBiasCalibrator(config)
     wheel = WheelScaleCalibrator(config)
     scale = np.where(t < 40.0, 1.01, 0.98)
@@ -104,7 +104,7 @@ def test_kalman_variants_converge_with_noise():
     rng = np.random.default_rng(3)
     t, speed, yaw_rate, yaw = _drive(n=1200)
     bias = np.radians(0.4)
-    phi = integrate_rate(t, yaw_rate + bias + rng.normal(0, np.radians(0.2), len(t)), t)
+    phi = integral_at(t, yaw_rate + bias + rng.normal(0, np.radians(0.2), len(t)), t)
     doppler_yaw = yaw + rng.normal(0, np.radians(0.3), len(t))
     doppler_speed = speed + rng.normal(0, 0.05, len(t))
     wheel = speed / 1.02
@@ -126,7 +126,7 @@ def test_kalman_with_the_prior_equals_least_squares_with_the_prior():
     rng = np.random.default_rng(11)
     t, speed, yaw_rate, yaw = _drive(n=100)
     bias, scale = np.radians(0.7), 1.04
-    phi = integrate_rate(t, yaw_rate + bias, t)
+    phi = integral_at(t, yaw_rate + bias, t)
     doppler_yaw = wrap_angle(yaw + rng.normal(0.0, np.radians(0.5), len(t)))
     doppler_speed = speed + rng.normal(0.0, 0.05, len(t))
     wheel = speed / scale
@@ -218,12 +218,12 @@ def test_comma_can_bias_and_scale_from_receiver_doppler():
     assert np.ptp(gps_minus_mono) < 1e-5
 
     # Ground-truth values, fitted with the same models the calibration uses.
-    phi_gt = integrate_rate(motion.yaw_rate.t, motion.yaw_rate.value, t_gt)
+    phi_gt = integral_at(motion.yaw_rate.t, motion.yaw_rate.value, t_gt)
     ok = np.isfinite(phi_gt)
     tau = t_gt[ok] - t_gt[ok].mean()
     design = np.column_stack([np.ones(ok.sum()), tau])
     bias_gt = np.linalg.lstsq(design, phi_gt[ok] - yaw_gt[ok], rcond=None)[0][1]
-    wheel_gt = sample_at(motion.speed.t, motion.speed.value, t_gt)
+    wheel_gt = sample(motion.speed.t, motion.speed.value, t_gt)
     scale_gt = np.nansum(wheel_gt * speed_gt) / np.nansum(wheel_gt**2)
     assert np.degrees(bias_gt) == pytest.approx(-0.41, abs=0.02)  # README: ≈0.4 deg/s
 
@@ -237,8 +237,8 @@ def test_comma_can_bias_and_scale_from_receiver_doppler():
     assert 0.0 < np.median(log_delay) < 0.5  # fixes are logged ≈0.2 s after their epoch
     doppler_speed = fixes[:, 2]
     doppler_yaw = course_to_yaw(np.radians(fixes[:, 5]))
-    phi = integrate_rate(motion.yaw_rate.t, motion.yaw_rate.value, t_fix)
-    wheel = sample_at(motion.speed.t, motion.speed.value, t_fix)
+    phi = integral_at(motion.yaw_rate.t, motion.yaw_rate.value, t_fix)
+    wheel = sample(motion.speed.t, motion.speed.value, t_fix)
 
     bias = estimate_gyro_bias(t_fix, doppler_yaw, phi, doppler_speed)
     scale = estimate_wheel_scale(t_fix, doppler_speed, wheel)
@@ -260,13 +260,13 @@ def test_standstill_runs_give_the_bias_without_a_course():
     true_rate = np.where(stopped, 0.0, yaw_rate)
     speed = np.where(stopped, 0.03, speed)
     bias = np.radians(-0.3)
-    phi = integrate_rate(t, true_rate + bias, t)
+    phi = integral_at(t, true_rate + bias, t)
     doppler_yaw = np.where(stopped, np.nan, yaw)  # no course while stopped
     only_stopped = estimate_gyro_bias(
         t[t < 15.0], doppler_yaw[t < 15.0], phi[t < 15.0], speed[t < 15.0]
     )
     assert only_stopped.value == pytest.approx(bias, abs=1e-12)
-    heading_true = 3.0 + integrate_rate(t, true_rate, t)
+    heading_true = 3.0 + integral_at(t, true_rate, t)
     both = estimate_gyro_bias(t, np.where(stopped, np.nan, heading_true), phi, speed)
     assert both.value == pytest.approx(bias, abs=1e-12)
     assert both.n_used == len(t)

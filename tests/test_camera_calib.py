@@ -8,7 +8,8 @@ import yaml
 
 from tests.conftest import REPO_ROOT, require_shared
 from vo_doppler.errors import InputError
-from vo_doppler.vo.camera import CAMERA_TO_VEHICLE_FORWARD, Camera, read_camera
+from vo_doppler.io.calibration import read_camera, write_camera_yaml
+from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD, Camera
 
 
 def test_bundled_kitti_yaml_matches_the_sequence_calib():
@@ -36,7 +37,7 @@ def test_forward_extrinsic_maps_optical_axis_to_vehicle_forward():
 
 def test_yaml_round_trip_and_kalibr_layout(tmp_path):
     camera = Camera(500.0, 501.0, 320.0, 240.0, 640, 480, np.array([0.1, -0.01, 0.001, 0.002, 0.0]))
-    camera.to_yaml(tmp_path / "cam.yaml")
+    write_camera_yaml(tmp_path / "cam.yaml", camera)
     back = read_camera(tmp_path / "cam.yaml")
     np.testing.assert_allclose(back.K, camera.K)
     np.testing.assert_allclose(back.distortion, camera.distortion)

@@ -24,12 +24,8 @@ from vo_doppler.io.can import (
     read_can_log,
     read_can_motion,
 )
-from vo_doppler.io.sensor_csv import (
-    SensorSeries,
-    read_speed_csv,
-    read_yaw_rate_csv,
-    write_sensor_csv,
-)
+from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv, write_sensor_csv
+from vo_doppler.model.series import SensorSeries
 
 DBC_TEXT = """VERSION ""
 BS_:

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from vo_doppler.cli import main
+from vo_doppler.io.trajectory import read_tum
 from vo_doppler.lowcost.drift import VARIANTS
 from vo_doppler.sim.two_gyro import TwoGyroSpec, generate_two_gyro, write_two_gyro
-from vo_doppler.trajectory import read_tum
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.eval.per_distance import error_per_100m
-from vo_doppler.trajectory import Trajectory
+from vo_doppler.model.trajectory import Trajectory
 
 
 def line(n: int, step: float, heading_rad: float = 0.0) -> Trajectory:

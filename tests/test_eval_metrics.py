@@ -11,7 +11,8 @@ from scipy.spatial.transform import Rotation
 from vo_doppler.cli import main
 from vo_doppler.eval.alignment import umeyama
 from vo_doppler.eval.metrics import evaluate, segment_lengths_that_fit
-from vo_doppler.trajectory import Trajectory, write_kitti, write_tum
+from vo_doppler.io.trajectory import write_kitti, write_tum
+from vo_doppler.model.trajectory import Trajectory
 
 
 def straight(n=301, step=1.0, yaw_rate=0.0):

@@ -12,7 +12,8 @@ from vo_doppler.gnss.ephemeris import transmit_states
 from vo_doppler.gnss.signals import wavelengths
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.io.rinex_nav import read_nav
-from vo_doppler.io.rinex_obs import Observations, ObsHeader, read_obs
+from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.model.observations import Observations, ObsHeader
 
 RECEIVER = np.array([-3817680.9841, 3562840.0688, 3650158.4543])
 T0 = 1403252400.0  # 2024-06-24 08:20:00 GPST

@@ -11,7 +11,8 @@ from vo_doppler.gnss.doppler_velocity import doppler_velocity
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.io.rinex_nav import read_nav
-from vo_doppler.io.rinex_obs import Observations, ObsHeader, read_obs
+from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.model.observations import Observations, ObsHeader
 
 CODES = ("L1C", "D1C", "S1C")
 

@@ -11,13 +11,13 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from vo_doppler.geo import SPEED_OF_LIGHT
-from vo_doppler.gnss.gpstime import (
+from vo_doppler.gnss.signals import carrier_frequency, strength_code, wavelengths
+from vo_doppler.model.gpstime import (
     calendar_to_gps_seconds,
     gps_minus_utc,
     time_of_week,
     utc_to_gps_seconds,
 )
-from vo_doppler.gnss.signals import carrier_frequency, strength_code, wavelengths
 
 
 def test_glonass_fdma_wavelengths_use_the_channel():

@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from tests.helpers.correction import blend_camera
 from tests.test_heading_correction import _ground_truth, _table, _vo_output
 from vo_doppler.cli import main
+from vo_doppler.fusion.correction import AbsoluteHeading, CorrectionConfig, correct
 from vo_doppler.fusion.heading_blend import (
     BlendConfig,
     DriftClock,
@@ -21,16 +23,13 @@ from vo_doppler.fusion.heading_blend import (
     forward_filter,
     rts_smooth,
 )
-from vo_doppler.fusion.heading_correction import (
-    FORWARD_CAMERA_TO_VEHICLE,
-    correct_heading,
-    yaw_of,
-)
-from vo_doppler.fusion.pipeline import AbsoluteHeading, PipelineConfig, corrected_level
-from vo_doppler.geo import wrap_angle
+from vo_doppler.fusion.heading_correction import correct_heading
+from vo_doppler.geo import wrap_angle, yaw_of
 from vo_doppler.heading.conventional import velocity_heading_sigma
 from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
-from vo_doppler.trajectory import Trajectory, read_tum, write_tum
+from vo_doppler.io.trajectory import read_tum, write_tum
+from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD as FORWARD_CAMERA_TO_VEHICLE
+from vo_doppler.model.trajectory import Trajectory
 
 FIXED = BlendConfig(sigma_distance=1e-3, sigma_turn=1e-3, measurement_scale=1.0)
 """Noise given, nothing fitted."""
@@ -64,9 +63,9 @@ def _straight(n: int, step_m: float = 1.0, rate_hz: float = 10.0) -> Trajectory:
 def test_constant_offset_is_recovered_exactly_and_the_trajectory_equals_the_truth(fit):
     t, yaw, gt = _ground_truth()
     config = BlendConfig() if fit else FIXED
-    result = blend_heading(_vo_output(gt), t, yaw, 0.01, config=config)
+    result = blend_camera(_vo_output(gt), t, yaw, 0.01, config=config)
     # The VO starts at yaw 0, the truth at 2.5 rad: δ = 2.5 everywhere.
-    np.testing.assert_allclose(result.offset, 2.5, atol=1e-9)
+    np.testing.assert_allclose(result.correction, 2.5, atol=1e-9)
     np.testing.assert_allclose(result.vehicle.matrices, _expected(gt), atol=1e-9)
     assert result.noise.fitted == fit
     assert result.has_absolute.all() and result.measurements == len(t) - 1
@@ -77,18 +76,18 @@ def test_extrinsic_and_camera_output_are_honoured():
     mount = np.eye(4)
     mount[:3, :3] = Rotation.from_euler("Z", 0.2).as_matrix() @ FORWARD_CAMERA_TO_VEHICLE[:3, :3]
     mount[:3, 3] = [1.5, 0.3, 1.2]
-    result = blend_heading(_vo_output(gt, mount), t, yaw, 0.01, camera_to_vehicle=mount)
+    result = blend_camera(_vo_output(gt, mount), t, yaw, 0.01, camera_to_vehicle=mount)
     np.testing.assert_allclose(result.vehicle.matrices, _expected(gt), atol=1e-9)
     np.testing.assert_allclose(result.camera.matrices, _expected(gt) @ mount, atol=1e-9)
 
 
 def test_forward_filter_is_causal_and_exact_from_the_first_measurement():
     t, yaw, gt = _ground_truth()
-    result = blend_heading(_vo_output(gt), t, yaw, 0.01, config=BlendConfig(smooth=False))
+    result = blend_camera(_vo_output(gt), t, yaw, 0.01, config=BlendConfig(smooth=False))
     # The first measurement is the first step's course, at its middle time: before it (the
     # first pose) nothing is known and the VO is left as it is; from it on, exact.
-    assert result.offset[0] == 0.0
-    np.testing.assert_allclose(result.offset[1:], 2.5, atol=1e-9)
+    assert result.correction[0] == 0.0
+    np.testing.assert_allclose(result.correction[1:], 2.5, atol=1e-9)
     np.testing.assert_allclose(result.vehicle.positions, _expected(gt)[:, :3, 3], atol=1e-9)
     np.testing.assert_allclose(result.vehicle.matrices[1:], _expected(gt)[1:], atol=1e-9)
 
@@ -97,13 +96,13 @@ def test_pitch_and_roll_are_untouched():
     t, yaw, gt = _ground_truth()
     drift = 0.02 * t
     vo = _turned_vo(gt, drift)
-    result = blend_heading(vo, t, yaw, 0.01, world="level", camera_to_vehicle=np.eye(4))
+    result = blend_heading(vo, t, yaw, 0.01)
     euler_out = Rotation.from_matrix(result.vehicle.matrices[:, :3, :3]).as_euler("ZYX")
     euler_in = vo.orientations.as_euler("ZYX")
     np.testing.assert_allclose(euler_out[:, 1:], euler_in[:, 1:], atol=1e-12)
     # The offset follows the drift (0.4 rad over the drive, 0.002 rad per step): noise-free
     # headings, so closely inside; beyond the first and last measurements it is held.
-    error = np.abs(wrap_angle(result.offset - drift))
+    error = np.abs(wrap_angle(result.correction - drift))
     assert error[5:-5].max() < 1e-4 and error.max() < 0.0025
 
 
@@ -114,7 +113,7 @@ def test_noisy_headings_on_a_perfect_vo_kalman_beats_the_window():
     # poses' yaws: each measurement has its own independent error.
     t_mid = 0.5 * (t[1:] + t[:-1])
     sigma = np.radians(1.0)
-    level = dict(world="level", camera_to_vehicle=np.eye(4))
+    level = {}
 
     def rmse(result):
         return np.sqrt(np.mean(wrap_angle(yaw_of(result.vehicle.matrices[:, :3, :3]) - yaw) ** 2))
@@ -142,11 +141,9 @@ def test_offset_across_the_wrap():
     true_offset = np.linspace(3.0, 3.3, len(t))  # crosses +π
     vo = _turned_vo(gt, true_offset)
     config = BlendConfig(sigma_distance=0.02, sigma_turn=1e-3, measurement_scale=1.0)
-    result = blend_heading(
-        vo, t, np.zeros(len(t)), 1e-4, world="level", camera_to_vehicle=np.eye(4), config=config
-    )
-    assert np.max(np.abs(wrap_angle(result.offset - true_offset))) < 1e-3
-    assert np.max(np.abs(np.diff(result.offset))) < 0.01  # held unwrapped, no 2π jumps
+    result = blend_heading(vo, t, np.zeros(len(t)), 1e-4, config=config)
+    assert np.max(np.abs(wrap_angle(result.correction - true_offset))) < 1e-3
+    assert np.max(np.abs(np.diff(result.correction))) < 0.01  # held unwrapped, no 2π jumps
     error = np.linalg.norm(result.vehicle.positions - (gt.positions - gt.positions[0]), axis=1)
     assert error.max() < 0.2
 
@@ -154,9 +151,7 @@ def test_offset_across_the_wrap():
 def test_circular_mean_of_measurements_either_side_of_pi():
     gt = _straight(100)
     absolute = np.where(np.arange(100) % 2 == 0, np.radians(179.0), np.radians(-179.0))
-    result = blend_heading(
-        gt, gt.t, absolute, np.radians(1.0), world="level", camera_to_vehicle=np.eye(4)
-    )
+    result = blend_heading(gt, gt.t, absolute, np.radians(1.0))
     final_yaw = yaw_of(result.vehicle.matrices[-1:, :3, :3])[0]
     assert abs(wrap_angle(final_yaw - np.pi)) < np.radians(0.2)
 
@@ -168,7 +163,7 @@ def test_gap_forward_holds_and_smoother_interpolates_by_distance():
     offset = np.where(t < 15.0, 0.01, 0.03)  # the VO's error jumps inside the gap
     vo = _turned_vo(gt, offset)
     absolute = np.zeros(len(t))
-    common = dict(world="level", camera_to_vehicle=np.eye(4))
+    common = {}
     smooth = blend_heading(vo, t, absolute, 1e-5, valid, config=FIXED, **common)
     forward = blend_heading(
         vo,
@@ -180,17 +175,17 @@ def test_gap_forward_holds_and_smoother_interpolates_by_distance():
         **common,
     )
     gap = (t > 10.05) & (t < 19.95)
-    last_before = forward.offset[np.flatnonzero(t < 10.0)[-1]]
+    last_before = forward.correction[np.flatnonzero(t < 10.0)[-1]]
     assert last_before == pytest.approx(0.01, abs=1e-6)
-    np.testing.assert_allclose(forward.offset[gap], last_before, atol=1e-12)
+    np.testing.assert_allclose(forward.correction[gap], last_before, atol=1e-12)
     # Straight at constant speed: the process variance grows linearly in time, so the smoother
     # goes linearly from the last estimate before the gap to the first after it.
     # Middles of the last and first steps with a measurement (9.95 lies between the epochs
     # 9.9 and 20.0, too far apart to interpolate).
     t_a, t_b = 9.85, 20.05
     line = 0.01 + (0.03 - 0.01) * (t[gap] - t_a) / (t_b - t_a)
-    np.testing.assert_allclose(smooth.offset[gap], line, atol=1e-5)
-    assert smooth.offset_sigma[gap].max() > 5 * np.median(smooth.offset_sigma[~gap])
+    np.testing.assert_allclose(smooth.correction[gap], line, atol=1e-5)
+    assert smooth.correction_sigma[gap].max() > 5 * np.median(smooth.correction_sigma[~gap])
 
 
 def test_process_noise_fit_recovers_a_known_random_walk():
@@ -231,13 +226,13 @@ def test_too_few_measurements_keep_the_defaults_and_the_floor_holds():
 def test_correlated_headings_are_inflated_in_the_filter():
     gt = _straight(400)
     static = BlendConfig(sigma_distance=1e-9, sigma_turn=1e-9, measurement_scale=1.0)
-    common = dict(world="level", camera_to_vehicle=np.eye(4), config=static)
+    common = dict(config=static)
     white = blend_heading(gt, gt.t, np.zeros(len(gt)), 0.01, **common)
     correlated = blend_heading(gt, gt.t, np.zeros(len(gt)), 0.01, correlation_s=2.0, **common)
     # 20 measurements per 2 s carry one measurement's information: √20 less certain.
-    ratio = correlated.offset_sigma[200] / white.offset_sigma[200]
+    ratio = correlated.correction_sigma[200] / white.correction_sigma[200]
     assert ratio == pytest.approx(np.sqrt(20.0), rel=1e-3)
-    assert white.offset_sigma[200] == pytest.approx(0.01 / np.sqrt(399), rel=1e-3)
+    assert white.correction_sigma[200] == pytest.approx(0.01 / np.sqrt(399), rel=1e-3)
 
 
 def test_filter_and_smoother_by_hand():
@@ -260,12 +255,14 @@ def test_pipeline_dispatches_on_the_method():
     heading = AbsoluteHeading(t, yaw, np.ones(len(t), bool), np.full(len(t), 0.01), 2.0)
     vo = _turned_vo(gt, 0.0)
     for method in ("window", "kalman"):
-        out = corrected_level(vo, heading, PipelineConfig(correction_method=method))
+        out = correct(vo, heading, CorrectionConfig(method=method)).vehicle
         np.testing.assert_allclose(out.matrices, gt.matrices, atol=1e-9)
     with pytest.raises(ValueError, match="unknown correction method"):
-        corrected_level(vo, heading, PipelineConfig(correction_method="median"))
+        CorrectionConfig(method="median")
     with pytest.raises(ValueError, match="reference must be"):
-        BlendConfig(reference="sideways")
+        CorrectionConfig(reference="sideways")
+    with pytest.raises(ValueError, match="reference must be"):
+        blend_heading(vo, t, yaw, reference="sideways")
 
 
 @pytest.mark.parametrize("extra", [[], ["--causal"]])
@@ -305,16 +302,14 @@ def test_velocity_heading_sigma_is_the_cross_track_sigma_over_the_speed():
 def test_without_any_absolute_heading_the_vo_is_left_as_it_is():
     t, yaw, gt = _ground_truth(n=50)
     vo = _turned_vo(gt, 0.3)
-    level = dict(world="level", camera_to_vehicle=np.eye(4))
+    level = {}
     for smooth in (True, False):
         result = blend_heading(
             vo, t, yaw, 0.01, np.zeros(len(t), bool), config=BlendConfig(smooth=smooth), **level
         )
         assert result.measurements == 0 and not result.noise.fitted
-        np.testing.assert_allclose(result.offset, 0.0)
-        expected = vo.matrices
-        expected[:, :3, 3] -= vo.positions[0]
-        np.testing.assert_allclose(result.vehicle.matrices, expected, atol=1e-12)
+        np.testing.assert_allclose(result.correction, 0.0)
+        np.testing.assert_allclose(result.vehicle.matrices, vo.matrices, atol=1e-12)
 
 
 @pytest.mark.parametrize("command", ["run", "correct"])

@@ -9,21 +9,19 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from tests.conftest import REPO_ROOT
+from tests.helpers.correction import correct_camera
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
-from vo_doppler.fusion.heading_correction import (
-    FORWARD_CAMERA_TO_VEHICLE,
-    chord_starts,
-    correct_heading,
-    headings_at,
-    vehicle_poses,
-    yaw_of,
-)
-from vo_doppler.geo import wrap_angle
-from vo_doppler.heading.pipeline import HeadingTable
+from vo_doppler.fusion.correction import CorrectionConfig, absolute_heading
+from vo_doppler.fusion.heading_correction import chord_starts, headings_at
+from vo_doppler.geo import wrap_angle, yaw_of
+from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
-from vo_doppler.trajectory import Trajectory, read_kitti, read_tum, write_kitti, write_tum
-from vo_doppler.vo.camera import read_camera
+from vo_doppler.io.trajectory import read_kitti, read_tum, write_kitti, write_tum
+from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD as FORWARD_CAMERA_TO_VEHICLE
+from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.vo.frames import vehicle_trajectory
 
 RATE_HZ = 10.0
 
@@ -56,21 +54,21 @@ def _assert_equal_poses(actual: Trajectory, expected_matrices: np.ndarray, atol=
 
 def test_absolute_heading_everywhere_recovers_the_enu_trajectory():
     t, yaw, gt = _ground_truth()
-    result = correct_heading(_vo_output(gt), t, yaw)
+    result = correct_camera(_vo_output(gt), t, yaw)
     expected = gt.matrices.copy()
     expected[:, :3, 3] -= gt.positions[0]
     _assert_equal_poses(result.vehicle, expected)
     assert result.has_absolute.all()
-    assert result.offset[0] == pytest.approx(-2.5)  # VO starts at yaw 0, truth at 2.5 rad
-    np.testing.assert_allclose(result.offset[1:], 0.0, atol=1e-12)
+    assert result.window_offset[0] == pytest.approx(-2.5)  # VO starts at yaw 0, truth at 2.5 rad
+    np.testing.assert_allclose(result.window_offset[1:], 0.0, atol=1e-12)
 
 
 def test_gap_holds_the_last_offset_and_rotation_is_about_the_oldest_window_pose():
     t, yaw, gt = _ground_truth()
     valid = (t >= 5.0) & (t <= 8.0)
     window_s = 2.0
-    result = correct_heading(_vo_output(gt), t, yaw, valid, window_s=window_s)
-    vo_level = vehicle_poses(_vo_output(gt))
+    result = correct_camera(_vo_output(gt), t, yaw, valid, window_s=window_s)
+    vo_level = vehicle_trajectory(_vo_output(gt)).matrices
     first_window = int(np.flatnonzero(t > 5.0 - window_s)[0])
     before = np.arange(len(t)) < first_window
     # Poses older than the first window with absolute heading stay as the VO put them.
@@ -84,7 +82,7 @@ def test_gap_holds_the_last_offset_and_rotation_is_about_the_oldest_window_pose(
     _assert_equal_poses(result.vehicle.subset(~before), expected)
     after = t > 8.0
     assert not result.has_absolute[after].any()
-    np.testing.assert_allclose(result.total_correction[after], 2.5, atol=1e-12)
+    np.testing.assert_allclose(result.correction[after], 2.5, atol=1e-12)
     np.testing.assert_allclose(
         wrap_angle(yaw_of(result.vehicle.matrices[after][:, :3, :3]) - yaw[after]), 0.0, atol=1e-9
     )
@@ -94,7 +92,7 @@ def test_pitch_and_roll_are_untouched_and_drift_is_removed():
     t, yaw, gt = _ground_truth()
     drift = 0.02 * t  # VO heading error growing 0.02 rad/s: rotate each step by the error
     vo = _vo_output(gt)
-    level = vehicle_poses(vo)
+    level = vehicle_trajectory(vo).matrices
     steps = np.diff(level[:, :3, 3], axis=0)
     turn = Rotation.from_euler("Z", drift[:, None]).as_matrix()
     positions = np.concatenate(
@@ -108,7 +106,7 @@ def test_pitch_and_roll_are_untouched_and_drift_is_removed():
         t, drifted_vehicle.matrices @ FORWARD_CAMERA_TO_VEHICLE
     )
     every_second = np.arange(len(t)) % 10 == 0  # 1 Hz absolute heading
-    result = correct_heading(drifted_camera, t[every_second], yaw[every_second], window_s=2.0)
+    result = correct_camera(drifted_camera, t[every_second], yaw[every_second], window_s=2.0)
     euler_out = Rotation.from_matrix(result.vehicle.matrices[:, :3, :3]).as_euler("ZYX")
     euler_in = drifted_vehicle.orientations.as_euler("ZYX")
     np.testing.assert_allclose(euler_out[:, 1:], euler_in[:, 1:], atol=1e-12)
@@ -128,7 +126,7 @@ def test_circular_mean_across_the_wrap():
     t = np.arange(10) / RATE_HZ
     east = Trajectory(t, np.stack([t, 0 * t, 0 * t], axis=1), Rotation.identity(len(t)))
     absolute = np.where(np.arange(10) % 2 == 0, np.radians(179.0), np.radians(-179.0))
-    result = correct_heading(
+    result = correct_camera(
         east, t, absolute, camera_to_vehicle=np.eye(4), world="level", window_s=5.0
     )
     final_yaw = yaw_of(result.vehicle.matrices[:, :3, :3])[-1]
@@ -140,7 +138,7 @@ def test_camera_extrinsic_is_honoured():
     mount = np.eye(4)
     mount[:3, :3] = Rotation.from_euler("Z", 0.2).as_matrix() @ FORWARD_CAMERA_TO_VEHICLE[:3, :3]
     mount[:3, 3] = [1.5, 0.3, 1.2]
-    result = correct_heading(_vo_output(gt, mount), t, yaw, camera_to_vehicle=mount)
+    result = correct_camera(_vo_output(gt, mount), t, yaw, camera_to_vehicle=mount)
     expected = gt.matrices.copy()
     expected[:, :3, 3] -= gt.positions[0]
     _assert_equal_poses(result.vehicle, expected)
@@ -190,8 +188,8 @@ def test_heading_csv_round_trip(tmp_path):
     np.testing.assert_allclose(back.gyro_bias, 0.001, atol=1e-7)
     first_course = float(path.read_text().splitlines()[1].split(",")[1])
     assert first_course == pytest.approx(80.0)  # yaw 10° ccw from east = course 80°
-    yaw_abs, valid = back.absolute_heading("tc+conv")
-    assert valid.all() and yaw_abs[2] == pytest.approx(back.yaw_conv[2])
+    combined = absolute_heading(back, "tc+conv", CorrectionConfig(tc_max_sigma=np.inf))
+    assert combined.valid.all() and combined.yaw[2] == pytest.approx(back.yaw_conv[2])
     path.write_text(path.read_text() + "1,2,3\n")
     with pytest.raises(InputError, match=r"heading.csv:7"):
         read_heading_csv(path)
@@ -276,12 +274,12 @@ def test_correct_cli_reads_the_extrinsic_and_writes_kitti(tmp_path):
 def test_any_constant_offset_is_removed_exactly(offset, yaw0):
     t, yaw, gt = _ground_truth(n=30, yaw0=yaw0)
     vo = _vo_output(gt)
-    level = vehicle_poses(vo)
+    level = vehicle_trajectory(vo).matrices
     turned = Rotation.from_euler("z", offset).as_matrix()
     rotated = level.copy()
     rotated[:, :3, :3] = turned @ level[:, :3, :3]
     rotated[:, :3, 3] = level[:, :3, 3] @ turned.T
-    result = correct_heading(
+    result = correct_camera(
         Trajectory.from_matrices(t, rotated), t, yaw, camera_to_vehicle=np.eye(4), world="level"
     )
     expected = gt.matrices.copy()
@@ -296,9 +294,9 @@ def test_innovation_gate_ignores_an_outlier_burst_once_established():
     corrupted[burst] += np.radians(40.0)
     expected = gt.matrices.copy()
     expected[:, :3, 3] -= gt.positions[0]
-    gated = correct_heading(_vo_output(gt), t, corrupted, gate_rad=np.radians(10.0))
+    gated = correct_camera(_vo_output(gt), t, corrupted, gate_rad=np.radians(10.0))
     _assert_equal_poses(gated.vehicle, expected, atol=1e-9)
-    ungated = correct_heading(_vo_output(gt), t, corrupted)
+    ungated = correct_camera(_vo_output(gt), t, corrupted)
     assert np.max(np.abs(wrap_angle(yaw_of(ungated.vehicle.matrices[:, :3, :3]) - yaw))) > 0.1
 
 
@@ -308,13 +306,13 @@ def test_course_reference_is_immune_to_an_extrinsic_yaw_error():
     skewed[:3, :3] = Rotation.from_euler("z", 2.0, degrees=True).as_matrix() @ skewed[:3, :3]
     vo = _vo_output(gt, skewed)
     expected = gt.positions - gt.positions[0]
-    by_course = correct_heading(vo, t, yaw, reference="course")
+    by_course = correct_camera(vo, t, yaw, reference="course")
     np.testing.assert_allclose(by_course.vehicle.positions, expected, atol=1e-9)
-    by_orientation = correct_heading(vo, t, yaw)
+    by_orientation = correct_camera(vo, t, yaw, reference="orientation")
     error = np.linalg.norm(by_orientation.vehicle.positions - expected, axis=1)
     assert error.max() > 1.0
     with pytest.raises(ValueError, match="reference must be"):
-        correct_heading(vo, t, yaw, reference="sideways")
+        correct_camera(vo, t, yaw, reference="sideways")
 
 
 def test_chord_starts_group_short_steps_until_the_chord_is_long_enough():
@@ -353,14 +351,14 @@ def test_creeping_steps_at_a_stop_do_not_turn_the_course_corrected_trajectory():
     vo = Trajectory(t, positions, Rotation.identity(len(t)))
     worst = {}
     for chord in (0.05, 0.5):
-        result = correct_heading(
+        result = correct_camera(
             vo,
             t,
             np.zeros(len(t)),
             None,
             2.0,
-            np.eye(4),
-            "level",
+            camera_to_vehicle=np.eye(4),
+            world="level",
             reference="course",
             min_chord_m=chord,
         )

@@ -10,18 +10,17 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from vo_doppler.cli import main
-from vo_doppler.fusion.heading_correction import yaw_of
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.conventional import vehicle_heading_from_antenna
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
-from vo_doppler.heading.sensors import sample_at
 from vo_doppler.heading.tight_heading import antenna_offset_velocity, tight_heading_series
 from vo_doppler.io.heading_csv import read_heading_csv
-from vo_doppler.io.sensor_csv import SensorSeries
 from vo_doppler.io.sequence import read_manifest
+from vo_doppler.io.trajectory import read_tum
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.timeseries import sample
 from vo_doppler.sim.doppler_rows import simulate_doppler
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
-from vo_doppler.trajectory import read_tum
 
 AZIMUTH = [30.0, 110.0, 200.0, 280.0, 330.0, 160.0]
 ELEVATION = [60.0, 30.0, 45.0, 20.0, 70.0, 15.0]
@@ -122,16 +121,15 @@ def test_heading_cli_on_a_simulated_drive_with_an_offset_antenna(tmp_path):
     args += ["--yaw-rate", can["yaw_rate"], "--wheel-speed", can["wheel_speed"]]
     args += ["--time-offset-can", str(can["time_offset_s"])]
     truth = read_tum(root / "ground_truth.tum")
-    yaw = np.unwrap(yaw_of(truth.matrices[:, :3, :3]))
-    turn_rate = np.gradient(yaw, truth.t)
+    turn_rate = np.gradient(truth.yaw(), truth.t)
     errors = {}
     for name, extra in (("applied", ["--antenna-lever-arm", "1.5,0,1.6"]), ("ignored", [])):
         out = tmp_path / f"{name}.csv"
         assert main([*args, *extra, "-o", str(out)]) == 0
         table = read_heading_csv(out)
-        turning = np.abs(sample_at(truth.t, turn_rate, table.t)) > np.radians(10.0)
+        turning = np.abs(sample(truth.t, turn_rate, table.t)) > np.radians(10.0)
         used = table.tc_available & table.tc_reliable & turning
-        error = np.abs(wrap_angle(table.yaw_tc - sample_at(truth.t, yaw, table.t)))[used]
+        error = np.abs(wrap_angle(table.yaw_tc - truth.yaw_at(table.t)))[used]
         errors[name] = np.degrees(np.sqrt(np.mean(error**2)))
     assert errors["applied"] < 1.0
     assert errors["ignored"] > 3.0

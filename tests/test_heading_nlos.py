@@ -18,7 +18,7 @@ from vo_doppler.heading.pipeline import heading_pipeline
 from vo_doppler.heading.rows import DopplerRows
 from vo_doppler.heading.tight_heading import TightHeadingConfig, tight_heading_series
 from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
-from vo_doppler.io.sensor_csv import SensorSeries
+from vo_doppler.model.series import SensorSeries
 from vo_doppler.sim.doppler_rows import simulate_doppler
 
 NO_REJECTION = TightHeadingConfig(outlier_passes=0)

@@ -6,7 +6,7 @@ import numpy as np
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, causal_calibration, heading_pipeline
-from vo_doppler.io.sensor_csv import SensorSeries
+from vo_doppler.model.series import SensorSeries
 from vo_doppler.sim.doppler_rows import gyro_from_heading, simulate_doppler
 
 AZIMUTH = [30.0, 110.0, 200.0, 280.0, 330.0, 160.0]

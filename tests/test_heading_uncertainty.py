@@ -17,7 +17,7 @@ from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.calibration import estimate_gyro_bias
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.tight_heading import TightHeadingConfig, tight_heading_series
-from vo_doppler.io.sensor_csv import SensorSeries
+from vo_doppler.model.series import SensorSeries
 from vo_doppler.sim.doppler_rows import simulate_doppler
 
 AZIMUTH = [30.0, 110.0, 200.0, 280.0]

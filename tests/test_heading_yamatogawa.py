@@ -31,9 +31,11 @@ from vo_doppler.heading.tight_heading import TightHeadingConfig
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
-from vo_doppler.io.sensor_csv import SensorSeries, write_sensor_csv
+from vo_doppler.io.sensor_csv import write_sensor_csv
+from vo_doppler.io.trajectory import write_tum
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.doppler_rows import gyro_from_heading
-from vo_doppler.trajectory import Trajectory, write_tum
 
 pytestmark = pytest.mark.shared_data
 

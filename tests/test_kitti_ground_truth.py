@@ -10,7 +10,8 @@ from scipy.spatial.transform import Rotation
 
 from benchmarks.vo_kitti import attitude_roughness_deg
 from tests.conftest import require_shared
-from vo_doppler.trajectory import Trajectory, read_kitti
+from vo_doppler.io.trajectory import read_kitti
+from vo_doppler.model.trajectory import Trajectory
 
 
 def test_constant_rate_rotation_has_zero_roughness_and_a_kick_is_found():

@@ -9,9 +9,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.path import Path
 
+from vo_doppler.model.camera import Camera
 from vo_doppler.sim.render import Renderer, look_at, project_points
 from vo_doppler.sim.scene import Plane, Scene, city_scene
-from vo_doppler.vo.camera import Camera
 
 CAMERA = Camera(300.0, 300.0, 159.5, 119.5, 320, 240)
 MARKER_TEXELS = [(64.0, 64.0), (192.0, 64.0), (128.0, 128.0), (64.0, 192.0), (192.0, 200.0)]

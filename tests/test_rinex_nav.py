@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from tests.conftest import require_shared
-from vo_doppler.gnss.gpstime import BDT_MINUS_GPST_S
 from vo_doppler.io.rinex_nav import read_nav
+from vo_doppler.model.gpstime import BDT_MINUS_GPST_S
 
 KEPLER_NAMES = {
     "af0": "SVclockBias",

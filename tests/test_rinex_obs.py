@@ -10,8 +10,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tests.rinex_text import field, rinex2_epoch, rinex2_header, rinex3_epoch, rinex3_header
-from vo_doppler.gnss.gpstime import calendar_to_gps_seconds
 from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.model.gpstime import calendar_to_gps_seconds
 
 T0 = float(calendar_to_gps_seconds(2024, 6, 24, 8, 20, 0))
 TYPES = {"G": ["C1C", "L1C", "D1C", "S1C"], "R": ["C1C", "D1C"], "E": ["C1C", "D1C", "S1C", "C5Q"]}

@@ -14,8 +14,8 @@ import pytest
 
 from vo_doppler.cli import main
 from vo_doppler.io.heading_csv import read_heading_csv
+from vo_doppler.io.trajectory import read_tum
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
-from vo_doppler.trajectory import read_tum
 
 OUTPUTS = ("trajectory_vo.tum", "trajectory_corrected.tum", "heading.csv", "summary.json")
 

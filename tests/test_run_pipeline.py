@@ -9,8 +9,8 @@ import pytest
 
 from vo_doppler.cli import main
 from vo_doppler.io.heading_csv import read_heading_csv
+from vo_doppler.io.trajectory import read_tum
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
-from vo_doppler.trajectory import read_tum
 
 
 @pytest.fixture(scope="module")

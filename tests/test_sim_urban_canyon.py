@@ -9,11 +9,11 @@ import pytest
 import yaml
 
 from vo_doppler.cli import main
+from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.io.trajectory import read_tum
 from vo_doppler.sim.urban_canyon import CityConfig, UrbanCanyonConfig, simulate_urban_canyon
-from vo_doppler.trajectory import read_tum
-from vo_doppler.vo.camera import read_camera
 
 SMALL = {"duration_s": 6.0, "fps": 5.0, "image_size": (160, 90)}
 

@@ -9,14 +9,8 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
-from vo_doppler.trajectory import (
-    Trajectory,
-    read_kitti,
-    read_trajectory,
-    read_tum,
-    write_kitti,
-    write_tum,
-)
+from vo_doppler.io.trajectory import read_kitti, read_trajectory, read_tum, write_kitti, write_tum
+from vo_doppler.model.trajectory import Trajectory
 
 finite = st.floats(-1e4, 1e4, allow_nan=False)
 

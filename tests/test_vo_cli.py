@@ -10,7 +10,7 @@ import pytest
 
 from tests.conftest import require_shared
 from vo_doppler.cli import main
-from vo_doppler.trajectory import read_kitti, read_tum
+from vo_doppler.io.trajectory import read_kitti, read_tum
 
 N = 14
 

@@ -8,9 +8,9 @@ import pytest
 
 from tests.conftest import require_shared
 from vo_doppler.eval.metrics import evaluate
-from vo_doppler.trajectory import read_kitti
+from vo_doppler.io.calibration import read_camera
+from vo_doppler.io.trajectory import read_kitti
 from vo_doppler.vo.batch import run_visual_odometry
-from vo_doppler.vo.camera import read_camera
 
 N_FRAMES = 24
 GLITCH = 10

@@ -8,7 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vo_doppler.errors import InputError
-from vo_doppler.vo.scale import metric_positions, travelled_distance
+from vo_doppler.model.timeseries import travelled_distance
+from vo_doppler.vo.scale import metric_positions
 
 
 def poses_along_z(centres: np.ndarray) -> np.ndarray:
@@ -31,7 +32,7 @@ def test_trapezoid_distance_and_held_speed_outside_the_record():
     t = np.array([0.0, 1.0, 2.0])
     v = np.array([0.0, 2.0, 2.0])
     np.testing.assert_allclose(
-        travelled_distance(t, v, np.array([-1.0, 0.5, 1.0, 2.0, 3.0])),
+        travelled_distance(t, v, np.array([-1.0, 0.5, 1.0, 2.0, 3.0]), outside="extend"),
         [0.0, 0.5, 1.0, 3.0, 5.0],
     )
 

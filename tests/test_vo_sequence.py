@@ -9,6 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.conftest import REPO_ROOT
+from vo_doppler.io.calibration import read_camera
+from vo_doppler.io.trajectory import read_kitti, read_tum
 from vo_doppler.sim.scene import CityLayout, city_scene
 from vo_doppler.sim.vo_sequence import (
     CAMERA_HEIGHT_M,
@@ -19,8 +21,6 @@ from vo_doppler.sim.vo_sequence import (
     simulate_vo,
     synthetic_camera,
 )
-from vo_doppler.trajectory import read_kitti, read_tum
-from vo_doppler.vo.camera import read_camera
 
 LAYOUT = CityLayout(4, 3, (60.0, 60.0), 16.0)
 

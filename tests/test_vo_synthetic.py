@@ -7,8 +7,8 @@ import pytest
 
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import evaluate
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.vo_sequence import simulate_vo
-from vo_doppler.trajectory import Trajectory
 from vo_doppler.vo.baseline import FrameToFrameVO
 from vo_doppler.vo.batch import run_visual_odometry
 from vo_doppler.vo.odometry import VisualOdometry

@@ -89,3 +89,8 @@ def yaw_to_course(yaw_rad):
 def course_to_yaw(course_rad):
     """Course (clockwise from north) to yaw (counter-clockwise from east), radians in [-π, π)."""
     return wrap_angle(np.pi / 2.0 - np.asarray(course_rad))
+
+
+def yaw_of(rotations: np.ndarray) -> np.ndarray:
+    """Yaw (ZYX Euler, counter-clockwise about z) of (N, 3, 3) body-to-world rotations."""
+    return np.arctan2(rotations[:, 1, 0], rotations[:, 0, 0])

@@ -10,13 +10,20 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.errors import InputError
-from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading
-from vo_doppler.fusion.heading_correction import FORWARD_CAMERA_TO_VEHICLE, correct_heading
-from vo_doppler.fusion.pipeline import CORRECTION_METHODS, PipelineConfig
-from vo_doppler.heading.tight_heading import TightHeadingConfig
+from vo_doppler.fusion.correction import (
+    CORRECTION_METHODS,
+    HEADING_SOURCES,
+    REFERENCES,
+    CorrectionConfig,
+    absolute_heading,
+    correct,
+)
+from vo_doppler.fusion.heading_blend import BlendConfig
+from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.heading_csv import read_heading_csv
-from vo_doppler.trajectory import read_trajectory, write_kitti, write_tum
-from vo_doppler.vo.camera import read_camera
+from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
+from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD
+from vo_doppler.vo.frames import WORLDS, camera_trajectory, vehicle_trajectory
 
 log = logging.getLogger(__name__)
 
@@ -43,7 +50,7 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--correction",
         choices=CORRECTION_METHODS,
-        default=PipelineConfig().correction_method,
+        default=CorrectionConfig().method,
         help="window: the seed's Eq. 11-13; kalman: the adaptive blend (default: %(default)s)",
     )
     parser.add_argument(
@@ -52,13 +59,36 @@ def register(subparsers) -> None:
         help="kalman: forward filter only (each pose uses the headings up to its time)",
     )
     parser.add_argument("--window-s", type=float, default=2.0, help="window method's W")
-    parser.add_argument("--source", choices=("tc", "conv", "tc+conv"), default="tc+conv")
-    parser.add_argument("--world", choices=("first_camera", "level"), default="first_camera")
-    parser.add_argument("--body", choices=("vehicle", "camera"), default="vehicle")
-    parser.add_argument("--max-gap-s", type=float, default=1.5)
+    parser.add_argument(
+        "--source",
+        choices=HEADING_SOURCES,
+        default="tc+conv",
+        help="absolute headings used: tightly coupled (usable: reliable and sigma < 2 deg), "
+        "conventional, or the former where usable else the latter (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--world",
+        choices=WORLDS,
+        default="first_camera",
+        help="the input's world: the first camera's frame (what VO systems write) or already "
+        "level, z up (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--body",
+        choices=("vehicle", "camera"),
+        default="vehicle",
+        help="write vehicle or camera poses (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--max-gap-s",
+        type=float,
+        default=1.5,
+        help="longest gap (s) across which absolute headings are interpolated "
+        "(default: %(default)s)",
+    )
     parser.add_argument(
         "--reference",
-        choices=("course", "orientation"),
+        choices=REFERENCES,
         default="course",
         help="compare the absolute heading with the VO's direction of travel (course, default) "
         "or with its orientation yaw (sec. 3.6 as written)",
@@ -80,9 +110,8 @@ def run(args: argparse.Namespace) -> int:
     trajectory = read_trajectory(args.trajectory, args.format, _times(args.times))
     trajectory.t = trajectory.t + args.time_offset
     table = read_heading_csv(args.heading)
-    yaw, valid = table.absolute_heading(args.source)
     extrinsic = (
-        read_camera(args.calib).T_vehicle_camera if args.calib else FORWARD_CAMERA_TO_VEHICLE
+        read_camera(args.calib).T_vehicle_camera if args.calib else CAMERA_TO_VEHICLE_FORWARD
     )
     overlap = (trajectory.t[-1] >= table.t[0]) and (trajectory.t[0] <= table.t[-1])
     if len(trajectory) == 0 or not overlap:
@@ -92,32 +121,15 @@ def run(args: argparse.Namespace) -> int:
             "use --time-offset",
             args.trajectory,
         )
-    if args.correction == "kalman":
-        tight = table.tc_reliable & table.tc_available & (args.source != "conv")
-        result = blend_heading(
-            trajectory,
-            table.t,
-            yaw,
-            np.where(tight, table.sigma_tc, table.sigma_conv),
-            valid,
-            np.where(tight, TightHeadingConfig().window_s, 0.0),
-            extrinsic,
-            args.world,
-            BlendConfig(smooth=not args.causal, reference=args.reference, max_gap_s=args.max_gap_s),
-        )
-    else:
-        result = correct_heading(
-            trajectory,
-            table.t,
-            yaw,
-            valid,
-            args.window_s,
-            extrinsic,
-            args.world,
-            args.max_gap_s,
-            reference=args.reference,
-        )
-    out = result.vehicle if args.body == "vehicle" else result.camera
+    config = CorrectionConfig(
+        method=args.correction,
+        reference=args.reference,
+        window_s=args.window_s,
+        blend=BlendConfig(smooth=not args.causal, max_gap_s=args.max_gap_s),
+    )
+    vehicle = vehicle_trajectory(trajectory, extrinsic, args.world)
+    result = correct(vehicle, absolute_heading(table, args.source, config), config)
+    out = result.vehicle if args.body == "vehicle" else camera_trajectory(result.vehicle, extrinsic)
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     if output.suffix.lower() in (".kitti", ".txt"):
@@ -127,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     summary = {
         "poses": len(out),
         "poses_with_absolute_heading": int(result.has_absolute.sum()),
-        "final_correction_deg": float(np.degrees(result.total_correction[-1])),
+        "final_correction_deg": float(np.degrees(result.correction[-1])),
         "correction": args.correction,
         "output": str(output),
     }

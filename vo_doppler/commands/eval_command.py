@@ -12,7 +12,7 @@ from rich.table import Table
 from vo_doppler.errors import InputError
 from vo_doppler.eval.alignment import ALIGNMENTS
 from vo_doppler.eval.metrics import TrajectoryErrors, associate, evaluate
-from vo_doppler.trajectory import read_trajectory
+from vo_doppler.io.trajectory import read_trajectory
 
 UP_AXES = {"z": (0.0, 0.0, 1.0), "-y": (0.0, -1.0, 0.0), "y": (0.0, 1.0, 0.0)}
 

@@ -11,13 +11,10 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.errors import InputError, VoDopplerError
-from vo_doppler.fusion.heading_correction import yaw_of
-from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
-from vo_doppler.heading.conventional import velocity_heading_sigma
-from vo_doppler.heading.from_gnss import emulated_canyon, heading_rows
-from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConfig, heading_pipeline
-from vo_doppler.heading.sensors import sample_at
+from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
+from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConfig
 from vo_doppler.heading.tight_heading import TightHeadingConfig
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.heading_csv import write_heading_csv
@@ -25,7 +22,8 @@ from vo_doppler.io.heading_figure import heading_figure
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
-from vo_doppler.trajectory import read_trajectory
+from vo_doppler.io.trajectory import read_trajectory
+from vo_doppler.model.timeseries import sample
 
 log = logging.getLogger(__name__)
 
@@ -146,21 +144,16 @@ def _sensors(args):
     )
 
 
-def _truth_yaw(path: Path, t: np.ndarray) -> np.ndarray:
-    truth = read_trajectory(path)
-    yaw = np.unwrap(yaw_of(truth.matrices[:, :3, :3]))
-    return sample_at(truth.t, yaw, t)
-
-
-def _conventional_yaw_sigma(velocity, receiver_ecef: np.ndarray) -> np.ndarray | None:
-    """The conventional headings' standard deviations, with the covariances turned to ENU at
-    the first receiver position (None without one)."""
+def _local_frame(receiver_ecef: np.ndarray, obs) -> EnuFrame:
+    """The ENU frame of the first receiver position used (a sequence folder names its own
+    origin; a bare RINEX file has this one), else of the RINEX approximate position."""
     finite = np.flatnonzero(np.all(np.isfinite(receiver_ecef), axis=1))
-    if finite.size == 0:
-        return None
-    lat, lon, _ = ecef_to_geodetic(receiver_ecef[finite[0]])
-    rotation = ecef_to_enu_rotation(float(lat), float(lon))
-    return velocity_heading_sigma(velocity.velocity_enu, velocity.covariance, rotation)
+    if finite.size:
+        return EnuFrame.from_ecef(receiver_ecef[finite[0]])
+    approx = obs.header.approx_position
+    if approx is not None and np.all(np.isfinite(approx)) and np.linalg.norm(approx) > 6.0e6:
+        return EnuFrame.from_ecef(approx)
+    raise InputError("no receiver position (no SPP fix, no approximate position)", obs.header.path)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -174,7 +167,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         start = obs.epoch_time[0] + args.max_sats_after
         rows, conventional = emulated_canyon(obs, nav, args.max_sats, start, systems, mask)
-    overlap = sample_at(speed.t, speed.value, obs.epoch_time)
+    overlap = sample(speed.t, speed.value, obs.epoch_time)
     if not np.isfinite(overlap).any():
         raise InputError(
             f"sensor times ({speed.t[:1]}..{speed.t[-1:]}) do not overlap the GNSS epochs "
@@ -189,21 +182,19 @@ def run(args: argparse.Namespace) -> int:
         fixed_gyro_bias=None if args.gyro_bias is None else np.radians(args.gyro_bias),
         fixed_wheel_scale=args.wheel_scale,
     )
-    table = heading_pipeline(
+    table = heading_from_gnss(
         obs.epoch_time,
-        heading_rows(rows),
-        conventional.velocity_enu,
-        conventional.valid,
+        rows,
+        conventional,
         speed,
         yaw_rate,
+        _local_frame(rows.receiver_ecef, obs),
         config,
-        conventional_sigma_mps=conventional.sigma_mps,
-        conventional_yaw_sigma=_conventional_yaw_sigma(conventional, rows.receiver_ecef),
-        antenna_lever_arm_m=args.antenna_lever_arm,
+        args.antenna_lever_arm,
     )
     args.output.parent.mkdir(parents=True, exist_ok=True)
     write_heading_csv(args.output, table)
-    truth = _truth_yaw(args.gt, table.t) if args.gt else None
+    truth = read_trajectory(args.gt).yaw_at(table.t) if args.gt else None
     figure = args.figure or args.output.with_suffix(".png")
     heading_figure(figure, table, truth, args.obs.name)
     summary = {

@@ -22,19 +22,13 @@ from vo_doppler.eval.report import (
     trajectories_figure,
     write_html_report,
 )
+from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
-from vo_doppler.fusion.heading_correction import yaw_of
-from vo_doppler.fusion.pipeline import (
-    CORRECTION_METHODS,
-    PipelineConfig,
-    PipelineResult,
-    run_pipeline,
-)
-from vo_doppler.heading.sensors import sample_at
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.heading_figure import heading_figure
 from vo_doppler.io.sequence import read_sequence
-from vo_doppler.trajectory import write_tum
+from vo_doppler.io.trajectory import write_tum
+from vo_doppler.run import Pipeline, RunConfig, RunResult, run_sequence
 from vo_doppler.vo.config import VoConfig
 
 log = logging.getLogger(__name__)
@@ -64,7 +58,7 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--correction",
         choices=CORRECTION_METHODS,
-        default=PipelineConfig().correction_method,
+        default=CorrectionConfig().method,
         help="heading correction: window (the seed's Eq. 11-13) or kalman (adaptive blend, "
         "filter and smoother on the VO heading offset); default %(default)s",
     )
@@ -78,13 +72,15 @@ def register(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     inputs = read_sequence(args.sequence)
-    config = PipelineConfig(
+    config = RunConfig(
         systems=args.systems.upper(),
-        elevation_mask_deg=args.elev_mask,
+        elevation_mask=np.radians(args.elev_mask),
         vo=VoConfig(window_size=args.window),
-        correction_reference=args.reference,
-        correction_method=args.correction,
-        blend=BlendConfig(smooth=not args.causal),
+        correction=CorrectionConfig(
+            method=args.correction,
+            reference=args.reference,
+            blend=BlendConfig(smooth=not args.causal),
+        ),
     )
     console = Console(width=None if sys.stdout.isatty() else 150)
     console.print(
@@ -94,12 +90,12 @@ def run(args: argparse.Namespace) -> int:
     )
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("visual odometry", total=len(inputs.image_paths))
-        result = run_pipeline(inputs, config, lambda _: progress.advance(task))
+        result = run_sequence(inputs, config, lambda _: progress.advance(task))
     out = args.output
     out.mkdir(parents=True, exist_ok=True)
-    write_tum(out / "trajectory_vo.tum", result.trajectories["vo"])
-    write_tum(out / "trajectory_corrected.tum", result.trajectories["vo_gps_tc"])
-    for name in ("vo_gps_conv", "dr_gps_tc"):
+    write_tum(out / "trajectory_vo.tum", result.trajectories[Pipeline.VO])
+    write_tum(out / "trajectory_corrected.tum", result.trajectories[Pipeline.VO_GPS_TC])
+    for name in (Pipeline.VO_GPS_CONV, Pipeline.DR_GPS_TC):
         if name in result.trajectories:
             write_tum(out / f"trajectory_{name}.tum", result.trajectories[name])
     write_heading_csv(out / "heading.csv", result.heading)
@@ -116,11 +112,7 @@ def run(args: argparse.Namespace) -> int:
         summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
         error_per_100m_figure(out / "error_per_100m.png", per_100m, inputs.name)
         figures.append(out / "error_per_100m.png")
-    truth_yaw = None
-    if truth is not None:
-        truth_yaw = sample_at(
-            truth.t, np.unwrap(yaw_of(truth.orientations.as_matrix())), result.heading.t
-        )
+    truth_yaw = truth.yaw_at(result.heading.t) if truth is not None else None
     trajectories_figure(figures[0], shown, truth, inputs.name)
     heading_figure(figures[1], result.heading, truth_yaw, inputs.name)
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
@@ -163,7 +155,7 @@ def readable_facts(summary: dict) -> dict[str, str]:
     return facts
 
 
-def summarise(result: PipelineResult) -> dict:
+def summarise(result: RunResult) -> dict:
     table = result.heading
     return {
         "gnss_epochs": len(table),

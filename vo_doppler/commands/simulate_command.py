@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from vo_doppler.errors import InputError
-from vo_doppler.gnss.gpstime import calendar_to_gps_seconds
+from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.sim.urban_canyon import (
     SCENARIOS,
     CityConfig,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vo_doppler.trajectory import Trajectory
+from vo_doppler.model.trajectory import Trajectory
 
 ALIGNMENTS = ("none", "start", "se2", "sim3")
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.trajectory import Trajectory
+from vo_doppler.model.trajectory import Trajectory
 
 
 @dataclass

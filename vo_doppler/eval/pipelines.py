@@ -10,10 +10,9 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from vo_doppler.eval.metrics import evaluate
 from vo_doppler.eval.per_distance import ErrorPerDistance, error_per_100m
-from vo_doppler.fusion.heading_correction import yaw_of
-from vo_doppler.geo import wrap_angle
-from vo_doppler.heading.pipeline import HeadingTable
-from vo_doppler.trajectory import Trajectory
+from vo_doppler.geo import wrap_angle, yaw_of
+from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.trajectory import Trajectory
 
 PIPELINE_LABELS = {
     "vo": "VO alone",

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from vo_doppler.trajectory import Trajectory
+from vo_doppler.model.trajectory import Trajectory
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 

@@ -9,7 +9,7 @@ from matplotlib.figure import Figure
 
 from vo_doppler.eval.per_distance import ErrorPerDistance
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, PipelineErrors
-from vo_doppler.trajectory import Trajectory
+from vo_doppler.model.trajectory import Trajectory
 
 TABLE_COLUMNS = (
     ("error_per_100m_m", "horizontal error per 100 m, mean [m]", "{:.2f}"),

@@ -55,7 +55,7 @@ State: the offset δ = (true course − VO course), a scalar in rad, held unwrap
 
 The corrected trajectory rotates every VO increment by δ at its middle time and every
 orientation by δ at its time, both as a yaw rotation on the world side (pitch and roll kept),
-as Eq. (12)–(13) do with the window's offset; frames and extrinsics as in
+as Eq. (12)–(13) do with the window's offset; frames as in
 :func:`vo_doppler.fusion.heading_correction.correct_heading`.
 """
 
@@ -66,15 +66,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.fusion.heading_correction import (
-    FORWARD_CAMERA_TO_VEHICLE,
-    chord_starts,
-    headings_at,
-    vehicle_poses,
-    yaw_of,
-)
-from vo_doppler.geo import wrap_angle
-from vo_doppler.trajectory import Trajectory
+from vo_doppler.fusion.heading_correction import chord_starts, headings_at
+from vo_doppler.fusion.result import CorrectionResult
+from vo_doppler.geo import wrap_angle, yaw_of
+from vo_doppler.model.trajectory import Trajectory
 
 SIGMA_GRID = np.logspace(-4.0, -1.0, 16)
 """Candidate σ_d (rad/√m) and σ_ψ (rad/√rad) for the maximum-likelihood fit, steps of 1.6×:
@@ -108,8 +103,6 @@ class BlendConfig:
     read from a heading.csv written before it had their column)."""
     smooth: bool = True
     """RTS smoother (B4, offline); False: forward filter only (causal)."""
-    reference: str = "course"
-    """Compare the absolute heading with the VO's 'course' or its 'orientation' yaw."""
     min_chord_m: float = 0.5
     """Length of the VO chord whose direction is the course (shorter, slower motion has none)."""
     max_gap_s: float = 1.5
@@ -117,10 +110,6 @@ class BlendConfig:
     min_fit_measurements: int = 20
     """Fewest measurements (after decimation to one per T_c) for the maximum-likelihood fit
     of the three noise parameters; below it the defaults hold."""
-
-    def __post_init__(self) -> None:
-        if self.reference not in ("course", "orientation"):
-            raise ValueError(f"reference must be 'course' or 'orientation', not {self.reference!r}")
 
 
 @dataclass
@@ -157,24 +146,6 @@ class NoiseModel:
     sigma_turn: float
     scale: float
     fitted: bool
-
-
-@dataclass
-class BlendResult:
-    """Corrected poses and the offset δ (rad, added to the VO yaw) at each pose."""
-
-    vehicle: Trajectory
-    camera: Trajectory
-    offset: np.ndarray
-    offset_sigma: np.ndarray
-    has_absolute: np.ndarray
-    """Poses with an absolute heading within ``max_gap_s`` (as the window method reports)."""
-    noise: NoiseModel
-    measurements: int
-
-    @property
-    def total_correction(self) -> np.ndarray:
-        return self.offset
 
 
 def vo_direction(
@@ -367,23 +338,25 @@ def offset_at(
 
 
 def blend_heading(
-    camera: Trajectory,
+    vehicle: Trajectory,
     t_heading: np.ndarray,
     yaw_heading: np.ndarray,
     sigma_heading: np.ndarray | float | None = None,
     valid: np.ndarray | None = None,
     correlation_s: np.ndarray | float = 0.0,
-    camera_to_vehicle: np.ndarray = FORWARD_CAMERA_TO_VEHICLE,
-    world: str = "first_camera",
     config: BlendConfig = BlendConfig(),
-) -> BlendResult:
+    reference: str = "course",
+) -> CorrectionResult:
     """Correct the VO heading with absolute headings by the Kalman blend (B1)–(B4).
 
     ``t_heading``/``yaw_heading`` (yaw, rad) are on the trajectory's clock; ``sigma_heading``
     their standard deviations (NaN or None: ``default_measurement_sigma``), ``valid`` marks
     the usable epochs, ``correlation_s`` is T_c of (B2) per epoch or for all (the tight
-    heading's window; 0 for the single-epoch conventional heading). Frames as in
+    heading's window; 0 for the single-epoch conventional heading); ``reference`` compares
+    them with the VO's 'course' or its 'orientation' yaw. Frames as in
     :func:`~vo_doppler.fusion.heading_correction.correct_heading`."""
+    if reference not in ("course", "orientation"):
+        raise ValueError(f"reference must be 'course' or 'orientation', not {reference!r}")
     t_heading = np.asarray(t_heading, dtype=float)
     n_heading = len(t_heading)
     yaw = np.asarray(yaw_heading, dtype=float).copy()
@@ -394,12 +367,12 @@ def blend_heading(
     )
     sigma = np.where(np.isfinite(sigma), sigma, config.default_measurement_sigma)
     correlation = np.broadcast_to(np.asarray(correlation_s, dtype=float), (n_heading,))
-    poses = vehicle_poses(camera, camera_to_vehicle, world)
-    t = camera.t
+    poses = vehicle.matrices
+    t = vehicle.t
     positions = poses[:, :3, 3] - (poses[0, :3, 3] if len(poses) else 0.0)
     rotations = poses[:, :3, :3]
     t_direction, yaw_direction = vo_direction(
-        t, positions, rotations, config.reference, config.min_chord_m
+        t, positions, rotations, reference, config.min_chord_m
     )
     measurements = offset_measurements(
         t_heading, yaw, sigma, correlation, t_direction, yaw_direction, config.max_gap_s
@@ -431,16 +404,14 @@ def blend_heading(
     steps = np.einsum("nij,nj->ni", turn_step[1:], np.diff(positions, axis=0))
     corrected_positions = np.concatenate([positions[:1], positions[:1] + np.cumsum(steps, axis=0)])
     corrected_rotations = Rotation.from_euler("z", delta[:, None]).as_matrix() @ rotations
-    vehicle = Trajectory(t.copy(), corrected_positions, Rotation.from_matrix(corrected_rotations))
-    T_veh_cam = np.asarray(camera_to_vehicle, dtype=float)
-    camera_out = Trajectory.from_matrices(t.copy(), vehicle.matrices @ T_veh_cam)
+    corrected_positions += poses[0, :3, 3] if len(poses) else 0.0
+    corrected = Trajectory(t.copy(), corrected_positions, Rotation.from_matrix(corrected_rotations))
     _, has_absolute = headings_at(t, t_heading, yaw, None, config.max_gap_s)
-    return BlendResult(
-        vehicle,
-        camera_out,
+    return CorrectionResult(
+        corrected,
         delta,
-        np.sqrt(variance),
         has_absolute,
-        noise,
-        len(measurements),
+        correction_sigma=np.sqrt(variance),
+        noise=noise,
+        measurements=len(measurements),
     )

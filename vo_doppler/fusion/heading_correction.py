@@ -11,58 +11,19 @@ Poses are processed in time order. For the window of poses in (t_i − W, t_i]:
 New VO increments are rotated by the accumulated correction, so the last correction is held
 through gaps in the absolute heading.
 
-Frames: the input trajectory holds camera poses (OpenCV axes) in the VO world, which by default
-is the first camera frame (what `vo-doppler vo`, KITTI and most VO systems write). With the
-camera→vehicle extrinsic, the vehicle poses (x forward, y left, z up) are expressed in the
-first vehicle frame, which is level when the vehicle starts level; ``world="level"`` declares
-that the input world is already z-up (e.g. ENU). Headings are yaw, counter-clockwise from
-east. The output world is ENU-aligned with its origin at the first position.
+Frames: the input holds vehicle poses (x forward, y left, z up) in a level, z-up world (the
+VO stage turns camera poses into these once, :func:`vo_doppler.vo.frames.vehicle_trajectory`).
+Headings are yaw, counter-clockwise from east. The output keeps the input's first position.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.geo import wrap_angle
-from vo_doppler.trajectory import Trajectory
-from vo_doppler.vo.camera import CAMERA_TO_VEHICLE_FORWARD
-
-FORWARD_CAMERA_TO_VEHICLE = CAMERA_TO_VEHICLE_FORWARD
-
-
-@dataclass
-class HeadingCorrectionResult:
-    """Corrected vehicle poses, the offset Δθ applied at each pose (0 without absolute heading)
-    and whether an absolute heading was used at that pose."""
-
-    vehicle: Trajectory
-    camera: Trajectory
-    offset: np.ndarray
-    has_absolute: np.ndarray
-    total_correction: np.ndarray
-
-
-def vehicle_poses(
-    camera: Trajectory,
-    camera_to_vehicle: np.ndarray = FORWARD_CAMERA_TO_VEHICLE,
-    world: str = "first_camera",
-) -> np.ndarray:
-    """(N, 4, 4) vehicle poses in a level world: the first vehicle frame, or the input world."""
-    T_veh_cam = np.asarray(camera_to_vehicle, dtype=float)
-    T_w_veh = camera.matrices @ np.linalg.inv(T_veh_cam)
-    if world == "first_camera":
-        return np.linalg.inv(T_w_veh[0]) @ T_w_veh if len(T_w_veh) else T_w_veh
-    if world == "level":
-        return T_w_veh
-    raise ValueError(f"unknown world {world!r} (first_camera or level)")
-
-
-def yaw_of(rotations: np.ndarray) -> np.ndarray:
-    """Yaw (ZYX Euler, counter-clockwise about z) of (N, 3, 3) body-to-world rotations."""
-    return np.arctan2(rotations[:, 1, 0], rotations[:, 0, 0])
+from vo_doppler.fusion.result import CorrectionResult
+from vo_doppler.geo import wrap_angle, yaw_of
+from vo_doppler.model.trajectory import Trajectory
 
 
 def headings_at(
@@ -135,18 +96,16 @@ def _window_yaw(
 
 
 def correct_heading(
-    camera: Trajectory,
+    vehicle: Trajectory,
     t_heading: np.ndarray,
     yaw_heading: np.ndarray,
     valid: np.ndarray | None = None,
     window_s: float = 2.0,
-    camera_to_vehicle: np.ndarray = FORWARD_CAMERA_TO_VEHICLE,
-    world: str = "first_camera",
     max_gap_s: float = 1.5,
     gate_rad: float | None = None,
-    reference: str = "orientation",
+    reference: str = "course",
     min_chord_m: float = 0.5,
-) -> HeadingCorrectionResult:
+) -> CorrectionResult:
     """Correct the VO heading with absolute headings (sec. 3.6, Eq. 11–13).
 
     ``t_heading``/``yaw_heading`` are on the trajectory's clock (shift them beforehand);
@@ -164,13 +123,13 @@ def correct_heading(
     """
     if reference not in ("orientation", "course"):
         raise ValueError(f"reference must be 'orientation' or 'course', not {reference!r}")
-    poses = vehicle_poses(camera, camera_to_vehicle, world)
+    poses = vehicle.matrices
     n = len(poses)
     vo_positions = poses[:, :3, 3] - (poses[0, :3, 3] if n else 0.0)
     chord_start = chord_starts(vo_positions, min_chord_m)
-    t_compare = camera.t
+    t_compare = vehicle.t
     if reference == "course":
-        t_compare = 0.5 * (camera.t + camera.t[np.maximum(chord_start, 0)])
+        t_compare = 0.5 * (vehicle.t + vehicle.t[np.maximum(chord_start, 0)])
     absolute, has_absolute = headings_at(t_compare, t_heading, yaw_heading, valid, max_gap_s)
     if reference == "course":
         has_absolute &= chord_start >= 0
@@ -187,7 +146,7 @@ def correct_heading(
         if i:
             positions[i] = positions[i - 1] + rotate @ (vo_positions[i] - vo_positions[i - 1])
         rotations[i] = rotate @ vo_rotations[i]
-        while camera.t[oldest] <= camera.t[i] - window_s:
+        while vehicle.t[oldest] <= vehicle.t[i] - window_s:
             oldest += 1
         window = slice(oldest, i + 1)
         vo_yaw = _window_yaw(positions, rotations, oldest, i + 1, reference, chord_start)
@@ -206,7 +165,6 @@ def correct_heading(
             correction -= delta
             offset[i] = delta
         total[i] = correction
-    vehicle = Trajectory(camera.t.copy(), positions, Rotation.from_matrix(rotations))
-    T_veh_cam = np.asarray(camera_to_vehicle, dtype=float)
-    camera_out = Trajectory.from_matrices(camera.t.copy(), vehicle.matrices @ T_veh_cam)
-    return HeadingCorrectionResult(vehicle, camera_out, offset, has_absolute, total)
+    positions += poses[0, :3, 3] if n else 0.0
+    corrected = Trajectory(vehicle.t.copy(), positions, Rotation.from_matrix(rotations))
+    return CorrectionResult(corrected, total, has_absolute, window_offset=offset)

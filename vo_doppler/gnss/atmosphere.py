@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from vo_doppler.geo import SPEED_OF_LIGHT
-from vo_doppler.gnss.gpstime import time_of_week
+from vo_doppler.model.gpstime import time_of_week
 
 L1_HZ = 1575.42e6
 

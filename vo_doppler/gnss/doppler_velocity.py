@@ -26,8 +26,8 @@ from vo_doppler.gnss.ephemeris import transmit_states
 from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.gnss.spp import elevation_azimuth
-from vo_doppler.io.rinex_nav import Navigation
-from vo_doppler.io.rinex_obs import Observations, lookup, row_keys
+from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.observations import Observations, lookup, row_keys
 
 log = logging.getLogger(__name__)
 

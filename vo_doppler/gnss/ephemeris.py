@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.geo import SPEED_OF_LIGHT
-from vo_doppler.io.rinex_nav import Navigation, NavRecords
+from vo_doppler.model.navigation import Navigation, NavRecords
 
 OMEGA_E = {"G": 7.2921151467e-5, "J": 7.2921151467e-5, "E": 7.2921151467e-5, "C": 7.292115e-5}
 MU = {"G": 3.986005e14, "J": 3.986005e14, "E": 3.986004418e14, "C": 3.986004418e14}

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vo_doppler.io.rinex_obs import Observations, lookup, row_keys
+from vo_doppler.model.observations import Observations, lookup, row_keys
 
 MAX_GAP_S = 1.5
 MAX_DISAGREEMENT_HZ = 5.0

@@ -9,8 +9,8 @@ import numpy as np
 from vo_doppler.gnss.doppler_velocity import DopplerRows, VelocitySolution, doppler_velocity
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
 from vo_doppler.gnss.spp import SppSolution, receiver_positions, solve_spp
-from vo_doppler.io.rinex_nav import Navigation
-from vo_doppler.io.rinex_obs import Observations
+from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.observations import Observations
 
 
 @dataclass(frozen=True)

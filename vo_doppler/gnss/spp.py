@@ -20,8 +20,8 @@ from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
 from vo_doppler.gnss.ephemeris import rotate_earth, satellite_states
 from vo_doppler.gnss.lsq import lsq_with_exclusion, weighted_lsq
 from vo_doppler.gnss.signals import wavelengths
-from vo_doppler.io.rinex_nav import Navigation
-from vo_doppler.io.rinex_obs import Observations
+from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.observations import Observations
 
 log = logging.getLogger(__name__)
 

@@ -7,17 +7,22 @@ position used for that row. Weights are 1/σ² from the GNSS package's C/N0–el
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import fields, replace
 
 import numpy as np
 
-from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.geo import EnuFrame, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.doppler_velocity import DopplerRows as GnssDopplerRows
 from vo_doppler.gnss.doppler_velocity import VelocitySolution, doppler_rows, solve_velocity
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
+from vo_doppler.heading.conventional import velocity_heading_sigma
+from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.rows import DopplerRows
-from vo_doppler.io.rinex_nav import Navigation
-from vo_doppler.io.rinex_obs import Observations
+from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.observations import Observations
+from vo_doppler.model.series import SensorSeries
 
 
 def satellite_names(rows: GnssDopplerRows) -> np.ndarray:
@@ -96,3 +101,36 @@ def emulated_canyon(
     rows = doppler_rows(obs, nav, positions, systems, elevation_mask_rad=elevation_mask_rad)
     rows = keep_highest_satellites(rows, n_keep, after_t)
     return rows, solve_velocity(rows, obs.epoch_time)
+
+
+def conventional_heading_sigma(velocity: VelocitySolution, enu: EnuFrame) -> np.ndarray:
+    """Standard deviation (rad) of each epoch's conventional heading, from its Doppler velocity
+    covariance turned into the ENU frame ``enu``
+    (:func:`~vo_doppler.heading.conventional.velocity_heading_sigma`)."""
+    return velocity_heading_sigma(velocity.velocity_enu, velocity.covariance, enu.rotation)
+
+
+def heading_from_gnss(
+    epoch_time: np.ndarray,
+    rows: GnssDopplerRows,
+    velocity: VelocitySolution,
+    wheel_speed: SensorSeries,
+    yaw_rate: SensorSeries,
+    enu: EnuFrame,
+    config: HeadingPipelineConfig,
+    antenna_lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0),
+) -> HeadingTable:
+    """The heading stage ([TK18] sec. 3.3–3.5) from the GNSS stage's Doppler rows and
+    conventional velocities: what ``run``, ``heading`` and the benchmarks all call."""
+    return heading_pipeline(
+        epoch_time,
+        heading_rows(rows),
+        velocity.velocity_enu,
+        velocity.valid,
+        wheel_speed,
+        yaw_rate,
+        config,
+        conventional_sigma_mps=velocity.sigma_mps,
+        conventional_yaw_sigma=conventional_heading_sigma(velocity, enu),
+        antenna_lever_arm_m=antenna_lever_arm_m,
+    )

@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from vo_doppler.geo import yaw_to_course
 from vo_doppler.heading.calibration import (
     PRIOR_GYRO_BIAS_SIGMA,
     PRIOR_WHEEL_SCALE_SIGMA,
@@ -32,13 +31,14 @@ from vo_doppler.heading.calibration import (
 )
 from vo_doppler.heading.conventional import heading_from_velocity, vehicle_heading_from_antenna
 from vo_doppler.heading.rows import DopplerRows
-from vo_doppler.heading.sensors import integrate_rate, sample_at
 from vo_doppler.heading.tight_heading import (
     TightHeadingConfig,
     antenna_offset_velocity,
     tight_heading_series,
 )
-from vo_doppler.io.sensor_csv import SensorSeries
+from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.timeseries import integral_at, sample
 
 CALIBRATION_METHODS = ("ls", "kalman", "none")
 
@@ -65,69 +65,6 @@ class HeadingPipelineConfig:
     """Spread of an uncalibrated wheel scale about one."""
     fixed_gyro_bias: float | None = None
     fixed_wheel_scale: float | None = None
-
-
-@dataclass
-class HeadingTable:
-    """One row per GNSS epoch. Yaw in rad counter-clockwise from east (NaN when unavailable)."""
-
-    t: np.ndarray
-    yaw_tc: np.ndarray
-    sigma_tc: np.ndarray
-    tc_reliable: np.ndarray
-    n_obs_window: np.ndarray
-    n_sat_epoch: np.ndarray
-    yaw_conv: np.ndarray
-    conv_valid: np.ndarray
-    gyro_bias: np.ndarray
-    wheel_scale: np.ndarray
-    rejected_rows: np.ndarray | None = None
-    """Doppler rows of the window rejected as biased (NLOS) by the tightly coupled solver."""
-    tc_verifiable: np.ndarray | None = None
-    """A bias on any satellite the tightly coupled heading used would have shown in the
-    residuals (False where it could hide, and where the heading is unavailable)."""
-    sigma_conv: np.ndarray | None = None
-    """Standard deviation (rad) of the conventional heading, NaN where unknown or invalid."""
-
-    def __post_init__(self) -> None:
-        n = len(self.t)
-        if self.rejected_rows is None:
-            self.rejected_rows = np.zeros(n, dtype=int)
-        if self.tc_verifiable is None:
-            self.tc_verifiable = np.zeros(n, dtype=bool)
-        if self.sigma_conv is None:
-            self.sigma_conv = np.full(n, np.nan)
-
-    def __len__(self) -> int:
-        return len(self.t)
-
-    @property
-    def tc_available(self) -> np.ndarray:
-        return np.isfinite(self.yaw_tc)
-
-    @property
-    def course_tc(self) -> np.ndarray:
-        """Tightly coupled heading as course (rad, clockwise from north), NaN if unavailable."""
-        return np.where(self.tc_available, yaw_to_course(np.nan_to_num(self.yaw_tc)), np.nan)
-
-    @property
-    def course_conv(self) -> np.ndarray:
-        return np.where(self.conv_valid, yaw_to_course(np.nan_to_num(self.yaw_conv)), np.nan)
-
-    def absolute_heading(self, source: str = "tc+conv") -> tuple[np.ndarray, np.ndarray]:
-        """Yaw and validity for heading correction: ``tc`` reliable tightly coupled headings,
-        ``conv`` conventional ones, ``tc+conv`` the former where reliable, else the latter."""
-        tc_ok = self.tc_reliable & self.tc_available
-        if source == "tc":
-            return np.where(tc_ok, self.yaw_tc, np.nan), tc_ok
-        if source == "conv":
-            return np.where(self.conv_valid, self.yaw_conv, np.nan), self.conv_valid.copy()
-        if source == "tc+conv":
-            ok = tc_ok | self.conv_valid
-            return np.where(
-                tc_ok, self.yaw_tc, np.where(self.conv_valid, self.yaw_conv, np.nan)
-            ), ok
-        raise ValueError(f"unknown heading source {source!r} (tc, conv or tc+conv)")
 
 
 def _calibrators(config: HeadingPipelineConfig):
@@ -236,8 +173,8 @@ def heading_pipeline(
     # Horizontal speed: the tightly coupled model's velocity is horizontal, and the vertical
     # component of a canyon fix is noisy (large VDOP), which would bias |v| and the scale up.
     conv_speed = np.where(conventional_valid, np.hypot(velocity[:, 0], velocity[:, 1]), np.nan)
-    wheel = sample_at(speed.t, speed.value, t_epoch)
-    raw_rate = sample_at(yaw_rate.t, yaw_rate.value, t_epoch)
+    wheel = sample(speed.t, speed.value, t_epoch)
+    raw_rate = sample(yaw_rate.t, yaw_rate.value, t_epoch)
     lever = any(float(v) != 0.0 for v in tuple(antenna_lever_arm_m)[:2])
     antenna_yaw, antenna_speed = conv_yaw, conv_speed
     if lever:
@@ -254,7 +191,7 @@ def heading_pipeline(
         config.calibration_max_speed_mismatch_ratio * np.abs(wheel),
     )
     calibrating &= np.abs(np.nan_to_num(conv_speed - wheel, nan=np.inf)) <= tolerance
-    raw_angle = integrate_rate(yaw_rate.t, yaw_rate.value, t_epoch)
+    raw_angle = integral_at(yaw_rate.t, yaw_rate.value, t_epoch)
     cal = causal_calibration(t_epoch, conv_speed, conv_yaw, calibrating, wheel, raw_angle, config)
     # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
     steps = cal.bias[:-1] * np.diff(t_epoch)
@@ -290,4 +227,5 @@ def heading_pipeline(
         sigma_conv=None
         if conventional_yaw_sigma is None
         else np.where(conv_ok, np.asarray(conventional_yaw_sigma, dtype=float), np.nan),
+        tc_window_s=config.tight.window_s,
     )

@@ -26,7 +26,7 @@ import cantools
 import numpy as np
 
 from vo_doppler.errors import InputError
-from vo_doppler.io.sensor_csv import SensorSeries
+from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
 

@@ -18,8 +18,8 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
-from vo_doppler.gnss.gpstime import SECONDS_PER_WEEK, utc_to_gps_seconds
 from vo_doppler.io.gps_fixes import GpsFixes
+from vo_doppler.model.gpstime import SECONDS_PER_WEEK, utc_to_gps_seconds
 
 UNIX_TO_GPS_EPOCH_S = 315964800.0
 

@@ -9,13 +9,11 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
-from scipy.spatial.transform import Rotation
 
 from vo_doppler.geo import EnuFrame, ecef_to_geodetic
-from vo_doppler.lowcost.dead_reckoning import DeadReckoning
+from vo_doppler.io.trajectory import write_tum
 from vo_doppler.lowcost.drift import DriftRow
 from vo_doppler.lowcost.pipeline import DeadReckonResult
-from vo_doppler.trajectory import Trajectory, write_tum
 
 DRIFT_COLUMNS = (
     "variant",
@@ -25,12 +23,6 @@ DRIFT_COLUMNS = (
     "loop_gap_percent",
     "path_length_m",
 )
-
-
-def dead_reckoning_trajectory(dr: DeadReckoning) -> Trajectory:
-    """ENU positions (z = 0) with the yaw (CCW from east) as a rotation about up."""
-    positions = np.column_stack([dr.east, dr.north, np.zeros(len(dr.t))])
-    return Trajectory(dr.t, positions, Rotation.from_euler("z", np.asarray(dr.yaw)[:, None]))
 
 
 def enu_to_lonlat(frame: EnuFrame, east: np.ndarray, north: np.ndarray) -> np.ndarray:
@@ -152,7 +144,7 @@ def write_outputs(folder: str | Path, result: DeadReckonResult) -> dict[str, Pat
         "map": folder / "map.png",
         "allan": folder / "allan_deviation.png",
     }
-    write_tum(paths["trajectory"], dead_reckoning_trajectory(result.selected_trajectory))
+    write_tum(paths["trajectory"], result.selected_trajectory.trajectory())
     paths["geojson"].write_text(json.dumps(geojson(result)))
     with paths["drift_table"].open("w", newline="") as handle:
         writer = csv.writer(handle)

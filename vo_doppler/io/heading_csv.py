@@ -3,9 +3,10 @@
 Columns: gps_time_s, heading_tc_deg, heading_tc_sigma_deg, tc_reliable, n_obs_window,
 n_sat_epoch, heading_conv_deg, conv_valid, gyro_bias_dps, wheel_scale, then rejected_rows (rows
 of the window rejected as biased, NLOS) and tc_verifiable (a bias on any satellite used would
-have shown) and heading_conv_sigma_deg (the conventional heading's standard deviation).
+have shown), tc_window_s (the tight heading's window, the same on every row) and
+heading_conv_sigma_deg (the conventional heading's standard deviation).
 Unavailable headings are written as ``nan``; flags as 0/1. Reading converts back to yaw (rad,
-counter-clockwise from east); the last three columns are optional (files written before they
+counter-clockwise from east); the last four columns are optional (files written before they
 existed read as zero, or NaN for the standard deviation).
 """
 
@@ -18,7 +19,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import course_to_yaw
-from vo_doppler.heading.pipeline import HeadingTable
+from vo_doppler.model.heading import DEFAULT_TC_WINDOW_S, HeadingTable
 
 COLUMNS = (
     "gps_time_s",
@@ -32,7 +33,7 @@ COLUMNS = (
     "gyro_bias_dps",
     "wheel_scale",
 )
-OPTIONAL_COLUMNS = ("rejected_rows", "tc_verifiable", "heading_conv_sigma_deg")
+OPTIONAL_COLUMNS = ("rejected_rows", "tc_verifiable", "tc_window_s", "heading_conv_sigma_deg")
 
 
 def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
@@ -49,6 +50,7 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         table.wheel_scale,
         table.rejected_rows.astype(int),
         table.tc_verifiable.astype(int),
+        np.full(len(table), table.tc_window_s),
         np.degrees(table.sigma_conv),
     ]
     formats = (
@@ -64,6 +66,7 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         "{:.6f}",
         "{:d}",
         "{:d}",
+        "{:g}",
         "{:.4f}",
     )
     with Path(path).open("w", newline="") as handle:
@@ -115,4 +118,15 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
         rejected_rows=optional.get("rejected_rows", np.zeros(len(data))).astype(int),
         tc_verifiable=optional.get("tc_verifiable", np.zeros(len(data))) > 0.5,
         sigma_conv=np.radians(optional.get("heading_conv_sigma_deg", np.full(len(data), np.nan))),
+        tc_window_s=_window_s(optional.get("tc_window_s"), path),
     )
+
+
+def _window_s(column: np.ndarray | None, path: Path) -> float:
+    """The file's tight-heading window: one positive value, or the default for older files."""
+    if column is None or not len(column):
+        return DEFAULT_TC_WINDOW_S
+    values = np.unique(column)
+    if len(values) != 1 or not np.isfinite(values[0]) or values[0] <= 0:
+        raise InputError(f"tc_window_s must be one positive value, found {values[:3]}", path)
+    return float(values[0])

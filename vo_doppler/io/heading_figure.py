@@ -9,7 +9,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from vo_doppler.geo import wrap_angle
-from vo_doppler.heading.pipeline import HeadingTable
+from vo_doppler.model.heading import HeadingTable
 
 
 def heading_figure(

@@ -10,18 +10,18 @@ from __future__ import annotations
 
 import logging
 import re
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.gnss.gpstime import (
+from vo_doppler.io.rinex_common import label, parse_version_line, read_rinex_bytes, split_header
+from vo_doppler.model.gpstime import (
     BDT_MINUS_GPST_S,
     SECONDS_PER_WEEK,
     calendar_to_gps_seconds,
     utc_to_gps_seconds,
 )
-from vo_doppler.io.rinex_common import label, parse_version_line, read_rinex_bytes, split_header
+from vo_doppler.model.navigation import Navigation, NavRecords
 
 log = logging.getLogger(__name__)
 
@@ -48,61 +48,6 @@ _START3 = re.compile(rb"^[A-Z][ \d]\d ")
 _NUMBER_WIDTH = 19
 
 
-@dataclass(frozen=True)
-class NavRecords:
-    """Columnar broadcast records of one kind: ``params[name]`` is an array with a row per record.
-
-    ``toc`` (clock reference) is in GPS seconds. For Keplerian records ``toe`` is the full GPS
-    time of the ephemeris reference epoch (from its second of week, within half a week of toc).
-    """
-
-    system: np.ndarray
-    prn: np.ndarray
-    toc: np.ndarray
-    params: dict[str, np.ndarray]
-    line: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.prn.size)
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        return self.params[name]
-
-    def subset(self, rows) -> NavRecords:
-        return NavRecords(
-            self.system[rows],
-            self.prn[rows],
-            self.toc[rows],
-            {k: v[rows] for k, v in self.params.items()},
-            self.line[rows],
-        )
-
-
-@dataclass(frozen=True)
-class Navigation:
-    """Broadcast ephemerides of one or more navigation files."""
-
-    kepler: NavRecords
-    glonass: NavRecords
-    leap_seconds: int | None = None
-    problems: tuple[str, ...] = field(default=())
-    klobuchar: np.ndarray | None = None
-
-    def merged(self, other: Navigation) -> Navigation:
-        return Navigation(
-            _concat(self.kepler, other.kepler),
-            _concat(self.glonass, other.glonass),
-            self.leap_seconds if self.leap_seconds is not None else other.leap_seconds,
-            self.problems + other.problems,
-            self.klobuchar if self.klobuchar is not None else other.klobuchar,
-        )
-
-    def glonass_channels(self) -> dict[int, int]:
-        """GLONASS frequency channel per slot, from the records."""
-        channel = self.glonass["channel"]
-        return {int(p): int(k) for p, k in zip(self.glonass.prn, channel, strict=True)}
-
-
 def read_nav(paths: str | Path | list[str | Path] | tuple[str | Path, ...]) -> Navigation:
     """Read and merge RINEX 2/3 navigation files (plain, .gz, .Z, Hatanaka not applicable)."""
     if isinstance(paths, str | Path):
@@ -114,16 +59,6 @@ def read_nav(paths: str | Path | list[str | Path] | tuple[str | Path, ...]) -> N
     if result is None:
         raise ValueError("no navigation file given")
     return result
-
-
-def _concat(a: NavRecords, b: NavRecords) -> NavRecords:
-    return NavRecords(
-        np.concatenate([a.system, b.system]),
-        np.concatenate([a.prn, b.prn]),
-        np.concatenate([a.toc, b.toc]),
-        {k: np.concatenate([a.params[k], b.params[k]]) for k in a.params},
-        np.concatenate([a.line, b.line]),
-    )
 
 
 def _problem(problems: list[str], path: Path, line: int, message: str) -> None:

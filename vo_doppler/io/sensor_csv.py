@@ -8,40 +8,17 @@ from __future__ import annotations
 
 import csv
 import logging
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
 
 YAW_RATE_COLUMN = "yaw_rate_rad_s"
 SPEED_COLUMN = "speed_mps"
-
-
-@dataclass
-class SensorSeries:
-    """One scalar sensor signal: sample times ``t`` (s, sorted) and ``value`` (SI units)."""
-
-    t: np.ndarray
-    value: np.ndarray
-    name: str = ""
-    unit: str = ""
-
-    def __post_init__(self) -> None:
-        self.t = np.asarray(self.t, dtype=float).reshape(-1)
-        self.value = np.asarray(self.value, dtype=float).reshape(-1)
-        if len(self.t) != len(self.value):
-            raise ValueError(f"{len(self.t)} times but {len(self.value)} values")
-
-    def __len__(self) -> int:
-        return len(self.t)
-
-    def shifted(self, offset_s: float) -> SensorSeries:
-        """The same samples with ``offset_s`` added to every time (sensor clock → GPS time)."""
-        return SensorSeries(self.t + offset_s, self.value.copy(), self.name, self.unit)
 
 
 def read_sensor_csv(path: str | Path, column: str, time_offset_s: float = 0.0) -> SensorSeries:

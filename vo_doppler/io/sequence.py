@@ -1,6 +1,6 @@
 """Read a sequence folder described by ``sequence.yaml`` (format ``vo-doppler-sequence/1``,
 written by ``vo-doppler simulate``; any recording laid out the same way works) into the
-pipeline's :class:`~vo_doppler.fusion.pipeline.SequenceInputs`.
+recording model :class:`~vo_doppler.model.sequence.Sequence`.
 
 Paths in the manifest are relative to its folder. Every sensor clock is mapped to GPS time by
 ``gps = sensor time + time_offset_s`` of that sensor.
@@ -16,14 +16,14 @@ import numpy as np
 import yaml
 
 from vo_doppler.errors import InputError
-from vo_doppler.fusion.pipeline import SequenceInputs
 from vo_doppler.geo import EnuFrame
+from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.images import list_images, read_times
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
-from vo_doppler.trajectory import read_tum
-from vo_doppler.vo.camera import read_camera
+from vo_doppler.io.trajectory import read_tum
+from vo_doppler.model.sequence import Sequence
 
 log = logging.getLogger(__name__)
 
@@ -62,7 +62,7 @@ def _entry(section: dict[str, Any], key: str, manifest: dict[str, Any], where: s
     return section[key]
 
 
-def read_sequence(folder: str | Path) -> SequenceInputs:
+def read_sequence(folder: str | Path) -> Sequence:
     """All inputs of a sequence folder, on GPS time; ground truth when the folder has one."""
     manifest = read_manifest(folder)
     root = manifest["_path"].parent
@@ -104,7 +104,7 @@ def read_sequence(folder: str | Path) -> SequenceInputs:
     truth_cfg = manifest.get("ground_truth")
     if isinstance(truth_cfg, dict) and (root / truth_cfg.get("trajectory", "")).is_file():
         truth = read_tum(root / truth_cfg["trajectory"])
-    return SequenceInputs(
+    return Sequence(
         name=str(manifest.get("name", root.name)),
         image_paths=images,
         image_times=times + float(camera_cfg.get("time_offset_s", 0.0)),
@@ -116,6 +116,11 @@ def read_sequence(folder: str | Path) -> SequenceInputs:
         enu=enu,
         truth=truth,
         antenna_lever_arm_m=lever_arm,
+        clock_offsets_s={
+            "camera": float(camera_cfg.get("time_offset_s", 0.0)),
+            "can": can_offset,
+            "gnss": 0.0,
+        },
     )
 
 

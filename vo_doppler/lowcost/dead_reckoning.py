@@ -13,26 +13,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import wrap_angle
-
-
-def integrate_yaw_rate(t: np.ndarray, rate: np.ndarray, yaw0: float = 0.0) -> np.ndarray:
-    """Yaw (rad, CCW, not wrapped) at each sample time by the trapezoidal rule."""
-    t = np.asarray(t, dtype=float)
-    rate = np.asarray(rate, dtype=float)
-    if len(t) != len(rate):
-        raise InputError(f"{len(t)} times but {len(rate)} rates")
-    increments = np.diff(t) * (rate[1:] + rate[:-1]) / 2.0
-    return yaw0 + np.concatenate([[0.0], np.cumsum(increments)])
-
-
-def yaw_increments(t_rate: np.ndarray, rate: np.ndarray, t_epochs: np.ndarray) -> np.ndarray:
-    """Δψ (rad, CCW) between consecutive epochs, from the integrated rate interpolated at the
-    epoch times; epochs outside the rate record see no rotation there. (N − 1,)."""
-    yaw = integrate_yaw_rate(t_rate, rate)
-    return np.diff(np.interp(np.asarray(t_epochs, dtype=float), t_rate, yaw))
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.timeseries import increments, travelled_distance
+from vo_doppler.model.trajectory import Trajectory
 
 
 @dataclass(frozen=True)
@@ -47,6 +34,13 @@ class DeadReckoning:
     @property
     def path_length(self) -> float:
         return float(np.sum(np.hypot(np.diff(self.east), np.diff(self.north))))
+
+    def trajectory(self, up: float = 0.0) -> Trajectory:
+        """Vehicle poses in ENU at height ``up`` (m), the yaw a rotation about up."""
+        positions = np.column_stack([self.east, self.north, np.full(len(self.t), up)])
+        return Trajectory(
+            self.t, positions, Rotation.from_euler("z", np.asarray(self.yaw)[:, None])
+        )
 
 
 def dead_reckon(
@@ -81,3 +75,11 @@ def track_yaw(east: np.ndarray, north: np.ndarray, min_step_m: float = 1.0) -> n
     dn = np.diff(np.asarray(north, dtype=float))
     yaw = np.where(np.hypot(de, dn) >= min_step_m, np.arctan2(dn, de), np.nan)
     return np.concatenate([yaw, [np.nan]])
+
+
+def wheel_gyro_track(speed: SensorSeries, yaw_rate: SensorSeries, t: np.ndarray) -> Trajectory:
+    """Planar wheel + gyro dead reckoning (Eq. 15–17) at times ``t`` inside both records,
+    starting at the origin facing east (yaw 0)."""
+    steps = np.diff(travelled_distance(speed.t, speed.value, t))
+    turns = increments(yaw_rate.t, yaw_rate.value, t)
+    return dead_reckon(t, steps, turns, 0.0).trajectory()

@@ -20,7 +20,6 @@ from vo_doppler.lowcost.dead_reckoning import (
     DeadReckoning,
     dead_reckon,
     track_yaw,
-    yaw_increments,
 )
 from vo_doppler.lowcost.drift import (
     VARIANTS,
@@ -41,6 +40,7 @@ from vo_doppler.lowcost.static_bias import (
     static_bias,
 )
 from vo_doppler.lowcost.threshold_filter import threshold_filter
+from vo_doppler.model.timeseries import increments
 
 log = logging.getLogger(__name__)
 
@@ -303,7 +303,9 @@ def run_deadreckon(
         model.combined, rates.omega1, rates.omega2, model.eps0["combined"], model.h
     )
     for name, rate in rates_by_variant.items():
-        dr = dead_reckon(epochs, steps, yaw_increments(rates.t, rate, epochs), yaw0, start)
+        dr = dead_reckon(
+            epochs, steps, increments(rates.t, rate, epochs, outside="hold"), yaw0, start
+        )
         error = heading_error(dr.yaw[valid], reference_yaw[valid])
         result.trajectories[name] = dr
         result.rows.append(

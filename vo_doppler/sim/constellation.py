@@ -24,9 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.gnss.ephemeris import MU, OMEGA_E
-from vo_doppler.gnss.gpstime import SECONDS_PER_WEEK, calendar_to_gps_seconds, time_of_week
-from vo_doppler.io.rinex_nav import KEPLER_FIELDS, Navigation, NavRecords
+from vo_doppler.io.rinex_nav import KEPLER_FIELDS
 from vo_doppler.io.rinex_write import KeplerRecord, rounded_nav_value
+from vo_doppler.model.gpstime import SECONDS_PER_WEEK, calendar_to_gps_seconds, time_of_week
+from vo_doppler.model.navigation import Navigation, NavRecords
 
 REFERENCE_EPOCH = float(calendar_to_gps_seconds(2025, 3, 14, 0, 0, 0))
 """GPS seconds of the epoch at which slot phases and right ascensions are defined."""

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from vo_doppler.model.camera import Camera
 from vo_doppler.sim.scene import Scene
-from vo_doppler.vo.camera import Camera
 
 NEAR_M = 0.05
 """Near clipping distance along the optical axis."""

@@ -11,7 +11,7 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     sequence.yaml            manifest (schema below)
     image_0/000000.png …     grey frames (``camera.fps``, default 15 Hz; .png or .jpg)
     times.txt                one frame time per line, camera clock (s, first frame at 0)
-    calib.yaml               camera calibration (Camera.to_yaml: intrinsics + camera→vehicle),
+    calib.yaml               camera calibration (write_camera_yaml: intrinsics + camera→vehicle),
                              exact by default; ``calib_focal_error`` / ``calib_principal_offset_px``
                              write a deliberately wrong one (true values in ``truth.camera``)
     gnss/rover.obs           RINEX 3.04 observations, 20 Hz: C1C D1C S1C, GPS + Galileo
@@ -58,7 +58,11 @@ import yaml
 from rich.progress import track
 
 from vo_doppler.geo import EnuFrame
+from vo_doppler.io.calibration import write_camera_yaml
 from vo_doppler.io.rinex_write import write_nav, write_obs
+from vo_doppler.io.trajectory import write_tum
+from vo_doppler.model.camera import Camera
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.can_bus import (
     DBC_PATH,
     WHEEL_SPEED_SIGNALS,
@@ -90,8 +94,6 @@ from vo_doppler.sim.vo_sequence import (
     render_frames,
     synthetic_camera,
 )
-from vo_doppler.trajectory import Trajectory, write_tum
-from vo_doppler.vo.camera import Camera
 
 log = logging.getLogger(__name__)
 
@@ -290,7 +292,7 @@ def simulate_urban_canyon(
     camera_clock = np.arange(n_frames) / config.fps
     camera_offset = t0 + CAMERA_START_DELAY_S
     np.savetxt(out / "times.txt", camera_clock, fmt="%.6f")
-    written_camera(camera, config).to_yaml(out / "calib.yaml")
+    write_camera_yaml(out / "calib.yaml", written_camera(camera, config))
     if config.render:
         _render(out, config, scene, camera, vehicle(camera_clock + camera_offset), progress)
     seconds["camera"] = time.perf_counter() - clock

@@ -8,7 +8,8 @@ camera → vehicle extrinsic of the calibration (default: forward-looking, 1.5 m
 
 Files written by :func:`generate_vo_sequence` (``out_dir``):
 ``image_0/000000.png …`` grey frames (or ``.jpg``); ``times.txt`` (one time in seconds per line);
-``calib.yaml`` (camera YAML, :meth:`Camera.to_yaml`); ``ground_truth_camera.kitti`` and
+``calib.yaml`` (camera YAML, :func:`~vo_doppler.io.calibration.write_camera_yaml`);
+``ground_truth_camera.kitti`` and
 ``ground_truth_camera.tum`` (camera poses in the frame of the first camera, OpenCV axes — the
 convention of the VO output); ``ground_truth.tum`` (vehicle poses in the ENU world frame of the
 city); ``speed.csv`` (``t,speed_mps`` at the frame times).
@@ -26,10 +27,12 @@ import cv2
 import numpy as np
 from rich.progress import track
 
+from vo_doppler.io.calibration import write_camera_yaml
+from vo_doppler.io.trajectory import write_kitti, write_tum
+from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD, Camera
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.render import Renderer
 from vo_doppler.sim.scene import CityLayout, Scene, city_scene
-from vo_doppler.trajectory import Trajectory, write_kitti, write_tum
-from vo_doppler.vo.camera import CAMERA_TO_VEHICLE_FORWARD, Camera
 
 log = logging.getLogger(__name__)
 
@@ -335,7 +338,7 @@ def generate_vo_sequence(
 def write_sequence_files(out: Path, plan: VoPlan) -> None:
     """Times, calibration, ground-truth poses and speed of a plan (everything but the images)."""
     np.savetxt(out / "times.txt", plan.times, fmt="%.6f")
-    plan.camera.to_yaml(out / "calib.yaml")
+    write_camera_yaml(out / "calib.yaml", plan.camera)
     camera_gt = Trajectory.from_matrices(plan.times, plan.T_first_camera)
     write_kitti(out / "ground_truth_camera.kitti", camera_gt)
     write_tum(out / "ground_truth_camera.tum", camera_gt)

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.trajectory import Trajectory
-from vo_doppler.vo.camera import Camera
+from vo_doppler.model.camera import Camera
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.odometry import VisualOdometry, VoStats
 from vo_doppler.vo.scale import metric_positions

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vo_doppler.errors import InputError
-from vo_doppler.vo.camera import Camera
+from vo_doppler.model.camera import Camera
 from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.geometry import (
     camera_center,

@@ -15,24 +15,9 @@ import logging
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.model.timeseries import travelled_distance
 
 log = logging.getLogger(__name__)
-
-
-def travelled_distance(speed_t: np.ndarray, speed: np.ndarray, query_t: np.ndarray) -> np.ndarray:
-    """Distance travelled since ``speed_t[0]`` at each query time (speed held beyond the ends)."""
-    speed_t = np.asarray(speed_t, dtype=float)
-    speed = np.asarray(speed, dtype=float)
-    cumulative = np.concatenate(
-        [[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(speed_t))]
-    )
-    query_t = np.asarray(query_t, dtype=float)
-    inside = np.interp(query_t, speed_t, cumulative)
-    before = query_t < speed_t[0]
-    after = query_t > speed_t[-1]
-    inside[before] = (query_t[before] - speed_t[0]) * speed[0]
-    inside[after] = cumulative[-1] + (query_t[after] - speed_t[-1]) * speed[-1]
-    return inside
 
 
 SCALE_FROM_STEPS = 30
@@ -64,7 +49,7 @@ def metric_positions(
     """
     frame_t = np.asarray(frame_t, dtype=float)
     outside = (frame_t < speed_t[0]) | (frame_t > speed_t[-1])
-    distance = np.diff(travelled_distance(speed_t, speed, frame_t))
+    distance = np.diff(travelled_distance(speed_t, speed, frame_t, outside="extend"))
     centres = poses_wc[:, :3, 3]
     steps = np.diff(centres, axis=0)
     lengths = np.linalg.norm(steps, axis=1)

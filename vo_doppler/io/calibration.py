@@ -1,69 +1,14 @@
-"""Pinhole camera with OpenCV distortion, read from KITTI ``calib.txt`` or an OpenCV/Kalibr YAML.
-
-Camera frame: OpenCV (x right, y down, z forward). ``T_vehicle_camera`` maps camera
-coordinates to vehicle coordinates (vehicle: x forward, y left, z up).
-"""
+"""Camera calibration files: KITTI ``calib.txt`` rows and OpenCV/Kalibr-style YAML."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import yaml
 
 from vo_doppler.errors import InputError
-
-CAMERA_TO_VEHICLE_FORWARD = np.array(
-    [
-        [0.0, 0.0, 1.0, 0.0],
-        [-1.0, 0.0, 0.0, 0.0],
-        [0.0, -1.0, 0.0, 0.0],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-)
-"""Default extrinsic of a forward-looking camera: camera z → vehicle x, x → −y, y → −z."""
-
-
-@dataclass
-class Camera:
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-    width: int = 0
-    height: int = 0
-    distortion: np.ndarray = field(default_factory=lambda: np.zeros(5))
-    T_vehicle_camera: np.ndarray = field(default_factory=lambda: CAMERA_TO_VEHICLE_FORWARD.copy())
-
-    @property
-    def K(self) -> np.ndarray:
-        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
-
-    @property
-    def has_distortion(self) -> bool:
-        return bool(np.any(np.asarray(self.distortion) != 0.0))
-
-    def project(self, points_camera: np.ndarray) -> np.ndarray:
-        """Project camera-frame points (N, 3) to pixels (N, 2), ignoring distortion."""
-        p = np.asarray(points_camera, dtype=float)
-        return np.column_stack(
-            [self.fx * p[:, 0] / p[:, 2] + self.cx, self.fy * p[:, 1] / p[:, 2] + self.cy]
-        )
-
-    def to_yaml(self, path: str | Path) -> None:
-        data = {
-            "model": "pinhole",
-            "fx": self.fx,
-            "fy": self.fy,
-            "cx": self.cx,
-            "cy": self.cy,
-            "width": self.width,
-            "height": self.height,
-            "distortion": [float(v) for v in np.asarray(self.distortion).ravel()],
-            "T_vehicle_camera": np.asarray(self.T_vehicle_camera).tolist(),
-        }
-        Path(path).write_text(yaml.safe_dump(data, sort_keys=False))
+from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD, Camera
 
 
 def read_kitti_calib(path: str | Path, row: str = "P0", width: int = 0, height: int = 0) -> Camera:
@@ -141,3 +86,19 @@ def read_camera(path: str | Path) -> Camera:
     if path.suffix.lower() in {".yaml", ".yml"}:
         return read_yaml_calib(path)
     return read_kitti_calib(path)
+
+
+def write_camera_yaml(path: str | Path, camera: Camera) -> None:
+    """Write the YAML that :func:`read_yaml_calib` reads back."""
+    data = {
+        "model": "pinhole",
+        "fx": camera.fx,
+        "fy": camera.fy,
+        "cx": camera.cx,
+        "cy": camera.cy,
+        "width": camera.width,
+        "height": camera.height,
+        "distortion": [float(v) for v in np.asarray(camera.distortion).ravel()],
+        "T_vehicle_camera": np.asarray(camera.T_vehicle_camera).tolist(),
+    }
+    Path(path).write_text(yaml.safe_dump(data, sort_keys=False))

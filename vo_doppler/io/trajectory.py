@@ -1,73 +1,16 @@
-"""Timestamped 6-DoF trajectories and their TUM / KITTI file formats.
-
-A pose maps body coordinates to world coordinates: p_world = R @ p_body + t.
-TUM rows are ``t x y z qx qy qz qw``; KITTI rows are the 3×4 matrix [R | t] row-major
-(KITTI files carry no time, so times come from elsewhere or default to the row index).
+"""Trajectory files: TUM rows ``t x y z qx qy qz qw`` and KITTI rows (the 3×4 matrix [R | t]
+row-major; KITTI files carry no time, so times come from elsewhere or default to the row index).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
-
-
-@dataclass
-class Trajectory:
-    """Poses at times ``t`` (N,), positions (N, 3) and orientations as scipy Rotations (N)."""
-
-    t: np.ndarray
-    positions: np.ndarray
-    orientations: Rotation
-
-    def __post_init__(self) -> None:
-        self.t = np.asarray(self.t, dtype=float).reshape(-1)
-        self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 3)
-        n = len(self.t)
-        if len(self.positions) != n or len(self.orientations) != n:
-            raise ValueError(
-                f"trajectory arrays disagree: {n} times, {len(self.positions)} positions, "
-                f"{len(self.orientations)} orientations"
-            )
-
-    def __len__(self) -> int:
-        return len(self.t)
-
-    @classmethod
-    def from_matrices(cls, t: np.ndarray, poses: np.ndarray) -> Trajectory:
-        """Build from (N, 4, 4) or (N, 3, 4) pose matrices."""
-        poses = np.asarray(poses, dtype=float)
-        return cls(t, poses[:, :3, 3], Rotation.from_matrix(poses[:, :3, :3]))
-
-    @property
-    def matrices(self) -> np.ndarray:
-        """Poses as (N, 4, 4) homogeneous matrices."""
-        out = np.tile(np.eye(4), (len(self), 1, 1))
-        if len(self):
-            out[:, :3, :3] = self.orientations.as_matrix()
-        out[:, :3, 3] = self.positions
-        return out
-
-    @property
-    def path_length(self) -> float:
-        return float(np.sum(np.linalg.norm(np.diff(self.positions, axis=0), axis=1)))
-
-    def cumulative_distance(self) -> np.ndarray:
-        steps = np.linalg.norm(np.diff(self.positions, axis=0), axis=1)
-        return np.concatenate([[0.0], np.cumsum(steps)])
-
-    def transformed(self, rotation: np.ndarray, translation: np.ndarray, scale: float = 1.0):
-        """Apply the similarity x ↦ s·R·x + t to every pose (orientations are rotated by R)."""
-        rot = Rotation.from_matrix(np.asarray(rotation, dtype=float))
-        positions = scale * self.positions @ np.asarray(rotation).T + np.asarray(translation)
-        return Trajectory(self.t.copy(), positions, rot * self.orientations)
-
-    def subset(self, index) -> Trajectory:
-        return Trajectory(self.t[index], self.positions[index], self.orientations[index])
+from vo_doppler.model.trajectory import Trajectory
 
 
 def _read_numeric_rows(path: Path, n_columns: int, what: str) -> np.ndarray:

@@ -1,0 +1,126 @@
+"""Heading correction of vehicle poses by an absolute heading: which headings may correct, and
+the method ([TK18] Eq. 11–13 window, or the Kalman blend (B1)–(B4)), chosen in one place."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading
+from vo_doppler.fusion.heading_correction import correct_heading
+from vo_doppler.fusion.result import CorrectionResult
+from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.trajectory import Trajectory
+
+CORRECTION_METHODS = ("kalman", "window")
+REFERENCES = ("course", "orientation")
+TC_MAX_SIGMA = np.radians(2.0)
+
+
+@dataclass
+class CorrectionConfig:
+    """How absolute headings correct the VO (angles in rad)."""
+
+    method: str = "kalman"
+    """'kalman': the adaptive blend (B1)–(B4) (smoother; ``blend.smooth=False`` is causal);
+    'window': [TK18] sec. 3.6, Eq. 11–13."""
+    reference: str = "course"
+    """What the absolute heading is compared with: the VO's 'course' (direction of travel, as a
+    Doppler heading is) or its 'orientation' yaw ([TK18] sec. 3.6 as written). The course is
+    immune to camera-calibration and extrinsic yaw errors that skew the VO's motion."""
+    window_s: float = 2.0
+    """The window method's W."""
+    gate: float = 0.0
+    """Window method: if > 0, absolute headings this far from the corrected VO heading are not
+    used. Off by default: a wrong first heading would then lock out the right ones."""
+    tc_max_sigma: float = TC_MAX_SIGMA
+    """Tightly coupled headings with a larger standard deviation do not correct."""
+    blend: BlendConfig = field(default_factory=BlendConfig)
+
+    def __post_init__(self) -> None:
+        if self.method not in CORRECTION_METHODS:
+            raise ValueError(f"unknown correction method {self.method!r} {CORRECTION_METHODS}")
+        if self.reference not in REFERENCES:
+            raise ValueError(f"reference must be 'course' or 'orientation', not {self.reference!r}")
+
+
+@dataclass
+class AbsoluteHeading:
+    """Absolute yaw per GNSS epoch with its validity, standard deviation (NaN: unknown, the
+    blend's default) and error-correlation time (s; 0 for single-epoch headings)."""
+
+    t: np.ndarray
+    yaw: np.ndarray
+    valid: np.ndarray
+    sigma: np.ndarray | None = None
+    correlation_s: np.ndarray | float = 0.0
+
+
+HEADING_SOURCES = ("tc", "conv", "tc+conv")
+
+
+def usable_tight_heading(table: HeadingTable, max_sigma: float = TC_MAX_SIGMA) -> np.ndarray:
+    """Epochs whose tightly coupled heading may correct: available, reliable, σ < ``max_sigma``."""
+    precise = np.nan_to_num(table.sigma_tc, nan=np.inf) < max_sigma
+    return table.tc_available & table.tc_reliable & precise
+
+
+def tight_absolute_heading(table: HeadingTable, config: CorrectionConfig) -> AbsoluteHeading:
+    """The usable tightly coupled headings; their errors are correlated over the solver's
+    window."""
+    usable = usable_tight_heading(table, config.tc_max_sigma)
+    return AbsoluteHeading(table.t, table.yaw_tc, usable, table.sigma_tc, table.tc_window_s)
+
+
+def conventional_absolute_heading(table: HeadingTable) -> AbsoluteHeading:
+    """The valid conventional (single-epoch Doppler velocity) headings."""
+    return AbsoluteHeading(table.t, table.yaw_conv, table.conv_valid, table.sigma_conv)
+
+
+def absolute_heading(table: HeadingTable, source: str, config: CorrectionConfig) -> AbsoluteHeading:
+    """The headings of ``source``: 'tc' usable tightly coupled ones, 'conv' conventional ones,
+    'tc+conv' the former where usable, else the latter (each with its σ and correlation time)."""
+    if source not in HEADING_SOURCES:
+        raise ValueError(f"unknown heading source {source!r} ({', '.join(HEADING_SOURCES)})")
+    tight = tight_absolute_heading(table, config)
+    conventional = conventional_absolute_heading(table)
+    if source == "tc":
+        return tight
+    if source == "conv":
+        return conventional
+    use_tight = tight.valid
+    return AbsoluteHeading(
+        table.t,
+        np.where(use_tight, tight.yaw, conventional.yaw),
+        use_tight | conventional.valid,
+        np.where(use_tight, tight.sigma, conventional.sigma),
+        np.where(use_tight, tight.correlation_s, conventional.correlation_s),
+    )
+
+
+def correct(
+    vehicle: Trajectory, heading: AbsoluteHeading, config: CorrectionConfig
+) -> CorrectionResult:
+    """Correct vehicle poses (level world) by ``config.method``."""
+    if config.method == "kalman":
+        return blend_heading(
+            vehicle,
+            heading.t,
+            heading.yaw,
+            heading.sigma,
+            heading.valid,
+            heading.correlation_s,
+            config.blend,
+            config.reference,
+        )
+    return correct_heading(
+        vehicle,
+        heading.t,
+        heading.yaw,
+        heading.valid,
+        config.window_s,
+        max_gap_s=config.blend.max_gap_s,
+        gate_rad=config.gate if config.gate > 0 else None,
+        reference=config.reference,
+    )

@@ -1,0 +1,75 @@
+"""The heading table: one row per GNSS epoch with every heading and calibration of the epoch."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.geo import yaw_to_course
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.timeseries import hold
+
+DEFAULT_TC_WINDOW_S = 2.0
+"""The tight heading's window where a heading file does not state its own."""
+
+
+@dataclass
+class HeadingTable:
+    """One row per GNSS epoch. Yaw in rad counter-clockwise from east (NaN when unavailable)."""
+
+    t: np.ndarray
+    yaw_tc: np.ndarray
+    sigma_tc: np.ndarray
+    tc_reliable: np.ndarray
+    n_obs_window: np.ndarray
+    n_sat_epoch: np.ndarray
+    yaw_conv: np.ndarray
+    conv_valid: np.ndarray
+    gyro_bias: np.ndarray
+    wheel_scale: np.ndarray
+    rejected_rows: np.ndarray | None = None
+    """Doppler rows of the window rejected as biased (NLOS) by the tightly coupled solver."""
+    tc_verifiable: np.ndarray | None = None
+    """A bias on any satellite the tightly coupled heading used would have shown in the
+    residuals (False where it could hide, and where the heading is unavailable)."""
+    sigma_conv: np.ndarray | None = None
+    """Standard deviation (rad) of the conventional heading, NaN where unknown or invalid."""
+    tc_window_s: float = DEFAULT_TC_WINDOW_S
+    """The tightly coupled solver's window (s): its headings' errors are correlated over it."""
+
+    def __post_init__(self) -> None:
+        n = len(self.t)
+        if self.rejected_rows is None:
+            self.rejected_rows = np.zeros(n, dtype=int)
+        if self.tc_verifiable is None:
+            self.tc_verifiable = np.zeros(n, dtype=bool)
+        if self.sigma_conv is None:
+            self.sigma_conv = np.full(n, np.nan)
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    @property
+    def tc_available(self) -> np.ndarray:
+        return np.isfinite(self.yaw_tc)
+
+    @property
+    def course_tc(self) -> np.ndarray:
+        """Tightly coupled heading as course (rad, clockwise from north), NaN if unavailable."""
+        return np.where(self.tc_available, yaw_to_course(np.nan_to_num(self.yaw_tc)), np.nan)
+
+    @property
+    def course_conv(self) -> np.ndarray:
+        return np.where(self.conv_valid, yaw_to_course(np.nan_to_num(self.yaw_conv)), np.nan)
+
+    def calibrated_speed(self, wheel: SensorSeries) -> SensorSeries:
+        """Wheel speed × the wheel scale current at each sample (held between epochs and
+        beyond the first and last epoch)."""
+        scale = hold(self.t, self.wheel_scale, wheel.t, outside="hold")
+        return SensorSeries(wheel.t, wheel.value * scale, "speed", "m/s")
+
+    def calibrated_yaw_rate(self, yaw_rate: SensorSeries) -> SensorSeries:
+        """Yaw rate minus the gyro bias current at each sample (held as the wheel scale is)."""
+        bias = hold(self.t, self.gyro_bias, yaw_rate.t, outside="hold")
+        return SensorSeries(yaw_rate.t, yaw_rate.value - bias, "yaw rate", "rad/s")

@@ -1,0 +1,47 @@
+"""A recording: what one run of the main job reads, already on GPS time and in SI units."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from vo_doppler.geo import EnuFrame
+from vo_doppler.model.camera import Camera
+from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.observations import Observations
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.trajectory import Trajectory
+
+
+@dataclass
+class Sequence:
+    """Images and camera, GNSS observations and navigation, vehicle signals, the local ENU
+    frame, the antenna lever arm and (when known) the ground truth of one recording.
+
+    Every time is GPS seconds: the reader applied each sensor's clock offset (kept in
+    ``clock_offsets_s`` by sensor name for the record).
+    """
+
+    name: str
+    image_paths: list[Path]
+    image_times: np.ndarray
+    camera: Camera | None
+    observations: Observations
+    navigation: Navigation
+    yaw_rate: SensorSeries
+    """Counter-clockwise positive, rad/s."""
+    wheel_speed: SensorSeries
+    """Vehicle speed from the wheels, m/s (before the wheel-scale calibration)."""
+    enu: EnuFrame
+    truth: Trajectory | None = None
+    """Vehicle poses in the ENU frame, if known."""
+    antenna_lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """GNSS antenna in the vehicle frame (x forward, y left, z up) from the vehicle origin (m)."""
+    clock_offsets_s: dict[str, float] = field(default_factory=dict)
+    """GPS time − sensor time per sensor ('camera', 'can', …) as the manifest gave it."""
+
+    @property
+    def has_camera(self) -> bool:
+        return self.camera is not None and len(self.image_paths) > 0

@@ -1,0 +1,223 @@
+"""The main job on one recording: GNSS → calibration and tight heading → VO → correction.
+
+Stages (docs/design.md, "The main job"):
+
+1. GNSS: SPP positions and the conventional Doppler velocity ([TK18] sec. 3.2) with the
+   Doppler rows behind it.
+2. Calibration ([TK18] sec. 3.3–3.4) and the tightly coupled heading ([TK18] sec. 3.5), epoch
+   by epoch: the wheel scale and gyro bias current at each epoch, the heading of every epoch's
+   window.
+3. VO on the images with metric steps from the calibrated wheel speed; its camera poses become
+   vehicle poses once (:func:`vo_doppler.vo.frames.vehicle_trajectory`).
+4. Heading correction of the VO by the tightly coupled heading (the adaptive blend by default,
+   [TK18] Eq. 11–13 on request); the conventional heading gives a second corrected trajectory.
+5. A dead-reckoning trajectory ([KZ] Eq. 15–17) from the calibrated wheel speed and gyro,
+   corrected the same way.
+
+All trajectories are vehicle poses (x forward, y left, z up) in the sequence's ENU frame, on GPS
+time. A recording without a camera runs every pipeline that needs none.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from vo_doppler.fusion.correction import (
+    CorrectionConfig,
+    conventional_absolute_heading,
+    correct,
+    tight_absolute_heading,
+    usable_tight_heading,
+)
+from vo_doppler.geo import EnuFrame, yaw_of
+from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
+from vo_doppler.heading.from_gnss import heading_from_gnss
+from vo_doppler.heading.pipeline import HeadingPipelineConfig
+from vo_doppler.io.images import read_image
+from vo_doppler.lowcost.dead_reckoning import wheel_gyro_track
+from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.observations import Observations
+from vo_doppler.model.sequence import Sequence
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.vo.batch import VoOutput, run_visual_odometry
+from vo_doppler.vo.config import VoConfig
+from vo_doppler.vo.frames import vehicle_trajectory
+
+log = logging.getLogger(__name__)
+
+
+class Pipeline(StrEnum):
+    """The trajectories of a run (their values are the file and summary keys)."""
+
+    VO = "vo"
+    VO_GPS_CONV = "vo_gps_conv"
+    VO_GPS_TC = "vo_gps_tc"
+    DR_GPS_TC = "dr_gps_tc"
+
+
+@dataclass
+class RunConfig:
+    """Everything :func:`run_sequence` can be told (SI units, radians)."""
+
+    systems: str = "GREJC"
+    elevation_mask: float = np.radians(10.0)
+    heading: HeadingPipelineConfig = field(default_factory=HeadingPipelineConfig)
+    vo: VoConfig = field(default_factory=VoConfig)
+    correction: CorrectionConfig = field(default_factory=CorrectionConfig)
+    dead_reckoning_rate_hz: float = 20.0
+
+
+@dataclass
+class RunResult:
+    gnss: GnssVelocityResult
+    heading: HeadingTable
+    vo: VoOutput | None
+    """None for a recording without a camera."""
+    calibrated_speed: SensorSeries
+    trajectories: dict[Pipeline, Trajectory]
+    """Vehicle poses in ENU."""
+    start_enu: np.ndarray
+    tc_usable: np.ndarray
+    """Epochs whose tightly coupled heading was allowed to correct."""
+
+
+def start_position(
+    gnss: GnssVelocityResult, obs: Observations, enu: EnuFrame, span_s: float = 5.0
+) -> np.ndarray:
+    """Median SPP position (ENU) over the first ``span_s`` seconds of valid fixes; without any
+    fix, the RINEX header's approximate position; without that, the ENU origin."""
+    spp = gnss.spp
+    valid = np.flatnonzero(spp.valid)
+    if valid.size:
+        near = valid[spp.t[valid] <= spp.t[valid[0]] + span_s]
+        return np.median(enu.ecef_to_enu(spp.position_ecef[near]), axis=0)
+    approx = obs.header.approx_position
+    if approx is not None and np.all(np.isfinite(approx)) and np.linalg.norm(approx) > 6.0e6:
+        log.warning("no SPP fix: the trajectories start at the RINEX approximate position")
+        return enu.ecef_to_enu(np.asarray(approx, dtype=float))
+    log.warning("no SPP fix and no approximate position: the trajectories start at the origin")
+    return np.zeros(3)
+
+
+def level_with_yaw(trajectory: Trajectory, yaw0: float, start: np.ndarray) -> Trajectory:
+    """Rotate vehicle poses (first-vehicle frame) about z by ``yaw0`` and move them to ``start``."""
+    rotation = np.eye(4)
+    rotation[:3, :3] = Rotation.from_euler("z", yaw0).as_matrix()
+    out = rotation @ trajectory.matrices
+    out[:, :3, 3] += start - out[0, :3, 3]
+    return Trajectory.from_matrices(trajectory.t, out)
+
+
+def yaw_at(trajectory: Trajectory, t0: float) -> float:
+    """Yaw of the pose at the first time ≥ ``t0`` (the last pose after the end)."""
+    k = int(np.clip(np.searchsorted(trajectory.t, t0), 0, len(trajectory) - 1))
+    return float(yaw_of(trajectory.matrices[k : k + 1, :3, :3])[0])
+
+
+def first_heading(t: np.ndarray, yaw: np.ndarray, valid: np.ndarray) -> tuple[float, float]:
+    """Time and yaw of the first valid absolute heading (NaNs when there is none)."""
+    usable = np.flatnonzero(valid & np.isfinite(yaw))
+    if usable.size == 0:
+        return float("nan"), float("nan")
+    return float(t[usable[0]]), float(yaw[usable[0]])
+
+
+def initial_heading(table: HeadingTable, tc_usable: np.ndarray, t_fallback: float):
+    """Time and yaw that start every trajectory: the first usable tightly coupled heading,
+    else the first conventional one, else east at ``t_fallback`` (with a warning)."""
+    t0, yaw0 = first_heading(table.t, table.yaw_tc, tc_usable)
+    if not np.isfinite(yaw0):
+        t0, yaw0 = first_heading(table.t, table.yaw_conv, table.conv_valid)
+    if not np.isfinite(yaw0):
+        log.warning("no absolute heading at any epoch: the trajectories start facing east")
+        t0, yaw0 = t_fallback, 0.0
+    return t0, yaw0
+
+
+def correct_all(
+    sequence: Sequence,
+    table: HeadingTable,
+    vo_vehicle: Trajectory | None,
+    speed: SensorSeries,
+    start: np.ndarray,
+    config: RunConfig,
+) -> dict[Pipeline, Trajectory]:
+    """The VO alone, the VO corrected by the conventional and by the tightly coupled heading,
+    and dead reckoning corrected by the tightly coupled heading (vehicle poses, ENU).
+
+    Every trajectory starts at ``start`` with the first absolute heading (tightly coupled, else
+    conventional), matched at its own time. Only usable tightly coupled headings correct.
+    """
+    yaw_rate = table.calibrated_yaw_rate(sequence.yaw_rate)
+    begin, end = max(speed.t[0], yaw_rate.t[0]), min(speed.t[-1], yaw_rate.t[-1])
+    if vo_vehicle is not None:
+        begin, end = max(begin, vo_vehicle.t[0]), min(end, vo_vehicle.t[-1])
+    t_dr = np.arange(begin, end, 1.0 / config.dead_reckoning_rate_hz)
+    dr = wheel_gyro_track(speed, yaw_rate, t_dr) if len(t_dr) > 1 else None
+    usable = usable_tight_heading(table, config.correction.tc_max_sigma)
+    t_fallback = vo_vehicle.t[0] if vo_vehicle is not None else table.t[0]
+    t0, yaw0 = initial_heading(table, usable, t_fallback)
+    tight = tight_absolute_heading(table, config.correction)
+    conventional = conventional_absolute_heading(table)
+    trajectories: dict[Pipeline, Trajectory] = {}
+    if vo_vehicle is not None:
+        vo_level = level_with_yaw(vo_vehicle, yaw0 - yaw_at(vo_vehicle, t0), start)
+        trajectories[Pipeline.VO] = vo_level
+        trajectories[Pipeline.VO_GPS_CONV] = correct(
+            vo_level, conventional, config.correction
+        ).vehicle
+        trajectories[Pipeline.VO_GPS_TC] = correct(vo_level, tight, config.correction).vehicle
+    if dr is not None:
+        dr_level = level_with_yaw(dr, yaw0 - yaw_at(dr, t0), start)
+        trajectories[Pipeline.DR_GPS_TC] = correct(dr_level, tight, config.correction).vehicle
+    return trajectories
+
+
+def run_sequence(
+    sequence: Sequence,
+    config: RunConfig | None = None,
+    on_frame: Callable[[int], None] | None = None,
+    images: Iterable[np.ndarray] | None = None,
+) -> RunResult:
+    """Run every stage on a recording. ``images`` replaces reading ``sequence.image_paths``
+    (e.g. frames already in memory); ``on_frame`` is called after each VO frame."""
+    config = config or RunConfig()
+    obs = sequence.observations
+    gnss = gnss_velocity(obs, sequence.navigation, config.systems, config.elevation_mask)
+    table = heading_from_gnss(
+        obs.epoch_time,
+        gnss.rows,
+        gnss.velocity,
+        sequence.wheel_speed,
+        sequence.yaw_rate,
+        sequence.enu,
+        config.heading,
+        sequence.antenna_lever_arm_m,
+    )
+    speed = table.calibrated_speed(sequence.wheel_speed)
+    vo = None
+    vo_vehicle = None
+    if sequence.has_camera:
+        frames = images if images is not None else (read_image(p) for p in sequence.image_paths)
+        vo = run_visual_odometry(
+            frames,
+            sequence.image_times,
+            sequence.camera,
+            config.vo,
+            (speed.t, speed.value),
+            on_frame,
+        )
+        vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
+    else:
+        log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
+    start = start_position(gnss, obs, sequence.enu)
+    trajectories = correct_all(sequence, table, vo_vehicle, speed, start, config)
+    usable = usable_tight_heading(table, config.correction.tc_max_sigma)
+    return RunResult(gnss, table, vo, speed, trajectories, start, usable)
