@@ -9,7 +9,7 @@ import pytest
 
 from tests.conftest import require_shared
 from vo_doppler.cli import main
-from vo_doppler.io.gnss_report import SPP_COLUMNS, VELOCITY_COLUMNS
+from vo_doppler.report.gnss import SPP_COLUMNS, VELOCITY_COLUMNS
 
 
 def _read(path):

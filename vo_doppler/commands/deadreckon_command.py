@@ -8,7 +8,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from vo_doppler.io.deadreckon_outputs import drift_table_rows, write_outputs
+from vo_doppler.report.deadreckon import drift_table_rows, write_outputs
 from vo_doppler.io.gps_fixes import read_gps_fixes
 from vo_doppler.io.gyro_csv import read_gyro_csv, read_numeric_csv
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon

@@ -11,7 +11,7 @@ import numpy as np
 from vo_doppler.errors import VoDopplerError
 from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
 from vo_doppler.gnss.spp import solve_spp
-from vo_doppler.io.gnss_report import (
+from vo_doppler.report.gnss import (
     spp_figure,
     velocity_figure,
     write_spp_csv,

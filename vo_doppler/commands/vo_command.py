@@ -12,7 +12,7 @@ from rich.progress import Progress
 
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import associate, evaluate
-from vo_doppler.eval.plots import plot_top_view
+from vo_doppler.report.plots import plot_top_view
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import (
     find_times_file,

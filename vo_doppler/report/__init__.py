@@ -1,0 +1,1 @@
+"""Figures and HTML reports (matplotlib; the only package that draws)."""
