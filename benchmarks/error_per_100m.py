@@ -20,8 +20,8 @@ from rich.table import Table
 
 from benchmarks.sequence_runs import read_with_truth, run_sequences, run_with_progress
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
-from vo_doppler.report.run_report import error_per_100m_figure, trajectories_figure
 from vo_doppler.report.heading_figure import heading_figure
+from vo_doppler.report.run_report import error_per_100m_figure, trajectories_figure
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -6,9 +6,9 @@ import matplotlib
 import numpy as np
 
 from vo_doppler.heading.pipeline import heading_pipeline
-from vo_doppler.report.heading_figure import build_heading_figure, heading_figure
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.report.heading_figure import build_heading_figure, heading_figure
 from vo_doppler.sim.doppler_rows import gyro_from_heading, simulate_doppler
 
 AZIMUTH = [30.0, 110.0, 200.0, 280.0, 330.0]

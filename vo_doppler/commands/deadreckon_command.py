@@ -8,10 +8,10 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from vo_doppler.report.deadreckon import drift_table_rows, write_outputs
 from vo_doppler.io.gps_fixes import read_gps_fixes
 from vo_doppler.io.gyro_csv import read_gyro_csv, read_numeric_csv
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon
+from vo_doppler.report.deadreckon import drift_table_rows, write_outputs
 
 TABLE_HEADERS = ("variant", "drift °/min", "final error °", "gap m", "gap %", "length m")
 

@@ -11,14 +11,14 @@ import numpy as np
 from vo_doppler.errors import VoDopplerError
 from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
 from vo_doppler.gnss.spp import solve_spp
+from vo_doppler.io.rinex_nav import read_nav
+from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
 from vo_doppler.report.gnss import (
     spp_figure,
     velocity_figure,
     write_spp_csv,
     write_velocity_csv,
 )
-from vo_doppler.io.rinex_nav import read_nav
-from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
 
 log = logging.getLogger(__name__)
 

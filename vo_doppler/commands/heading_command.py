@@ -18,12 +18,12 @@ from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConf
 from vo_doppler.heading.tight_heading import TightHeadingConfig
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.heading_csv import write_heading_csv
-from vo_doppler.report.heading_figure import heading_figure
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
 from vo_doppler.model.timeseries import sample
+from vo_doppler.report.heading_figure import heading_figure
 
 log = logging.getLogger(__name__)
 

@@ -16,18 +16,18 @@ from rich.table import Table
 from vo_doppler.commands.vo_command import window_size
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
+from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
+from vo_doppler.fusion.heading_blend import BlendConfig
+from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.io.sequence import read_sequence
+from vo_doppler.io.trajectory import write_tum
+from vo_doppler.report.heading_figure import heading_figure
 from vo_doppler.report.run_report import (
     TABLE_COLUMNS,
     error_per_100m_figure,
     trajectories_figure,
     write_html_report,
 )
-from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
-from vo_doppler.fusion.heading_blend import BlendConfig
-from vo_doppler.io.heading_csv import write_heading_csv
-from vo_doppler.report.heading_figure import heading_figure
-from vo_doppler.io.sequence import read_sequence
-from vo_doppler.io.trajectory import write_tum
 from vo_doppler.run import Pipeline, RunConfig, RunResult, run_sequence
 from vo_doppler.vo.config import VoConfig
 

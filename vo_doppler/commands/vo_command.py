@@ -12,7 +12,6 @@ from rich.progress import Progress
 
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import associate, evaluate
-from vo_doppler.report.plots import plot_top_view
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import (
     find_times_file,
@@ -23,6 +22,7 @@ from vo_doppler.io.images import (
 )
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
 from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
+from vo_doppler.report.plots import plot_top_view
 from vo_doppler.vo.batch import run_visual_odometry
 from vo_doppler.vo.config import VoConfig
 
