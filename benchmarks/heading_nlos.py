@@ -32,7 +32,6 @@ from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
 from vo_doppler.gnss.pipeline import gnss_velocity
-from vo_doppler.heading.from_gnss import heading_rows
 from vo_doppler.heading.pipeline import heading_pipeline
 from vo_doppler.run import RunConfig
 
@@ -67,7 +66,7 @@ def evaluate(folder: Path) -> dict:
     inputs, gnss, truth_yaw = sequence_with_truth(folder)
     config = RunConfig()
     obs = inputs.observations
-    rows = heading_rows(gnss.rows)
+    rows = gnss.rows.in_enu()
     variants = {
         "off": dataclasses.replace(config.heading.tight, outlier_passes=0),
         "on": config.heading.tight,

@@ -27,118 +27,20 @@ import numpy as np
 from matplotlib.figure import Figure
 from rich.console import Console
 from rich.table import Table
-from scipy.optimize import minimize_scalar
-from scipy.spatial import cKDTree
 
-from vo_doppler.geo import EnuFrame
-from vo_doppler.io.can import read_can_motion
-from vo_doppler.io.comma2k19 import read_ground_truth, read_gyro_yaw_rate, read_live_fixes
-from vo_doppler.lowcost.gps_reconstruction import reconstruct_track
-from vo_doppler.lowcost.pipeline import DeadReckonConfig, Reference, run_deadreckon
-from vo_doppler.model.timeseries import cumulative_integral
+from vo_doppler.io.comma2k19 import read_lowcost_inputs
+from vo_doppler.lowcost.evaluation import (
+    block_rate_errors,
+    fitted_time_offset,
+    gps_scatter,
+    heading_run,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_DATA = (
     Path(os.environ.get("VO_DOPPLER_SHARED_DATA", ROOT.parent / "shared" / "data"))
     / "comma2k19_example1"
 )
-
-
-def load(base: Path):
-    truth = read_ground_truth(base)
-    fixes = read_live_fixes(base, truth.gps_minus_mono_s)
-    gyro = read_gyro_yaw_rate(base)
-    can = read_can_motion(
-        base / "can_motion.log", base / "toyota_2017_motion.dbc", yaw_rate="KINEMATICS.YAW_RATE"
-    ).yaw_rate
-    return truth, fixes, gyro, (can.t, can.value)
-
-
-def heading_run(truth, fixes, gyro, can, window_s: float, k: float | None, body: bool = False):
-    start = max(gyro[0][0], can[0][0], fixes.t[0], truth.t[0])
-    config = DeadReckonConfig(
-        k=k,
-        tau_s=window_s,
-        standstill=(start, start + window_s),
-        window_is_standstill=False,
-        drift_window_s=0.0,
-    )
-    if body:
-        reference = Reference(truth.t, truth.body_yaw, "global_pose body yaw")
-    else:
-        reference = Reference(truth.t, truth.yaw, "global_pose course")
-    return run_deadreckon(gyro, can, fixes.as_tuple(), config, reference=reference)
-
-
-def block_rate_errors(t_rate, rate, truth, block_s: float = 5.0) -> np.ndarray:
-    """(sensor − truth) heading change per block divided by its length (rad/s): the error of a
-    block-mean ε0 taken there."""
-    heading = cumulative_integral(t_rate, rate)
-    edges = np.arange(max(t_rate[0], truth.t[0]), min(t_rate[-1], truth.t[-1]) - block_s, block_s)
-    return np.array(
-        [
-            (
-                np.interp(a + block_s, t_rate, heading)
-                - np.interp(a, t_rate, heading)
-                - np.interp(a + block_s, truth.t, truth.yaw)
-                + np.interp(a, truth.t, truth.yaw)
-            )
-            / block_s
-            for a in edges
-        ]
-    )
-
-
-def scatter_metrics(enu_xy: np.ndarray, truth_xy: np.ndarray, tree: cKDTree) -> dict:
-    """Errors of points against time-matched truth, and their cross-track distance to the path."""
-    error = enu_xy - truth_xy
-    cross, _ = tree.query(enu_xy)
-    jitter = np.diff(error, n=2, axis=0)
-    return {
-        "rms_m": float(np.sqrt(np.mean(np.sum(error**2, axis=1)))),
-        "std_about_mean_m": float(np.sqrt(np.mean(np.sum((error - error.mean(0)) ** 2, axis=1)))),
-        "cross_track_rms_m": float(np.sqrt(np.mean(cross**2))),
-        "jitter_rms_m": float(np.sqrt(np.mean(np.sum(jitter**2, axis=1)))),
-    }
-
-
-def gps_scatter(truth, fixes, downsamples, cluster_m):
-    frame = EnuFrame(float(truth.lat[0]), float(truth.lon[0]), float(truth.height[0]))
-    truth_enu = frame.geodetic_to_enu(truth.lat, truth.lon, truth.height)[:, :2]
-    inside = (fixes.t >= truth.t[0]) & (fixes.t <= truth.t[-1])
-    t = fixes.t[inside]
-    at_t = np.column_stack([np.interp(t, truth.t, truth_enu[:, i]) for i in range(2)])
-    fine_t = np.linspace(truth.t[0], truth.t[-1], 20 * len(truth.t))
-    dense = np.column_stack([np.interp(fine_t, truth.t, truth_enu[:, i]) for i in range(2)])
-    tree = cKDTree(dense)
-    raw = frame.geodetic_to_enu(fixes.lat[inside], fixes.lon[inside], 0.0)[:, :2]
-    results = {"raw": scatter_metrics(raw, at_t, tree)}
-    tracks = {}
-    for m in downsamples:
-        track = reconstruct_track(t, fixes.lat[inside], fixes.lon[inside], m, cluster_m)
-        xy = frame.geodetic_to_enu(track.lat, track.lon, 0.0)[:, :2]
-        results[f"reconstructed M={m}"] = scatter_metrics(xy, at_t, tree) | {
-            "kept": len(track.kept)
-        }
-        tracks[m] = xy
-    return results, (t, at_t), raw, tracks
-
-
-def fitted_time_offset(truth, fixes) -> float:
-    """Time shift (s) added to the fix times that minimises their RMS distance to the truth at
-    the shifted times: the offset between the two time bases (an evaluation alignment, like
-    associating timestamps)."""
-    frame = EnuFrame(float(truth.lat[0]), float(truth.lon[0]), float(truth.height[0]))
-    truth_enu = frame.geodetic_to_enu(truth.lat, truth.lon, truth.height)[:, :2]
-    inside = (fixes.t >= truth.t[0] + 1.0) & (fixes.t <= truth.t[-1] - 1.0)
-    fix_enu = frame.geodetic_to_enu(fixes.lat[inside], fixes.lon[inside], 0.0)[:, :2]
-
-    def rms(shift: float) -> float:
-        t = fixes.t[inside] + shift
-        at = np.column_stack([np.interp(t, truth.t, truth_enu[:, i]) for i in range(2)])
-        return float(np.sqrt(np.mean(np.sum((fix_enu - at) ** 2, axis=1))))
-
-    return float(minimize_scalar(rms, bounds=(-1.0, 1.0), method="bounded").x)
 
 
 def scatter_table(title: str, scatter: dict, raw_count: int) -> Table:
@@ -171,7 +73,7 @@ def main(argv=None) -> int:
         print(f"comma2k19 data not found at {args.data}", file=sys.stderr)
         return 1
     console = Console()
-    truth, fixes, gyro, can = load(args.data)
+    truth, fixes, gyro, can = read_lowcost_inputs(args.data)
     out: dict = {"data": str(args.data)}
 
     result = heading_run(truth, fixes, gyro, can, 5.0, None)

@@ -26,9 +26,8 @@ from pathlib import Path
 import numpy as np
 from rich.console import Console
 from rich.table import Table
-from scipy.spatial.transform import Rotation
 
-from vo_doppler.eval.metrics import evaluate
+from vo_doppler.eval.metrics import attitude_roughness_deg, evaluate
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import list_images, read_image, read_times
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
@@ -59,14 +58,6 @@ def write_speed_csv(truth: Trajectory, path: Path) -> None:
         speed = np.r_[steps[0] / dt[0], steps / dt]
     rows = np.column_stack([truth.t, speed])
     np.savetxt(path, rows, delimiter=",", header=f"t,{SPEED_COLUMN}", comments="", fmt="%.9f")
-
-
-def attitude_roughness_deg(truth: Trajectory) -> np.ndarray:
-    """Change of the frame-to-frame rotation at frames 1 … N−2 (deg): the attitude's second
-    difference. A measured attitude jitters; an interpolated one is smooth."""
-    R = truth.orientations.as_matrix()
-    relative = Rotation.from_matrix(np.einsum("nji,njk->nik", R[:-1], R[1:])).as_rotvec()
-    return np.degrees(np.linalg.norm(np.diff(relative, axis=0), axis=1))
 
 
 def travel_direction_deg(trajectory: Trajectory) -> tuple[float, float]:

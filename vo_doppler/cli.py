@@ -6,37 +6,43 @@ Exit codes: 0 success, 1 runtime failure (bad input, failed processing), 2 usage
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
 import sys
 
 from vo_doppler import __version__
-from vo_doppler.commands import (
-    correct_command,
-    deadreckon_command,
-    eval_command,
-    gnss_command,
-    heading_command,
-    run_command,
-    simulate_command,
-    vo_command,
-)
 from vo_doppler.errors import VoDopplerError
 
-SUBCOMMANDS = (
-    eval_command,
-    deadreckon_command,
-    vo_command,
-    gnss_command,
-    correct_command,
-    heading_command,
-    simulate_command,
-    run_command,
-)
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "run": (
+        "run_command",
+        "VO -> calibration -> tightly coupled heading -> correction on a sequence folder",
+    ),
+    "vo": ("vo_command", "monocular visual odometry over an image folder"),
+    "gnss": ("gnss_command", "GNSS Doppler velocity and positions from RINEX"),
+    "heading": ("heading_command", "tightly coupled Doppler-gyro-wheel heading per GNSS epoch"),
+    "correct": ("correct_command", "correct a VO trajectory's heading with Doppler headings"),
+    "eval": ("eval_command", "trajectory errors against ground truth"),
+    "deadreckon": (
+        "deadreckon_command",
+        "low-cost path mapping: two gyros + GPS dead reckoning and drift table",
+    ),
+    "simulate": ("simulate_command", "generate a synthetic multi-sensor sequence"),
+}
+"""Subcommand → (module in ``vo_doppler.commands``, one-line help). A module is imported only
+when its subcommand runs, so ``vo-doppler --help`` loads none of the library."""
 
 log = logging.getLogger("vo_doppler")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def chosen_command(argv: list[str]) -> str | None:
+    """The subcommand named on the command line (the first known name), if any."""
+    return next((word for word in argv if word in SUBCOMMANDS), None)
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser with every subcommand listed; ``command``'s own options are loaded (all of
+    them when ``command`` is "*", for documentation and tests)."""
     parser = argparse.ArgumentParser(
         prog="vo-doppler",
         description="Monocular visual odometry with heading corrected by GNSS Doppler.",
@@ -45,13 +51,17 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more log output")
     parser.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for module in SUBCOMMANDS:
-        module.register(subparsers)
+    for name, (module, summary) in SUBCOMMANDS.items():
+        if command in (name, "*"):
+            importlib.import_module(f"vo_doppler.commands.{module}").register(subparsers, summary)
+        else:
+            subparsers.add_parser(name, help=summary, add_help=False)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(chosen_command(argv))
     args = parser.parse_args(argv)
     level = logging.WARNING if args.quiet else (logging.DEBUG if args.verbose else logging.INFO)
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")

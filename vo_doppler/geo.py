@@ -1,6 +1,6 @@
 """Geodetic, ECEF and local ENU transforms, and yaw/course conversions.
 
-Conventions (DESIGN.md): WGS-84; ENU world frame (x east, y north, z up) anchored at a
+Conventions (docs/design.md): WGS-84; ENU world frame (x east, y north, z up) anchored at a
 geodetic origin; yaw ψ counter-clockwise from east; course clockwise from north, course = 90° − ψ.
 """
 

@@ -1,4 +1,4 @@
-"""``vo-doppler correct TRAJ --heading heading.csv``: VO heading correction (sec. 3.6)."""
+"""``vo-doppler correct TRAJ --heading heading.csv``: VO heading correction ([TK18] sec. 3.6)."""
 
 from __future__ import annotations
 
@@ -28,13 +28,13 @@ from vo_doppler.vo.frames import WORLDS, camera_trajectory, vehicle_trajectory
 log = logging.getLogger(__name__)
 
 
-def register(subparsers) -> None:
+def register(subparsers, summary: str) -> None:
     parser = subparsers.add_parser(
         "correct",
-        help="correct a VO trajectory's heading with Doppler headings",
+        help=summary,
         description="Correct the heading of a VO trajectory (TUM or KITTI, any VO system) with "
         "absolute headings: by the window method (shift to the window's absolute heading and "
-        "rotate the positions about the window's oldest position, sec. 3.6, Eq. 11-13) or by "
+        "rotate the positions about the window's oldest position, [TK18] Eq. 11-13) or by "
         "the Kalman blend (a filter and smoother on the VO heading offset whose noise is fitted "
         "to the drive). Output: vehicle (or camera) poses in an ENU-aligned frame with its "
         "origin at the first position.",
@@ -51,7 +51,7 @@ def register(subparsers) -> None:
         "--correction",
         choices=CORRECTION_METHODS,
         default=CorrectionConfig().method,
-        help="window: the seed's Eq. 11-13; kalman: the adaptive blend (default: %(default)s)",
+        help="window: [TK18] Eq. 11-13; kalman: the adaptive blend (default: %(default)s)",
     )
     parser.add_argument(
         "--causal",
@@ -91,7 +91,7 @@ def register(subparsers) -> None:
         choices=REFERENCES,
         default="course",
         help="compare the absolute heading with the VO's direction of travel (course, default) "
-        "or with its orientation yaw (sec. 3.6 as written)",
+        "or with its orientation yaw ([TK18] sec. 3.6 as written)",
     )
     parser.add_argument("-o", "--output", required=True, help="corrected trajectory (.tum/.kitti)")
     parser.set_defaults(func=run)

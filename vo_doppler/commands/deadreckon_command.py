@@ -9,7 +9,7 @@ from rich.console import Console
 from rich.table import Table
 
 from vo_doppler.io.gps_fixes import read_gps_fixes
-from vo_doppler.io.gyro_csv import read_gyro_csv, read_numeric_csv
+from vo_doppler.io.sensor_csv import read_numeric_csv, read_yaw_rate_csv
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon
 from vo_doppler.report.deadreckon import drift_table_rows, write_outputs
 
@@ -49,13 +49,14 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def register(subparsers) -> None:
+def register(subparsers, summary: str) -> None:
     parser = subparsers.add_parser(
         "deadreckon",
-        help="low-cost path mapping: two gyros + GPS dead reckoning and drift table",
-        description="Combine two yaw-rate sensors (Eq. 7), remove the static bias (Eq. 5-6), "
-        "optionally threshold (Eq. 9), thin and interpolate the GPS (Eq. 10-14), dead-reckon "
-        "(Eq. 15-17) and report the heading drift in deg/min per variant.",
+        help=summary,
+        description="The low-cost path mapping of [KZ]: combine two yaw-rate sensors (Eq. 7), "
+        "remove the static bias (Eq. 5-6), optionally threshold (Eq. 9), thin and interpolate "
+        "the GPS (Eq. 10-14), dead-reckon (Eq. 15-17) and report the heading drift in deg/min "
+        "per variant.",
     )
     parser.add_argument("--gyro1", required=True, help="CSV t,yaw_rate_rad_s (CCW positive)")
     parser.add_argument("--gyro2", required=True, help="CSV t,yaw_rate_rad_s (CCW positive)")
@@ -82,7 +83,7 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--threshold",
         type=float,
-        help="threshold h (rad/s) of Eq. 9; default 3σ of the de-biased standstill rate",
+        help="threshold h (rad/s) of [KZ] Eq. 9; default 3σ of the de-biased standstill rate",
     )
     parser.add_argument("--downsample", type=_positive_int, default=1, help="keep every M-th fix")
     parser.add_argument(
@@ -103,8 +104,8 @@ def _speed_source(args, fixes):
 
 
 def run(args: argparse.Namespace) -> int:
-    gyro1 = read_gyro_csv(args.gyro1)
-    gyro2 = read_gyro_csv(args.gyro2)
+    gyro1 = read_yaw_rate_csv(args.gyro1)
+    gyro2 = read_yaw_rate_csv(args.gyro2)
     fixes = read_gps_fixes(args.gps)
     config = DeadReckonConfig(
         k=args.k,
@@ -116,7 +117,11 @@ def run(args: argparse.Namespace) -> int:
         cluster_m=args.cluster_m,
     )
     result = run_deadreckon(
-        gyro1.as_tuple(), gyro2.as_tuple(), fixes.as_tuple(), config, _speed_source(args, fixes)
+        (gyro1.t, gyro1.value),
+        (gyro2.t, gyro2.value),
+        fixes.as_tuple(),
+        config,
+        _speed_source(args, fixes),
     )
     paths = write_outputs(args.output, result)
 
@@ -135,8 +140,7 @@ def run(args: argparse.Namespace) -> int:
         f"h {np.degrees(model.h):.3g} deg/s; standstill "
         f"{result.prepared.standstill[0]:.2f}–{result.prepared.standstill[1]:.2f} s"
     )
-    skipped = gyro1.report.n_malformed + gyro1.report.n_non_finite
-    skipped += gyro2.report.n_malformed + gyro2.report.n_non_finite
+    skipped = gyro1.n_skipped + gyro2.n_skipped
     console.print(
         f"skipped input rows: gyros {skipped}, GPS {fixes.n_skipped}; GPS gaps "
         f"{result.prepared.report.n_gaps}, duplicate GPS times "

@@ -17,10 +17,10 @@ from vo_doppler.io.trajectory import read_trajectory
 UP_AXES = {"z": (0.0, 0.0, 1.0), "-y": (0.0, -1.0, 0.0), "y": (0.0, 1.0, 0.0)}
 
 
-def register(subparsers) -> None:
+def register(subparsers, summary: str) -> None:
     parser = subparsers.add_parser(
         "eval",
-        help="trajectory errors against ground truth",
+        help=summary,
         description="KITTI-devkit segment errors (translation %%, rotation deg/100 m), final "
         "drift %% of path length, yaw error at the end and ATE RMSE.",
     )

@@ -11,14 +11,10 @@ import numpy as np
 from vo_doppler.errors import VoDopplerError
 from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
 from vo_doppler.gnss.spp import solve_spp
+from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
-from vo_doppler.report.gnss import (
-    spp_figure,
-    velocity_figure,
-    write_spp_csv,
-    write_velocity_csv,
-)
+from vo_doppler.report.gnss import spp_figure, velocity_figure
 
 log = logging.getLogger(__name__)
 
@@ -42,8 +38,11 @@ def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
 
 
-def register(subparsers) -> None:
-    parser = subparsers.add_parser("gnss", help="GNSS Doppler velocity and positions from RINEX")
+def register(subparsers, summary: str) -> None:
+    parser = subparsers.add_parser(
+        "gnss",
+        help=summary,
+    )
     actions = parser.add_subparsers(dest="gnss_command", metavar="ACTION", required=True)
     velocity = actions.add_parser(
         "velocity",

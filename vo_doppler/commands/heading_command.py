@@ -28,13 +28,13 @@ from vo_doppler.report.heading_figure import heading_figure
 log = logging.getLogger(__name__)
 
 
-def register(subparsers) -> None:
+def register(subparsers, summary: str) -> None:
     parser = subparsers.add_parser(
         "heading",
-        help="tightly coupled Doppler-gyro-wheel heading per GNSS epoch",
+        help=summary,
         description="Calibrate wheel scale and gyro bias from the conventional Doppler velocity "
-        "(sec. 3.3-3.4) and estimate the heading from a window of Doppler rows of all "
-        "satellites with the calibrated speed and yaw rate (sec. 3.5). Writes one CSV row per "
+        "([TK18] sec. 3.3-3.4) and estimate the heading from a window of Doppler rows of all "
+        "satellites with the calibrated speed and yaw rate ([TK18] sec. 3.5). Writes a CSV row per "
         "GNSS epoch (headings as course, degrees clockwise from north) and a figure.",
     )
     parser.add_argument("obs", type=Path, help="RINEX observation file")

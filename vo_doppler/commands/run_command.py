@@ -34,10 +34,10 @@ from vo_doppler.vo.config import VoConfig
 log = logging.getLogger(__name__)
 
 
-def register(subparsers) -> None:
+def register(subparsers, summary: str) -> None:
     parser = subparsers.add_parser(
         "run",
-        help="VO -> calibration -> tightly coupled heading -> correction on a sequence folder",
+        help=summary,
         description="Run the main job on a sequence folder (sequence.yaml): monocular VO with "
         "metric scale from the calibrated wheel speed, wheel-scale and gyro-bias calibration "
         "from Doppler, tightly coupled Doppler heading, VO heading correction; evaluates "
@@ -53,13 +53,13 @@ def register(subparsers) -> None:
         choices=("course", "orientation"),
         default="course",
         help="heading correction compares the absolute heading with the VO's course (default) "
-        "or its orientation yaw (sec. 3.6 as written)",
+        "or its orientation yaw ([TK18] sec. 3.6 as written)",
     )
     parser.add_argument(
         "--correction",
         choices=CORRECTION_METHODS,
         default=CorrectionConfig().method,
-        help="heading correction: window (the seed's Eq. 11-13) or kalman (adaptive blend, "
+        help="heading correction: window ([TK18] Eq. 11-13) or kalman (adaptive blend, "
         "filter and smoother on the VO heading offset); default %(default)s",
     )
     parser.add_argument(

@@ -47,12 +47,12 @@ def _triple(text: str) -> tuple:
     return _numbers(text, 3)
 
 
-def register(subparsers) -> None:
+def register(subparsers, summary: str) -> None:
     defaults = UrbanCanyonConfig()
     city = defaults.city
     parser = subparsers.add_parser(
         "simulate",
-        help="generate a synthetic multi-sensor sequence",
+        help=summary,
         description="Drive a car around a closed loop through a city of tall buildings and "
         "write camera images, RINEX 3 observations + navigation, a candump CAN log + DBC, "
         "ground truth and sequence.yaml (deterministic per seed).",

@@ -31,10 +31,10 @@ log = logging.getLogger(__name__)
 CAMERA_UP = np.array([0.0, -1.0, 0.0])
 
 
-def register(subparsers) -> None:
+def register(subparsers, summary: str) -> None:
     parser = subparsers.add_parser(
         "vo",
-        help="monocular visual odometry over an image folder",
+        help=summary,
         description="Track corners, initialise from two views and refine poses and points by "
         "Levenberg–Marquardt bundle adjustment over a sliding window. Writes camera poses in "
         "the first camera's frame (OpenCV axes), one per image.",

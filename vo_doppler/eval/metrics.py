@@ -136,3 +136,11 @@ def associate(estimate: Trajectory, truth: Trajectory, max_dt: float = 0.02) -> 
     )
     ok = np.abs(truth.t[nearer] - estimate.t) <= max_dt
     return estimate.subset(np.flatnonzero(ok)), truth.subset(nearer[ok])
+
+
+def attitude_roughness_deg(truth: Trajectory) -> np.ndarray:
+    """Change of the frame-to-frame rotation at frames 1 … N−2 (deg): the attitude's second
+    difference. A measured attitude jitters; an interpolated one is smooth."""
+    R = truth.orientations.as_matrix()
+    relative = Rotation.from_matrix(np.einsum("nji,njk->nik", R[:-1], R[1:])).as_rotvec()
+    return np.degrees(np.linalg.norm(np.diff(relative, axis=0), axis=1))

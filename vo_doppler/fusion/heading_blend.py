@@ -1,6 +1,6 @@
 """Adaptive heading blend: a 1-D Kalman filter (and RTS smoother) on the VO heading offset.
 
-This is our addition beyond the seed. The seed's correction (sec. 3.6, Eq. 11–13, see
+This is our addition beyond [TK18]. Its correction (sec. 3.6, Eq. 11–13, see
 :mod:`vo_doppler.fusion.heading_correction`) replaces the VO heading by the window's mean
 absolute heading, so a good VO inherits the absolute heading's noise; a fixed blend time
 constant helps a good VO but hurts a drifting one. Here the gain follows from a model of both.
@@ -55,7 +55,7 @@ State: the offset δ = (true course − VO course), a scalar in rad, held unwrap
 
 The corrected trajectory rotates every VO increment by δ at its middle time and every
 orientation by δ at its time, both as a yaw rotation on the world side (pitch and roll kept),
-as Eq. (12)–(13) do with the window's offset; frames as in
+as [TK18] Eq. (12)–(13) do with the window's offset; frames as in
 :func:`vo_doppler.fusion.heading_correction.correct_heading`.
 """
 
@@ -171,7 +171,7 @@ def offset_measurements(
     yaw_direction: np.ndarray,
     max_gap_s: float,
 ) -> OffsetMeasurements:
-    """z of (B2) at the VO direction samples (step middles for the course, as Eq. (11)'s
+    """z of (B2) at the VO direction samples (step middles for the course, as [TK18] Eq. (11)'s
     course reference compares them) that have an absolute heading interpolated on the short
     arc between epochs at most ``max_gap_s`` apart; σ and T_c interpolated alike."""
     ok = np.isfinite(yaw_heading) & np.isfinite(sigma_heading)

@@ -1,12 +1,12 @@
-"""Heading correction of a visual-odometry trajectory with absolute heading (sec. 3.6, Eq. 11–13).
+"""Heading correction of VO by absolute heading ([TK18] sec. 3.6, Eq. 11–13).
 
 Poses are processed in time order. For the window of poses in (t_i − W, t_i]:
 
-* Eq. (11): the offset Δθ is the circular mean of (VO heading − absolute heading) over the
+* [TK18] Eq. (11): the offset Δθ is the circular mean of (VO heading − absolute heading) over the
   poses of the window that have an absolute heading;
-* Eq. (12): the window's headings are shifted by −Δθ (a yaw rotation applied on the world
+* [TK18] Eq. (12): the window's headings are shifted by −Δθ (a yaw rotation applied on the world
   side, so pitch and roll are untouched);
-* Eq. (13): the window's positions are rotated by −Δθ about the window's oldest position.
+* [TK18] Eq. (13): the window's positions are rotated by −Δθ about the window's oldest position.
 
 New VO increments are rotated by the accumulated correction, so the last correction is held
 through gaps in the absolute heading.
@@ -106,14 +106,14 @@ def correct_heading(
     reference: str = "course",
     min_chord_m: float = 0.5,
 ) -> CorrectionResult:
-    """Correct the VO heading with absolute headings (sec. 3.6, Eq. 11–13).
+    """Correct the VO heading with absolute headings ([TK18] sec. 3.6, [TK18] Eq. 11–13).
 
     ``t_heading``/``yaw_heading`` are on the trajectory's clock (shift them beforehand);
     ``valid`` marks the usable samples. With ``gate_rad``, once a first correction has been
     made, absolute headings further than the gate from the corrected VO heading are ignored
     (an innovation gate against wrong but self-consistent absolute solutions).
 
-    ``reference`` is what Eq. (11) compares with the absolute heading: the VO's
+    ``reference`` is what [TK18] Eq. (11) compares with the absolute heading: the VO's
     ``"orientation"`` (vehicle yaw), or its ``"course"``, the direction of the chord of at least
     ``min_chord_m`` ending at each pose (:func:`chord_starts`) compared with the absolute
     heading at the chord's middle time. A Doppler heading is a direction of travel, so "course"

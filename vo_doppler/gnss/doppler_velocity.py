@@ -1,4 +1,4 @@
-"""Conventional Doppler velocity: receiver velocity and clock drift per epoch (DESIGN.md,
+"""Conventional Doppler velocity: receiver velocity and clock drift per epoch (docs/design.md,
 "Conventional Doppler velocity").
 
 Sign convention (RINEX 3.05 sec. 5.2.10: Doppler is positive for approaching satellites):
@@ -17,7 +17,6 @@ exclusion: chi-square test, iterated (``lsq.lsq_with_exclusion``). Fewer than fo
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -26,6 +25,8 @@ from vo_doppler.gnss.ephemeris import transmit_states
 from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.gnss.spp import elevation_azimuth
+from vo_doppler.model.doppler import DopplerRows
+from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations, lookup, row_keys
 
@@ -37,95 +38,11 @@ CN0_DEFAULT_DBHZ = 40.0
 MIN_SATELLITES = 4
 
 
-@dataclass(frozen=True)
-class DopplerRows:
-    """One row per (epoch, satellite, Doppler observable) with everything a Doppler solver needs.
-
-    Flat numpy arrays of length N (vectors N×3, ECEF of the reception epoch):
-    ``t`` GPS s of reception; ``epoch`` index into the observation epochs; ``system``, ``prn``,
-    ``code`` (e.g. 'D1C'); ``wavelength_m``; ``los`` unit vector receiver → satellite;
-    ``sat_position``, ``sat_vel`` (m, m/s, at transmission, rotated to the reception frame);
-    ``sat_clock_drift_mps`` = c·δṫ_s; ``range_rate_mps`` = −λ·D (measured); ``cn0`` dB-Hz (NaN
-    when not logged); ``elevation``/``azimuth`` rad; ``receiver_ecef`` the position used.
-    Model: range_rate = los·(sat_vel − v) + b − sat_clock_drift_mps (b receiver clock drift, m/s).
-    Counts: ``n_no_ephemeris`` rows dropped for lack of a healthy ephemeris (``missing`` lists
-    'SAT@t' once per satellite), ``n_no_wavelength`` (GLONASS channel unknown),
-    ``n_below_mask``.
-    """
-
-    t: np.ndarray
-    epoch: np.ndarray
-    system: np.ndarray
-    prn: np.ndarray
-    code: np.ndarray
-    wavelength_m: np.ndarray
-    los: np.ndarray
-    sat_position: np.ndarray
-    sat_vel: np.ndarray
-    sat_clock_drift_mps: np.ndarray
-    range_rate_mps: np.ndarray
-    cn0: np.ndarray
-    elevation: np.ndarray
-    azimuth: np.ndarray
-    receiver_ecef: np.ndarray
-    n_no_ephemeris: int = 0
-    n_no_wavelength: int = 0
-    n_below_mask: int = 0
-    missing: tuple[str, ...] = field(default=())
-
-    def __len__(self) -> int:
-        return int(self.t.size)
-
-    def corrected_range_rate(self) -> np.ndarray:
-        """ρ̇ − e·v_s + c·δṫ_s, which equals −e·v + b."""
-        return (
-            self.range_rate_mps
-            - np.einsum("ij,ij->i", self.los, self.sat_vel)
-            + self.sat_clock_drift_mps
-        )
-
-    def sigma(self, sigma0: float = SIGMA_RANGE_RATE_MPS) -> np.ndarray:
-        """Standard deviation per row from C/N0 and elevation (module docstring)."""
-        cn0 = np.where(np.isfinite(self.cn0), self.cn0, CN0_DEFAULT_DBHZ)
-        strength = 10.0 ** ((CN0_REFERENCE_DBHZ - np.minimum(cn0, 55.0)) / 20.0)
-        return sigma0 * strength / np.sin(np.maximum(self.elevation, np.deg2rad(5.0)))
-
-
-@dataclass(frozen=True)
-class VelocitySolution:
-    """Per-epoch receiver velocity (ECEF and ENU at the receiver, m/s) and clock drift (m/s).
-
-    ``covariance`` 4×4 of (v_x, v_y, v_z, b) in ECEF; ``dop`` columns (GDOP, PDOP, HDOP, VDOP,
-    TDOP) of the velocity geometry (unweighted). Unavailable epochs: ``valid`` False, NaN values.
-    """
-
-    t: np.ndarray
-    velocity_ecef: np.ndarray
-    velocity_enu: np.ndarray
-    clock_drift_mps: np.ndarray
-    covariance: np.ndarray
-    dop: np.ndarray
-    n_sat: np.ndarray
-    n_obs: np.ndarray
-    n_excluded: np.ndarray
-    residual_rms_mps: np.ndarray
-    valid: np.ndarray
-    n_no_ephemeris: int = 0
-
-    @property
-    def speed_mps(self) -> np.ndarray:
-        return np.linalg.norm(self.velocity_enu, axis=1)
-
-    @property
-    def sigma_mps(self) -> np.ndarray:
-        """√trace of the velocity covariance (m/s): one figure of each fix's precision."""
-        return np.sqrt(np.trace(self.covariance[:, :3, :3], axis1=1, axis2=2))
-
-    @property
-    def course_deg(self) -> np.ndarray:
-        """Course over ground, degrees clockwise from north in [0, 360)."""
-        e, n = self.velocity_enu[:, 0], self.velocity_enu[:, 1]
-        return np.mod(np.rad2deg(np.arctan2(e, n)), 360.0)
+def range_rate_sigma(cn0: np.ndarray, elevation: np.ndarray, sigma0: float) -> np.ndarray:
+    """σ of a range rate (m/s) from C/N0 and elevation (module docstring)."""
+    cn0 = np.where(np.isfinite(cn0), cn0, CN0_DEFAULT_DBHZ)
+    strength = 10.0 ** ((CN0_REFERENCE_DBHZ - np.minimum(cn0, 55.0)) / 20.0)
+    return sigma0 * strength / np.sin(np.maximum(elevation, np.deg2rad(5.0)))
 
 
 def doppler_codes(obs: Observations, systems: str, bands: str | None = None) -> list[str]:
@@ -143,6 +60,7 @@ def doppler_rows(
     systems: str = "GREJC",
     bands: str | None = None,
     elevation_mask_rad: float = np.deg2rad(10.0),
+    sigma0: float = SIGMA_RANGE_RATE_MPS,
 ) -> DopplerRows:
     """Doppler rows of the chosen systems/bands with satellite states and geometry.
 
@@ -199,9 +117,12 @@ def doppler_rows(
         wavelength_m=wavelength[idx],
         los=los[good],
         sat_position=states.position[good],
-        sat_vel=states.velocity[good],
-        sat_clock_drift_mps=SPEED_OF_LIGHT * states.clock_drift[good],
-        range_rate_mps=-wavelength[idx] * sel.value[idx],
+        sat_velocity=states.velocity[good],
+        sat_clock_drift=SPEED_OF_LIGHT * states.clock_drift[good],
+        range_rate=-wavelength[idx] * sel.value[idx],
+        weight=range_rate_sigma(cn0[idx], elevation[good], sigma0) ** -2.0,
+        sat_id=sel.subset(idx).satellites(),
+        frame="ecef",
         cn0=cn0[idx],
         elevation=elevation[good],
         azimuth=azimuth[good],
@@ -237,7 +158,6 @@ def _missing_messages(sel: Observations, no_eph: np.ndarray) -> tuple[str, ...]:
 def solve_velocity(
     rows: DopplerRows,
     epoch_time: np.ndarray,
-    sigma0: float = SIGMA_RANGE_RATE_MPS,
     alpha: float = DEFAULT_ALPHA,
 ) -> VelocitySolution:
     """Weighted LS velocity + clock drift per epoch with iterated chi-square FDE."""
@@ -253,8 +173,8 @@ def solve_velocity(
     rms = np.full(n, np.nan)
     order = np.argsort(rows.epoch, kind="stable")
     bounds = np.searchsorted(rows.epoch[order], np.arange(n + 1))
-    y_all = rows.corrected_range_rate()
-    sigma_all = rows.sigma(sigma0)
+    y_all = rows.reduced()
+    sigma_all = rows.sigma()
     satellite = np.char.add(rows.system, rows.prn.astype(str)) if len(rows) else rows.system
     for k in range(n):
         r = order[bounds[k] : bounds[k + 1]]
@@ -316,5 +236,5 @@ def doppler_velocity(
 ) -> tuple[VelocitySolution, DopplerRows]:
     """Rows (``doppler_rows`` with ``row_options``: systems, bands, elevation_mask_rad) and the
     per-epoch solution (``solve_velocity``) in one call."""
-    rows = doppler_rows(obs, nav, receiver_ecef, **row_options)
-    return solve_velocity(rows, obs.epoch_time, sigma0), rows
+    rows = doppler_rows(obs, nav, receiver_ecef, sigma0=sigma0, **row_options)
+    return solve_velocity(rows, obs.epoch_time), rows

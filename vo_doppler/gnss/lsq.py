@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2
+from scipy.special import chdtri
 
 DEFAULT_ALPHA = 1e-3
 
@@ -73,7 +73,7 @@ def lsq_with_exclusion(
         residuals = y - H @ x
         dof = int(used.sum()) - u
         omega = float(np.sum((residuals[used] / su) ** 2))
-        if dof < 1 or omega <= chi2.ppf(1.0 - alpha, dof) or (~used).sum() >= max_excluded:
+        if dof < 1 or omega <= chdtri(dof, alpha) or (~used).sum() >= max_excluded:
             return LsqResult(x, covariance, residuals, used.copy(), omega, dof, True)
         q_vv = su**2 - np.einsum("ij,jk,ik->i", Hu, covariance, Hu)
         normalised = np.abs(residuals[used]) / np.sqrt(np.maximum(q_vv, 1e-30))

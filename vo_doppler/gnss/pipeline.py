@@ -6,9 +6,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.gnss.doppler_velocity import DopplerRows, VelocitySolution, doppler_velocity
+from vo_doppler.gnss.doppler_velocity import DopplerRows, doppler_velocity
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
-from vo_doppler.gnss.spp import SppSolution, receiver_positions, solve_spp
+from vo_doppler.gnss.spp import receiver_positions, solve_spp
+from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 

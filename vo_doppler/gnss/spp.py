@@ -20,6 +20,7 @@ from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
 from vo_doppler.gnss.ephemeris import rotate_earth, satellite_states
 from vo_doppler.gnss.lsq import lsq_with_exclusion, weighted_lsq
 from vo_doppler.gnss.signals import wavelengths
+from vo_doppler.model.gnss_solutions import SppSolution
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 
@@ -37,20 +38,6 @@ PSEUDORANGE_PRIORITY = {
 SIGMA_PSEUDORANGE_M = 3.0
 EARTH_SURFACE_M = 6.0e6
 _GROUP_DELAY_FIELD = {("G", "1"): "tgd", ("J", "1"): "tgd", ("E", "1"): "iodc", ("C", "2"): "tgd"}
-
-
-@dataclass(frozen=True)
-class SppSolution:
-    """Per-epoch positions (ECEF m), receiver clock bias per system (m), quality figures."""
-
-    t: np.ndarray
-    position_ecef: np.ndarray
-    clock_bias_m: dict[str, np.ndarray]
-    n_sat: np.ndarray
-    residual_rms_m: np.ndarray
-    pdop: np.ndarray
-    valid: np.ndarray
-    n_no_ephemeris: int
 
 
 def pseudorange_codes(obs: Observations, systems: str) -> dict[str, str]:

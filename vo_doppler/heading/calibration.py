@@ -1,4 +1,4 @@
-"""Wheel-speed scale (sec. 3.3) and gyro yaw-rate bias (sec. 3.4) calibrated against Doppler.
+"""Wheel-speed scale ([TK18] sec. 3.3) and gyro yaw-rate bias (sec. 3.4) calibrated by Doppler.
 
 Models (yaw counter-clockwise from east, yaw rate counter-clockwise positive):
 
@@ -104,7 +104,7 @@ def estimate_wheel_scale(
     doppler_valid: np.ndarray | None = None,
     config: GateConfig = GateConfig(),
 ) -> CalibrationEstimate:
-    """Least-squares wheel scale k (sec. 3.3) with its standard deviation."""
+    """Least-squares wheel scale k ([TK18] sec. 3.3) with its standard deviation."""
     t = np.asarray(t, dtype=float)
     vd, vw = np.asarray(doppler_speed, dtype=float), np.asarray(wheel_speed, dtype=float)
     usable = np.isfinite(vd) & np.isfinite(vw) & (vw >= config.min_speed_mps)
@@ -132,7 +132,7 @@ def estimate_gyro_bias(
     doppler_valid: np.ndarray | None = None,
     config: GateConfig = GateConfig(),
 ) -> CalibrationEstimate:
-    """Least-squares yaw-rate bias b (sec. 3.4, rad/s) with its standard deviation.
+    """Least-squares yaw-rate bias b ([TK18] sec. 3.4, rad/s) with its standard deviation.
 
     ``doppler_yaw`` is the Doppler course as yaw (rad, counter-clockwise from east),
     ``integrated_yaw`` is Φ(t), the integral of the measured (counter-clockwise) yaw rate.
@@ -213,7 +213,7 @@ class _StreamingFit:
 
 
 class WheelScaleCalibrator(_StreamingFit):
-    """Streaming sec. 3.3: least squares over the stored recent samples, refreshed per sample."""
+    """Streaming [TK18] sec. 3.3: least squares over the stored recent samples, per sample."""
 
     n_columns = 3
 
@@ -227,7 +227,7 @@ class WheelScaleCalibrator(_StreamingFit):
 
 
 class GyroBiasCalibrator(_StreamingFit):
-    """Streaming sec. 3.4: least squares over the stored recent samples, refreshed per sample."""
+    """Streaming [TK18] sec. 3.4: least squares over the stored recent samples, per sample."""
 
     n_columns = 4
 
@@ -291,7 +291,8 @@ class _KalmanFit:
 
 
 class WheelScaleKalman(_KalmanFit):
-    """Kalman variant of sec. 3.3: state k, a random walk of ``q_per_sqrt_s`` per √s, starting
+    """Kalman variant of [TK18] sec. 3.3: state k, a random walk of ``q_per_sqrt_s`` per √s,
+    starting
     at the prior ``prior`` ± ``prior_sigma``."""
 
     def __init__(
@@ -333,7 +334,7 @@ class WheelScaleKalman(_KalmanFit):
 
 
 class GyroBiasKalman(_KalmanFit):
-    """Kalman variant of sec. 3.4: state [e, b] with e = ψ_true − Φ, ė = −b, b a random walk.
+    """Kalman variant of [TK18] sec. 3.4: state [e, b] with e = ψ_true − Φ, ė = −b, b a random walk.
 
     b starts at the prior ``prior`` ± ``prior_sigma``; e has no prior (a flat one), so the
     first accepted measurement sets it with the measurement variance and leaves b at its prior.

@@ -1,4 +1,4 @@
-"""Conventional heading (sec. 3.2): the direction of a Doppler velocity solution, and its
+"""Conventional heading ([TK18] sec. 3.2): the direction of a Doppler velocity solution, and its
 standard deviation from the velocity covariance."""
 
 from __future__ import annotations

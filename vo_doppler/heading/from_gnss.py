@@ -1,78 +1,34 @@
-"""Adapter: the GNSS package's Doppler rows (ECEF) → heading rows (local ENU at the receiver).
-
-Both use the same range-rate convention (ṙ = G·(v_s − v) + ρ − ρ_s, G receiver → satellite),
-so only the frame changes: each row's vectors are rotated into the ENU frame at the receiver
-position used for that row. Weights are 1/σ² from the GNSS package's C/N0–elevation model.
-"""
+"""The heading stage fed by the GNSS stage: its Doppler rows (turned from ECEF into the ENU
+frame at each row's receiver, :meth:`~vo_doppler.model.doppler.DopplerRows.in_enu`) and its
+conventional velocities; and an emulated street canyon for testing the heading on open-sky
+recordings."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import fields, replace
+from dataclasses import replace
 
 import numpy as np
 
-from vo_doppler.geo import EnuFrame, ecef_to_enu_rotation, ecef_to_geodetic
-from vo_doppler.gnss.doppler_velocity import DopplerRows as GnssDopplerRows
-from vo_doppler.gnss.doppler_velocity import VelocitySolution, doppler_rows, solve_velocity
+from vo_doppler.geo import EnuFrame
+from vo_doppler.gnss.doppler_velocity import doppler_rows, solve_velocity
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.heading.conventional import velocity_heading_sigma
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
-from vo_doppler.heading.rows import DopplerRows
+from vo_doppler.model.doppler import DopplerRows
+from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.series import SensorSeries
 
 
-def satellite_names(rows: GnssDopplerRows) -> np.ndarray:
-    """'G05'-style names of the rows' satellites."""
-    return np.array([f"{s}{int(p):02d}" for s, p in zip(rows.system, rows.prn, strict=True)])
-
-
-def heading_rows(rows: GnssDopplerRows) -> DopplerRows:
-    """ENU heading rows from GNSS Doppler rows (per-row receiver position → ENU rotation)."""
-    n = len(rows)
-    if n == 0:
-        empty = np.zeros((0, 3))
-        return DopplerRows(np.zeros(0), empty, empty, np.zeros(0), np.zeros(0), np.zeros(0), [])
-    positions, inverse = np.unique(rows.receiver_ecef, axis=0, return_inverse=True)
-    lat, lon, _ = ecef_to_geodetic(positions)
-    rotations = np.stack(
-        [
-            ecef_to_enu_rotation(a, b)
-            for a, b in zip(np.atleast_1d(lat), np.atleast_1d(lon), strict=True)
-        ]
-    )
-    return DopplerRows.from_ecef(
-        rows.t,
-        rows.los,
-        rows.sat_vel,
-        rows.sat_clock_drift_mps,
-        rows.range_rate_mps,
-        1.0 / rows.sigma() ** 2,
-        satellite_names(rows),
-        rotations[inverse.reshape(-1)],
-    )
-
-
-def select_rows(rows: GnssDopplerRows, keep: np.ndarray) -> GnssDopplerRows:
-    """The rows where ``keep`` is True (every per-row array filtered, counts unchanged)."""
-    n = len(rows)
-    changes = {
-        f.name: getattr(rows, f.name)[keep]
-        for f in fields(rows)
-        if isinstance(getattr(rows, f.name), np.ndarray) and getattr(rows, f.name).shape[:1] == (n,)
-    }
-    return replace(rows, **changes)
-
-
 def keep_highest_satellites(
-    rows: GnssDopplerRows, n_keep: int, after_t: float = -np.inf
-) -> GnssDopplerRows:
+    rows: DopplerRows, n_keep: int, after_t: float = -np.inf
+) -> DopplerRows:
     """Emulate an urban canyon: from ``after_t`` on, keep only the ``n_keep`` satellites of
     highest elevation at each epoch (the open sky of a street canyon is overhead)."""
-    names = satellite_names(rows)
+    names = rows.sat_id
     keep = np.ones(len(rows), dtype=bool)
     for epoch in np.unique(rows.epoch[rows.t >= after_t]):
         members = np.flatnonzero((rows.epoch == epoch) & (rows.t >= after_t))
@@ -81,7 +37,7 @@ def keep_highest_satellites(
             best[names[i]] = max(best.get(names[i], -np.inf), rows.elevation[i])
         chosen = sorted(best, key=best.get, reverse=True)[:n_keep]
         keep[members] = np.isin(names[members], chosen)
-    return select_rows(rows, keep)
+    return rows.select(keep)
 
 
 def emulated_canyon(
@@ -91,7 +47,7 @@ def emulated_canyon(
     after_t: float,
     systems: str = "GREJC",
     elevation_mask_rad: float = np.radians(10.0),
-) -> tuple[GnssDopplerRows, VelocitySolution]:
+) -> tuple[DopplerRows, VelocitySolution]:
     """Doppler rows and conventional velocities as a receiver in a street canyon would have them
     from ``after_t`` on: only the ``n_keep`` highest satellites, and line-of-sight vectors from
     the last single-point fix before ``after_t`` (the header's approximate position if none)."""
@@ -112,7 +68,7 @@ def conventional_heading_sigma(velocity: VelocitySolution, enu: EnuFrame) -> np.
 
 def heading_from_gnss(
     epoch_time: np.ndarray,
-    rows: GnssDopplerRows,
+    rows: DopplerRows,
     velocity: VelocitySolution,
     wheel_speed: SensorSeries,
     yaw_rate: SensorSeries,
@@ -124,7 +80,7 @@ def heading_from_gnss(
     conventional velocities: what ``run``, ``heading`` and the benchmarks all call."""
     return heading_pipeline(
         epoch_time,
-        heading_rows(rows),
+        rows.in_enu(),
         velocity.velocity_enu,
         velocity.valid,
         wheel_speed,

@@ -1,5 +1,5 @@
-"""Per-epoch heading from Doppler rows and vehicle sensors: calibration (sec. 3.3–3.4) feeding
-the tightly coupled heading (sec. 3.5), with the conventional heading (sec. 3.2) alongside.
+"""Per-epoch heading from Doppler rows and vehicle sensors: calibration ([TK18] sec. 3.3–3.4)
+feeding the tightly coupled heading (sec. 3.5), with the conventional heading (sec. 3.2) alongside.
 
 Calibration is causal: at each GNSS epoch the wheel scale and gyro bias are refreshed from the
 conventional Doppler speed and course of the epochs so far (stored recent data), and the
@@ -30,12 +30,12 @@ from vo_doppler.heading.calibration import (
     WheelScaleKalman,
 )
 from vo_doppler.heading.conventional import heading_from_velocity, vehicle_heading_from_antenna
-from vo_doppler.heading.rows import DopplerRows
 from vo_doppler.heading.tight_heading import (
     TightHeadingConfig,
     antenna_offset_velocity,
     tight_heading_series,
 )
+from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample

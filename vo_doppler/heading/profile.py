@@ -1,4 +1,4 @@
-"""The tightly coupled heading's profiled cost (sec. 3.5) and its minimisation, per window.
+"""The tightly coupled heading's profiled cost ([TK18] sec. 3.5) and its minimisation, per window.
 
 With the model y = a·cos θ₀ + b·sin θ₀ + T·p (p the parameters that enter linearly: clock drift
 and its rate, and any bias being tested), the observation matrix X = [−a, −b, y] and

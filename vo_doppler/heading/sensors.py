@@ -1,6 +1,6 @@
 """Vehicle sensor series sampled at GNSS epochs: speed by interpolation, yaw by integration.
 
-Yaw rate is counter-clockwise positive (DESIGN.md); the integrated yaw angle Φ(t) is the
+Yaw rate is counter-clockwise positive (docs/design.md); the integrated yaw angle Φ(t) is the
 trapezoidal integral of the yaw rate from the first sample, so Φ(t₂) − Φ(t₁) is the yaw change
 between two epochs.
 """
@@ -21,7 +21,8 @@ def calibrated_epoch_inputs(
     wheel_scale: float = 1.0,
     gyro_bias: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Calibrated speed k·v and integrated calibrated yaw ∫(ω − b) at the epochs (sec. 3.3–3.4)."""
+    """Calibrated speed k·v and integrated calibrated yaw ∫(ω − b) at the epochs
+    ([TK18] sec. 3.3–3.4)."""
     speed_at = wheel_scale * sample(speed_t, speed, t_epoch)
     yaw_at = integral_at(yaw_rate_t, np.asarray(yaw_rate, dtype=float) - gyro_bias, t_epoch)
     return speed_at, yaw_at

@@ -1,4 +1,4 @@
-"""Tightly coupled time-series heading from Doppler, gyro and wheel speed (sec. 3.5).
+"""Tightly coupled time-series heading from Doppler, gyro and wheel speed ([TK18] sec. 3.5).
 
 For the window of epochs t ∈ (t_k − W, t_k] ending at epoch k, every Doppler row (see
 :mod:`vo_doppler.heading.rows`) gives one equation in three unknowns:
@@ -36,7 +36,7 @@ name and tests again. What it detects but cannot name makes the window *inconsis
 heading); a window where a bias on some satellite would not show is flagged *unverifiable*;
 after a rejected reflection the θ₀ variance allows for one more, undetected, biased satellite.
 
-Reliability (sec. 3.5): the heading at epoch k is compared with the headings of the previous
+Reliability ([TK18] sec. 3.5): the heading at epoch k is compared with the headings of the previous
 epochs of the last ``reliability_epochs`` propagated by the gyro; it is reliable when enough of
 them exist and all agree within the gate.
 """
@@ -58,8 +58,8 @@ from vo_doppler.heading.profile import (
     weighted_gram,
     z_of,
 )
-from vo_doppler.heading.rows import DopplerRows
 from vo_doppler.heading.snooping import snoop_satellites
+from vo_doppler.model.doppler import DopplerRows
 
 
 @dataclass(frozen=True)
@@ -395,7 +395,7 @@ def tight_heading_series(
     gyro_bias_sigma: np.ndarray | float = 0.0,
     lever_velocity: np.ndarray | float = 0.0,
 ) -> TightHeadingResult:
-    """Heading at every epoch from the window of Doppler rows ending there (sec. 3.5).
+    """Heading at every epoch from the window of Doppler rows ending there ([TK18] sec. 3.5).
 
     ``speed`` (m/s) and ``yaw_angle`` Φ (rad, integral of the calibrated counter-clockwise yaw
     rate) are given per epoch; rows are matched to epochs by time. ``speed_scale_sigma``
@@ -570,7 +570,7 @@ def _decide(
 
 
 def _reliability(yaw, sigma, available, yaw_angle, config):
-    """Gyro-consistency over the last ``reliability_epochs`` epochs (sec. 3.5).
+    """Gyro-consistency over the last ``reliability_epochs`` epochs ([TK18] sec. 3.5).
 
     Each earlier heading propagated by the gyro must agree with the current one within
     max(gate, n_sigma · √(σ_k² + σ_j²)): a fixed gate for precise headings, the combined

@@ -4,7 +4,7 @@ Log formats are read by python-can (candump ``-l`` ``.log``, Vector ``.asc`` and
 python-can ``.csv``); signals are decoded by cantools. A signal is named ``MESSAGE.SIGNAL``;
 several wheel-speed signals are averaged. Values are converted from the DBC unit to SI
 (km/h → m/s, deg/s → rad/s). The yaw rate leaves this module counter-clockwise positive
-(DESIGN.md): ``yaw_rate_sign=-1`` flips a bus that reports clockwise-positive yaw rate.
+(docs/design.md): ``yaw_rate_sign=-1`` flips a bus that reports clockwise-positive yaw rate.
 
 Frames shorter than their DBC length are skipped, counted and named in a warning (their
 missing bytes would decode as made-up values); ``short_frames="pad"`` zero-pads them instead,

@@ -2,7 +2,7 @@
 
 Each signal folder holds ``t`` (s, the logger's monotonic clock) and ``value``. Read here:
 the IMU gyro as a yaw rate, the u-blox receiver fixes, and ground truth from ``global_pose``.
-Conventions on the way out (DESIGN.md): the IMU axes are forward/right/down, so the
+Conventions on the way out (docs/design.md): the IMU axes are forward/right/down, so the
 counter-clockwise yaw rate is −gyro_z; the ground-truth yaw is the course of the ECEF velocity
 rotated into the ENU frame at its own position, as a CCW-from-east angle, unwrapped. The
 ground truth's body yaw is the same angle for the forward axis of ``frame_orientations``.
@@ -18,6 +18,7 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.gps_fixes import GpsFixes
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK, utc_to_gps_seconds
 
@@ -88,3 +89,14 @@ def read_live_fixes(
     return GpsFixes(
         t, np.radians(value[:, 0]), np.radians(value[:, 1]), value[:, 2], Path(base, *folder)
     )
+
+
+def read_lowcost_inputs(base: Path):
+    """Ground truth, receiver fixes, IMU yaw rate and CAN yaw rate ``(t, value)`` of a segment."""
+    truth = read_ground_truth(base)
+    fixes = read_live_fixes(base, truth.gps_minus_mono_s)
+    gyro = read_gyro_yaw_rate(base)
+    can = read_can_motion(
+        base / "can_motion.log", base / "toyota_2017_motion.dbc", yaw_rate="KINEMATICS.YAW_RATE"
+    ).yaw_rate
+    return truth, fixes, gyro, (can.t, can.value)

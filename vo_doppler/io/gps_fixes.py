@@ -18,7 +18,7 @@ import numpy as np
 from pynmeagps import NMEAMessageError, NMEAParseError, NMEAReader, NMEATypeError
 
 from vo_doppler.errors import InputError
-from vo_doppler.io.gyro_csv import read_numeric_csv
+from vo_doppler.io.sensor_csv import read_numeric_csv
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.model.gpstime import utc_to_gps_seconds as gpstime_utc_to_gps
 

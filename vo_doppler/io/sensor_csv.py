@@ -1,13 +1,16 @@
-"""Plain sensor CSV files: ``t,yaw_rate_rad_s`` (counter-clockwise positive) and ``t,speed_mps``.
+"""Headed numeric CSV files, and the sensor CSVs built on them: ``t,yaw_rate_rad_s``
+(counter-clockwise positive) and ``t,speed_mps`` (any ``t,<column>`` signal).
 
-One header row naming the two columns, then one sample per row; ``#`` comments and blank lines
-are allowed. Times are seconds on the sensor's clock; a per-sensor offset maps them to GPS time.
+One header row naming the columns, then one sample per row; ``#`` comments and blank lines are
+allowed. Rows that cannot be read or hold non-finite numbers are skipped, counted and logged; a
+file without a single usable row is an error. Sensor times must not go backwards (the line is
+named); they are seconds on the sensor's clock, and a per-sensor offset maps them to GPS time.
 """
 
 from __future__ import annotations
 
-import csv
 import logging
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -17,54 +20,97 @@ from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
 
-YAW_RATE_COLUMN = "yaw_rate_rad_s"
-SPEED_COLUMN = "speed_mps"
+
+@dataclass
+class CsvReadReport:
+    """Rows read and skipped in one CSV file (line numbers are 1-based)."""
+
+    path: Path
+    n_rows: int = 0
+    n_malformed: int = 0
+    n_non_finite: int = 0
+    skipped_lines: list[int] = field(default_factory=list)
+    row_lines: list[int] = field(default_factory=list)
+    """Line of every row read, in order."""
+
+    def log_summary(self) -> None:
+        if self.n_malformed or self.n_non_finite:
+            log.warning(
+                "%s: skipped %d malformed and %d non-finite rows (first lines: %s)",
+                self.path,
+                self.n_malformed,
+                self.n_non_finite,
+                self.skipped_lines[:5],
+            )
+
+
+def read_numeric_csv(
+    path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = ()
+) -> tuple[dict[str, np.ndarray], CsvReadReport]:
+    """Columns of a headed numeric CSV by name; bad rows skipped and counted."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read CSV: {exc}", path) from exc
+    report = CsvReadReport(path)
+    header: list[str] | None = None
+    index: dict[str, int] = {}
+    rows: list[list[float]] = []
+    for number, line in enumerate(lines, start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        fields = [f.strip() for f in stripped.split(",")]
+        if header is None:
+            header = [f.lower() for f in fields]
+            missing = [name for name in required if name not in header]
+            if missing:
+                raise InputError(
+                    f"CSV header {','.join(fields)!r} lacks column(s) {', '.join(missing)}; "
+                    f"expected {','.join(required)}",
+                    path,
+                    number,
+                )
+            index = {name: header.index(name) for name in (*required, *optional) if name in header}
+            continue
+        try:
+            if len(fields) != len(header):
+                raise ValueError(f"{len(fields)} fields, header has {len(header)}")
+            values = [float(fields[i]) for i in index.values()]
+        except ValueError:
+            report.n_malformed += 1
+            report.skipped_lines.append(number)
+            continue
+        if not np.all(np.isfinite(values)):
+            report.n_non_finite += 1
+            report.skipped_lines.append(number)
+            continue
+        rows.append(values)
+        report.row_lines.append(number)
+    if header is None:
+        raise InputError("CSV file is empty", path)
+    if not rows:
+        raise InputError("CSV file has no usable data rows", path)
+    report.n_rows = len(rows)
+    report.log_summary()
+    data = np.asarray(rows, dtype=float)
+    return {name: data[:, j] for j, name in enumerate(index)}, report
 
 
 def read_sensor_csv(path: str | Path, column: str, time_offset_s: float = 0.0) -> SensorSeries:
-    """Read a two-column sensor CSV whose header is ``t,<column>``.
-
-    Rows with a non-numeric or non-finite field are skipped, counted and logged; rows out of
-    time order raise :class:`InputError` naming the line.
-    """
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InputError(f"cannot read sensor CSV: {exc.strerror or exc}", path) from exc
-    lines = [
-        (number, line)
-        for number, line in enumerate(text.splitlines(), start=1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    if not lines:
-        raise InputError("sensor CSV has no header row", path)
-    _, header = lines[0]
-    names = [name.strip() for name in next(csv.reader([header]))]
-    if "t" not in names or column not in names:
-        raise InputError(f"header must name columns 't' and '{column}', found {names}", path, 1)
-    i_t, i_v = names.index("t"), names.index(column)
-    times: list[float] = []
-    values: list[float] = []
-    skipped = 0
-    for number, line in lines[1:]:
-        fields = next(csv.reader([line]))
-        try:
-            t_value, v_value = float(fields[i_t]), float(fields[i_v])
-        except (ValueError, IndexError):
-            t_value, v_value = np.nan, np.nan
-        if not (np.isfinite(t_value) and np.isfinite(v_value)):
-            skipped += 1
-            log.warning("%s:%d: unusable sensor row skipped", path, number)
-            continue
-        if times and t_value < times[-1]:
-            raise InputError("time goes backwards", path, number)
-        times.append(t_value)
-        values.append(v_value)
-    if skipped:
-        log.warning("%s: %d of %d rows skipped", path, skipped, len(lines) - 1)
+    """The ``t,<column>`` signal of a headed CSV, ``time_offset_s`` added to its times."""
+    columns, report = read_numeric_csv(path, ("t", column))
+    backwards = np.flatnonzero(np.diff(columns["t"]) < 0)
+    if backwards.size:
+        raise InputError("time goes backwards", path, report.row_lines[backwards[0] + 1])
     unit = "rad/s" if column == YAW_RATE_COLUMN else "m/s" if column == SPEED_COLUMN else ""
-    return SensorSeries(np.array(times) + time_offset_s, np.array(values), column, unit)
+    skipped = report.n_malformed + report.n_non_finite
+    return SensorSeries(columns["t"] + time_offset_s, columns[column], column, unit, skipped)
+
+
+YAW_RATE_COLUMN = "yaw_rate_rad_s"
+SPEED_COLUMN = "speed_mps"
 
 
 def read_yaw_rate_csv(path: str | Path, time_offset_s: float = 0.0) -> SensorSeries:
@@ -78,6 +124,6 @@ def read_speed_csv(path: str | Path, time_offset_s: float = 0.0) -> SensorSeries
 
 
 def write_sensor_csv(path: str | Path, series: SensorSeries, column: str) -> None:
-    """Write ``t,<column>`` with full double precision."""
+    """Write ``t,<column>`` with full double precision (what :func:`read_sensor_csv` reads)."""
     data = np.column_stack([series.t, series.value])
-    np.savetxt(path, data, fmt="%.9f", delimiter=",", header=f"t,{column}", comments="")
+    np.savetxt(path, data, fmt="%.17g", delimiter=",", header=f"t,{column}", comments="")

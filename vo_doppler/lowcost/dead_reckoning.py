@@ -1,10 +1,10 @@
-"""Dead reckoning from step lengths and yaw-rate increments, Eq. (15)–(17).
+"""Dead reckoning from step lengths and yaw-rate increments, [KZ] Eq. (15)–(17).
 
-The seed writes the update in a clockwise heading θ measured from north:
+[KZ] writes the update in a clockwise heading θ measured from north:
     x ← x + ΔL·sin(θ + Δθ/2)     (15)   east
     y ← y + ΔL·cos(θ + Δθ/2)     (16)   north
     θ ← θ + Δθ                   (17)
-The public functions take and return DESIGN.md's yaw ψ (counter-clockwise from east, positive
+The public functions take and return docs/design.md's yaw ψ (counter-clockwise from east, positive
 yaw rate turns left); the conversion θ = π/2 − ψ, Δθ = −Δψ happens only at the boundary.
 """
 
@@ -50,7 +50,8 @@ def dead_reckon(
     yaw0: float,
     start: tuple[float, float] = (0.0, 0.0),
 ) -> DeadReckoning:
-    """Eq. (15)–(17) over N epochs from N − 1 step lengths (m) and yaw increments (rad, CCW)."""
+    """[KZ] Eq. (15)–(17) over N epochs from N − 1 step lengths (m) and yaw increments (rad,
+    CCW)."""
     t = np.asarray(t, dtype=float)
     step_length = np.asarray(step_length, dtype=float)
     delta_yaw = np.asarray(delta_yaw, dtype=float)
@@ -78,7 +79,7 @@ def track_yaw(east: np.ndarray, north: np.ndarray, min_step_m: float = 1.0) -> n
 
 
 def wheel_gyro_track(speed: SensorSeries, yaw_rate: SensorSeries, t: np.ndarray) -> Trajectory:
-    """Planar wheel + gyro dead reckoning (Eq. 15–17) at times ``t`` inside both records,
+    """Planar wheel + gyro dead reckoning ([KZ] Eq. 15–17) at times ``t`` inside both records,
     starting at the origin facing east (yaw 0)."""
     steps = np.diff(travelled_distance(speed.t, speed.value, t))
     turns = increments(yaw_rate.t, yaw_rate.value, t)

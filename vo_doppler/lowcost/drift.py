@@ -1,4 +1,4 @@
-"""Heading drift in deg/min and the start–end gap of a closed loop, in the seed's Table 1 layout.
+"""Heading drift in deg/min and the start–end gap of a closed loop, in [KZ]'s Table 1 layout.
 
 Drift of a yaw history against a reference (ground truth, the GPS course, or a constant heading
 on a standstill): e(t) = ψ(t) − ψ_ref(t), unwrapped, and drift = (ē_end − ē_start) / Δt, where ē

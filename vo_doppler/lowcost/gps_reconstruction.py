@@ -1,10 +1,10 @@
 """GPS track reconstruction: thin the fixes, drop jitter clusters, interpolate back.
 
-Eq. (10): keep every M-th fix, and of those drop each fix lying closer than ``cluster_m`` to
+[KZ] Eq. (10): keep every M-th fix, and of those drop each fix lying closer than ``cluster_m`` to
 the previously kept one (a standing receiver's scatter collapses onto one point).
-Eq. (11): linear interpolation of latitude and longitude between the kept fixes, evaluated at
+[KZ] Eq. (11): linear interpolation of latitude and longitude between the kept fixes, evaluated at
 every original fix time, so the track keeps one point per original time.
-Eq. (12)–(14): step length by the equirectangular approximation on a sphere of radius
+[KZ] Eq. (12)–(14): step length by the equirectangular approximation on a sphere of radius
 R = 6371 km: x = Δλ·cos(φ_m), y = Δφ, d = R·√(x² + y²). The haversine formula is given for
 comparison. Angles are radians.
 """
@@ -20,7 +20,7 @@ from vo_doppler.geo import EARTH_MEAN_RADIUS_M
 
 
 def equirectangular_distance(lat1, lon1, lat2, lon2, radius_m: float = EARTH_MEAN_RADIUS_M):
-    """Eq. (12)–(14): distance (m) between points given in radians."""
+    """[KZ] Eq. (12)–(14): distance (m) between points given in radians."""
     x = (np.asarray(lon2) - np.asarray(lon1)) * np.cos((np.asarray(lat1) + np.asarray(lat2)) / 2)
     y = np.asarray(lat2) - np.asarray(lat1)
     return radius_m * np.hypot(x, y)
@@ -35,7 +35,7 @@ def haversine_distance(lat1, lon1, lat2, lon2, radius_m: float = EARTH_MEAN_RADI
 
 
 def step_lengths(lat: np.ndarray, lon: np.ndarray, method: str = "equirectangular") -> np.ndarray:
-    """Distances (m) between consecutive points, (N − 1,), by Eq. (12)–(14) or haversine."""
+    """Distances (m) between consecutive points, (N − 1,), by [KZ] Eq. (12)–(14) or haversine."""
     lat = np.asarray(lat, dtype=float)
     lon = np.asarray(lon, dtype=float)
     formulas = {"equirectangular": equirectangular_distance, "haversine": haversine_distance}
@@ -51,7 +51,7 @@ def select_fixes(
     cluster_m: float = 3.0,
     always_keep: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Eq. (10): indices of the kept fixes — every ``downsample``-th fix, minus those closer
+    """[KZ] Eq. (10): indices of the kept fixes — every ``downsample``-th fix, minus those closer
     than ``cluster_m`` metres to the previously kept fix. The first and the last fix are always
     kept, so that interpolation never has to hold a stale position at either end.
 
@@ -83,7 +83,7 @@ def select_fixes(
 
 @dataclass(frozen=True)
 class ReconstructedTrack:
-    """One point per original fix time, from the kept fixes by Eq. (11)."""
+    """One point per original fix time, from the kept fixes by [KZ] Eq. (11)."""
 
     t: np.ndarray
     lat: np.ndarray
@@ -102,7 +102,8 @@ def reconstruct_track(
     cluster_m: float = 3.0,
     always_keep: np.ndarray | None = None,
 ) -> ReconstructedTrack:
-    """Eq. (10)–(11): select fixes, then interpolate latitude and longitude linearly between the
+    """[KZ] Eq. (10)–(11): select fixes, then interpolate latitude and longitude linearly between
+    the
     kept fixes at every original time.
 
     ``t`` must be strictly increasing (see ``vo_doppler.lowcost.series.clean_series``).

@@ -1,8 +1,8 @@
 """Two yaw-rate sensors combined into one, and the three ways of choosing the weight k.
 
-Eq. (7) of the low-cost path-mapping seed: ω = ((2 − k)·ω1 + k·ω2) / 2 with k ∈ [0, 2]
+[KZ] Eq. (7) : ω = ((2 − k)·ω1 + k·ω2) / 2 with k ∈ [0, 2]
 (k = 0 is sensor 1 alone, k = 2 sensor 2 alone, k = 1 their average).
-Rates are yaw rates in rad/s, counter-clockwise positive (DESIGN.md); the weight does not
+Rates are yaw rates in rad/s, counter-clockwise positive (docs/design.md); the weight does not
 depend on the sign convention.
 """
 
@@ -22,7 +22,7 @@ K_MAX = 2.0
 
 
 def combine_rates(omega1: np.ndarray, omega2: np.ndarray, k: float) -> np.ndarray:
-    """Eq. (7): the weighted combination ((2 − k)·ω1 + k·ω2) / 2 of two aligned rate series."""
+    """[KZ] Eq. (7): the weighted combination ((2 − k)·ω1 + k·ω2) / 2 of two aligned rate series."""
     if not K_MIN <= k <= K_MAX:
         raise ValueError(f"k must lie in [0, 2], got {k}")
     omega1 = np.asarray(omega1, dtype=float)
@@ -67,14 +67,14 @@ def _standstill_integrals(t: np.ndarray, omega1: np.ndarray, omega2: np.ndarray)
 def k_by_sweep(
     t: np.ndarray, omega1: np.ndarray, omega2: np.ndarray, step: float = 0.01
 ) -> tuple[KChoice, np.ndarray, np.ndarray]:
-    """The seed's sweep: k over 0..2 in ``step`` increments, keeping the k whose combined rate,
+    """[KZ]'s sweep: k over 0..2 in ``step`` increments, keeping the k whose combined rate,
     integrated over the standstill record, ends with the smallest heading drift.
 
     Returns the choice and the swept grid with its final heading drift (rad) for each k.
     """
     integral1, integral2 = _standstill_integrals(t, omega1, omega2)
     grid = np.round(np.arange(K_MIN, K_MAX + step / 2.0, step), 10)
-    # The final heading of the combined rate is Eq. (7) applied to the two heading integrals.
+    # The final heading of the combined rate is [KZ] Eq. (7) applied to the two heading integrals.
     final_heading = ((2.0 - grid) * integral1 + grid * integral2) / 2.0
     best = int(np.argmin(np.abs(final_heading)))
     return KChoice("sweep", float(grid[best])), grid, final_heading

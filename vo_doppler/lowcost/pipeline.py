@@ -1,7 +1,8 @@
-"""The low-cost path-mapping chain end to end: align → combine (Eq. 7) → de-bias (Eq. 5–6) →
-threshold (Eq. 9) → GPS reconstruction (Eq. 10–14) → dead reckoning (Eq. 15–17) → drift table.
+"""The low-cost path-mapping chain of [KZ] end to end: align → combine (Eq. 7) → de-bias
+(Eq. 5–6) → threshold (Eq. 9) → GPS reconstruction (Eq. 10–14) → dead reckoning (Eq. 15–17) →
+drift table.
 
-Our additions to the seed, stated: the standstill interval is found from a speed (wheel, GPS, or
+Our additions to [KZ], stated: the standstill interval is found from a speed (wheel, GPS, or
 the reconstructed track) when not given; ε0 is averaged over the last τ seconds of it (closest to
 the drive); steps inside the standstill are set to zero; when no threshold is given, h is three
 times the standard deviation of the de-biased combined standstill rate.
@@ -207,7 +208,8 @@ class BiasModel:
 
 
 def _bias_model(rates: AlignedRates, standstill, config: DeadReckonConfig) -> BiasModel:
-    """k (Eq. 7), the Allan deviations, τ, ε0 (Eq. 5) and the threshold h over the standstill."""
+    """k ([KZ] Eq. 7), the Allan deviations, τ, ε0 (Eq. 5) and the threshold h over the
+    standstill."""
     still = (rates.t >= standstill[0]) & (rates.t <= standstill[1])
     if np.sum(still) < 10:
         raise InputError(

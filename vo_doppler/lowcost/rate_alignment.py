@@ -1,4 +1,4 @@
-"""Two yaw-rate sensors brought onto one time base before they are combined by Eq. (7).
+"""Two yaw-rate sensors brought onto one time base before they are combined by [KZ] Eq. (7).
 
 The sensors may run at different rates and hold bad samples; the common time base is the
 first sensor's sample times inside the interval both sensors cover, and the second sensor is

@@ -1,7 +1,7 @@
 """Static bias of a yaw-rate sensor and its removal, with τ proposed by the Allan deviation.
 
-Eq. (5): ε0 = (1/N)·Σ ω_i over the N samples of τ seconds of standstill.
-Eq. (6): ω' = ω − ε0.
+[KZ] Eq. (5): ε0 = (1/N)·Σ ω_i over the N samples of τ seconds of standstill.
+[KZ] Eq. (6): ω' = ω − ε0.
 τ is proposed at the minimum of the overlapping Allan deviation of the standstill rates: shorter
 averages are dominated by white noise, longer ones by the wandering bias.
 """
@@ -27,7 +27,7 @@ class StaticBias:
 
 
 def static_bias(t: np.ndarray, rate: np.ndarray, t0: float, t1: float) -> StaticBias:
-    """Eq. (5): the mean rate over the samples with t0 ≤ t ≤ t1."""
+    """[KZ] Eq. (5): the mean rate over the samples with t0 ≤ t ≤ t1."""
     t = np.asarray(t, dtype=float)
     inside = (t >= t0) & (t <= t1)
     n = int(np.sum(inside))
@@ -37,7 +37,7 @@ def static_bias(t: np.ndarray, rate: np.ndarray, t0: float, t1: float) -> Static
 
 
 def remove_bias(rate: np.ndarray, eps0: float) -> np.ndarray:
-    """Eq. (6): ω − ε0."""
+    """[KZ] Eq. (6): ω − ε0."""
     return np.asarray(rate, dtype=float) - eps0
 
 

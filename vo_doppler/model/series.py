@@ -15,6 +15,8 @@ class SensorSeries:
     value: np.ndarray
     name: str = ""
     unit: str = ""
+    n_skipped: int = 0
+    """Input rows the reader could not use (unreadable or non-finite)."""
 
     def __post_init__(self) -> None:
         self.t = np.asarray(self.t, dtype=float).reshape(-1)
@@ -27,4 +29,6 @@ class SensorSeries:
 
     def shifted(self, offset_s: float) -> SensorSeries:
         """The same samples with ``offset_s`` added to every time (sensor clock → GPS time)."""
-        return SensorSeries(self.t + offset_s, self.value.copy(), self.name, self.unit)
+        return SensorSeries(
+            self.t + offset_s, self.value.copy(), self.name, self.unit, self.n_skipped
+        )

@@ -1,112 +1,15 @@
-"""CSV tables and a figure for GNSS velocity and SPP results (people-facing units: degrees)."""
+"""Figures of GNSS velocity and SPP results (people-facing units: degrees)."""
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from vo_doppler.geo import EnuFrame, ecef_to_geodetic
-from vo_doppler.gnss.doppler_velocity import VelocitySolution
-from vo_doppler.gnss.spp import SppSolution
-
-VELOCITY_COLUMNS = (
-    "gps_time_s",
-    "ve",
-    "vn",
-    "vu",
-    "speed_mps",
-    "course_deg",
-    "clock_drift_mps",
-    "n_sat",
-    "residual_rms_mps",
-    "valid",
-)
-SPP_COLUMNS = (
-    "gps_time_s",
-    "lat_deg",
-    "lon_deg",
-    "height_m",
-    "x_m",
-    "y_m",
-    "z_m",
-    "e_m",
-    "n_m",
-    "u_m",
-    "n_sat",
-    "residual_rms_m",
-    "pdop",
-    "valid",
-)
-
-
-def _write(path: Path, columns: tuple[str, ...], table: list[np.ndarray], formats: list[str]):
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(columns)
-        for row in zip(*table, strict=True):
-            writer.writerow(
-                "" if isinstance(v, float) and np.isnan(v) else f.format(v)
-                for v, f in zip(row, formats, strict=True)
-            )
-
-
-def write_velocity_csv(path: str | Path, solution: VelocitySolution) -> None:
-    """One row per epoch; unavailable epochs have empty numbers and valid = 0."""
-    v = solution.velocity_enu
-    _write(
-        Path(path),
-        VELOCITY_COLUMNS,
-        [
-            solution.t,
-            v[:, 0],
-            v[:, 1],
-            v[:, 2],
-            solution.speed_mps,
-            solution.course_deg,
-            solution.clock_drift_mps,
-            solution.n_sat,
-            solution.residual_rms_mps,
-            solution.valid.astype(int),
-        ],
-        ["{:.3f}"] + ["{:.4f}"] * 4 + ["{:.2f}", "{:.4f}", "{:d}", "{:.4f}", "{:d}"],
-    )
-
-
-def write_spp_csv(path: str | Path, solution: SppSolution) -> None:
-    """Positions per epoch: geodetic, ECEF and ENU about the median valid fix."""
-    lat, lon, height = ecef_to_geodetic(solution.position_ecef)
-    enu = np.full_like(solution.position_ecef, np.nan)
-    if solution.valid.any():
-        frame = EnuFrame.from_ecef(np.median(solution.position_ecef[solution.valid], axis=0))
-        enu = frame.ecef_to_enu(solution.position_ecef)
-    p = solution.position_ecef
-    _write(
-        Path(path),
-        SPP_COLUMNS,
-        [
-            solution.t,
-            np.rad2deg(lat),
-            np.rad2deg(lon),
-            height,
-            p[:, 0],
-            p[:, 1],
-            p[:, 2],
-            enu[:, 0],
-            enu[:, 1],
-            enu[:, 2],
-            solution.n_sat,
-            solution.residual_rms_m,
-            solution.pdop,
-            solution.valid.astype(int),
-        ],
-        ["{:.3f}", "{:.9f}", "{:.9f}"] + ["{:.3f}"] * 7 + ["{:d}", "{:.3f}", "{:.2f}", "{:d}"],
-    )
+from vo_doppler.geo import EnuFrame
+from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 
 
 def velocity_figure(path: str | Path, solution: VelocitySolution, title: str = "") -> None:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.geo import wrap_angle
-from vo_doppler.heading.rows import DopplerRows
+from vo_doppler.model.doppler import DopplerRows
 
 
 @dataclass

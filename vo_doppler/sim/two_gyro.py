@@ -3,7 +3,7 @@
 Known truth: yaw, yaw rate and ENU position at every gyro-1 sample. Each gyro adds a constant
 turn-on bias, a bias random walk (rate random walk K, rad/s/√s) and white noise (angle random
 walk N, rad/s/√Hz); the GPS adds a first-order Gauss–Markov error per axis (a cheap receiver
-wanders slowly rather than jumping) plus a little white noise. Yaw is CCW from east (DESIGN.md).
+wanders slowly rather than jumping) plus a little white noise. Yaw is CCW from east.
 """
 
 from __future__ import annotations
@@ -15,7 +15,8 @@ import numpy as np
 
 from vo_doppler.geo import EnuFrame, ecef_to_geodetic
 from vo_doppler.io.gps_fixes import write_gps_csv
-from vo_doppler.io.gyro_csv import write_gyro_csv
+from vo_doppler.io.sensor_csv import YAW_RATE_COLUMN, write_sensor_csv
+from vo_doppler.model.series import SensorSeries
 
 DEG = np.pi / 180.0
 
@@ -169,8 +170,9 @@ def write_two_gyro(record: TwoGyroRecord, folder: str | Path) -> dict[str, Path]
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     paths = {name: folder / f"{name}.csv" for name in ("gyro1", "gyro2", "gps")}
-    write_gyro_csv(paths["gyro1"], *record.gyro1)
-    write_gyro_csv(paths["gyro2"], *record.gyro2)
+    for name in ("gyro1", "gyro2"):
+        series = SensorSeries(*getattr(record, name))
+        write_sensor_csv(paths[name], series, YAW_RATE_COLUMN)
     t, lat, lon = record.gps
     write_gps_csv(paths["gps"], t, lat, lon)
     return paths

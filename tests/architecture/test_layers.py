@@ -1,0 +1,90 @@
+"""The import rules of docs/design.md ("Layers"), checked on the source by an AST walk: any
+back edge fails the suite, naming the module, the line and the import."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[2] / "vo_doppler"
+BASE = {"errors", "geo", "model"}
+STAGES = {"vo", "gnss", "heading", "fusion", "lowcost", "eval"}
+ALLOWED: dict[str, set[str]] = {
+    "errors": set(),
+    "geo": {"errors"},
+    "model": BASE,
+    "vo": BASE | {"vo"},
+    "gnss": BASE | {"gnss"},
+    "lowcost": BASE | {"lowcost"},
+    "eval": BASE | {"eval"},
+    "heading": BASE | {"heading", "gnss"},
+    "fusion": BASE | {"fusion", "heading", "gnss", "lowcost"},
+    "io": BASE | {"io"},
+    "sim": BASE | STAGES | {"io", "sim"},
+    "run": BASE | STAGES | {"io"},
+    "report": BASE | STAGES | {"io", "run", "report"},
+    "batch": BASE | STAGES | {"io", "run", "report"},
+}
+"""Layer → the layers it may import. Commands and the CLI may import anything."""
+
+
+def layer_of(module: str) -> str:
+    """'vo_doppler.heading.pipeline' → 'heading'; top-level modules are their own layer."""
+    return module.split(".")[1] if "." in module else module
+
+
+def project_imports(path: Path) -> list[tuple[int, str]]:
+    """(line, module) of every ``vo_doppler`` import in a file, function-level ones included."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names = [node.module]
+        elif isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        else:
+            continue
+        found += [(node.lineno, name) for name in names if name.startswith("vo_doppler.")]
+    return found
+
+
+def violations(package: Path = PACKAGE) -> list[str]:
+    out = []
+    for path in sorted(package.rglob("*.py")):
+        relative = path.relative_to(package.parent).with_suffix("")
+        module = ".".join(relative.parts).removesuffix(".__init__")
+        layer = layer_of(module)
+        if layer not in ALLOWED:
+            continue
+        for line, imported in project_imports(path):
+            target = layer_of(imported)
+            if target not in ALLOWED[layer]:
+                out.append(f"{path.relative_to(package.parent)}:{line}: {layer} imports {imported}")
+    return out
+
+
+def test_no_module_imports_against_the_layers():
+    assert violations() == []
+
+
+def test_every_package_has_a_rule():
+    packages = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()}
+    modules = {p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__"}
+    assert (packages | modules) - set(ALLOWED) <= {"commands", "cli", "__main__"}
+
+
+def test_a_back_edge_is_caught(tmp_path):
+    fake = tmp_path / "vo_doppler"
+    (fake / "heading").mkdir(parents=True)
+    (fake / "heading" / "bad.py").write_text("def f():\n    from vo_doppler.io.can import x\n")
+    (fake / "model").mkdir()
+    (fake / "model" / "ok.py").write_text("from vo_doppler.geo import EnuFrame\n")
+    assert violations(fake) == ["vo_doppler/heading/bad.py:2: heading imports vo_doppler.io.can"]
+
+
+@pytest.mark.parametrize(
+    ("module", "layer"), [("vo_doppler.run", "run"), ("vo_doppler.io.can", "io"), ("cli", "cli")]
+)
+def test_layer_of(module, layer):
+    assert layer_of(module) == layer

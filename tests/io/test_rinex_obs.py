@@ -1,0 +1,273 @@
+"""RINEX observation reader on synthetic files: exact values, versions, compression, events."""
+
+from __future__ import annotations
+
+import gzip
+
+import hatanaka
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from tests.helpers.rinex_text import field, rinex2_epoch, rinex2_header, rinex3_epoch, rinex3_header
+from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.model.gpstime import calendar_to_gps_seconds
+
+T0 = float(calendar_to_gps_seconds(2024, 6, 24, 8, 20, 0))
+TYPES = {"G": ["C1C", "L1C", "D1C", "S1C"], "R": ["C1C", "D1C"], "E": ["C1C", "D1C", "S1C", "C5Q"]}
+
+values = st.one_of(
+    st.none(),
+    st.integers(min_value=-99_999_999_999, max_value=999_999_999_999).map(lambda k: k / 1000),
+)
+indicators = st.one_of(st.none(), st.integers(0, 9))
+
+
+def observation_rows(obs) -> list[tuple]:
+    """Every observation as (time, satellite, code, value, LLI, SSI), sorted."""
+    return sorted(
+        zip(
+            obs.time.tolist(),
+            obs.satellites().tolist(),
+            [obs.codes[c] for c in obs.code],
+            obs.value.tolist(),
+            obs.lli.tolist(),
+            obs.ssi.tolist(),
+            strict=True,
+        )
+    )
+
+
+@st.composite
+def epochs(draw):
+    satellites = draw(
+        st.lists(
+            st.tuples(st.sampled_from(sorted(TYPES)), st.integers(1, 36)),
+            min_size=1,
+            max_size=15,
+            unique=True,
+        )
+    )
+    records = []
+    for system, prn in satellites:
+        fields = [(draw(values), draw(indicators), draw(indicators)) for _ in TYPES[system]]
+        records.append((f"{system}{prn:02d}", fields))
+    return records
+
+
+@settings(
+    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(st.lists(epochs(), min_size=1, max_size=4))
+def test_rinex3_round_trip(tmp_path, written):
+    text = rinex3_header(TYPES)
+    expected = []
+    for k, records in enumerate(written):
+        text += rinex3_epoch(
+            f"2024 06 24 08 20 {k:2d}.0000000",
+            [(sat, [field(*f) for f in fields]) for sat, fields in records],
+        )
+        for sat, fields in records:
+            for code, (value, lli, ssi) in zip(TYPES[sat[0]], fields, strict=True):
+                if value is not None:
+                    expected.append(
+                        (
+                            T0 + k,
+                            sat,
+                            code,
+                            value,
+                            -1 if lli is None else lli,
+                            -1 if ssi is None else ssi,
+                        )
+                    )
+    path = tmp_path / "random.24o"
+    path.write_text(text)
+    obs = read_obs(path)
+    assert observation_rows(obs) == sorted(expected)
+    assert obs.problems == ()
+    np.testing.assert_array_equal(obs.epoch_time, T0 + np.arange(len(written)))
+
+
+def _rinex2_file(n_sats: int = 14) -> tuple[str, list[str], dict]:
+    types = ["C1", "L1", "D1", "S1", "P2", "L2", "D2"]
+    records, expected = [], {}
+    for k in range(n_sats):
+        values = [20_000_000.0 + k, -1234.567 - k, 2000.25 * (k % 3 - 1), 40.0 + k, None, 7.5, -k]
+        fields = [field(v, 1 if i == 1 else None, 7) for i, v in enumerate(values)]
+        records.append((f"G{k + 1:2d}", fields))
+        expected[f"G{k + 1:02d}"] = values
+    text = rinex2_header(types) + rinex2_epoch(" 10  1  6  5 57  3.0000000", records)
+    text += rinex2_epoch(" 10  1  6  5 57  4.0000000", records[:3])
+    return text, types, expected
+
+
+def test_rinex2_long_epoch_and_continuation_lines(tmp_path):
+    text, types, expected = _rinex2_file()
+    path = tmp_path / "walk.10o"
+    path.write_text(text)
+    obs = read_obs(path)
+    t0 = float(calendar_to_gps_seconds(2010, 1, 6, 5, 57, 3.0))
+    np.testing.assert_array_equal(obs.epoch_time, [t0, t0 + 1])
+    first = obs.time == t0
+    sats = obs.satellites()
+    for sat, vals in expected.items():
+        for code, value in zip(types, vals, strict=True):
+            rows = first & (sats == sat) & obs.mask(code=code)
+            assert rows.sum() == (value is not None)
+            if value is not None:
+                assert obs.value[rows][0] == value
+    assert np.all(obs.lli[obs.mask(code="L1")] == 1)
+    assert np.all(obs.lli[obs.mask(code="C1")] == -1)
+    assert np.all(obs.ssi == 7)
+    assert (obs.time == t0 + 1).sum() == 3 * 6
+
+
+def test_gzip_and_hatanaka_equal_plain(tmp_path):
+    text, _, _ = _rinex2_file()
+    plain = tmp_path / "walk.10o"
+    plain.write_text(text)
+    (tmp_path / "walk.10o.gz").write_bytes(gzip.compress(text.encode()))
+    (tmp_path / "walk.10d").write_bytes(hatanaka.compress(text.encode(), compression="none"))
+    reference = read_obs(plain)
+    for name in ("walk.10o.gz", "walk.10d"):
+        other = read_obs(tmp_path / name)
+        np.testing.assert_array_equal(other.value, reference.value)
+        np.testing.assert_array_equal(other.lli, reference.lli)
+        np.testing.assert_array_equal(other.time, reference.time)
+
+
+def test_rinex3_event_flags(tmp_path):
+    g = [("G05", [field(1.0), field(2.0), field(3.0), field(4.0)])]
+    text = rinex3_header({"G": ["C1C", "L1C", "D1C", "S1C"]})
+    text += rinex3_epoch("2024 06 24 08 20  0.0000000", g)
+    text += "> 2024 06 24 08 20  0.5000000  2  1\nCOMMENT LINE THAT STARTS WITH G\n"
+    text += "> 2024 06 24 08 20  1.0000000  1  1\n" + "G05" + field(9.0) + "\n"
+    new_types = "G    2 D1C C1C" + " " * 46 + "SYS / # / OBS TYPES \n"
+    text += ">" + " " * 30 + "4  1\n" + new_types
+    text += rinex3_epoch("2024 06 24 08 20  2.0000000", [("G05", [field(5.0), field(6.0)])])
+    text += rinex3_epoch("2024 06 24 08 20  3.0000000", [("G05", [field(7.0)])], flag=6)
+    path = tmp_path / "events.24o"
+    path.write_text(text)
+    obs = read_obs(path)
+    np.testing.assert_array_equal(obs.epoch_time, T0 + np.array([0.0, 1.0, 2.0]))
+    np.testing.assert_array_equal(obs.epoch_flag, [0, 1, 0])
+    last = obs.time == T0 + 2
+    assert obs.value[last & obs.mask(code="D1C")].tolist() == [5.0]
+    assert obs.value[last & obs.mask(code="C1C")].tolist() == [6.0]
+    assert obs.value[obs.time == T0 + 1].tolist() == [9.0]
+    assert obs.problems == ()
+
+
+def test_header_fields(tmp_path):
+    text = rinex3_header({"G": ["C1C"]}, time_system="GPS")
+    path = tmp_path / "h.24o"
+    path.write_text(text + rinex3_epoch("2024 06 24 08 20  0.0000000", [("G01", [field(1.0)])]))
+    header = read_obs(path).header
+    assert header.version == 3.04
+    assert header.interval == 1.0
+    assert header.obs_types == {"G": ("C1C",)}
+    np.testing.assert_array_equal(
+        header.approx_position, [-3817680.9841, 3562840.0688, 3650158.4543]
+    )
+
+
+def test_glonass_time_system_is_converted_to_gps(tmp_path):
+    text = rinex3_header({"R": ["C1C"]}, time_system="GLO")
+    path = tmp_path / "glo.24o"
+    path.write_text(text + rinex3_epoch("2024 06 24 08 20  0.0000000", [("R01", [field(1.0)])]))
+    assert read_obs(path).epoch_time[0] == T0 + 18.0
+
+
+def test_rinex2_mixed_file_events_and_blank_system_letter(tmp_path):
+    types = ["C1", "D1"]
+    g = [("  5", [field(2.0e7), field(-100.0)]), ("R 3", [field(2.1e7), field(200.0)])]
+    text = rinex2_header(types, system="M")
+    text += rinex2_epoch(" 10  1  6  5 57  3.0000000", g)
+    # flag 4: header records inside the body change the observation types
+    new_types = "     3    D1    C1    S1" + " " * 36 + "# / TYPES OF OBSERV \n"
+    text += " " * 28 + "4  2\n" + new_types + " " * 60 + "COMMENT             \n"
+    text += rinex2_epoch(
+        " 10  1  6  5 57  4.0000000", [("G05", [field(-101.0), field(2.0e7 + 1), field(45.0)])]
+    )
+    text += rinex2_epoch(" 10  1  6  5 57  5.0000000", [("G05", [field(1.0)] * 3)], flag=6)
+    path = tmp_path / "mixed.10o"
+    path.write_text(text)
+    obs = read_obs(path)
+    assert obs.problems == ()
+    t0 = float(calendar_to_gps_seconds(2010, 1, 6, 5, 57, 3.0))
+    np.testing.assert_array_equal(obs.epoch_time, [t0, t0 + 1])
+    assert obs.satellites()[obs.time == t0].tolist() == ["G05", "G05", "R03", "R03"]
+    second = obs.time == t0 + 1
+    assert obs.value[second & obs.mask(code="D1")].tolist() == [-101.0]
+    assert obs.value[second & obs.mask(code="S1")].tolist() == [45.0]
+
+
+def test_hatanaka_rinex3_real_file_equals_plain(tmp_path):
+    from tests.conftest import require_shared
+
+    source = require_shared("septentrio_static/rover.obs")
+    crx = tmp_path / "rover.crx.gz"
+    crx.write_bytes(hatanaka.compress(source.read_bytes(), compression="gz"))
+    plain, compressed = read_obs(source), read_obs(crx)
+    np.testing.assert_array_equal(compressed.value, plain.value)
+    np.testing.assert_array_equal(compressed.ssi, plain.ssi)
+    np.testing.assert_array_equal(compressed.lli, plain.lli)
+    assert compressed.codes == plain.codes
+
+
+def test_matrix_helper(tmp_path):
+    text = rinex3_header(TYPES)
+    text += rinex3_epoch("2024 06 24 08 20  0.0000000", [("G05", [field(1.0)] * 4)])
+    both = [("G05", [field(2.0)] * 4), ("E04", [field(3.0)] * 4)]
+    text += rinex3_epoch("2024 06 24 08 20  1.0000000", both)
+    path = tmp_path / "m.24o"
+    path.write_text(text)
+    names, values = read_obs(path).matrix("C1C")
+    assert names.tolist() == ["E04", "G05"]
+    np.testing.assert_array_equal(values, [[np.nan, 1.0], [3.0, 2.0]])
+    names, _ = read_obs(path).matrix("C1C", system="G")
+    assert names.tolist() == ["G05"]
+
+
+TYPES2 = ["C1", "L1", "D1", "S1", "P2", "L2", "D2"]
+
+
+@st.composite
+def epochs2(draw):
+    satellites = draw(
+        st.lists(
+            st.tuples(st.sampled_from("GR"), st.integers(1, 32)),
+            min_size=1,
+            max_size=26,
+            unique=True,
+        )
+    )
+    return [
+        (f"{s}{p:2d}", [(draw(values), draw(indicators), draw(indicators)) for _ in TYPES2])
+        for s, p in satellites
+    ]
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(st.lists(epochs2(), min_size=1, max_size=3))
+def test_rinex2_round_trip(tmp_path, written):
+    text = rinex2_header(TYPES2, system="M")
+    expected = []
+    t0 = float(calendar_to_gps_seconds(2010, 1, 6, 5, 57, 0.0))
+    for k, records in enumerate(written):
+        text += rinex2_epoch(
+            f" 10  1  6  5 57 {k:2d}.0000000",
+            [(sat, [field(*f) for f in fields]) for sat, fields in records],
+        )
+        for sat, fields in records:
+            for code, (value, lli, ssi) in zip(TYPES2, fields, strict=True):
+                if value is not None:
+                    flags = (-1 if lli is None else lli, -1 if ssi is None else ssi)
+                    expected.append((t0 + k, sat.replace(" ", "0"), code, value, *flags))
+    path = tmp_path / "random.10o"
+    path.write_text(text)
+    obs = read_obs(path)
+    assert observation_rows(obs) == sorted(expected)
+    assert obs.problems == ()

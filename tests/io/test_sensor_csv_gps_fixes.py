@@ -1,0 +1,198 @@
+"""Gyro CSV and GPS CSV/NMEA readers: round trips (property tests), bad rows skipped and counted."""
+
+from __future__ import annotations
+
+import datetime as dt
+import functools
+import logging
+import operator
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from vo_doppler.errors import InputError
+from vo_doppler.io.gps_fixes import (
+    read_gps_csv,
+    read_gps_fixes,
+    read_nmea,
+    utc_to_gps_seconds,
+    write_gps_csv,
+)
+from vo_doppler.io.sensor_csv import (
+    YAW_RATE_COLUMN,
+    read_numeric_csv,
+    read_yaw_rate_csv,
+    write_sensor_csv,
+)
+from vo_doppler.model.series import SensorSeries
+
+finite = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)
+tmp_settings = settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+
+
+@tmp_settings
+@given(st.lists(st.tuples(finite, finite), min_size=1, max_size=50))
+def test_gyro_csv_round_trip(tmp_path, rows):
+    t, rate = np.array(sorted(rows)).T  # sensor times never go backwards (the reader's rule)
+    path = tmp_path / "gyro.csv"
+    write_sensor_csv(path, SensorSeries(t, rate), YAW_RATE_COLUMN)
+    series = read_yaw_rate_csv(path)
+    np.testing.assert_array_equal(series.t, t)
+    np.testing.assert_array_equal(series.value, rate)
+    assert len(series) == len(t) and series.n_skipped == 0
+
+
+@tmp_settings
+@given(
+    st.lists(
+        st.tuples(finite, st.floats(-90, 90), st.floats(-180, 180), st.floats(0, 100)),
+        min_size=1,
+        max_size=50,
+    )
+)
+def test_gps_csv_round_trip(tmp_path, rows):
+    t, lat, lon, speed = np.array(rows).T
+    path = tmp_path / "gps.csv"
+    write_gps_csv(path, t, np.radians(lat), np.radians(lon), speed)
+    fixes = read_gps_fixes(path)
+    np.testing.assert_array_equal(fixes.t, t)
+    np.testing.assert_allclose(np.degrees(fixes.lat), lat, atol=1e-12)
+    np.testing.assert_allclose(np.degrees(fixes.lon), lon, atol=1e-12)
+    np.testing.assert_array_equal(fixes.speed, speed)
+
+
+def test_gyro_csv_bad_rows_are_skipped_and_counted(tmp_path, caplog):
+    path = tmp_path / "gyro.csv"
+    path.write_text(
+        "# a comment\nt,yaw_rate_rad_s\n0.0,0.1\n0.01,nan\n0.02,abc\n0.03\n\n0.04,0.2\n0.05,inf\n"
+    )
+    with caplog.at_level(logging.WARNING):
+        series = read_yaw_rate_csv(path)
+    np.testing.assert_array_equal(series.t, [0.0, 0.04])
+    assert series.n_skipped == 4
+    _, report = read_numeric_csv(path, ("t", YAW_RATE_COLUMN))
+    assert (report.n_malformed, report.n_non_finite) == (2, 2)
+    assert report.skipped_lines == [4, 5, 6, 9] and report.row_lines == [3, 8]
+    assert "skipped 2 malformed and 2 non-finite" in caplog.text
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("", "empty"),
+        ("time,rate\n0,1\n", "lacks column"),
+        ("t,yaw_rate_rad_s\nx,y\n", "no usable data rows"),
+    ],
+)
+def test_gyro_csv_unusable_files_raise(tmp_path, text, message):
+    path = tmp_path / "gyro.csv"
+    path.write_text(text)
+    with pytest.raises(InputError, match=message) as info:
+        read_yaw_rate_csv(path)
+    assert str(path) in str(info.value)
+
+
+def test_missing_file_raises_input_error(tmp_path):
+    with pytest.raises(InputError, match="cannot read"):
+        read_yaw_rate_csv(tmp_path / "absent.csv")
+    with pytest.raises(InputError, match="cannot read"):
+        read_gps_fixes(tmp_path / "absent.nmea")
+
+
+def test_gps_csv_out_of_range_fixes_skipped(tmp_path):
+    path = tmp_path / "gps.csv"
+    path.write_text("t,lat_deg,lon_deg\n0,10,20\n1,95,20\n2,10,200\n3,nan,1\n4,10.5,20.5\n")
+    fixes = read_gps_csv(path)
+    np.testing.assert_array_equal(fixes.t, [0.0, 4.0])
+    assert fixes.n_skipped == 3 and np.all(np.isnan(fixes.speed))
+
+
+def _sentence(body: str) -> str:
+    checksum = functools.reduce(operator.xor, body.encode(), 0)
+    return f"${body}*{checksum:02X}"
+
+
+def _ddmm(value: float, positive: str, negative: str, width: int) -> tuple[str, str]:
+    hemisphere = positive if value >= 0 else negative
+    value = abs(value)
+    degrees = int(value)
+    minutes = (value - degrees) * 60.0
+    return f"{degrees:0{width}d}{minutes:010.7f}", hemisphere
+
+
+def _gga(time: dt.time, lat: float, lon: float, quality: int = 1) -> str:
+    la, ns = _ddmm(lat, "N", "S", 2)
+    lo, ew = _ddmm(lon, "E", "W", 3)
+    stamp = time.strftime("%H%M%S.%f")[:9]
+    return _sentence(f"GPGGA,{stamp},{la},{ns},{lo},{ew},{quality},08,0.9,10.0,M,30.0,M,,")
+
+
+def _rmc(moment: dt.datetime, lat: float, lon: float, knots: float, status="A") -> str:
+    la, ns = _ddmm(lat, "N", "S", 2)
+    lo, ew = _ddmm(lon, "E", "W", 3)
+    stamp = moment.strftime("%H%M%S.%f")[:9]
+    day = moment.strftime("%d%m%y")
+    return _sentence(f"GPRMC,{stamp},{status},{la},{ns},{lo},{ew},{knots:.2f},45.0,{day},,,A")
+
+
+def test_nmea_gga_rmc_pairs_give_gps_time_and_speed(tmp_path):
+    start = dt.datetime(2024, 6, 24, 8, 20, 0)
+    lines = []
+    for i in range(5):
+        moment = start + dt.timedelta(seconds=0.5 * i)
+        lines += [_gga(moment.time(), 48.1 + i * 1e-5, -11.5, 1), _rmc(moment, 48.1, -11.5, 10.0)]
+    lines.insert(3, _gga(start.time(), 1.0, 1.0).replace("*", "0*"))  # bad checksum
+    lines.append(_gga((start + dt.timedelta(seconds=9)).time(), 48.2, -11.5, quality=0))
+    lines.append(_rmc(start + dt.timedelta(seconds=9), 48.2, -11.5, 0.0, status="V"))
+    path = tmp_path / "log.nmea"
+    path.write_text("\n".join(["garbage line", *lines]) + "\n")
+    fixes = read_gps_fixes(path)
+    expected_t0 = (start - dt.datetime(1980, 1, 6)).total_seconds() + 18.0
+    np.testing.assert_allclose(fixes.t, expected_t0 + 0.5 * np.arange(5))
+    np.testing.assert_allclose(np.degrees(fixes.lat), 48.1 + np.arange(5) * 1e-5, atol=1e-9)
+    np.testing.assert_allclose(np.degrees(fixes.lon), -11.5, atol=1e-9)
+    np.testing.assert_allclose(fixes.speed, 10.0 * 1852 / 3600)
+    assert fixes.n_skipped == 3 and fixes.time_system == "gps"
+
+
+def test_nmea_midnight_roll_over_and_gga_only(tmp_path):
+    before = dt.datetime(2020, 12, 31, 23, 59, 59)
+    after = before + dt.timedelta(seconds=2)
+    path = tmp_path / "midnight.nmea"
+    path.write_text("\n".join([_rmc(before, 1.0, 2.0, 1.0), _gga(after.time(), 1.0, 2.0)]) + "\n")
+    fixes = read_nmea(path)
+    assert fixes.t[1] - fixes.t[0] == pytest.approx(2.0)
+    gga_only = tmp_path / "gga.nmea"
+    gga_only.write_text(_gga(dt.time(1, 2, 3, 500000), 1.0, 2.0) + "\n")
+    fixes = read_nmea(gga_only)
+    assert fixes.time_system == "utc-seconds-of-day" and fixes.t[0] == pytest.approx(3723.5)
+    empty = tmp_path / "empty.nmea"
+    empty.write_text(_gga(dt.time(1, 2, 3), 1.0, 2.0, quality=0) + "\n")
+    with pytest.raises(InputError, match="no GGA or RMC fix"):
+        read_nmea(empty)
+
+
+@tmp_settings
+@given(st.floats(-89.9, 89.9), st.floats(-179.9, 179.9), st.integers(0, 86399))
+def test_nmea_coordinates_round_trip(tmp_path, lat, lon, second):
+    moment = dt.datetime(2023, 3, 1) + dt.timedelta(seconds=second)
+    path = Path(tmp_path) / "one.nmea"
+    path.write_text(_rmc(moment, lat, lon, 3.0) + "\n")
+    fixes = read_nmea(path)
+    assert np.degrees(fixes.lat[0]) == pytest.approx(lat, abs=1e-8)
+    assert np.degrees(fixes.lon[0]) == pytest.approx(lon, abs=1e-8)
+    assert fixes.t[0] == pytest.approx(utc_to_gps_seconds(moment))
+
+
+def test_utc_to_gps_leap_seconds():
+    # The leap second at the end of 2016 makes these two UTC moments 3 days + 1 s apart.
+    before = utc_to_gps_seconds(dt.datetime(2016, 12, 30))
+    after = utc_to_gps_seconds(dt.datetime(2017, 1, 2))
+    assert after - before == pytest.approx(3 * 86400 + 1)
+    assert utc_to_gps_seconds(dt.datetime(1980, 1, 6)) == 0.0
+    assert utc_to_gps_seconds(dt.datetime(2018, 8, 2, tzinfo=dt.UTC)) == pytest.approx(1217203218.0)

@@ -1,0 +1,58 @@
+"""Per-epoch GNSS solutions: single-point positions and Doppler velocities."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SppSolution:
+    """Per-epoch positions (ECEF m), receiver clock bias per system (m), quality figures."""
+
+    t: np.ndarray
+    position_ecef: np.ndarray
+    clock_bias_m: dict[str, np.ndarray]
+    n_sat: np.ndarray
+    residual_rms_m: np.ndarray
+    pdop: np.ndarray
+    valid: np.ndarray
+    n_no_ephemeris: int
+
+
+@dataclass(frozen=True)
+class VelocitySolution:
+    """Per-epoch receiver velocity (ECEF and ENU at the receiver, m/s) and clock drift (m/s).
+
+    ``covariance`` 4×4 of (v_x, v_y, v_z, b) in ECEF; ``dop`` columns (GDOP, PDOP, HDOP, VDOP,
+    TDOP) of the velocity geometry (unweighted). Unavailable epochs: ``valid`` False, NaN values.
+    """
+
+    t: np.ndarray
+    velocity_ecef: np.ndarray
+    velocity_enu: np.ndarray
+    clock_drift_mps: np.ndarray
+    covariance: np.ndarray
+    dop: np.ndarray
+    n_sat: np.ndarray
+    n_obs: np.ndarray
+    n_excluded: np.ndarray
+    residual_rms_mps: np.ndarray
+    valid: np.ndarray
+    n_no_ephemeris: int = 0
+
+    @property
+    def speed_mps(self) -> np.ndarray:
+        return np.linalg.norm(self.velocity_enu, axis=1)
+
+    @property
+    def sigma_mps(self) -> np.ndarray:
+        """√trace of the velocity covariance (m/s): one figure of each fix's precision."""
+        return np.sqrt(np.trace(self.covariance[:, :3, :3], axis1=1, axis2=2))
+
+    @property
+    def course_deg(self) -> np.ndarray:
+        """Course over ground, degrees clockwise from north in [0, 360)."""
+        e, n = self.velocity_enu[:, 0], self.velocity_enu[:, 1]
+        return np.mod(np.rad2deg(np.arctan2(e, n)), 360.0)
