@@ -1,0 +1,81 @@
+"""RINEX clock files (versions 2.00 to 3.04, "RINEX Extensions to Handle Clock Information")
+→ :class:`SatelliteClocks`.
+
+Only the satellite records ``AS`` are kept (receiver ``AR``, calibration and discontinuity
+records are skipped). A record reads ``AS <name> yyyy mm dd hh mi ss.ssssss n bias [σ …]``,
+the values continuing on the next line when n > 2; it is split on blanks, which reads both the
+4-character names of 3.02 and the 9-character names of 3.04. The time system is the header's
+``TIME SYSTEM ID`` (GPS when absent). CRLF line endings are accepted; errors name the line.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from vo_doppler.errors import InputError
+from vo_doppler.io.sp3 import TIME_SYSTEMS, satellite_id, text_lines, to_gps_seconds
+from vo_doppler.model.gpstime import calendar_to_gps_seconds
+from vo_doppler.model.precise_orbits import SatelliteClocks
+
+VALUES_PER_LINE = 2
+MAX_VALUES = 6
+
+
+def read_rinex_clock(path: str | Path) -> SatelliteClocks:
+    """Satellite clock offsets (s) of every ``AS`` record, one row per distinct epoch."""
+    path = Path(path)
+    lines = text_lines(path, "RINEX clock")
+    if not lines or "RINEX VERSION / TYPE" not in lines[0] or lines[0][20:21] != "C":
+        raise InputError("not a RINEX clock file (first line: RINEX VERSION / TYPE, type C)", path)
+    time_system = "GPS"
+    body = None
+    for number, line in enumerate(lines):
+        label = line[60:].strip()
+        if label == "TIME SYSTEM ID":
+            time_system = line[3:6].strip() or "GPS"
+        elif label == "END OF HEADER":
+            body = number + 1
+            break
+    if body is None:
+        raise InputError("no END OF HEADER", path)
+    if time_system not in TIME_SYSTEMS:
+        raise InputError(f"unknown time system {time_system!r}", path)
+    sats: list[str] = []
+    calendar: list[tuple[float, ...]] = []
+    bias: list[float] = []
+    number = body
+    while number < len(lines):
+        fields = lines[number].split()
+        number += 1
+        if not fields or fields[0] != "AS":
+            continue
+        sat, epoch, n_values, value = _record(path, number, fields)
+        if n_values > VALUES_PER_LINE:
+            number += 1
+        sats.append(sat)
+        calendar.append(epoch)
+        bias.append(value)
+    if not sats:
+        raise InputError("no satellite clock (AS) records", path)
+    t_all = to_gps_seconds(calendar_to_gps_seconds(*np.array(calendar).T), time_system)
+    times, row = np.unique(t_all, return_inverse=True)
+    ids, col = np.unique(np.array(sats, dtype="U3"), return_inverse=True)
+    table = np.full((times.size, ids.size), np.nan)
+    table[row, col] = bias
+    return SatelliteClocks(times, ids, table, path)
+
+
+def _record(path: Path, line: int, fields: list[str]) -> tuple[str, tuple[float, ...], int, float]:
+    """Satellite, calendar epoch, number of values and clock bias (s) of one AS record."""
+    try:
+        sat = satellite_id(fields[1].ljust(3))
+        epoch = tuple(float(v) for v in fields[2:8])
+        n_values = int(fields[8])
+        value = float(fields[9].replace("D", "E"))
+    except (ValueError, IndexError):
+        raise InputError(f"bad clock record {' '.join(fields)!r}", path, line) from None
+    if len(epoch) != 6 or not 1 <= n_values <= MAX_VALUES:
+        raise InputError(f"bad clock record {' '.join(fields)!r}", path, line)
+    return sat, epoch, n_values, value

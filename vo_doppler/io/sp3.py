@@ -1,0 +1,179 @@
+"""SP3-c / SP3-d precise orbit files (NGS/IGS "The Extended Standard Product 3 Orbit Format",
+SP3-c 2007, SP3-d 2016) → :class:`PreciseOrbits`.
+
+Read: the first line (version ``c``/``d``, position-only or position+velocity flag, number of
+epochs, coordinate system, agency), the ``+`` satellite list (any number of lines, as SP3-d
+allows), the ``%c`` time system, the ``*`` epoch lines and the ``P`` position/clock records
+(km, µs; a position of 0.000000 or a clock of 999999.999999 marks a missing value). Velocity
+(``V``) and correlation (``EP``/``EV``) records are skipped: the GNSS stage differentiates the
+interpolated positions. CRLF line endings are accepted. Errors name the file and the line.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from vo_doppler.errors import InputError
+from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, calendar_to_gps_seconds, utc_to_gps_seconds
+from vo_doppler.model.precise_orbits import PreciseOrbits
+
+BAD_CLOCK_US = 999999.0
+TAI_MINUS_GPST_S = 19.0
+GLONASS_TIME_MINUS_UTC_S = 3 * 3600.0
+TIME_SYSTEMS = ("GPS", "GAL", "QZS", "IRN", "BDT", "TAI", "UTC", "GLO")
+
+
+def to_gps_seconds(calendar_seconds: np.ndarray, time_system: str) -> np.ndarray:
+    """Calendar times of a product's time system (read as if GPS) to GPS seconds (RINEX 3.05
+    sec. 6.1: GST, QZSST and IRNSST run on GPS time, BDT = GPST − 14 s, TAI = GPST + 19 s,
+    GLONASS time = UTC + 3 h)."""
+    t = np.asarray(calendar_seconds, dtype=float)
+    if time_system in ("GPS", "GAL", "QZS", "IRN"):
+        return t
+    if time_system == "BDT":
+        return t - BDT_MINUS_GPST_S
+    if time_system == "TAI":
+        return t - TAI_MINUS_GPST_S
+    if time_system == "GLO":
+        t = t - GLONASS_TIME_MINUS_UTC_S
+    return utc_to_gps_seconds(t)
+
+
+def satellite_id(text: str) -> str:
+    """'G05' from an SP3 satellite field ('G05', 'G 5', ' 5' = GPS in old files)."""
+    letter = text[0] if text[0] != " " else "G"
+    return f"{letter}{int(text[1:3]):02d}"
+
+
+def text_lines(path: Path, what: str) -> list[str]:
+    """The lines of a text product, LF or CRLF (splitlines drops either)."""
+    try:
+        return path.read_text(encoding="ascii", errors="replace").splitlines()
+    except OSError as exc:
+        raise InputError(f"cannot read {what} file: {exc}", path) from exc
+
+
+def read_sp3(path: str | Path) -> PreciseOrbits:
+    """Positions (ECEF m) and clocks (s) of every listed satellite at every epoch."""
+    path = Path(path)
+    lines = text_lines(path, "SP3")
+    if not lines or lines[0][:1] != "#" or lines[0][1:2] not in ("c", "d"):
+        raise InputError("not an SP3-c/d file (first line must start with '#c' or '#d')", path, 1)
+    first = lines[0]
+    declared_epochs = _int(first[32:39], path, 1, "number of epochs")
+    sats, time_system, body = _header(path, lines)
+    column = {sat: i for i, sat in enumerate(sats)}
+    calendar: list[tuple[float, ...]] = []
+    positions = np.full((declared_epochs, len(sats), 3), np.nan)
+    clocks = np.full((declared_epochs, len(sats)), np.nan)
+    for number in range(body, len(lines)):
+        line = lines[number]
+        tag = line[:1]
+        if line.startswith("EOF"):
+            break
+        if tag == "*":
+            calendar.append(_epoch(path, number + 1, line))
+            if len(calendar) > declared_epochs:
+                raise InputError(f"more epochs than the {declared_epochs} declared", path, 1)
+        elif tag == "P":
+            if not calendar:
+                raise InputError("position record before the first epoch line", path, number + 1)
+            sat = _known(path, number + 1, line, column)
+            positions[len(calendar) - 1, sat] = _position(path, number + 1, line)
+            clocks[len(calendar) - 1, sat] = _clock(path, number + 1, line)
+        elif tag not in ("V", "E", "/", ""):
+            raise InputError(f"unexpected record {line[:2]!r}", path, number + 1)
+    if len(calendar) != declared_epochs:
+        raise InputError(f"{len(calendar)} epochs, header declares {declared_epochs}", path, 1)
+    times = to_gps_seconds(calendar_to_gps_seconds(*np.array(calendar).T), time_system)
+    if np.any(np.diff(times) <= 0):
+        raise InputError("epochs not strictly increasing", path)
+    return PreciseOrbits(
+        t=times,
+        sat_id=np.array(sats, dtype="U3"),
+        position=positions,
+        clock_s=clocks,
+        time_system=time_system,
+        coordinate_system=first[46:51].strip(),
+        agency=first[56:60].strip(),
+        path=path,
+    )
+
+
+def _header(path: Path, lines: list[str]) -> tuple[list[str], str, int]:
+    """Satellite list, time system, index of the first body line."""
+    if len(lines) < 2 or not lines[1].startswith("##"):
+        raise InputError("second line must start with '##'", path, 2)
+    sats: list[str] = []
+    n_sats = None
+    time_system = None
+    number = 2
+    while number < len(lines) and not lines[number].startswith("*"):
+        line = lines[number]
+        if line.startswith("+ ") and n_sats is None:
+            n_sats = _int(line[3:6], path, number + 1, "number of satellites")
+        if line.startswith("+ "):
+            sats.extend(line[9 + 3 * k : 12 + 3 * k] for k in range(17))
+        elif line.startswith("%c") and time_system is None:
+            time_system = line[9:12].strip()
+        number += 1
+    if n_sats is None:
+        raise InputError("no '+' satellite list in the header", path)
+    listed = [s for s in sats if s.strip() and s.strip() != "0"]
+    if len(listed) < n_sats:
+        raise InputError(f"{len(listed)} satellites listed, header declares {n_sats}", path)
+    try:
+        ids = [satellite_id(s) for s in listed[:n_sats]]
+    except ValueError as exc:
+        raise InputError(f"bad satellite identifier in the '+' lines: {exc}", path) from exc
+    if time_system not in TIME_SYSTEMS:
+        raise InputError(f"unknown time system {time_system!r} in the '%c' line", path)
+    return ids, time_system, number
+
+
+def _int(text: str, path: Path, line: int, what: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise InputError(f"bad {what} {text.strip()!r}", path, line) from None
+
+
+def _epoch(path: Path, line_number: int, line: str) -> tuple[float, ...]:
+    fields = line[1:].split()
+    try:
+        year, month, day, hour, minute = (int(v) for v in fields[:5])
+        second = float(fields[5])
+    except (ValueError, IndexError):
+        raise InputError(f"bad epoch line {line.strip()!r}", path, line_number) from None
+    return float(year), float(month), float(day), float(hour), float(minute), second
+
+
+def _position(path: Path, line_number: int, line: str) -> np.ndarray:
+    """ECEF metres, NaN for the missing-value mark 0.000000."""
+    try:
+        xyz = np.array([float(line[4:18]), float(line[18:32]), float(line[32:46])])
+    except ValueError:
+        raise InputError(f"bad position in {line.strip()!r}", path, line_number) from None
+    return 1000.0 * xyz if np.any(xyz != 0.0) else np.full(3, np.nan)
+
+
+def _clock(path: Path, line_number: int, line: str) -> float:
+    """Seconds, NaN for a blank field or the missing-value mark 999999.999999."""
+    text = line[46:60].strip()
+    try:
+        microseconds = float(text) if text else np.nan
+    except ValueError:
+        raise InputError(f"bad clock {text!r}", path, line_number) from None
+    return 1e-6 * microseconds if microseconds < BAD_CLOCK_US else np.nan
+
+
+def _known(path: Path, line_number: int, line: str, column: dict[str, int]) -> int:
+    try:
+        sat = satellite_id(line[1:4])
+    except ValueError:
+        raise InputError(f"bad satellite identifier {line[1:4]!r}", path, line_number) from None
+    if sat not in column:
+        raise InputError(f"satellite {sat} not in the header list", path, line_number)
+    return column[sat]
