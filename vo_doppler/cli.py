@@ -28,6 +28,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "low-cost path mapping: two gyros + GPS dead reckoning and drift table",
     ),
     "simulate": ("simulate_command", "generate a synthetic multi-sensor sequence"),
+    "import": ("import_command", "convert a recording (comma2k19 segment) into a sequence folder"),
 }
 """Subcommand → (module in ``vo_doppler.commands``, one-line help). A module is imported only
 when its subcommand runs, so ``vo-doppler --help`` loads none of the library."""

@@ -8,7 +8,7 @@ import pytest
 from tests.conftest import require_shared
 from vo_doppler.geo import SPEED_OF_LIGHT
 from vo_doppler.gnss.doppler_velocity import doppler_rows, doppler_velocity, solve_velocity
-from vo_doppler.gnss.ephemeris import transmit_states
+from vo_doppler.gnss.satellite_source import transmit_states
 from vo_doppler.gnss.signals import wavelengths
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.io.rinex_nav import read_nav

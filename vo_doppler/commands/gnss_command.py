@@ -1,4 +1,5 @@
-"""``vo-doppler gnss``: Doppler velocity and single-point positions from RINEX files."""
+"""``vo-doppler gnss``: Doppler velocity and single-point positions from RINEX files, with
+broadcast (``--nav``) or precise (``--orbits``) satellite states."""
 
 from __future__ import annotations
 
@@ -8,12 +9,13 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.commands.satellite_options import add_satellite_options, satellite_states
 from vo_doppler.errors import VoDopplerError
 from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
 from vo_doppler.gnss.spp import solve_spp
 from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
-from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
+from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.report.gnss import spp_figure, velocity_figure
 
 log = logging.getLogger(__name__)
@@ -29,9 +31,7 @@ def _systems(text: str) -> str:
 
 def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("obs", type=Path, help="RINEX 2/3 observation file (.gz / Hatanaka ok)")
-    parser.add_argument(
-        "--nav", type=Path, action="append", required=True, help="RINEX navigation file (repeat)"
-    )
+    add_satellite_options(parser)
     parser.add_argument("--systems", type=_systems, default="GREJC", help="default GREJC")
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees (default 10)")
     parser.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
@@ -67,7 +67,7 @@ def register(subparsers, summary: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     obs = read_obs(args.obs)
-    nav = read_nav(args.nav)
+    nav = satellite_states(args)
     mask = np.deg2rad(args.elev_mask)
     figure = args.figure or args.output.with_suffix(".png")
     title = f"{args.obs.name} ({args.systems})"
@@ -96,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
                 np.median(speed),
                 np.percentile(speed, 95),
             )
-    skipped = len(obs.problems) + len(nav.problems)
+    skipped = len(obs.problems) + len(state_problems(nav))
     log.info(
         "%d of %d epochs valid; wrote %s and %s%s",
         int(valid.sum()),

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.commands.satellite_options import add_satellite_options, satellite_states
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
@@ -18,7 +19,6 @@ from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConf
 from vo_doppler.heading.tight_heading import TightHeadingConfig
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.heading_csv import write_heading_csv
-from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
@@ -38,7 +38,7 @@ def register(subparsers, summary: str) -> None:
         "GNSS epoch (headings as course, degrees clockwise from north) and a figure.",
     )
     parser.add_argument("obs", type=Path, help="RINEX observation file")
-    parser.add_argument("--nav", type=Path, action="append", required=True)
+    add_satellite_options(parser)
     parser.add_argument("--systems", default="GREJC")
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
     sensors = parser.add_argument_group("vehicle sensors (CAN log + DBC, or two CSV files)")
@@ -159,7 +159,7 @@ def _local_frame(receiver_ecef: np.ndarray, obs) -> EnuFrame:
 def run(args: argparse.Namespace) -> int:
     speed, yaw_rate = _sensors(args)
     obs = read_obs(args.obs)
-    nav = read_nav(args.nav)
+    nav = satellite_states(args)
     systems, mask = args.systems.upper(), np.radians(args.elev_mask)
     if args.max_sats is None:
         gnss = gnss_velocity(obs, nav, systems, mask)

@@ -21,13 +21,12 @@ import logging
 import numpy as np
 
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
-from vo_doppler.gnss.ephemeris import transmit_states
 from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion
+from vo_doppler.gnss.satellite_source import StateSource, satellite_source, transmit_states
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.gnss.spp import elevation_azimuth
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.gnss_solutions import VelocitySolution
-from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations, lookup, row_keys
 
 log = logging.getLogger(__name__)
@@ -55,7 +54,7 @@ def doppler_codes(obs: Observations, systems: str, bands: str | None = None) -> 
 
 def doppler_rows(
     obs: Observations,
-    nav: Navigation,
+    source: StateSource,
     receiver_ecef: np.ndarray,
     systems: str = "GREJC",
     bands: str | None = None,
@@ -66,13 +65,13 @@ def doppler_rows(
 
     ``receiver_ecef``: (3,) or one position per observation epoch (E, 3; NaN rows are skipped).
     Satellite states are taken at signal transmission (travel time from the geometric range) in
-    the ECEF frame of reception. Rows without ephemeris or wavelength are dropped and counted.
+    the ECEF frame of reception, from ``source`` (broadcast or precise, ``satellite_source``).
+    Rows without ephemeris or wavelength are dropped and counted.
     """
+    source = satellite_source(source)
     n_epochs = obs.epoch_time.size
     receiver = np.broadcast_to(np.asarray(receiver_ecef, dtype=float), (n_epochs, 3))
-    channels = dict(obs.header.glonass_channels)
-    if len(nav.glonass):
-        channels = {**nav.glonass_channels(), **channels}
+    channels = {**source.glonass_channels(), **obs.header.glonass_channels}
     keep = np.zeros(len(obs), dtype=bool)
     for system in systems:
         for code in doppler_codes(obs, system, bands):
@@ -93,7 +92,7 @@ def doppler_rows(
     n_no_wavelength = int((~np.isfinite(wavelength)).sum())
     usable = np.isfinite(wavelength) & has_position
     states, _ = transmit_states(
-        nav,
+        source,
         sel.system[usable],
         sel.prn[usable],
         sel.time[usable],
@@ -229,12 +228,12 @@ def _dop(H: np.ndarray, rotation: np.ndarray) -> np.ndarray:
 
 def doppler_velocity(
     obs: Observations,
-    nav: Navigation,
+    source: StateSource,
     receiver_ecef: np.ndarray,
     sigma0: float = SIGMA_RANGE_RATE_MPS,
     **row_options,
 ) -> tuple[VelocitySolution, DopplerRows]:
     """Rows (``doppler_rows`` with ``row_options``: systems, bands, elevation_mask_rad) and the
     per-epoch solution (``solve_velocity``) in one call."""
-    rows = doppler_rows(obs, nav, receiver_ecef, sigma0=sigma0, **row_options)
+    rows = doppler_rows(obs, source, receiver_ecef, sigma0=sigma0, **row_options)
     return solve_velocity(rows, obs.epoch_time), rows

@@ -1,4 +1,5 @@
-"""RINEX observations + navigation → SPP positions and Doppler velocities (no file I/O)."""
+"""Observations + satellite states (broadcast or precise) → SPP positions and Doppler
+velocities (no file I/O)."""
 
 from __future__ import annotations
 
@@ -8,9 +9,9 @@ import numpy as np
 
 from vo_doppler.gnss.doppler_velocity import DopplerRows, doppler_velocity
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
+from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
-from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 
 
@@ -29,7 +30,7 @@ RANGE_RATE_SOURCES = ("doppler", "phase")
 
 def gnss_velocity(
     obs: Observations,
-    nav: Navigation,
+    source: StateSource,
     systems: str = "GREJC",
     elevation_mask_rad: float = np.deg2rad(10.0),
     bands: str | None = None,
@@ -41,17 +42,17 @@ def gnss_velocity(
     ``range_rate`` 'phase' replaces the Doppler by the carrier-phase rate (``phase_rate``)."""
     if range_rate not in RANGE_RATE_SOURCES:
         raise ValueError(f"range_rate must be one of {RANGE_RATE_SOURCES}")
-    spp = solve_spp(obs, nav, systems, elevation_mask_rad)
+    spp = solve_spp(obs, source, systems, elevation_mask_rad)
     fallback = receiver_ecef if receiver_ecef is not None else obs.header.approx_position
     position = (
         np.broadcast_to(receiver_ecef, (obs.epoch_time.size, 3))
         if receiver_ecef is not None
         else receiver_positions(spp, fallback)
     )
-    source = carrier_phase_doppler(obs) if range_rate == "phase" else obs
+    measured = carrier_phase_doppler(obs) if range_rate == "phase" else obs
     velocity, rows = doppler_velocity(
+        measured,
         source,
-        nav,
         position,
         systems=systems,
         bands=bands,

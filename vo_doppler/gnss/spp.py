@@ -17,11 +17,11 @@ import numpy as np
 
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_geodetic
 from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
-from vo_doppler.gnss.ephemeris import rotate_earth, satellite_states
+from vo_doppler.gnss.ephemeris import rotate_earth
 from vo_doppler.gnss.lsq import lsq_with_exclusion, weighted_lsq
+from vo_doppler.gnss.satellite_source import StateSource, satellite_source
 from vo_doppler.gnss.signals import wavelengths
 from vo_doppler.model.gnss_solutions import SppSolution
-from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 
 log = logging.getLogger(__name__)
@@ -37,7 +37,6 @@ PSEUDORANGE_PRIORITY = {
 }
 SIGMA_PSEUDORANGE_M = 3.0
 EARTH_SURFACE_M = 6.0e6
-_GROUP_DELAY_FIELD = {("G", "1"): "tgd", ("J", "1"): "tgd", ("E", "1"): "iodc", ("C", "2"): "tgd"}
 
 
 def pseudorange_codes(obs: Observations, systems: str) -> dict[str, str]:
@@ -71,29 +70,26 @@ def elevation_azimuth(
 
 def solve_spp(
     obs: Observations,
-    nav: Navigation,
+    source: StateSource,
     systems: str = "GREJC",
     elevation_mask_rad: float = np.deg2rad(10.0),
 ) -> SppSolution:
-    """Single-point position per data epoch of ``obs`` (invalid epochs NaN, never guessed)."""
+    """Single-point position per data epoch of ``obs`` (invalid epochs NaN, never guessed),
+    satellite states from ``source`` (broadcast or precise, ``satellite_source``)."""
+    source = satellite_source(source)
     codes = pseudorange_codes(obs, systems)
     rows = np.zeros(len(obs), dtype=bool)
     for system, code in codes.items():
         rows |= obs.mask(system, code)
     sel = obs.subset(rows & np.isfinite(obs.value) & (obs.value > 1e6))
     travel = sel.value / SPEED_OF_LIGHT
-    first = satellite_states(nav, sel.system, sel.prn, sel.time - travel)
+    first = source.states(sel.system, sel.prn, sel.time - travel)
     t_tx = sel.time - travel - np.nan_to_num(first.clock_bias_s)
-    states = satellite_states(nav, sel.system, sel.prn, t_tx)
-    group_delay = np.zeros(len(sel))
-    for (system, band), name in _GROUP_DELAY_FIELD.items():
-        code = codes.get(system, "")
-        hit = (sel.system == system) & states.valid
-        if code[1:2] == band and hit.any():
-            group_delay[hit] = nav.kepler[name][states.record[hit]]
+    states = source.states(sel.system, sel.prn, t_tx)
+    group_delay = source.group_delay_s(sel.system, states, codes)
     satellite_clock_m = SPEED_OF_LIGHT * (states.clock_bias_s - np.nan_to_num(group_delay))
     n_no_ephemeris = int((~states.valid).sum())
-    channels = {**nav.glonass_channels(), **obs.header.glonass_channels}
+    channels = {**source.glonass_channels(), **obs.header.glonass_channels}
     frequency = np.full(len(sel), L1_HZ)
     for system, code in codes.items():
         hit = sel.system == system
@@ -104,7 +100,7 @@ def solve_spp(
     start = obs.header.approx_position
     if start is None or np.linalg.norm(start) < EARTH_SURFACE_M:
         start = np.zeros(3)
-    model = _Model(sorted(codes), elevation_mask_rad, nav.klobuchar)
+    model = _Model(sorted(codes), elevation_mask_rad, source.klobuchar)
     n_epochs = obs.epoch_time.size
     position = np.full((n_epochs, 3), np.nan)
     clocks = {s: np.full(n_epochs, np.nan) for s in model.systems}

@@ -100,3 +100,81 @@ def read_lowcost_inputs(base: Path):
         base / "can_motion.log", base / "toyota_2017_motion.dbc", yaw_rate="KINEMATICS.YAW_RATE"
     ).yaw_rate
     return truth, fixes, gyro, (can.t, can.value)
+
+
+RAW_GNSS = ("processed_log", "GNSS", "raw_gnss_ublox")
+GLONASS_PRN_OFFSET = 64
+"""comma2k19 numbers GLONASS satellites 65 + (slot − 1)."""
+
+
+@dataclass(frozen=True)
+class RawGnss:
+    """``raw_gnss_ublox`` rows (one per satellite and epoch, u-blox RXM-RAWX): epoch GPS time
+    (week × 604800 + time of week, s), system letter, PRN/slot, GLONASS frequency channel,
+    pseudorange (m) and its σ, pseudorange rate (m/s, positive when the range grows) and its σ,
+    C/N0 (dB-Hz), carrier phase (cycles, NaN when not tracked). Rows of other systems are
+    dropped and counted."""
+
+    t: np.ndarray
+    system: np.ndarray
+    prn: np.ndarray
+    glonass_channel: np.ndarray
+    pseudorange: np.ndarray
+    pseudorange_sigma: np.ndarray
+    range_rate: np.ndarray
+    range_rate_sigma: np.ndarray
+    cn0: np.ndarray
+    carrier_phase: np.ndarray
+    n_dropped: int
+
+
+def read_raw_gnss(base: str | Path) -> RawGnss:
+    value = load_array(base, *RAW_GNSS, "value")
+    if value.ndim != 2 or value.shape[1] < 10:
+        raise InputError(f"raw_gnss_ublox/value has shape {value.shape}, not (N, 10)", base)
+    number = value[:, 0].astype(np.int64)
+    gps = (number >= 1) & (number <= 32)
+    glonass = (number > GLONASS_PRN_OFFSET) & (number <= GLONASS_PRN_OFFSET + 24)
+    keep = (gps | glonass) & np.isfinite(value[:, 6])
+    rows = value[keep]
+    return RawGnss(
+        t=rows[:, 1] * SECONDS_PER_WEEK + rows[:, 2],
+        system=np.where(gps[keep], "G", "R"),
+        prn=np.where(gps[keep], number[keep], number[keep] - GLONASS_PRN_OFFSET),
+        glonass_channel=rows[:, 3],
+        pseudorange=rows[:, 4],
+        pseudorange_sigma=rows[:, 5],
+        range_rate=rows[:, 6],
+        range_rate_sigma=rows[:, 7],
+        cn0=rows[:, 8],
+        carrier_phase=rows[:, 9],
+        n_dropped=int((~keep).sum()),
+    )
+
+
+def gps_minus_mono(base: str | Path) -> float:
+    """GPS time (s since 1980) − the logs' monotonic clock, from ``global_pose``'s paired
+    ``frame_times`` and ``frame_gps_times`` (their spread is checked below 1 ms)."""
+    t = load_array(base, "global_pose", "frame_times")
+    gps_times = load_array(base, "global_pose", "frame_gps_times")
+    offsets = gps_times[:, 0] * SECONDS_PER_WEEK + gps_times[:, 1] - t
+    if np.ptp(offsets) > 1e-3:
+        raise InputError(
+            f"global_pose frame_gps_times − frame_times varies by {np.ptp(offsets):.3f} s",
+            Path(base, "global_pose"),
+        )
+    return float(np.median(offsets))
+
+
+def read_vehicle_poses(base: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``global_pose`` as vehicle poses: GPS times (s), ECEF positions (m) and vehicle→ECEF
+    rotation matrices (vehicle x forward, y left, z up). ``frame_orientations`` (w, x, y, z)
+    rotate the device frame (x forward, y right, z down; its x follows the ECEF velocity to
+    within the mounting angle) into ECEF, so the vehicle frame is the device's with y and z
+    flipped."""
+    gps_times = load_array(base, "global_pose", "frame_gps_times")
+    positions = load_array(base, "global_pose", "frame_positions")
+    quaternion_wxyz = load_array(base, "global_pose", "frame_orientations")
+    device_to_ecef = Rotation.from_quat(quaternion_wxyz[:, [1, 2, 3, 0]]).as_matrix()
+    vehicle_to_ecef = device_to_ecef * np.array([1.0, -1.0, -1.0])
+    return gps_times[:, 0] * SECONDS_PER_WEEK + gps_times[:, 1], positions, vehicle_to_ecef

@@ -137,11 +137,13 @@ def write_obs(
     marker_name: str = "SIM",
     receiver: str = "SIMULATED",
     antenna_height_m: float = 0.0,
+    glonass_channels: dict[int, int] | None = None,
 ) -> None:
     """Write a RINEX 3.04 mixed observation file (GPS time).
 
     The signal-strength digit of every observable comes from the row's ``S`` observable (the
-    C/N0), when there is one.
+    C/N0), when there is one. ``glonass_channels`` (slot → frequency channel) are written as
+    ``GLONASS SLOT / FRQ #`` records (RINEX 3.04 Table A2), eight slots per line.
     """
     systems = sorted({s[0] for s in data.satellite.tolist()})
     x, y, z = approx_position
@@ -175,6 +177,11 @@ def write_obs(
     ]
     for system in systems:
         lines.append(header_line(system, "SYS / PHASE SHIFT"))
+    slots = sorted((glonass_channels or {}).items())
+    for start in range(0, len(slots), 8):
+        count = f"{len(slots):3d} " if start == 0 else " " * 4
+        chunk = "".join(f"R{slot:02d} {channel:2d} " for slot, channel in slots[start : start + 8])
+        lines.append(header_line(count + chunk, "GLONASS SLOT / FRQ #"))
     lines.append(header_line("", "END OF HEADER"))
     strength = next((k for k, c in enumerate(data.codes) if c.startswith("S")), None)
     ssi = (

@@ -19,9 +19,10 @@ from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.doppler_sigma import read_doppler_sigma
 from vo_doppler.io.images import list_images, read_times
-from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.io.satellite_states import read_satellite_states
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.model.sequence import Sequence
 
@@ -66,16 +67,19 @@ def read_sequence(folder: str | Path) -> Sequence:
     """All inputs of a sequence folder, on GPS time; ground truth when the folder has one."""
     manifest = read_manifest(folder)
     root = manifest["_path"].parent
-    camera_cfg = _section(manifest, "camera")
     gnss_cfg = _section(manifest, "gnss")
     can_cfg = _section(manifest, "can")
     origin = _section(manifest, "origin")
-    images = list_images(root / _entry(camera_cfg, "images", manifest, "camera"))
-    times = read_times(root / _entry(camera_cfg, "times", manifest, "camera"), len(images))
-    camera = read_camera(root / _entry(camera_cfg, "calib", manifest, "camera"))
+    images, times, camera, camera_offset = [], np.zeros(0), None, 0.0
+    if "camera" in manifest:  # a recording without video has no camera section
+        camera_cfg = _section(manifest, "camera")
+        camera_offset = float(camera_cfg.get("time_offset_s", 0.0))
+        images = list_images(root / _entry(camera_cfg, "images", manifest, "camera"))
+        times = read_times(root / _entry(camera_cfg, "times", manifest, "camera"), len(images))
+        camera = read_camera(root / _entry(camera_cfg, "calib", manifest, "camera"))
     obs = read_obs(root / _entry(gnss_cfg, "obs", manifest, "gnss"))
-    nav_paths = _entry(gnss_cfg, "nav", manifest, "gnss")
-    nav = read_nav([root / p for p in np.atleast_1d(nav_paths)])
+    nav = _satellite_states(gnss_cfg, manifest, root)
+    sigma_file = gnss_cfg.get("doppler_sigma")
     if float(gnss_cfg.get("time_offset_s", 0.0)) != 0.0:
         raise InputError("GNSS observations must be on GPS time (time_offset_s 0)", root)
     can_offset = float(can_cfg.get("time_offset_s", 0.0))
@@ -107,21 +111,33 @@ def read_sequence(folder: str | Path) -> Sequence:
     return Sequence(
         name=str(manifest.get("name", root.name)),
         image_paths=images,
-        image_times=times + float(camera_cfg.get("time_offset_s", 0.0)),
+        image_times=times + camera_offset,
         camera=camera,
         observations=obs,
         navigation=nav,
+        doppler_sigma=None if sigma_file is None else read_doppler_sigma(root / sigma_file),
         yaw_rate=motion.yaw_rate,
         wheel_speed=motion.speed,
         enu=enu,
         truth=truth,
         antenna_lever_arm_m=lever_arm,
         clock_offsets_s={
-            "camera": float(camera_cfg.get("time_offset_s", 0.0)),
+            "camera": camera_offset,
             "can": can_offset,
             "gnss": 0.0,
         },
     )
+
+
+def _satellite_states(gnss_cfg: dict[str, Any], manifest: dict[str, Any], root: Path):
+    """``gnss.orbits`` (SP3, with ``gnss.clocks``) when given, else ``gnss.nav``."""
+    if "orbits" in gnss_cfg:
+        clocks = gnss_cfg.get("clocks")
+        return read_satellite_states(
+            orbits=root / gnss_cfg["orbits"], clocks=None if clocks is None else root / clocks
+        )
+    nav_paths = _entry(gnss_cfg, "nav", manifest, "gnss")
+    return read_satellite_states([root / p for p in np.atleast_1d(nav_paths)])
 
 
 def _lever_arm(value, root: Path) -> tuple[float, float, float]:

@@ -9,8 +9,10 @@ import numpy as np
 
 from vo_doppler.geo import EnuFrame
 from vo_doppler.model.camera import Camera
+from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
+from vo_doppler.model.precise_orbits import PreciseOrbits
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
 
@@ -29,7 +31,8 @@ class Sequence:
     image_times: np.ndarray
     camera: Camera | None
     observations: Observations
-    navigation: Navigation
+    navigation: Navigation | PreciseOrbits
+    """Broadcast ephemerides or precise orbits (+ clocks): the GNSS stage takes either."""
     yaw_rate: SensorSeries
     """Counter-clockwise positive, rad/s."""
     wheel_speed: SensorSeries
@@ -41,6 +44,8 @@ class Sequence:
     """GNSS antenna in the vehicle frame (x forward, y left, z up) from the vehicle origin (m)."""
     clock_offsets_s: dict[str, float] = field(default_factory=dict)
     """GPS time − sensor time per sensor ('camera', 'can', …) as the manifest gave it."""
+    doppler_sigma: ReportedSigma | None = None
+    """The receiver's σ of each Doppler range rate, when it reported one."""
 
     @property
     def has_camera(self) -> bool:

@@ -46,7 +46,8 @@ import numpy as np
 
 from vo_doppler.geo import SPEED_OF_LIGHT, EnuFrame
 from vo_doppler.gnss.atmosphere import klobuchar_delay, troposphere_delay
-from vo_doppler.gnss.ephemeris import OMEGA_E, transmit_states
+from vo_doppler.gnss.ephemeris import OMEGA_E
+from vo_doppler.gnss.satellite_source import transmit_states
 from vo_doppler.gnss.signals import FREQUENCIES_HZ
 from vo_doppler.io.rinex_write import ObsEpochs
 from vo_doppler.model.navigation import Navigation

@@ -1,0 +1,22 @@
+"""The satellite-state options of the GNSS commands: ``--nav``, or ``--orbits`` + ``--clocks``."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from vo_doppler.io.satellite_states import read_satellite_states
+from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.precise_orbits import PreciseOrbits
+
+
+def add_satellite_options(parser: argparse.ArgumentParser) -> None:
+    choice = parser.add_mutually_exclusive_group(required=True)
+    choice.add_argument("--nav", type=Path, action="append", help="RINEX navigation file (repeat)")
+    choice.add_argument("--orbits", type=Path, help="SP3-c/d precise orbits (instead of --nav)")
+    parser.add_argument("--clocks", type=Path, help="RINEX clock file beside --orbits")
+
+
+def satellite_states(args: argparse.Namespace) -> Navigation | PreciseOrbits:
+    """The navigation files or the precise orbits (+ clocks) the options name."""
+    return read_satellite_states(args.nav, args.orbits, args.clocks)

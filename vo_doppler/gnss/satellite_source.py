@@ -1,0 +1,158 @@
+"""Where the GNSS stage takes satellite states from: broadcast ephemerides (a navigation file)
+or precise orbits and clocks (SP3 + RINEX clock), behind one small protocol, so that SPP, the
+Doppler rows and the heading never branch on the source.
+
+Every function of the stage accepts a :data:`StateSource` (a ``Navigation``, a
+``PreciseOrbits`` or an object following :class:`SatelliteSource`) and turns it into a
+source once with :func:`satellite_source`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from vo_doppler.geo import SPEED_OF_LIGHT
+from vo_doppler.gnss.ephemeris import SatelliteStates, rotate_earth, satellite_states
+from vo_doppler.gnss.precise_orbits import LAGRANGE_POINTS, precise_states
+from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.precise_orbits import PreciseOrbits
+
+_GROUP_DELAY_FIELD = {("G", "1"): "tgd", ("J", "1"): "tgd", ("E", "1"): "iodc", ("C", "2"): "tgd"}
+
+
+class SatelliteSource(Protocol):
+    """What the GNSS stage needs from a source of satellite states."""
+
+    @property
+    def klobuchar(self) -> np.ndarray | None:
+        """Broadcast ionosphere coefficients (α₀…α₃, β₀…β₃), None when the source has none."""
+
+    def states(self, system, prn, t) -> SatelliteStates:
+        """Satellite states at GPS times ``t`` (s), arrays broadcast (``ephemeris`` docstring)."""
+
+    def group_delay_s(
+        self, system: np.ndarray, states: SatelliteStates, codes: dict[str, str]
+    ) -> np.ndarray:
+        """Group delay (s) to subtract from the satellite clock for the pseudorange ``codes``
+        chosen per system (IS-GPS-200 sec. 20.3.3.3.3.2)."""
+
+    def glonass_channels(self) -> dict[int, int]:
+        """GLONASS frequency channel per slot, as far as the source knows them."""
+
+
+@dataclass(frozen=True)
+class BroadcastSource:
+    """Broadcast ephemerides (``ephemeris.satellite_states``) and their group delays."""
+
+    nav: Navigation
+
+    @property
+    def klobuchar(self) -> np.ndarray | None:
+        return self.nav.klobuchar
+
+    def states(self, system, prn, t) -> SatelliteStates:
+        return satellite_states(self.nav, system, prn, t)
+
+    def group_delay_s(
+        self, system: np.ndarray, states: SatelliteStates, codes: dict[str, str]
+    ) -> np.ndarray:
+        delay = np.zeros(system.size)
+        for (letter, band), name in _GROUP_DELAY_FIELD.items():
+            hit = (system == letter) & states.valid
+            if codes.get(letter, "")[1:2] == band and hit.any():
+                delay[hit] = self.nav.kepler[name][states.record[hit]]
+        return delay
+
+    def glonass_channels(self) -> dict[int, int]:
+        return self.nav.glonass_channels()
+
+
+@dataclass(frozen=True)
+class PreciseSource:
+    """Precise orbits and clocks (``precise_orbits.precise_states``). The products' clocks
+    refer to the ionosphere-free code combination; no differential code bias is applied for
+    single-frequency pseudoranges (a few ns, within the SPP error budget; Doppler is unaffected).
+    """
+
+    orbits: PreciseOrbits
+    n_points: int = LAGRANGE_POINTS
+
+    @property
+    def klobuchar(self) -> np.ndarray | None:
+        return None
+
+    def states(self, system, prn, t) -> SatelliteStates:
+        return precise_states(self.orbits, system, prn, t, self.n_points)
+
+    def group_delay_s(
+        self, system: np.ndarray, states: SatelliteStates, codes: dict[str, str]
+    ) -> np.ndarray:
+        return np.zeros(system.size)
+
+    def glonass_channels(self) -> dict[int, int]:
+        return {}
+
+
+StateSource = Navigation | PreciseOrbits | SatelliteSource
+
+
+def satellite_source(source: StateSource) -> SatelliteSource:
+    """The source behind a navigation file, precise orbits, or a source already."""
+    if isinstance(source, Navigation):
+        return BroadcastSource(source)
+    if isinstance(source, PreciseOrbits):
+        return PreciseSource(source)
+    return source
+
+
+def transmit_states(
+    source: StateSource,
+    system,
+    prn,
+    t_receive,
+    receiver_ecef: np.ndarray | None = None,
+    pseudorange: np.ndarray | None = None,
+) -> tuple[SatelliteStates, np.ndarray]:
+    """Satellite states at signal transmission, in the ECEF frame of the reception epoch.
+
+    With a pseudorange P the transmission time is t_tx = t_rx − P/c − Δt_sv (IS-GPS-200
+    sec. 20.3.3.3.3.1; exact whatever the receiver clock error); without one, the travel time
+    τ is solved by fixed point from the geometric range to ``receiver_ecef``. The Earth rotation
+    during travel uses the geometric travel time when ``receiver_ecef`` is given (else P/c).
+    Returns the states and the travel times τ (s).
+    """
+    source = satellite_source(source)
+    t_receive = np.asarray(t_receive, dtype=float)
+    system, prn, t_receive = np.broadcast_arrays(np.asarray(system), np.asarray(prn), t_receive)
+    if pseudorange is not None:
+        travel = np.asarray(pseudorange, dtype=float) / SPEED_OF_LIGHT
+        first = source.states(system, prn, t_receive - travel)
+        t_tx = t_receive - travel - np.nan_to_num(first.clock_bias_s)
+        states = source.states(system, prn, t_tx)
+    elif receiver_ecef is not None:
+        travel = np.full(t_receive.shape, 0.075)
+        for _ in range(3):
+            states = source.states(system, prn, t_receive - travel)
+            travel = _geometric_travel(states.position, travel, receiver_ecef)
+    else:
+        raise ValueError("need a pseudorange or a receiver position")
+    if receiver_ecef is not None:
+        travel = _geometric_travel(states.position, travel, receiver_ecef)
+    rotated = SatelliteStates(
+        rotate_earth(states.position, travel),
+        rotate_earth(states.velocity, travel),
+        states.clock_bias_s,
+        states.clock_drift,
+        states.valid,
+        states.record,
+    )
+    return rotated, travel
+
+
+def _geometric_travel(position, travel, receiver_ecef) -> np.ndarray:
+    """Signal travel time from the range between the rotated satellite and the receiver."""
+    distance = np.linalg.norm(rotate_earth(position, travel) - receiver_ecef, axis=-1)
+    return np.nan_to_num(distance / SPEED_OF_LIGHT, nan=0.075)

@@ -1,0 +1,195 @@
+"""A comma2k19 segment → a standard sequence folder (``sequence.yaml``, format
+``vo-doppler-sequence/1``, docs/sequence_format.md) that ``vo-doppler run`` reads.
+
+Written: ``gnss/raw_gnss_ublox.obs`` (RINEX 3.04, GPS + GLONASS: C1C L1C D1C S1C; the Doppler
+D = −ṙ/λ from the pseudorange rate ṙ, RINEX 3.05 sec. 5.2.10), ``gnss/doppler_sigma.csv`` (the
+receiver's σ of each pseudorange rate, ``gnss.doppler_sigma``), the precise orbits (and
+clocks) copied beside them, ``can/`` (the segment's ``can_motion.log``, or one written from
+``raw_can`` in candump format, with the DBC), ``imu/yaw_rate.csv`` (gyro yaw rate on the log
+clock, a record for ``heading --yaw-rate-csv``), ``ground_truth.tum`` (``global_pose`` as
+vehicle poses in the ENU frame of the first pose, GPS time) and the clock offsets (log
+clock → GPS time from ``global_pose``). A segment's ``video.hevc`` is not decoded: the camera
+section is left out, and ``run`` then runs the non-visual pipelines.
+"""
+
+from __future__ import annotations
+
+import logging
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import can
+import numpy as np
+import yaml
+from scipy.spatial.transform import Rotation
+
+from vo_doppler.errors import InputError
+from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.io.comma2k19 import (
+    gps_minus_mono,
+    load_array,
+    read_gyro_yaw_rate,
+    read_raw_gnss,
+    read_vehicle_poses,
+)
+from vo_doppler.io.doppler_sigma import write_doppler_sigma
+from vo_doppler.io.rinex_write import ObsEpochs, write_obs
+from vo_doppler.io.sensor_csv import YAW_RATE_COLUMN, write_sensor_csv
+from vo_doppler.io.sequence import FORMAT, MANIFEST
+from vo_doppler.io.trajectory import write_tum
+from vo_doppler.model.doppler_sigma import ReportedSigma
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.trajectory import Trajectory
+
+log = logging.getLogger(__name__)
+
+GPS_L1_HZ = 1575.42e6
+GLONASS_G1_HZ = (1602.0e6, 0.5625e6)
+"""ICD-GLONASS 5.1 sec. 3.3.1.4: G1 = 1602 + 0.5625·k MHz for channel k."""
+CODES = ("C1C", "L1C", "D1C", "S1C")
+CAN_LOG = "can_motion.log"
+DBC = "toyota_2017_motion.dbc"
+YAW_RATE_SIGNAL = "KINEMATICS.YAW_RATE"
+WHEEL_SIGNALS = ",".join(f"WHEEL_SPEEDS.WHEEL_SPEED_{w}" for w in ("FL", "FR", "RL", "RR"))
+
+
+@dataclass(frozen=True)
+class ImportSummary:
+    folder: Path
+    gnss_epochs: int
+    gnss_rows: int
+    dropped_rows: int
+    gps_minus_log_s: float
+    ground_truth_poses: int
+    has_video: bool
+
+
+def import_comma2k19(
+    segment: str | Path,
+    output: str | Path,
+    orbits: str | Path,
+    clocks: str | Path | None = None,
+    dbc: str | Path | None = None,
+) -> ImportSummary:
+    """Write the sequence folder ``output`` from the segment folder ``segment``."""
+    segment, output = Path(segment), Path(output)
+    dbc = Path(dbc) if dbc is not None else segment / DBC
+    if not dbc.is_file():
+        raise InputError("no DBC for the CAN log (give --dbc)", dbc)
+    for folder in ("gnss", "can", "imu"):
+        (output / folder).mkdir(parents=True, exist_ok=True)
+    offset = gps_minus_mono(segment)
+    raw = read_raw_gnss(segment)
+    t_pose, ecef, vehicle_to_ecef = read_vehicle_poses(segment)
+    lat, lon, height = (float(v) for v in ecef_to_geodetic(ecef[0]))
+    epochs, obs_rows = _write_gnss(output / "gnss", raw, ecef[0])
+    gnss = {
+        "obs": "gnss/raw_gnss_ublox.obs",
+        "orbits": f"gnss/{Path(orbits).name}",
+        "doppler_sigma": "gnss/doppler_sigma.csv",
+    }
+    shutil.copyfile(orbits, output / gnss["orbits"])
+    if clocks is not None:
+        gnss["clocks"] = f"gnss/{Path(clocks).name}"
+        shutil.copyfile(clocks, output / gnss["clocks"])
+    _write_can(segment, output / "can" / CAN_LOG)
+    shutil.copyfile(dbc, output / "can" / dbc.name)
+    t_gyro, yaw_rate = read_gyro_yaw_rate(segment)
+    write_sensor_csv(
+        output / "imu" / "yaw_rate.csv", SensorSeries(t_gyro, yaw_rate), YAW_RATE_COLUMN
+    )
+    rotation = ecef_to_enu_rotation(lat, lon)
+    truth = Trajectory(
+        t_pose,
+        (ecef - ecef[0]) @ rotation.T,
+        Rotation.from_matrix(np.einsum("ij,njk->nik", rotation, vehicle_to_ecef)),
+    )
+    write_tum(output / "ground_truth.tum", truth)
+    has_video = (segment / "video.hevc").is_file()
+    manifest = {
+        "format": FORMAT,
+        "name": segment.name,
+        "source": f"comma2k19 segment {segment} (vo-doppler import comma2k19)",
+        "origin": {
+            "lat_deg": float(np.degrees(lat)),
+            "lon_deg": float(np.degrees(lon)),
+            "height_m": height,
+        },
+        "gnss": gnss,
+        "can": {
+            "log": f"can/{CAN_LOG}",
+            "dbc": f"can/{dbc.name}",
+            "yaw_rate": YAW_RATE_SIGNAL,
+            "wheel_speed": WHEEL_SIGNALS,
+            "time_offset_s": offset,
+        },
+        "imu": {"yaw_rate": "imu/yaw_rate.csv", "time_offset_s": offset},
+        "ground_truth": {"trajectory": "ground_truth.tum"},
+        "clock_offsets": {
+            "log_to_gps_s": offset,
+            "from": "global_pose frame_gps_times − frame_times",
+        },
+    }
+    if has_video:
+        log.warning("%s: video.hevc is not decoded; the sequence has no camera", segment)
+    (output / MANIFEST).write_text(yaml.safe_dump(manifest, sort_keys=False))
+    return ImportSummary(output, epochs, obs_rows, raw.n_dropped, offset, len(truth), has_video)
+
+
+def _write_gnss(folder: Path, raw, approx_position: np.ndarray) -> tuple[int, int]:
+    """RINEX observations and the σ table; returns (epochs, rows)."""
+    epoch_time, epoch = np.unique(np.round(raw.t, 3), return_inverse=True)
+    satellite = np.char.add(raw.system, np.char.zfill(raw.prn.astype(str), 2))
+    glonass = raw.system == "R"
+    frequency = np.where(
+        glonass, GLONASS_G1_HZ[0] + GLONASS_G1_HZ[1] * np.nan_to_num(raw.glonass_channel), GPS_L1_HZ
+    )
+    doppler_hz = -raw.range_rate * frequency / SPEED_OF_LIGHT
+    values = np.column_stack([raw.pseudorange, raw.carrier_phase, doppler_hz, raw.cn0])
+    channels = {
+        int(p): int(k)
+        for p, k in zip(raw.prn[glonass], raw.glonass_channel[glonass], strict=True)
+        if np.isfinite(k)
+    }
+    write_obs(
+        folder / "raw_gnss_ublox.obs",
+        ObsEpochs(epoch_time, epoch, satellite, values, CODES),
+        approx_position,
+        float(np.median(np.diff(epoch_time))) if epoch_time.size > 1 else 0.0,
+        marker_name="COMMA2K19",
+        receiver="U-BLOX M8",
+        glonass_channels=channels,
+    )
+    write_doppler_sigma(
+        folder / "doppler_sigma.csv",
+        ReportedSigma(
+            epoch_time[epoch], satellite, np.full(satellite.size, "D1C"), raw.range_rate_sigma
+        ),
+    )
+    return int(epoch_time.size), int(satellite.size)
+
+
+def _write_can(segment: Path, target: Path) -> None:
+    """The segment's candump log, or one written from ``processed_log/CAN/raw_can`` (payloads
+    stored as numpy ``S8`` lose trailing zero bytes: padded back to 8)."""
+    if (segment / CAN_LOG).is_file():
+        shutil.copyfile(segment / CAN_LOG, target)
+        return
+    folder = ("processed_log", "CAN", "raw_can")
+    t = load_array(segment, *folder, "t")
+    address = load_array(segment, *folder, "address")
+    data = load_array(segment, *folder, "data")
+    source = load_array(segment, *folder, "src")
+    with can.CanutilsLogWriter(str(target), channel="can0") as writer:
+        for k in np.flatnonzero(source == 0):
+            payload = bytes(data[k]).ljust(8, b"\0")
+            writer.on_message_received(
+                can.Message(
+                    timestamp=float(t[k]),
+                    arbitration_id=int(address[k]),
+                    data=payload,
+                    is_extended_id=False,
+                    channel="can0",
+                )
+            )
