@@ -190,7 +190,13 @@ def run_sequence(
     (e.g. frames already in memory); ``on_frame`` is called after each VO frame."""
     config = config or RunConfig()
     obs = sequence.observations
-    gnss = gnss_velocity(obs, sequence.navigation, config.systems, config.elevation_mask)
+    gnss = gnss_velocity(
+        obs,
+        sequence.navigation,
+        config.systems,
+        config.elevation_mask,
+        reported_sigma=sequence.doppler_sigma,
+    )
     table = heading_from_gnss(
         obs.epoch_time,
         gnss.rows,

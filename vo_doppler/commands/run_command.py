@@ -93,11 +93,11 @@ def run(args: argparse.Namespace) -> int:
         result = run_sequence(inputs, config, lambda _: progress.advance(task))
     out = args.output
     out.mkdir(parents=True, exist_ok=True)
-    write_tum(out / "trajectory_vo.tum", result.trajectories[Pipeline.VO])
-    write_tum(out / "trajectory_corrected.tum", result.trajectories[Pipeline.VO_GPS_TC])
-    for name in (Pipeline.VO_GPS_CONV, Pipeline.DR_GPS_TC):
-        if name in result.trajectories:
-            write_tum(out / f"trajectory_{name}.tum", result.trajectories[name])
+    file_names = {Pipeline.VO: "trajectory_vo.tum", Pipeline.VO_GPS_TC: "trajectory_corrected.tum"}
+    for name, trajectory in result.trajectories.items():
+        write_tum(out / file_names.get(name, f"trajectory_{name}.tum"), trajectory)
+    if result.vo is None:
+        console.print(f"{inputs.name} has no camera: only the non-visual pipelines ran")
     write_heading_csv(out / "heading.csv", result.heading)
     summary = summarise(result)
     summary["heading_correction"] = args.correction + (" (causal)" if args.causal else "")
@@ -167,9 +167,15 @@ def summarise(result: RunResult) -> dict:
         "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "final_wheel_scale": float(table.wheel_scale[-1]),
         "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
-        "vo_frames": result.vo.stats.frames,
-        "vo_flagged_frames": len(result.vo.stats.flagged_frames),
-        "vo_fps": result.vo.stats.fps,
+        **(
+            {
+                "vo_frames": result.vo.stats.frames,
+                "vo_flagged_frames": len(result.vo.stats.flagged_frames),
+                "vo_fps": result.vo.stats.fps,
+            }
+            if result.vo is not None
+            else {"camera": "none: non-visual pipelines only"}
+        ),
     }
 
 
@@ -180,8 +186,12 @@ def print_summary(console: Console, summary: dict, errors: dict) -> None:
         f"{summary['gnss_epochs']} epochs ({summary['tight_heading_rejected_rows']} Doppler rows "
         "rejected by the NLOS tests); "
         f"wheel scale {summary['final_wheel_scale']:.4f}, "
-        f"gyro bias {summary['final_gyro_bias_dps']:+.3f} deg/s; VO {summary['vo_frames']} "
-        f"frames ({summary['vo_flagged_frames']} flagged)"
+        f"gyro bias {summary['final_gyro_bias_dps']:+.3f} deg/s; "
+        + (
+            f"VO {summary['vo_frames']} frames ({summary['vo_flagged_frames']} flagged)"
+            if "vo_frames" in summary
+            else "no camera"
+        )
     )
     if not errors:
         return

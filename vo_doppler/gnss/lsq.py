@@ -21,7 +21,9 @@ class LsqResult:
     """Solution of one weighted least-squares problem after fault exclusion.
 
     ``residuals`` = y − H x for every row (excluded rows included); ``used`` marks the rows kept.
-    ``chi_square`` = Ω of the kept rows, ``dof`` = kept rows − unknowns.
+    ``chi_square`` = Ω of the kept rows, ``dof`` = kept rows − unknowns. ``passed``: the global
+    test accepts the kept rows (dof ≥ 1); False both when it rejects them after the allowed
+    exclusions and when there is no redundancy to test (dof 0).
     """
 
     x: np.ndarray
@@ -31,6 +33,7 @@ class LsqResult:
     chi_square: float
     dof: int
     valid: bool
+    passed: bool = False
 
 
 def weighted_lsq(H: np.ndarray, y: np.ndarray, sigma: np.ndarray):
@@ -73,8 +76,9 @@ def lsq_with_exclusion(
         residuals = y - H @ x
         dof = int(used.sum()) - u
         omega = float(np.sum((residuals[used] / su) ** 2))
-        if dof < 1 or omega <= chdtri(dof, alpha) or (~used).sum() >= max_excluded:
-            return LsqResult(x, covariance, residuals, used.copy(), omega, dof, True)
+        passed = dof >= 1 and omega <= chdtri(dof, alpha)
+        if dof < 1 or passed or (~used).sum() >= max_excluded:
+            return LsqResult(x, covariance, residuals, used.copy(), omega, dof, True, passed)
         q_vv = su**2 - np.einsum("ij,jk,ik->i", Hu, covariance, Hu)
         normalised = np.abs(residuals[used]) / np.sqrt(np.maximum(q_vv, 1e-30))
         worst = np.flatnonzero(used)[int(np.argmax(normalised))]

@@ -11,6 +11,7 @@ from vo_doppler.gnss.doppler_velocity import DopplerRows, doppler_velocity
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
 from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
+from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.observations import Observations
 
@@ -36,10 +37,14 @@ def gnss_velocity(
     bands: str | None = None,
     range_rate: str = "doppler",
     receiver_ecef: np.ndarray | None = None,
+    reported_sigma: ReportedSigma | None = None,
+    fit_noise: bool = False,
 ) -> GnssVelocityResult:
     """Per-epoch Doppler velocity. Line-of-sight vectors use the SPP fix of each epoch (or the
     nearest one, or ``receiver_ecef`` / the RINEX approximate position when SPP fails);
-    ``range_rate`` 'phase' replaces the Doppler by the carrier-phase rate (``phase_rate``)."""
+    ``range_rate`` 'phase' replaces the Doppler by the carrier-phase rate (``phase_rate``);
+    ``reported_sigma`` the receiver's σ of the range rates (weights where present);
+    ``fit_noise`` re-solves with σ fitted to the residuals (``doppler_noise``)."""
     if range_rate not in RANGE_RATE_SOURCES:
         raise ValueError(f"range_rate must be one of {RANGE_RATE_SOURCES}")
     spp = solve_spp(obs, source, systems, elevation_mask_rad)
@@ -57,5 +62,7 @@ def gnss_velocity(
         systems=systems,
         bands=bands,
         elevation_mask_rad=elevation_mask_rad,
+        reported_sigma=reported_sigma,
+        fit_noise=fit_noise,
     )
     return GnssVelocityResult(velocity, rows, spp, np.asarray(position))

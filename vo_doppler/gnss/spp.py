@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_geodetic
+from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
 from vo_doppler.gnss.ephemeris import rotate_earth
 from vo_doppler.gnss.lsq import lsq_with_exclusion, weighted_lsq
@@ -107,6 +107,9 @@ def solve_spp(
     n_sat = np.zeros(n_epochs, dtype=np.int64)
     rms = np.full(n_epochs, np.nan)
     pdop = np.full(n_epochs, np.nan)
+    quality = np.full((n_epochs, 2), np.nan)
+    valid = np.zeros(n_epochs, dtype=bool)
+    verified = np.zeros(n_epochs, dtype=bool)
     for k in range(n_epochs):
         r = np.arange(bounds[k], bounds[k + 1])
         r = r[states.valid[r]]
@@ -121,7 +124,10 @@ def solve_spp(
         result = _solve_epoch(data, model, start)
         if result is None:
             continue
-        x, clock, used, residuals, dop = result
+        x, clock, used, residuals, dop, fit = result
+        valid[k] = fit.passed or fit.dof == 0
+        verified[k] = fit.passed
+        quality[k] = _horizontal_quality(x, fit.design, fit.covariance[:3, :3])
         position[k] = x
         for s, value in clock.items():
             clocks[s][k] = value
@@ -136,8 +142,11 @@ def solve_spp(
         n_sat,
         rms,
         pdop,
-        np.isfinite(position[:, 0]),
+        valid,
         n_no_ephemeris,
+        verified=verified,
+        hdop=quality[:, 0],
+        horizontal_sigma_m=quality[:, 1],
     )
 
 
@@ -191,7 +200,28 @@ def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray):
     rms_value = float(np.sqrt(np.mean(result.residuals[result.used] ** 2)))
     pdop = float(np.sqrt(np.trace(np.linalg.inv(H.T @ H)[:3, :3])))
     clock = {s: clocks[i] for i, s in enumerate(model.systems) if present[i]}
-    return x, clock, int(used - (~result.used).sum()), rms_value, pdop
+    fit = _Fit(result.passed, result.dof, result.covariance, H[result.used])
+    return x, clock, int(used - (~result.used).sum()), rms_value, pdop, fit
+
+
+@dataclass(frozen=True)
+class _Fit:
+    """What the integrity figures need from an epoch's final least squares."""
+
+    passed: bool
+    dof: int
+    covariance: np.ndarray
+    design: np.ndarray
+
+
+def _horizontal_quality(x: np.ndarray, design: np.ndarray, covariance: np.ndarray):
+    """HDOP (unweighted geometry) and √(σ_e² + σ_n²) (weighted covariance) at position x."""
+    lat, lon, _ = ecef_to_geodetic(x)
+    rotation = ecef_to_enu_rotation(float(lat), float(lon))
+    geometry = np.linalg.inv(design.T @ design)[:3, :3]
+    horizontal = (rotation @ geometry @ rotation.T)[:2, :2]
+    weighted = (rotation @ covariance @ rotation.T)[:2, :2]
+    return np.sqrt(np.trace(horizontal)), np.sqrt(np.trace(weighted))
 
 
 def _linearise(data: _EpochData, model: _Model, x, clocks, keep):

@@ -12,13 +12,14 @@ import numpy as np
 
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.doppler_velocity import doppler_rows, solve_velocity
+from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.heading.conventional import velocity_heading_sigma
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.model.doppler import DopplerRows
+from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.heading import HeadingTable
-from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.series import SensorSeries
 
@@ -42,11 +43,12 @@ def keep_highest_satellites(
 
 def emulated_canyon(
     obs: Observations,
-    nav: Navigation,
+    nav: StateSource,
     n_keep: int,
     after_t: float,
     systems: str = "GREJC",
     elevation_mask_rad: float = np.radians(10.0),
+    reported_sigma: ReportedSigma | None = None,
 ) -> tuple[DopplerRows, VelocitySolution]:
     """Doppler rows and conventional velocities as a receiver in a street canyon would have them
     from ``after_t`` on: only the ``n_keep`` highest satellites, and line-of-sight vectors from
@@ -54,7 +56,14 @@ def emulated_canyon(
     spp = solve_spp(obs, nav, systems, elevation_mask_rad)
     open_sky = replace(spp, valid=spp.valid & (spp.t < after_t))
     positions = receiver_positions(open_sky, obs.header.approx_position)
-    rows = doppler_rows(obs, nav, positions, systems, elevation_mask_rad=elevation_mask_rad)
+    rows = doppler_rows(
+        obs,
+        nav,
+        positions,
+        systems,
+        elevation_mask_rad=elevation_mask_rad,
+        reported_sigma=reported_sigma,
+    )
     rows = keep_highest_satellites(rows, n_keep, after_t)
     return rows, solve_velocity(rows, obs.epoch_time)
 

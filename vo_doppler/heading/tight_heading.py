@@ -19,7 +19,10 @@ window — a trigonometric polynomial of degree 2 in θ₀ with at most two mini
 both, Gauss–Newton refines them, and iteratively re-weighted passes apply Huber weights. Two
 minima that fit equally well (e.g. two satellites on a straight road) make the window
 *ambiguous*: the one nearer the previous heading propagated by the gyro is kept, or the epoch
-is unavailable. The θ₀ variance is s²/(J_θᵀ P J_θ) (the marginal of the full covariance),
+is unavailable. Whenever two separated minima and a recent heading exist, that propagated
+heading weighs in as a pseudo-observation (variance σ_prev² + σ²): the root of least fit +
+prior cost is kept, so that one noisy window cannot switch a two-satellite solution to its
+mirror root. The θ₀ variance is s²/(J_θᵀ P J_θ) (the marginal of the full covariance),
 s² the a-posteriori variance factor, or more where the profiled cost is not a parabola (a flat
 side, a near second minimum: the Δcost = n²·s² intervals, n = 1 … 3, are read off the cost),
 plus the errors that white Doppler noise does not cover:
@@ -544,10 +547,13 @@ def _decide(
     last = -1
     for k in range(m):
         recent = last >= 0 and t_epoch[k] - t_epoch[last] <= config.prior_max_age_s
-        if candidate[k] and ambiguous[k] and recent:
+        if candidate[k] and separated[k] and recent:
+            # the gyro-propagated previous heading is a pseudo-observation of θ₀ with the
+            # variance σ_last² + σ_k²: the root of least data + prior cost (χ² units) is kept
             prior = yaw[last] + yaw_angle[k] - yaw_angle[last]
             options = np.array([sol.theta[k], sol.theta_second[k]])
-            yaw[k] = options[np.argmin(np.abs(wrap_angle(options - prior)))]
+            prior_cost = wrap_angle(options - prior) ** 2 / (sigma[last] ** 2 + sigma[k] ** 2)
+            yaw[k] = options[np.argmin(np.array([0.0, chi2_gap[k]]) + prior_cost)]
             available[k] = True
         if available[k]:
             last = k

@@ -166,15 +166,31 @@ def gps_minus_mono(base: str | Path) -> float:
     return float(np.median(offsets))
 
 
-def read_vehicle_poses(base: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``global_pose`` as vehicle poses: GPS times (s), ECEF positions (m) and vehicle→ECEF
-    rotation matrices (vehicle x forward, y left, z up). ``frame_orientations`` (w, x, y, z)
-    rotate the device frame (x forward, y right, z down; its x follows the ECEF velocity to
-    within the mounting angle) into ECEF, so the vehicle frame is the device's with y and z
-    flipped."""
+MOVING_MPS = 5.0
+
+
+def read_vehicle_poses(base: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """``global_pose`` as vehicle poses: GPS times (s), ECEF positions (m), vehicle→ECEF
+    rotation matrices (vehicle x forward, y left, z up) and the device's mounting yaw (rad).
+
+    ``frame_orientations`` (w, x, y, z) rotate the device frame (x forward, y right, z down)
+    into ECEF: checked, its x axis follows ``frame_velocities`` to within the mounting angle.
+    The vehicle frame is the device's with y and z flipped, turned about the vertical by the
+    median angle from the device's forward axis to the velocity while moving (> 5 m/s; a car
+    does not slip), so that the vehicle's x axis is its direction of travel.
+    """
     gps_times = load_array(base, "global_pose", "frame_gps_times")
     positions = load_array(base, "global_pose", "frame_positions")
+    velocity = load_array(base, "global_pose", "frame_velocities")
     quaternion_wxyz = load_array(base, "global_pose", "frame_orientations")
     device_to_ecef = Rotation.from_quat(quaternion_wxyz[:, [1, 2, 3, 0]]).as_matrix()
-    vehicle_to_ecef = device_to_ecef * np.array([1.0, -1.0, -1.0])
-    return gps_times[:, 0] * SECONDS_PER_WEEK + gps_times[:, 1], positions, vehicle_to_ecef
+    lat, lon, _ = ecef_to_geodetic(positions)
+    to_enu = np.stack([ecef_to_enu_rotation(a, b) for a, b in zip(lat, lon, strict=True)])
+    forward = np.einsum("nij,nj->ni", to_enu, device_to_ecef[:, :, 0])
+    travel = np.einsum("nij,nj->ni", to_enu, velocity)
+    moving = np.linalg.norm(travel[:, :2], axis=1) > MOVING_MPS
+    offset = np.arctan2(travel[:, 1], travel[:, 0]) - np.arctan2(forward[:, 1], forward[:, 0])
+    mount = float(np.median(np.angle(np.exp(1j * offset[moving])))) if moving.any() else 0.0
+    turn = Rotation.from_euler("z", mount).as_matrix()
+    vehicle_to_ecef = (device_to_ecef * np.array([1.0, -1.0, -1.0])) @ turn
+    return gps_times[:, 0] * SECONDS_PER_WEEK + gps_times[:, 1], positions, vehicle_to_ecef, mount

@@ -81,7 +81,7 @@ def import_comma2k19(
         (output / folder).mkdir(parents=True, exist_ok=True)
     offset = gps_minus_mono(segment)
     raw = read_raw_gnss(segment)
-    t_pose, ecef, vehicle_to_ecef = read_vehicle_poses(segment)
+    t_pose, ecef, vehicle_to_ecef, mount = read_vehicle_poses(segment)
     lat, lon, height = (float(v) for v in ecef_to_geodetic(ecef[0]))
     epochs, obs_rows = _write_gnss(output / "gnss", raw, ecef[0])
     gnss = {
@@ -125,7 +125,10 @@ def import_comma2k19(
             "time_offset_s": offset,
         },
         "imu": {"yaw_rate": "imu/yaw_rate.csv", "time_offset_s": offset},
-        "ground_truth": {"trajectory": "ground_truth.tum"},
+        "ground_truth": {
+            "trajectory": "ground_truth.tum",
+            "device_mount_yaw_deg": float(np.degrees(mount)),
+        },
         "clock_offsets": {
             "log_to_gps_s": offset,
             "from": "global_pose frame_gps_times − frame_times",

@@ -21,6 +21,11 @@ VELOCITY_COLUMNS = (
     "n_sat",
     "residual_rms_mps",
     "valid",
+    "verified",
+    "speed_sigma_mps",
+    "course_sigma_deg",
+    "pdop",
+    "hdop",
 )
 SPP_COLUMNS = (
     "gps_time_s",
@@ -37,6 +42,9 @@ SPP_COLUMNS = (
     "residual_rms_m",
     "pdop",
     "valid",
+    "verified",
+    "hdop",
+    "horizontal_sigma_m",
 )
 
 
@@ -70,8 +78,16 @@ def write_velocity_csv(path: str | Path, solution: VelocitySolution) -> None:
             solution.n_sat,
             solution.residual_rms_mps,
             solution.valid.astype(int),
+            solution.verified.astype(int),
+            solution.speed_sigma_mps,
+            np.degrees(solution.course_sigma_rad),
+            solution.dop[:, 1],
+            solution.dop[:, 2],
         ],
-        ["{:.3f}"] + ["{:.4f}"] * 4 + ["{:.2f}", "{:.4f}", "{:d}", "{:.4f}", "{:d}"],
+        ["{:.3f}"]
+        + ["{:.4f}"] * 4
+        + ["{:.2f}", "{:.4f}", "{:d}", "{:.4f}", "{:d}", "{:d}"]
+        + ["{:.4f}", "{:.3f}", "{:.2f}", "{:.2f}"],
     )
 
 
@@ -101,6 +117,12 @@ def write_spp_csv(path: str | Path, solution: SppSolution) -> None:
             solution.residual_rms_m,
             solution.pdop,
             solution.valid.astype(int),
+            solution.verified.astype(int),
+            solution.hdop,
+            solution.horizontal_sigma_m,
         ],
-        ["{:.3f}", "{:.9f}", "{:.9f}"] + ["{:.3f}"] * 7 + ["{:d}", "{:.3f}", "{:.2f}", "{:d}"],
+        ["{:.3f}", "{:.9f}", "{:.9f}"]
+        + ["{:.3f}"] * 7
+        + ["{:d}", "{:.3f}", "{:.2f}", "{:d}"]
+        + ["{:d}", "{:.2f}", "{:.2f}"],
     )

@@ -19,6 +19,12 @@ class SppSolution:
     pdop: np.ndarray
     valid: np.ndarray
     n_no_ephemeris: int
+    verified: np.ndarray | None = None
+    """Redundant and passing the chi-square test (``valid`` adds the solved epochs without
+    redundancy; an epoch still failing the test after the allowed exclusions is not valid)."""
+    hdop: np.ndarray | None = None
+    horizontal_sigma_m: np.ndarray | None = None
+    """√(σ_e² + σ_n²) of the position from the weighted covariance (m)."""
 
 
 @dataclass(frozen=True)
@@ -26,7 +32,11 @@ class VelocitySolution:
     """Per-epoch receiver velocity (ECEF and ENU at the receiver, m/s) and clock drift (m/s).
 
     ``covariance`` 4×4 of (v_x, v_y, v_z, b) in ECEF; ``dop`` columns (GDOP, PDOP, HDOP, VDOP,
-    TDOP) of the velocity geometry (unweighted). Unavailable epochs: ``valid`` False, NaN values.
+    TDOP) of the velocity geometry (unweighted). Integrity: ``verified`` epochs have redundancy
+    (≥ 5 satellites after exclusion) and pass the chi-square test; ``valid`` epochs are the
+    verified ones plus the solved four-satellite epochs, whose fault cannot be detected (the
+    weaker flag: valid, not verified). An epoch whose residuals still fail the test after the
+    allowed exclusions is not valid (its values are kept for inspection). Unsolved epochs: NaN.
     """
 
     t: np.ndarray
@@ -41,6 +51,11 @@ class VelocitySolution:
     residual_rms_mps: np.ndarray
     valid: np.ndarray
     n_no_ephemeris: int = 0
+    verified: np.ndarray | None = None
+    speed_sigma_mps: np.ndarray | None = None
+    """σ of the horizontal speed from the covariance (m/s)."""
+    course_sigma_rad: np.ndarray | None = None
+    """σ of the course from the covariance (rad; large when slow)."""
 
     @property
     def speed_mps(self) -> np.ndarray:

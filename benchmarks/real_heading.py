@@ -1,0 +1,252 @@
+"""Heading on real recordings: conventional Doppler velocity and tight heading against ground
+truth, the calibration against truth, and an emulated street canyon.
+
+    python benchmarks/real_heading.py SEQUENCE_DIR [SEQUENCE_DIR ...] [--json FILE]
+
+Each folder is a sequence with ground truth, e.g. the comma2k19 minute imported by
+
+    vo-doppler import comma2k19 ../shared/data/comma2k19_example1 \\
+        --orbits ../shared/data/comma2k19_example1/Sta20124_1400_1845.sp3 -o /tmp/comma
+
+The GNSS and heading stages run as in ``vo-doppler run`` (``RunConfig``; the receiver-reported
+Doppler σ when the folder has one). Figures:
+
+* conventional velocity (epochs flagged valid): |speed error| and |course error| against the
+  ground truth's velocity (differences of its positions, central, at the GNSS epochs), median
+  and p95, and how many valid epochs fall outside 0.05 m/s / 1.5°;
+* calibration: the heading stage's final wheel scale and gyro bias against the values that fit
+  the ground truth with the same models (scale = Σ w·v / Σ w², bias = slope of ∫ω − ψ_truth);
+* tight heading: availability and |error| against the truth yaw, open sky and with an
+  emulated canyon (the ``CANYON_SATS`` highest GPS satellites per epoch after ``CANYON_AFTER_S``
+  of open sky, ``heading.from_gnss.emulated_canyon``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from benchmarks.sequence_runs import read_with_truth, run_sequences
+from vo_doppler.geo import wrap_angle
+from vo_doppler.gnss.pipeline import gnss_velocity
+from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
+from vo_doppler.model.sequence import Sequence
+from vo_doppler.model.timeseries import integral_at, sample
+from vo_doppler.run import RunConfig
+
+ROOT = Path(__file__).resolve().parents[1]
+CANYON_SATS = 2
+CANYON_AFTER_S = 20.0
+COURSE_BOUND_DEG = 1.5
+MOVING_MPS = 2.0
+
+
+def truth_velocity(sequence: Sequence, t: np.ndarray) -> np.ndarray:
+    """ENU velocity of the ground truth at ``t`` (central differences of its positions)."""
+    truth = sequence.truth
+    velocity = np.gradient(truth.positions, truth.t, axis=0)
+    return np.column_stack([sample(truth.t, velocity[:, i], t) for i in range(3)])
+
+
+def calibration_truth(sequence: Sequence) -> tuple[float, float]:
+    """(wheel scale, gyro bias rad/s) fitted to the ground truth with the calibration's models."""
+    truth = sequence.truth
+    t = truth.t
+    velocity = truth_velocity(sequence, t)
+    speed = np.linalg.norm(velocity, axis=1)
+    wheel = sample(sequence.wheel_speed.t, sequence.wheel_speed.value, t)
+    ok = np.isfinite(wheel) & (speed > MOVING_MPS)
+    scale = float(np.sum(wheel[ok] * speed[ok]) / np.sum(wheel[ok] ** 2))
+    phi = integral_at(sequence.yaw_rate.t, sequence.yaw_rate.value, t)
+    yaw = np.unwrap(np.arctan2(velocity[:, 1], velocity[:, 0]))
+    ok &= np.isfinite(phi)
+    design = np.column_stack([np.ones(ok.sum()), t[ok] - t[ok].mean()])
+    bias = float(np.linalg.lstsq(design, phi[ok] - yaw[ok], rcond=None)[0][1])
+    return scale, bias
+
+
+def _stats(values: np.ndarray) -> dict:
+    if not values.size:
+        return {"median": None, "p95": None, "max": None}
+    return {
+        "median": float(np.median(values)),
+        "p95": float(np.percentile(values, 95)),
+        "max": float(np.max(values)),
+    }
+
+
+def conventional_figures(sequence: Sequence, velocity) -> dict:
+    truth = truth_velocity(sequence, velocity.t)
+    moving = np.linalg.norm(truth[:, :2], axis=1) > MOVING_MPS
+    valid = velocity.valid & moving
+    speed_error = np.abs(
+        np.linalg.norm(velocity.velocity_enu[:, :2], axis=1) - np.linalg.norm(truth[:, :2], axis=1)
+    )
+    course = np.arctan2(velocity.velocity_enu[:, 1], velocity.velocity_enu[:, 0])
+    course_error = np.degrees(np.abs(wrap_angle(course - np.arctan2(truth[:, 1], truth[:, 0]))))
+    beyond = valid & (
+        (speed_error > 3.0 * velocity.speed_sigma_mps)
+        | (course_error > 3.0 * np.degrees(velocity.course_sigma_rad))
+    )
+    return {
+        "moving_epochs": int(moving.sum()),
+        "valid": float(valid.sum() / max(moving.sum(), 1)),
+        "verified": float((velocity.verified & moving).sum() / max(moving.sum(), 1)),
+        "speed_error_mps": _stats(speed_error[valid]),
+        "course_error_deg": _stats(course_error[valid]),
+        "valid_course_beyond_bound": int((valid & (course_error > COURSE_BOUND_DEG)).sum()),
+        "valid_beyond_3_sigma": int(beyond.sum()),
+    }
+
+
+def tight_figures(sequence: Sequence, table, epochs: np.ndarray) -> dict:
+    """Heading figures over the moving epochs among ``epochs`` (mask)."""
+    truth = truth_velocity(sequence, table.t)
+    moving = (np.linalg.norm(truth[:, :2], axis=1) > MOVING_MPS) & epochs
+    truth_yaw = sequence.truth.yaw_at(table.t)
+    error = np.degrees(np.abs(wrap_angle(table.yaw_tc - truth_yaw)))
+    available = table.tc_available & moving
+    conventional = table.conv_valid & moving
+    conv_error = np.degrees(np.abs(wrap_angle(table.yaw_conv - truth_yaw)))
+    return {
+        "tc_available": float(available.sum() / max(moving.sum(), 1)),
+        "tc_error_deg": _stats(error[available]),
+        "conv_valid": float(conventional.sum() / max(moving.sum(), 1)),
+        "conv_error_deg": _stats(conv_error[conventional]),
+        "wheel_scale": float(table.wheel_scale[-1]),
+        "gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
+    }
+
+
+def evaluate(folder: Path, fit_noise: bool) -> dict:
+    sequence = read_with_truth(folder)
+    config = RunConfig()
+    obs = sequence.observations
+    gnss = gnss_velocity(
+        obs,
+        sequence.navigation,
+        config.systems,
+        config.elevation_mask,
+        reported_sigma=sequence.doppler_sigma,
+        fit_noise=fit_noise,
+    )
+    scale_truth, bias_truth = calibration_truth(sequence)
+    open_sky = heading_from_gnss(
+        obs.epoch_time,
+        gnss.rows,
+        gnss.velocity,
+        sequence.wheel_speed,
+        sequence.yaw_rate,
+        sequence.enu,
+        config.heading,
+        sequence.antenna_lever_arm_m,
+    )
+    rows, conventional = emulated_canyon(
+        obs,
+        sequence.navigation,
+        CANYON_SATS,
+        obs.epoch_time[0] + CANYON_AFTER_S,
+        "G",
+        config.elevation_mask,
+        reported_sigma=sequence.doppler_sigma,
+    )
+    canyon = heading_from_gnss(
+        obs.epoch_time,
+        rows,
+        conventional,
+        sequence.wheel_speed,
+        sequence.yaw_rate,
+        sequence.enu,
+        config.heading,
+        sequence.antenna_lever_arm_m,
+    )
+    after = obs.epoch_time >= obs.epoch_time[0] + CANYON_AFTER_S
+    figures = {
+        "epochs": int(obs.epoch_time.size),
+        "conventional": conventional_figures(sequence, gnss.velocity),
+        "truth_wheel_scale": scale_truth,
+        "truth_gyro_bias_dps": float(np.degrees(bias_truth)),
+        "open_sky": tight_figures(sequence, open_sky, np.ones(after.size, dtype=bool)),
+        "canyon": tight_figures(sequence, canyon, after),
+    }
+    return figures
+
+
+def _fmt(value, spec: str) -> str:
+    return "—" if value is None else format(value, spec)
+
+
+def print_sequence(console: Console, name: str, variants: dict) -> None:
+    for noise, figures in variants.items():
+        print_variant(console, f"{name}, {noise} Doppler noise", figures)
+
+
+def print_variant(console: Console, name: str, figures: dict) -> None:
+    c = figures["conventional"]
+    table = Table(title=f"{name}: conventional Doppler velocity ({figures['epochs']} epochs)")
+    for column in (
+        "valid",
+        "verified",
+        "speed med",
+        "speed p95",
+        "course med [°]",
+        "course p95 [°]",
+        "> 1.5°",
+        "> 3σ",
+    ):
+        table.add_column(column, justify="right")
+    table.add_row(
+        f"{c['valid']:.1%}",
+        f"{c['verified']:.1%}",
+        _fmt(c["speed_error_mps"]["median"], ".3f"),
+        _fmt(c["speed_error_mps"]["p95"], ".3f"),
+        _fmt(c["course_error_deg"]["median"], ".2f"),
+        _fmt(c["course_error_deg"]["p95"], ".2f"),
+        str(c["valid_course_beyond_bound"]),
+        str(c["valid_beyond_3_sigma"]),
+    )
+    console.print(table)
+    heading = Table(title=f"{name}: tight heading and calibration")
+    for column in (
+        "case",
+        "tc avail",
+        "tc med [°]",
+        "tc p95 [°]",
+        "conv valid",
+        "conv p95 [°]",
+        "wheel scale (truth)",
+        "gyro bias °/s (truth)",
+    ):
+        heading.add_column(column, justify="right")
+    for case in ("open_sky", "canyon"):
+        f = figures[case]
+        heading.add_row(
+            case,
+            f"{f['tc_available']:.1%}",
+            _fmt(f["tc_error_deg"]["median"], ".2f"),
+            _fmt(f["tc_error_deg"]["p95"], ".2f"),
+            f"{f['conv_valid']:.1%}",
+            _fmt(f["conv_error_deg"]["p95"], ".2f"),
+            f"{f['wheel_scale']:.4f} ({figures['truth_wheel_scale']:.4f})",
+            f"{f['gyro_bias_dps']:.3f} ({figures['truth_gyro_bias_dps']:.3f})",
+        )
+    console.print(heading)
+
+
+def main(argv: list[str] | None = None) -> int:
+    return run_sequences(
+        __doc__.splitlines()[0],
+        ROOT / "benchmarks" / "results" / "real_heading.json",
+        lambda folder, _, console: {
+            noise: evaluate(folder, noise == "fitted") for noise in ("a priori", "fitted")
+        },
+        print_sequence,
+        argv,
+    )
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,157 @@
+"""The comma2k19 minute with its precise orbits: imported into a sequence folder, then the
+conventional Doppler velocity, the calibration and the emulated-canyon tight heading against
+``global_pose`` (benchmarks/real_heading.py computes the same figures; issue 11 acceptance)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.real_heading import (
+    CANYON_AFTER_S,
+    CANYON_SATS,
+    calibration_truth,
+    conventional_figures,
+    tight_figures,
+    truth_velocity,
+)
+from tests.conftest import require_shared
+from vo_doppler.geo import ecef_to_enu_rotation
+from vo_doppler.gnss.pipeline import gnss_velocity
+from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
+from vo_doppler.io.comma2k19 import read_vehicle_poses
+from vo_doppler.io.comma2k19_import import import_comma2k19
+from vo_doppler.io.sequence import read_sequence
+from vo_doppler.run import RunConfig
+
+pytestmark = pytest.mark.shared_data
+COMMA = "comma2k19_example1"
+SP3 = f"{COMMA}/Sta20124_1400_1845.sp3"
+
+
+@pytest.fixture(scope="module")
+def comma(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("comma") / "sequence"
+    import_comma2k19(require_shared(COMMA), folder, require_shared(SP3))
+    sequence = read_sequence(folder)
+    config = RunConfig()
+    gnss = gnss_velocity(
+        sequence.observations,
+        sequence.navigation,
+        config.systems,
+        config.elevation_mask,
+        reported_sigma=sequence.doppler_sigma,
+    )
+    return sequence, gnss, config
+
+
+def test_imported_sequence(comma):
+    sequence, gnss, _ = comma
+    assert sequence.camera is None and not sequence.has_camera
+    assert sequence.observations.epoch_time.size == 600
+    assert sequence.doppler_sigma is not None and len(sequence.doppler_sigma) == 9228
+    # GLONASS channels travel through the RINEX header: every GLONASS row has a wavelength
+    assert gnss.rows.n_no_wavelength == 0 and gnss.rows.n_no_ephemeris == 0
+    assert set(gnss.rows.system) == {"G", "R"}
+    # the receiver's σ became the weights (0.097 m/s is the most common reported value)
+    assert np.median(gnss.rows.sigma()) == pytest.approx(0.0974, abs=1e-3)
+    # ground truth on GPS time, vehicle x along the velocity (mount yaw removed)
+    truth = sequence.truth
+    assert truth.t[0] == pytest.approx(2012 * 604800 + 404106.397, abs=1e-6)
+    velocity = truth_velocity(sequence, truth.t)
+    moving = np.linalg.norm(velocity[:, :2], axis=1) > 5.0
+    course = np.arctan2(velocity[moving, 1], velocity[moving, 0])
+    offset = np.degrees(np.angle(np.exp(1j * (course - truth.yaw()[moving]))))
+    assert abs(np.median(offset)) < 0.05 and np.percentile(np.abs(offset), 95) < 1.0
+
+
+def test_device_orientation_convention():
+    """frame_orientations rotate the device frame (x forward, y right, z down) into ECEF: the
+    device x axis is within 1.5° of the velocity, its z axis points down."""
+    _, positions, vehicle_to_ecef, mount = read_vehicle_poses(require_shared(COMMA))
+    up = positions / np.linalg.norm(positions, axis=1, keepdims=True)
+    assert np.all(np.einsum("ni,ni->n", vehicle_to_ecef[:, :, 2], up) > 0.99)
+    assert abs(np.degrees(mount)) == pytest.approx(0.89, abs=0.05)
+
+
+def test_conventional_velocity_against_global_pose(comma):
+    """Measured: valid 100 %, speed error median 0.084 m/s (p95 0.25), course error median
+    0.19° (p95 0.73°). Issue 11 asks for a speed median ≤ 0.05 m/s: not reached — the
+    receiver's own Kalman-filtered fixes measure 0.053 m/s against the same truth, and the
+    truth's velocity lags the Doppler epochs by ≈ 0.1 s (shifting it gives 0.05 m/s)."""
+    sequence, gnss, _ = comma
+    figures = conventional_figures(sequence, gnss.velocity)
+    assert figures["valid"] >= 0.99
+    assert figures["course_error_deg"]["median"] <= 0.3
+    assert figures["course_error_deg"]["p95"] <= 1.5
+    assert figures["speed_error_mps"]["median"] <= 0.09  # measured 0.084 (goal 0.05: not met)
+    assert figures["valid_course_beyond_bound"] <= 3  # measured 2 of 600 beyond 1.5°
+
+
+def test_calibration_through_the_raw_doppler_path(comma):
+    sequence, gnss, config = comma
+    scale_truth, bias_truth = calibration_truth(sequence)
+    assert np.degrees(bias_truth) == pytest.approx(-0.41, abs=0.02)
+    table = heading_from_gnss(
+        sequence.observations.epoch_time,
+        gnss.rows,
+        gnss.velocity,
+        sequence.wheel_speed,
+        sequence.yaw_rate,
+        sequence.enu,
+        config.heading,
+        sequence.antenna_lever_arm_m,
+    )
+    assert abs(table.wheel_scale[-1] / scale_truth - 1.0) <= 0.003  # measured 0.03 %
+    assert abs(np.degrees(table.gyro_bias[-1] - bias_truth)) <= 0.05  # measured 0.000°/s
+
+
+def test_emulated_canyon_tight_heading(comma):
+    """Two GPS satellites per epoch after 20 s of open sky, CAN yaw rate and wheel speed:
+    measured 98.0 % available, median 0.39°, p95 1.22°; conventional 0 %."""
+    sequence, _, config = comma
+    obs = sequence.observations
+    start = obs.epoch_time[0] + CANYON_AFTER_S
+    rows, conventional = emulated_canyon(
+        obs,
+        sequence.navigation,
+        CANYON_SATS,
+        start,
+        "G",
+        config.elevation_mask,
+        reported_sigma=sequence.doppler_sigma,
+    )
+    table = heading_from_gnss(
+        obs.epoch_time,
+        rows,
+        conventional,
+        sequence.wheel_speed,
+        sequence.yaw_rate,
+        sequence.enu,
+        config.heading,
+        sequence.antenna_lever_arm_m,
+    )
+    figures = tight_figures(sequence, table, obs.epoch_time >= start)
+    assert figures["conv_valid"] == 0.0
+    assert figures["tc_available"] >= 0.95
+    assert figures["tc_error_deg"]["median"] <= 0.5
+    assert figures["tc_error_deg"]["p95"] <= 2.0
+
+
+def test_doppler_residuals_with_precise_orbits(comma):
+    """The precise states checked through the Doppler: with global_pose's velocity in place
+    of the estimate, each high-elevation satellite's residuals about the epoch's common clock
+    drift centre on zero (|median| ≤ 2 cm/s), and the clock drift is the README's 3.8 m/s."""
+    sequence, gnss, _ = comma
+    rows = gnss.rows
+    velocity = truth_velocity(sequence, rows.t)
+    ecef = velocity @ ecef_to_enu_rotation(sequence.enu.lat_rad, sequence.enu.lon_rad)
+    y = rows.reduced() + np.einsum("ij,ij->i", rows.los, ecef)
+    drift = np.array([np.median(y[rows.epoch == k]) for k in range(rows.epoch.max() + 1)])
+    assert np.median(drift) == pytest.approx(3.8, abs=0.2)
+    residual = y - drift[rows.epoch]
+    high = rows.elevation > np.radians(45.0)
+    sats = np.char.add(rows.system, rows.prn.astype(str))
+    for sat in np.unique(sats[high]):
+        chosen = high & (sats == sat)
+        assert abs(np.median(residual[chosen])) <= 0.02, sat

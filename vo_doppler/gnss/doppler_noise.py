@@ -1,0 +1,70 @@
+"""Doppler noise estimated from the data: the σ of each range rate from the residuals of the
+conventional solutions, per satellite and signal, refreshed as the data arrive.
+
+For each (satellite, Doppler code) the residuals r = y − H x̂ of the solved epochs over the
+last ``window_s`` seconds (causal: only rows up to the current one) give a robust scale,
+σ = 1.4826 · median |r − median r| (the normalised median absolute deviation, consistent with
+a Gaussian σ and unmoved by up to half of the rows being faults, e.g. reflections). Until a
+satellite has ``min_rows`` residuals its σ stays the prior one (receiver-reported or the
+C/N0 model). Each residual is first divided by √r_i, r_i = 1 − h_ii its redundancy number
+(h_ii the diagonal of the weighted hat matrix H (HᵀWH)⁻¹ HᵀW of its epoch): a least-squares
+residual has variance r_i σ_i², so the raw residuals would understate σ. A floor keeps one
+quiet satellite from dominating. The residuals include the
+fault rows the exclusion removed, so a satellite that keeps faulting gets a large σ.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+WINDOW_S = 60.0
+MIN_ROWS = 20
+FLOOR_MPS = 0.02
+MAD_TO_SIGMA = 1.4826
+
+
+def fitted_sigma(
+    rows,
+    solution,
+    prior_sigma: np.ndarray,
+    window_s: float = WINDOW_S,
+    min_rows: int = MIN_ROWS,
+    floor_mps: float = FLOOR_MPS,
+) -> np.ndarray:
+    """σ (m/s) per Doppler row from the residuals of ``solution`` (rows of unsolved epochs and
+    satellites with too few residuals keep ``prior_sigma``)."""
+    state = np.column_stack([solution.velocity_ecef, solution.clock_drift_mps])[rows.epoch]
+    predicted = -np.einsum("ij,ij->i", rows.los, state[:, :3]) + state[:, 3]
+    redundancy = _redundancy(rows, rows.sigma())
+    residual = (rows.reduced() - predicted) / np.sqrt(redundancy)
+    sigma = np.asarray(prior_sigma, dtype=float).copy()
+    signal = np.char.add(np.char.add(rows.system, rows.prn.astype(str)), rows.code)
+    for name in np.unique(signal):
+        members = np.flatnonzero((signal == name) & np.isfinite(residual))
+        members = members[np.argsort(rows.t[members], kind="stable")]
+        t = rows.t[members]
+        start = np.searchsorted(t, t - window_s, side="left")
+        for k, row in enumerate(members):
+            if k + 1 - start[k] < min_rows:
+                continue
+            recent = residual[members[start[k] : k + 1]]
+            spread = MAD_TO_SIGMA * np.median(np.abs(recent - np.median(recent)))
+            sigma[row] = max(spread, floor_mps)
+    return sigma
+
+
+def _redundancy(rows, sigma: np.ndarray) -> np.ndarray:
+    """r_i = 1 − h_ii per row with all of its epoch's rows in the design (NaN without
+    redundancy)."""
+    out = np.full(len(rows), np.nan)
+    order = np.argsort(rows.epoch, kind="stable")
+    bounds = np.flatnonzero(np.diff(rows.epoch[order])) + 1
+    for members in np.split(order, bounds):
+        H = np.hstack([-rows.los[members], np.ones((members.size, 1))])
+        if members.size <= H.shape[1]:
+            continue
+        weight = sigma[members] ** -2.0
+        normal = (H * weight[:, None]).T @ H
+        hat = np.einsum("ij,jk,ik->i", H, np.linalg.pinv(normal), H) * weight
+        out[members] = np.clip(1.0 - hat, 1e-6, 1.0)
+    return out
