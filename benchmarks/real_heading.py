@@ -32,10 +32,10 @@ from rich.table import Table
 from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.geo import wrap_angle
 from vo_doppler.gnss.pipeline import gnss_velocity
-from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
+from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.run import RunConfig
+from vo_doppler.run import RunConfig, sequence_heading
 
 ROOT = Path(__file__).resolve().parents[1]
 CANYON_SATS = 2
@@ -121,6 +121,20 @@ def tight_figures(sequence: Sequence, table, epochs: np.ndarray) -> dict:
     }
 
 
+def canyon_inputs(sequence: Sequence, config: RunConfig):
+    """Doppler rows and conventional velocities of the emulated canyon (module docstring)."""
+    obs = sequence.observations
+    return emulated_canyon(
+        obs,
+        sequence.navigation,
+        CANYON_SATS,
+        obs.epoch_time[0] + CANYON_AFTER_S,
+        "G",
+        config.elevation_mask,
+        reported_sigma=sequence.doppler_sigma,
+    )
+
+
 def evaluate(folder: Path, fit_noise: bool) -> dict:
     sequence = read_with_truth(folder)
     config = RunConfig()
@@ -134,35 +148,8 @@ def evaluate(folder: Path, fit_noise: bool) -> dict:
         fit_noise=fit_noise,
     )
     scale_truth, bias_truth = calibration_truth(sequence)
-    open_sky = heading_from_gnss(
-        obs.epoch_time,
-        gnss.rows,
-        gnss.velocity,
-        sequence.wheel_speed,
-        sequence.yaw_rate,
-        sequence.enu,
-        config.heading,
-        sequence.antenna_lever_arm_m,
-    )
-    rows, conventional = emulated_canyon(
-        obs,
-        sequence.navigation,
-        CANYON_SATS,
-        obs.epoch_time[0] + CANYON_AFTER_S,
-        "G",
-        config.elevation_mask,
-        reported_sigma=sequence.doppler_sigma,
-    )
-    canyon = heading_from_gnss(
-        obs.epoch_time,
-        rows,
-        conventional,
-        sequence.wheel_speed,
-        sequence.yaw_rate,
-        sequence.enu,
-        config.heading,
-        sequence.antenna_lever_arm_m,
-    )
+    open_sky = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
+    canyon = sequence_heading(sequence, *canyon_inputs(sequence, config), config.heading)
     after = obs.epoch_time >= obs.epoch_time[0] + CANYON_AFTER_S
     figures = {
         "epochs": int(obs.epoch_time.size),

@@ -41,6 +41,8 @@ from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.io.images import read_image
 from vo_doppler.lowcost.dead_reckoning import wheel_gyro_track
+from vo_doppler.model.doppler import DopplerRows
+from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.sequence import Sequence
@@ -180,6 +182,26 @@ def correct_all(
     return trajectories
 
 
+def sequence_heading(
+    sequence: Sequence,
+    rows: DopplerRows,
+    velocity: VelocitySolution,
+    config: HeadingPipelineConfig,
+) -> HeadingTable:
+    """The heading stage on a recording's vehicle signals from given Doppler rows and
+    conventional velocities (``heading_from_gnss``)."""
+    return heading_from_gnss(
+        sequence.observations.epoch_time,
+        rows,
+        velocity,
+        sequence.wheel_speed,
+        sequence.yaw_rate,
+        sequence.enu,
+        config,
+        sequence.antenna_lever_arm_m,
+    )
+
+
 def run_sequence(
     sequence: Sequence,
     config: RunConfig | None = None,
@@ -197,16 +219,7 @@ def run_sequence(
         config.elevation_mask,
         reported_sigma=sequence.doppler_sigma,
     )
-    table = heading_from_gnss(
-        obs.epoch_time,
-        gnss.rows,
-        gnss.velocity,
-        sequence.wheel_speed,
-        sequence.yaw_rate,
-        sequence.enu,
-        config.heading,
-        sequence.antenna_lever_arm_m,
-    )
+    table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
     speed = table.calibrated_speed(sequence.wheel_speed)
     vo = None
     vo_vehicle = None

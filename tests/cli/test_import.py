@@ -12,7 +12,9 @@ import yaml
 
 from tests.conftest import require_shared
 from vo_doppler.cli import main
+from vo_doppler.errors import InputError
 from vo_doppler.io.gnss_csv import SPP_COLUMNS, VELOCITY_COLUMNS
+from vo_doppler.io.satellite_states import read_satellite_states
 
 COMMA = "comma2k19_example1"
 
@@ -72,10 +74,11 @@ def test_gnss_commands_with_orbits(imported, tmp_path):
     assert np.array(rows, dtype=float)[:, header.index("valid")].mean() > 0.9
 
 
-def test_clocks_need_orbits(tmp_path, capsys):
-    args = ["gnss", "velocity", "x.obs", "--nav", "x.nav", "--clocks", "x.clk", "-o", "v.csv"]
-    assert main(args) == 1
-    assert "precise orbits" in capsys.readouterr().err
+def test_clocks_need_orbits(tmp_path):
+    with pytest.raises(InputError, match="precise orbits"):
+        read_satellite_states([tmp_path / "x.nav"], clocks=tmp_path / "x.clk")
+    with pytest.raises(InputError, match="no satellite states"):
+        read_satellite_states()
 
 
 def test_nav_and_orbits_are_exclusive():

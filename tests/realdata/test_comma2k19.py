@@ -9,8 +9,8 @@ import pytest
 
 from benchmarks.real_heading import (
     CANYON_AFTER_S,
-    CANYON_SATS,
     calibration_truth,
+    canyon_inputs,
     conventional_figures,
     tight_figures,
     truth_velocity,
@@ -18,11 +18,10 @@ from benchmarks.real_heading import (
 from tests.conftest import require_shared
 from vo_doppler.geo import ecef_to_enu_rotation
 from vo_doppler.gnss.pipeline import gnss_velocity
-from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
 from vo_doppler.io.comma2k19 import read_vehicle_poses
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.sequence import read_sequence
-from vo_doppler.run import RunConfig
+from vo_doppler.run import RunConfig, sequence_heading
 
 pytestmark = pytest.mark.shared_data
 COMMA = "comma2k19_example1"
@@ -92,16 +91,7 @@ def test_calibration_through_the_raw_doppler_path(comma):
     sequence, gnss, config = comma
     scale_truth, bias_truth = calibration_truth(sequence)
     assert np.degrees(bias_truth) == pytest.approx(-0.41, abs=0.02)
-    table = heading_from_gnss(
-        sequence.observations.epoch_time,
-        gnss.rows,
-        gnss.velocity,
-        sequence.wheel_speed,
-        sequence.yaw_rate,
-        sequence.enu,
-        config.heading,
-        sequence.antenna_lever_arm_m,
-    )
+    table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
     assert abs(table.wheel_scale[-1] / scale_truth - 1.0) <= 0.003  # measured 0.03 %
     assert abs(np.degrees(table.gyro_bias[-1] - bias_truth)) <= 0.05  # measured 0.000°/s
 
@@ -112,25 +102,7 @@ def test_emulated_canyon_tight_heading(comma):
     sequence, _, config = comma
     obs = sequence.observations
     start = obs.epoch_time[0] + CANYON_AFTER_S
-    rows, conventional = emulated_canyon(
-        obs,
-        sequence.navigation,
-        CANYON_SATS,
-        start,
-        "G",
-        config.elevation_mask,
-        reported_sigma=sequence.doppler_sigma,
-    )
-    table = heading_from_gnss(
-        obs.epoch_time,
-        rows,
-        conventional,
-        sequence.wheel_speed,
-        sequence.yaw_rate,
-        sequence.enu,
-        config.heading,
-        sequence.antenna_lever_arm_m,
-    )
+    table = sequence_heading(sequence, *canyon_inputs(sequence, config), config.heading)
     figures = tight_figures(sequence, table, obs.epoch_time >= start)
     assert figures["conv_valid"] == 0.0
     assert figures["tc_available"] >= 0.95

@@ -66,8 +66,8 @@ def register(subparsers, summary: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    nav = satellite_states(args)
     obs = read_obs(args.obs)
+    nav = satellite_states(args)
     mask = np.deg2rad(args.elev_mask)
     figure = args.figure or args.output.with_suffix(".png")
     title = f"{args.obs.name} ({args.systems})"
