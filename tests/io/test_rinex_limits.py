@@ -125,6 +125,12 @@ def test_missing_file_is_an_input_error(tmp_path):
         read_rinex_bytes(tmp_path / "absent.24o")
 
 
+@pytest.mark.parametrize("path", ["/dev/zero", "/tmp"])
+def test_device_or_folder_is_not_read(path):
+    with pytest.raises(InputError, match="not a regular file"):
+        read_obs(path)
+
+
 @pytest.mark.parametrize(
     ("text", "reason"),
     [

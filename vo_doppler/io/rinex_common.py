@@ -13,6 +13,7 @@ import io
 import logging
 import math
 import re
+import stat
 import subprocess
 import tempfile
 import zlib
@@ -83,12 +84,14 @@ def read_rinex_bytes(path: str | Path) -> bytes:
     """
     path = Path(path)
     try:
-        size = path.stat().st_size
-        if size > MAX_TEXT_BYTES:
-            raise InputError(f"file is larger than {MAX_TEXT_BYTES >> 20} MiB", path)
-        raw = path.read_bytes()
+        if not stat.S_ISREG(path.stat().st_mode):
+            raise InputError("not a regular file", path)
+        with path.open("rb") as stream:
+            raw = stream.read(MAX_TEXT_BYTES + 1)
     except OSError as exc:
         raise InputError(f"cannot read file: {exc.strerror or exc}", path) from exc
+    if len(raw) > MAX_TEXT_BYTES:
+        raise InputError(f"file is larger than {MAX_TEXT_BYTES >> 20} MiB", path)
     limit = expanded_limit(len(raw))
     try:
         if raw[:2] == b"\x1f\x8b":
