@@ -205,6 +205,9 @@ class Report:
     max_rss_mb: dict[str, float] = field(default_factory=dict)
 
     def add(self, outcome: dict) -> None:
+        done = sum(sum(c.values()) for c in self.counts.values()) + 1
+        if done % 500 == 0:
+            print(f"{done} cases, {len(self.failures)} failures", file=sys.stderr, flush=True)
         family = outcome["case"]["family"]
         self.counts.setdefault(family, Counter())[outcome["kind"]] += 1
         for name in outcome["case"]["mutations"]:
