@@ -24,6 +24,7 @@ import tempfile
 import time
 import traceback
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -203,11 +204,13 @@ class Report:
     failures: list[dict] = field(default_factory=list)
     max_seconds: dict[str, float] = field(default_factory=dict)
     max_rss_mb: dict[str, float] = field(default_factory=dict)
+    progress: Callable[[Report], None] | None = None
+    """Called every 500 cases (the long run writes its JSON so far)."""
+
+    def done(self) -> int:
+        return sum(sum(c.values()) for c in self.counts.values())
 
     def add(self, outcome: dict) -> None:
-        done = sum(sum(c.values()) for c in self.counts.values()) + 1
-        if done % 500 == 0:
-            print(f"{done} cases, {len(self.failures)} failures", file=sys.stderr, flush=True)
         family = outcome["case"]["family"]
         self.counts.setdefault(family, Counter())[outcome["kind"]] += 1
         for name in outcome["case"]["mutations"]:
@@ -216,6 +219,12 @@ class Report:
         self.max_rss_mb[family] = max(self.max_rss_mb.get(family, 0.0), outcome["rss_mb"])
         if outcome["kind"] in FAILURES:
             self.failures.append(outcome)
+        if self.done() % 500 == 0:
+            print(
+                f"{self.done()} cases, {len(self.failures)} failures", file=sys.stderr, flush=True
+            )
+            if self.progress:
+                self.progress(self)
 
     def table(self) -> str:
         kinds = ("ok", "error", *FAILURES)
@@ -229,11 +238,13 @@ class Report:
         return "\n".join(rows)
 
 
-def run(families: list[str], cases: int, run_seed: int, workers: int) -> Report:
+def run(
+    families: list[str], cases: int, run_seed: int, workers: int, report: Report | None = None
+) -> Report:
     """Run ``cases`` cases of each family on ``workers`` processes."""
     jobs = [(family, k) for k in range(cases) for family in families]
     jobs.reverse()
-    report = Report()
+    report = report or Report()
     pool = [_Process(run_seed) for _ in range(max(1, workers))]
     try:
         busy: dict[int, _Process] = {}
@@ -304,10 +315,28 @@ def main(argv: list[str] | None = None) -> int:
             print(f"file: {kept}")
         return 0
     started = time.perf_counter()
-    report = run(families, args.cases, args.seed, args.workers)
-    elapsed = time.perf_counter() - started
+
+    def write_json(report: Report) -> None:
+        if args.json:
+            args.json.parent.mkdir(parents=True, exist_ok=True)
+            summary = {
+                "command": " ".join(sys.argv),
+                "seed": args.seed,
+                "cases_per_family": args.cases,
+                "cases_done": report.done(),
+                "seconds": round(time.perf_counter() - started, 1),
+                "limits": {"seconds": TIME_LIMIT_S, "memory_mb": MEMORY_LIMIT_MB},
+                "counts": {f: dict(c) for f, c in report.counts.items()},
+                "by_mutation": {m: dict(c) for m, c in report.by_mutation.items()},
+                "max_seconds": report.max_seconds,
+                "max_rss_mb": report.max_rss_mb,
+                "failures": report.failures,
+            }
+            args.json.write_text(json.dumps(summary, indent=1))
+
+    report = run(families, args.cases, args.seed, args.workers, Report(progress=write_json))
     print(report.table())
-    print(f"{sum(sum(c.values()) for c in report.counts.values())} cases in {elapsed:.0f} s")
+    print(f"{report.done()} cases in {time.perf_counter() - started:.0f} s")
     for failure in report.failures[:20]:
         case = failure["case"]
         print(
@@ -315,21 +344,7 @@ def main(argv: list[str] | None = None) -> int:
             f"({case['seed_name']}, {case['stage']}, {'+'.join(case['mutations'])}): "
             f"{failure['detail'][:300]}"
         )
-    if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        summary = {
-            "command": " ".join(sys.argv),
-            "seed": args.seed,
-            "cases_per_family": args.cases,
-            "seconds": round(elapsed, 1),
-            "limits": {"seconds": TIME_LIMIT_S, "memory_mb": MEMORY_LIMIT_MB},
-            "counts": {f: dict(c) for f, c in report.counts.items()},
-            "by_mutation": {m: dict(c) for m, c in report.by_mutation.items()},
-            "max_seconds": report.max_seconds,
-            "max_rss_mb": report.max_rss_mb,
-            "failures": report.failures,
-        }
-        args.json.write_text(json.dumps(summary, indent=1))
+    write_json(report)
     return 1 if report.failures else 0
 
 
