@@ -4,7 +4,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench fuzz clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -26,6 +26,9 @@ test: $(TEST_STAMP)
 
 lint: $(TEST_STAMP)
 	$(BIN)/ruff check . && $(BIN)/ruff format --check .
+
+fuzz: $(TEST_STAMP)
+	$(BIN)/python -m tests.fuzz.runner --cases 3000 --json out/fuzz.json
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/vo_kitti.py

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import require_shared
+from tests.helpers.rinex_text import field, rinex2_epoch, rinex2_header
 from vo_doppler.io.rinex_obs import read_obs
 
 FILES = ("septentrio_static/rover.obs", "yamatogawa_ublox_walk/yamatogawa_rover.obs")
@@ -71,3 +72,48 @@ def test_every_observable_equal(both_readers):
         compared += int(np.isfinite(theirs).sum())
     assert compared > 1000
     assert np.isfinite(obs.value).all()
+
+
+def _assert_equal_to_georinex(path) -> int:
+    georinex = pytest.importorskip("georinex")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        reference = georinex.load(path, useindicators=True)
+    obs = read_obs(path)
+    compared = 0
+    for name in reference.data_vars:
+        name = str(name)
+        if name.endswith(("lli", "ssi")):
+            continue
+        ours = _ours_as_grid(obs, name, "value", reference)
+        theirs = reference[name].values
+        np.testing.assert_array_equal(ours, theirs, err_msg=name)
+        compared += int(np.isfinite(theirs).sum())
+    return compared
+
+
+def test_truncated_last_rinex2_record_kept_as_far_as_it_goes(tmp_path):
+    """Seven observables take two lines a satellite; the file ends after the first line of the
+    last satellite: its five values are kept, as georinex keeps them."""
+    types = ["C1", "L1", "D1", "S1", "P2", "L2", "D2"]
+    records = [(f"G{k:2d}", [field(2.0e7 + k + j) for j in range(len(types))]) for k in range(1, 5)]
+    text = rinex2_header(types) + rinex2_epoch(" 10  1  6  5 57  3.0000000", records)
+    path = tmp_path / "cut.10o"
+    path.write_text(text[: text.rstrip("\n").rfind("\n") + 1])
+    obs = read_obs(path)
+    assert obs.value[obs.satellites() == "G04"].tolist() == [2.0e7 + 4 + j for j in range(5)]
+    assert _assert_equal_to_georinex(path) == 3 * 7 + 5
+
+
+@pytest.mark.shared_data
+def test_real_rinex2_file_cut_inside_a_line_equals_georinex(tmp_path):
+    """The yamatogawa file cut 32 characters into its last line (after two whole fields)."""
+    source = require_shared("yamatogawa_ublox_walk/yamatogawa_rover.obs").read_bytes()
+    cut = source.rstrip(b"\n")
+    cut = cut[: cut.rfind(b"\n") + 1 + 32]
+    path = tmp_path / "cut.10o"
+    path.write_bytes(cut)
+    full = read_obs(require_shared("yamatogawa_ublox_walk/yamatogawa_rover.obs"))
+    obs = read_obs(path)
+    assert len(obs) == len(full) - 2
+    assert _assert_equal_to_georinex(path) == len(obs)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import require_shared
+from tests.helpers.rinex_text import as_rinex4, with_glonass_status_lines
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.model.gpstime import BDT_MINUS_GPST_S
 
@@ -114,3 +115,52 @@ def test_rinex2_glonass_file(tmp_path):
     np.testing.assert_array_equal(v2.glonass.toc, v3.glonass.toc)
     for name, values in v3.glonass.params.items():
         np.testing.assert_array_equal(v2.glonass[name], values, err_msg=name)
+
+
+def _params_equal(a, b) -> None:
+    assert len(a) == len(b)
+    np.testing.assert_array_equal(a.prn, b.prn)
+    np.testing.assert_array_equal(a.toc, b.toc)
+    for name in a.params:
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+
+
+def test_rinex4_is_read_by_record_type(tmp_path):
+    """The same records behind '> EPH' lines read as in RINEX 3; CNAV, STO, ION counted."""
+    source = require_shared("septentrio_static/base.nav")
+    path = tmp_path / "base.rnx"
+    path.write_bytes(as_rinex4(source.read_bytes()))
+    nav, v3 = read_nav(path), read_nav(source)
+    assert nav.problems == ()
+    assert nav.skipped == {"EPH CNAV": 1, "STO LNAV": 1, "ION LNAV": 1}
+    _params_equal(nav.kepler, v3.kepler)
+    _params_equal(nav.glonass, v3.glonass)
+
+
+def test_rinex4_record_without_its_type_line_is_skipped(tmp_path):
+    source = require_shared("septentrio_static/base.nav")
+    text = as_rinex4(source.read_bytes()).replace(b"> EPH G06 LNAV\n", b"", 1)
+    path = tmp_path / "base.rnx"
+    path.write_bytes(text)
+    nav = read_nav(path)
+    line = text.split(b"\n").index(next(x for x in text.split(b"\n") if x.startswith(b"G06"))) + 1
+    assert nav.problems == (f"{path}:{line}: record without its '> EPH' line: skipped",)
+    assert len(nav.kepler) == len(read_nav(source).kepler) - 1
+
+
+def test_rinex305_glonass_fifth_line_is_read(tmp_path):
+    source = require_shared("septentrio_static/base.nav")
+    status = b"     1.500000000000E+01 2.793967723846E-09 3.000000000000E+00 0.000000000000E+00"
+    path = tmp_path / "base305.nav"
+    path.write_bytes(with_glonass_status_lines(source.read_bytes(), status))
+    nav, v304 = read_nav(path), read_nav(source)
+    assert nav.problems == ()
+    assert len(nav.glonass) == len(v304.glonass) > 0
+    np.testing.assert_array_equal(nav.glonass["status_flags"], 15.0)
+    np.testing.assert_array_equal(nav.glonass["delta_tau_n"], 2.793967723846e-09)
+    np.testing.assert_array_equal(nav.glonass["urai"], 3.0)
+    np.testing.assert_array_equal(nav.glonass["health_flags"], 0.0)
+    assert np.isnan(v304.glonass["status_flags"]).all()
+    for name in ("x", "vx", "ax", "minus_tau_n", "channel"):
+        np.testing.assert_array_equal(nav.glonass[name], v304.glonass[name])
+    _params_equal(nav.kepler, v304.kepler)

@@ -6,10 +6,13 @@ import gzip
 
 import hatanaka
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tests.helpers.rinex_text import field, rinex2_epoch, rinex2_header, rinex3_epoch, rinex3_header
+from vo_doppler.errors import InputError
+from vo_doppler.io.rinex_common import PRN_RANGE
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 
@@ -38,11 +41,18 @@ def observation_rows(obs) -> list[tuple]:
     )
 
 
+def satellite_ids(systems):
+    """(system, number) pairs with numbers valid for the system (RINEX 3.05 sec. 3.5)."""
+    return st.sampled_from(systems).flatmap(
+        lambda s: st.tuples(st.just(s), st.integers(*PRN_RANGE[s]))
+    )
+
+
 @st.composite
 def epochs(draw):
     satellites = draw(
         st.lists(
-            st.tuples(st.sampled_from(sorted(TYPES)), st.integers(1, 36)),
+            satellite_ids(sorted(TYPES)),
             min_size=1,
             max_size=15,
             unique=True,
@@ -82,6 +92,10 @@ def test_rinex3_round_trip(tmp_path, written):
                     )
     path = tmp_path / "random.24o"
     path.write_text(text)
+    if not expected:
+        with pytest.raises(InputError, match="no observation could be read"):
+            read_obs(path)
+        return
     obs = read_obs(path)
     assert observation_rows(obs) == sorted(expected)
     assert obs.problems == ()
@@ -236,7 +250,7 @@ TYPES2 = ["C1", "L1", "D1", "S1", "P2", "L2", "D2"]
 def epochs2(draw):
     satellites = draw(
         st.lists(
-            st.tuples(st.sampled_from("GR"), st.integers(1, 32)),
+            satellite_ids("GR"),
             min_size=1,
             max_size=26,
             unique=True,
@@ -268,6 +282,10 @@ def test_rinex2_round_trip(tmp_path, written):
                     expected.append((t0 + k, sat.replace(" ", "0"), code, value, *flags))
     path = tmp_path / "random.10o"
     path.write_text(text)
+    if not expected:
+        with pytest.raises(InputError, match="no observation could be read"):
+            read_obs(path)
+        return
     obs = read_obs(path)
     assert observation_rows(obs) == sorted(expected)
     assert obs.problems == ()

@@ -46,14 +46,20 @@ class Navigation:
     leap_seconds: int | None = None
     problems: tuple[str, ...] = field(default=())
     klobuchar: np.ndarray | None = None
+    skipped: dict[str, int] = field(default_factory=dict)
+    """Records not read, counted by RINEX 4 type ('EPH CNAV', 'STO LNAV', …)."""
 
     def merged(self, other: Navigation) -> Navigation:
+        skipped = dict(self.skipped)
+        for kind, count in other.skipped.items():
+            skipped[kind] = skipped.get(kind, 0) + count
         return Navigation(
             concat_records(self.kepler, other.kepler),
             concat_records(self.glonass, other.glonass),
             self.leap_seconds if self.leap_seconds is not None else other.leap_seconds,
             self.problems + other.problems,
             self.klobuchar if self.klobuchar is not None else other.klobuchar,
+            skipped,
         )
 
     def glonass_channels(self) -> dict[int, int]:

@@ -1,0 +1,90 @@
+"""Short fuzz run of the RINEX readers (the long one is ``make fuzz``), and the runner's own
+classification of outcomes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.fuzz.families import FAMILIES, Family, Seed, check_observations
+from tests.fuzz.mutators import TEXT_MUTATIONS
+from tests.fuzz.runner import FAILURES, Worker, run
+from vo_doppler.errors import InputError
+
+
+def test_short_fuzz_of_the_rinex_readers():
+    """240 mutated files: each read plausibly or refused with the project's error naming the
+    file, within 5 s and 500 MB."""
+    report = run(["rinex-nav", "rinex-obs"], cases=120, run_seed=12, workers=2)
+    failures = [(f["kind"], f["case"]["family"], f["case"]["number"]) for f in report.failures]
+    assert failures == []
+    for family in ("rinex-nav", "rinex-obs"):
+        counts = report.counts[family]
+        assert sum(counts.values()) == 120
+        assert counts["ok"] > 20 and counts["error"] > 10
+
+
+def _sample_obs_seed() -> Seed:
+    """The sample sequence's observation file, plain (its four variants come last)."""
+    return FAMILIES["rinex-obs"].seeds()[-4]
+
+
+def _seed_text() -> bytes:
+    return _sample_obs_seed().load()[:20_000]
+
+
+@pytest.fixture
+def fake_family():
+    """A family whose behaviour the test chooses, registered for the test only."""
+    made = []
+
+    def make(read):
+        family = Family(
+            "fake", lambda: [Seed("obs", _seed_text, suffix=".obs")], read, lambda r, p: r
+        )
+        FAMILIES["fake"] = family
+        made.append(family)
+        return family
+
+    yield make
+    FAMILIES.pop("fake", None)
+
+
+@pytest.mark.parametrize(
+    ("read", "kind"),
+    [
+        (lambda path: [], "ok"),
+        (lambda path: ["time goes backwards"], "violation"),
+        (lambda path: (_ for _ in ()).throw(KeyError("x")), "crash"),
+        (lambda path: (_ for _ in ()).throw(InputError("bad", path)), "error"),
+        (lambda path: (_ for _ in ()).throw(InputError("bad")), "unnamed"),
+    ],
+)
+def test_runner_classifies_outcomes(fake_family, read, kind):
+    fake_family(read)
+    outcome = Worker(0).run("fake", 3)
+    assert outcome.kind == kind
+    assert (kind in FAILURES) == (kind not in ("ok", "error"))
+
+
+def test_mutations_are_deterministic_and_change_the_file():
+    import random
+
+    data = _seed_text()
+    changed = 0
+    for name, mutation in TEXT_MUTATIONS.items():
+        first = mutation(data, random.Random(5))
+        assert first == mutation(data, random.Random(5)), name
+        changed += first != data
+    assert changed >= len(TEXT_MUTATIONS) - 1
+
+
+def test_observation_invariants_catch_impossible_values(tmp_path):
+    obs_path = tmp_path / "seed.obs"
+    obs_path.write_bytes(_sample_obs_seed().load())
+    obs = FAMILIES["rinex-obs"].read(obs_path)
+    assert check_observations(obs, obs_path) == []
+    backwards = obs.__class__(**{**obs.__dict__, "epoch_time": obs.epoch_time[::-1]})
+    assert "epoch times not strictly increasing" in check_observations(backwards, obs_path)
+    bad_prn = obs.__class__(**{**obs.__dict__, "prn": np.zeros_like(obs.prn)})
+    assert any("number outside" in v for v in check_observations(bad_prn, obs_path))
