@@ -118,6 +118,7 @@ class VisualOdometry:
         self._ref_image: np.ndarray | None = None
         self._ref_frame: _Frame | None = None
         self._last_keyframe: _Frame | None = None
+        self._keyframes_since_adjustment = 0
         self._failures = 0
         self._track_counts: list[int] = []
         self._rms_values: list[float] = []
@@ -363,7 +364,9 @@ class VisualOdometry:
         frame.keyframe = True
         self._last_keyframe = frame
         self._triangulate_new(frame)
-        self._adjust_window()
+        self._keyframes_since_adjustment += 1
+        if self._keyframes_since_adjustment >= self.config.ba_every_keyframes:
+            self._adjust_window()
 
     def _triangulate_new(self, frame: _Frame) -> None:
         """New landmarks from tracks without one, using each track's oldest measured view."""
@@ -392,9 +395,11 @@ class VisualOdometry:
             wanted = np.setdiff1d(wanted, ids)
 
     def _adjust_window(self) -> None:
+        """Bundle adjustment of the window's measured frames and the landmarks they share."""
         frames = [f for f in self._window if f.measured]
         if len(frames) < 3:
             return
+        self._keyframes_since_adjustment = 0
         landmarks = self._landmarks
         obs_f, obs_p, obs_uv = [], [], []
         for k, f in enumerate(frames):
