@@ -13,6 +13,7 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from vo_doppler.errors import InputError
@@ -187,7 +188,7 @@ class VisualOdometry:
             return "unreadable"
         if image.ndim != 2:
             return "not-grey"
-        if float(image.std()) < self.config.min_texture_std:
+        if float(cv2.meanStdDev(image)[1][0, 0]) < self.config.min_texture_std:
             return "blank"
         if self._ref_image is not None and image.shape != self._ref_image.shape:
             return "size-changed"
