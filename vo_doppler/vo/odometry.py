@@ -1,5 +1,7 @@
 """Streaming monocular visual odometry: KLT front end, essential-matrix initialisation, PnP
-tracking, and Levenberg–Marquardt bundle adjustment over a sliding window of frames.
+tracking, and Levenberg–Marquardt bundle adjustment over a sliding window of frames, solved at
+every ``ba_every_keyframes``-th keyframe (a fixed lag) with the landmarks in a
+:class:`~vo_doppler.vo.landmarks.LandmarkMap`.
 
 World frame: the first camera's frame (OpenCV axes). Internally poses are world→camera (T_cw);
 results are camera→world (T_wc). Without a metric source the translation unit is arbitrary
