@@ -39,7 +39,7 @@ from vo_doppler.geo import EnuFrame, yaw_of
 from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
-from vo_doppler.io.images import read_image
+from vo_doppler.io.images import prefetch_images
 from vo_doppler.lowcost.dead_reckoning import wheel_gyro_track
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.gnss_solutions import VelocitySolution
@@ -224,7 +224,7 @@ def run_sequence(
     vo = None
     vo_vehicle = None
     if sequence.has_camera:
-        frames = images if images is not None else (read_image(p) for p in sequence.image_paths)
+        frames = images if images is not None else prefetch_images(sequence.image_paths)
         vo = run_visual_odometry(
             frames,
             sequence.image_times,

@@ -9,7 +9,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vo_doppler.errors import InputError
-from vo_doppler.io.images import list_images, read_image, read_times, times_from_fps
+from vo_doppler.io.images import (
+    list_images,
+    prefetch_images,
+    read_image,
+    read_times,
+    times_from_fps,
+)
 
 
 @settings(max_examples=40, deadline=None)
@@ -49,3 +55,33 @@ def test_folder_listing_and_unreadable_images(tmp_path):
     assert [f.name for f in files] == ["a.png", "b.png", "c.jpg"]
     assert read_image(files[0]).shape == (8, 8)
     assert read_image(files[2]) is None
+
+
+@pytest.mark.parametrize("depth", [1, 3, 50])
+def test_prefetched_images_equal_direct_reads_in_order(tmp_path, depth):
+    rng = np.random.default_rng(depth)
+    for k in range(7):
+        cv2.imwrite(str(tmp_path / f"{k:02d}.png"), rng.integers(0, 256, (6, 9), dtype=np.uint8))
+    (tmp_path / "03.png").write_bytes(b"broken")
+    files = list_images(tmp_path)
+    prefetched = list(prefetch_images(files, depth))
+    assert len(prefetched) == len(files)
+    for path, image in zip(files, prefetched, strict=True):
+        direct = read_image(path)
+        if direct is None:
+            assert image is None
+        else:
+            np.testing.assert_array_equal(image, direct)
+    assert prefetched[3] is None and prefetched[2] is not None
+
+
+def test_prefetch_stops_when_the_consumer_does(tmp_path):
+    for k in range(20):
+        cv2.imwrite(str(tmp_path / f"{k:02d}.png"), np.full((4, 4), k, np.uint8))
+    images = prefetch_images(list_images(tmp_path), depth=2)
+    assert [int(next(images)[0, 0]) for _ in range(3)] == [0, 1, 2]
+    images.close()
+    with pytest.raises(StopIteration):
+        next(images)
+    with pytest.raises(ValueError, match="depth"):
+        next(prefetch_images(list_images(tmp_path), depth=0))

@@ -11,6 +11,7 @@ from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.vo_sequence import simulate_vo
 from vo_doppler.vo.baseline import FrameToFrameVO
 from vo_doppler.vo.batch import run_visual_odometry
+from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.odometry import VisualOdometry
 from vo_doppler.vo.scale import metric_positions
 
@@ -65,3 +66,26 @@ def test_frame_to_frame_baseline_follows_a_straight_stretch(drive):
     poses[:, :3, 3] = metric_positions(poses, truth.t, truth.t, np.r_[steps[0], steps])
     errors = evaluate(Trajectory.from_matrices(truth.t, poses), truth, "start", CAMERA_UP)
     assert errors.final_drift_pct < 3.0
+
+
+@pytest.fixture(scope="module")
+def short_drive():
+    return simulate_vo(duration_s=9.0, fps=10.0, seed=5)
+
+
+@pytest.mark.parametrize("every", [1, 3])
+def test_window_is_adjusted_at_every_nth_keyframe(short_drive, every):
+    plan = short_drive.plan
+    truth = Trajectory.from_matrices(plan.times, plan.T_first_camera)
+    steps = np.linalg.norm(np.diff(truth.positions, axis=0), axis=1) / np.diff(plan.times)
+    speed = (plan.times, np.r_[steps[0], steps])
+    config = VoConfig(ba_every_keyframes=every)
+    output = run_visual_odometry(list(short_drive.images), plan.times, plan.camera, config, speed)
+    stats = output.stats
+    # The first solve needs three measured frames; after it, one per ``every`` keyframes.
+    assert stats.keyframes > 10
+    assert stats.keyframes // every - 1 <= stats.ba_runs <= stats.keyframes // every
+    assert stats.reprojection_rms_px < 1.0
+    errors = evaluate(output.trajectory, truth, "start", CAMERA_UP)
+    assert errors.final_drift_pct < 1.0
+    assert abs(errors.end_yaw_error_deg) < 0.5

@@ -16,7 +16,7 @@ from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import (
     find_times_file,
     list_images,
-    read_image,
+    prefetch_images,
     read_times,
     times_from_fps,
 )
@@ -81,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
     with Progress(transient=True) as progress:
         task = progress.add_task("visual odometry", total=len(files))
         output = run_visual_odometry(
-            (read_image(f) for f in files),
+            prefetch_images(files),
             times,
             camera,
             config,

@@ -4,7 +4,11 @@ from ``times.txt`` (one time per line, KITTI style), a CSV, or a fixed frame rat
 from __future__ import annotations
 
 import csv
+import itertools
 import logging
+from collections import deque
+from collections.abc import Iterable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import cv2
@@ -36,6 +40,25 @@ def read_image(path: Path) -> np.ndarray | None:
     if image is None:
         log.warning("%s: cannot decode image; the frame is flagged and bridged", path)
     return image
+
+
+def prefetch_images(paths: Iterable[Path], depth: int = 4) -> Iterator[np.ndarray | None]:
+    """:func:`read_image` of every path, in order, decoded by a background thread that keeps up
+    to ``depth`` images ready (OpenCV releases the GIL while decoding, so decoding overlaps the
+    caller's work on another core)."""
+    if depth < 1:
+        raise ValueError(f"prefetch depth must be at least 1, got {depth}")
+    remaining = iter(paths)
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="image-prefetch") as pool:
+        pending = deque(pool.submit(read_image, p) for p in itertools.islice(remaining, depth))
+        try:
+            while pending:
+                image = pending.popleft().result()
+                pending.extend(pool.submit(read_image, p) for p in itertools.islice(remaining, 1))
+                yield image
+        finally:
+            for future in pending:
+                future.cancel()
 
 
 def read_times(path: str | Path, n_images: int) -> np.ndarray:

@@ -36,6 +36,11 @@ class VoConfig:
     keyframe_flow_px: float = 25.0
     """A frame becomes a keyframe when the median flow since the last keyframe exceeds this."""
     keyframe_max_gap: int = 5
+    ba_every_keyframes: int = 2
+    """The window is adjusted at every this many keyframes (a fixed lag), not at every one: each
+    frame is adjusted about ``window_size`` / (this × the mean keyframe spacing) times. Measured
+    with 1/2/3: simulator drive 0.204/0.202/0.202 m per 100 m, KITTI 06 clip final error
+    0.485/0.484/0.490 m, at 167/84/56 solves on the simulator drive."""
     ba_max_iterations: int = 4
     ba_function_tolerance: float = 1e-5
     ba_threads: int = 1

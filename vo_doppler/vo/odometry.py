@@ -1,5 +1,7 @@
 """Streaming monocular visual odometry: KLT front end, essential-matrix initialisation, PnP
-tracking, and Levenberg–Marquardt bundle adjustment over a sliding window of frames.
+tracking, and Levenberg–Marquardt bundle adjustment over a sliding window of frames, solved at
+every ``ba_every_keyframes``-th keyframe (a fixed lag) with the landmarks in a
+:class:`~vo_doppler.vo.landmarks.LandmarkMap`.
 
 World frame: the first camera's frame (OpenCV axes). Internally poses are world→camera (T_cw);
 results are camera→world (T_wc). Without a metric source the translation unit is arbitrary
@@ -13,6 +15,7 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from vo_doppler.errors import InputError
@@ -27,6 +30,7 @@ from vo_doppler.vo.geometry import (
     triangulate,
     two_view_geometry,
 )
+from vo_doppler.vo.landmarks import LandmarkMap
 from vo_doppler.vo.tracker import FeatureTracker, TrackedFeatures
 from vo_doppler.vo.window_ba import BundleProblem, bundle_adjust
 
@@ -111,12 +115,13 @@ class VisualOdometry:
         self.tracker = FeatureTracker(self.config)
         self._window: deque[_Frame] = deque()
         self._done: list[_Frame] = []
-        self._landmarks: dict[int, np.ndarray] = {}
+        self._landmarks = LandmarkMap()
         self._initialised = False
         self._init_ref: _Frame | None = None
         self._ref_image: np.ndarray | None = None
         self._ref_frame: _Frame | None = None
         self._last_keyframe: _Frame | None = None
+        self._keyframes_since_adjustment = 0
         self._failures = 0
         self._track_counts: list[int] = []
         self._rms_values: list[float] = []
@@ -185,7 +190,7 @@ class VisualOdometry:
             return "unreadable"
         if image.ndim != 2:
             return "not-grey"
-        if float(image.std()) < self.config.min_texture_std:
+        if float(cv2.meanStdDev(image)[1][0, 0]) < self.config.min_texture_std:
             return "blank"
         if self._ref_image is not None and image.shape != self._ref_image.shape:
             return "size-changed"
@@ -239,10 +244,9 @@ class VisualOdometry:
         landmarks are projected; other features move by the landmarks' median displacement."""
         if not self._initialised or not len(ref.features):
             return None
-        has_landmark = np.array([int(i) in self._landmarks for i in ref.features.ids], bool)
+        has_landmark, points = self._landmarks.lookup(ref.features.ids)
         if has_landmark.sum() < MIN_TRACKED:
             return None
-        points = np.array([self._landmarks[int(i)] for i in ref.features.ids[has_landmark]])
         in_front = transform_points(frame.T_cw, points)[:, 2] > 0.1
         if in_front.sum() < MIN_TRACKED:
             return None
@@ -300,8 +304,7 @@ class VisualOdometry:
         frame.measured = True
         T_wa = invert_pose(ref.T_cw)
         points_world = transform_points(T_wa, two_view.points_a[two_view.valid] * scale)
-        for track_id, xyz in zip(ids[two_view.valid], points_world, strict=True):
-            self._landmarks[int(track_id)] = xyz
+        self._landmarks.set(ids[two_view.valid], points_world)
         self._initialised = True
         self._stats.initialisations += 1
         self._relocate_pending(ref, frame)
@@ -328,12 +331,9 @@ class VisualOdometry:
                     pending.measured = True
 
     def _pnp(self, frame: _Frame, guess: np.ndarray) -> np.ndarray | None:
-        mask = np.fromiter(
-            (int(i) in self._landmarks for i in frame.features.ids), bool, len(frame.features)
-        )
+        mask, points = self._landmarks.lookup(frame.features.ids)
         if mask.sum() < self.config.pnp_min_inliers:
             return None
-        points = np.array([self._landmarks[int(i)] for i in frame.features.ids[mask]])
         result = solve_pnp(
             self.K,
             points,
@@ -367,12 +367,14 @@ class VisualOdometry:
         frame.keyframe = True
         self._last_keyframe = frame
         self._triangulate_new(frame)
-        self._adjust_window()
+        self._keyframes_since_adjustment += 1
+        if self._keyframes_since_adjustment >= self.config.ba_every_keyframes:
+            self._adjust_window()
 
     def _triangulate_new(self, frame: _Frame) -> None:
         """New landmarks from tracks without one, using each track's oldest measured view."""
         cfg = self.config
-        new = np.array([int(i) not in self._landmarks for i in frame.features.ids], bool)
+        new = ~self._landmarks.contains(frame.features.ids)
         if not new.any():
             return
         wanted = frame.features.ids[new]
@@ -392,32 +394,31 @@ class VisualOdometry:
                 cfg.max_reprojection_px,
                 cfg.triangulation_min_parallax_deg,
             )
-            for track_id, xyz in zip(ids[tri.valid], tri.points[tri.valid], strict=True):
-                self._landmarks[int(track_id)] = xyz
+            self._landmarks.set(ids[tri.valid], tri.points[tri.valid])
             wanted = np.setdiff1d(wanted, ids)
 
     def _adjust_window(self) -> None:
+        """Bundle adjustment of the window's measured frames and the landmarks they share."""
         frames = [f for f in self._window if f.measured]
         if len(frames) < 3:
             return
-        lm_ids = np.array(sorted(self._landmarks), dtype=np.int64)
+        self._keyframes_since_adjustment = 0
+        landmarks = self._landmarks
         obs_f, obs_p, obs_uv = [], [], []
         for k, f in enumerate(frames):
-            pos = np.searchsorted(lm_ids, f.features.ids)
-            pos = np.clip(pos, 0, max(len(lm_ids) - 1, 0))
-            hit = lm_ids[pos] == f.features.ids if len(lm_ids) else np.zeros(len(pos), bool)
+            hit, rows = landmarks.rows(f.features.ids)
             obs_f.append(np.full(hit.sum(), k))
-            obs_p.append(pos[hit])
+            obs_p.append(rows[hit])
             obs_uv.append(f.features.points[hit])
         obs_p_all = np.concatenate(obs_p)
-        counts = np.bincount(obs_p_all, minlength=len(lm_ids))
+        counts = np.bincount(obs_p_all, minlength=len(landmarks))
         used = np.flatnonzero(counts >= 2)
-        remap = np.full(len(lm_ids), -1)
+        remap = np.full(len(landmarks), -1)
         remap[used] = np.arange(len(used))
         keep = remap[obs_p_all] >= 0
         problem = BundleProblem(
             np.array([f.T_cw for f in frames]),
-            np.array([self._landmarks[int(i)] for i in lm_ids[used]]).reshape(-1, 3),
+            landmarks.xyz[used],
             np.concatenate(obs_f)[keep],
             remap[obs_p_all[keep]],
             np.concatenate(obs_uv)[keep],
@@ -454,11 +455,8 @@ class VisualOdometry:
             > 0
         )
         bad_obs = (errors > 2.0 * self.config.max_reprojection_px) | ~depth_ok
-        bad_points = np.unique(problem.obs_point[bad_obs])
-        for p, track_id in enumerate(lm_ids[used]):
-            self._landmarks[int(track_id)] = result.points[p]
-        for p in bad_points:
-            self._landmarks.pop(int(lm_ids[used][p]), None)
+        landmarks.xyz[used] = result.points
+        landmarks.remove(landmarks.ids[used[np.unique(problem.obs_point[bad_obs])]])
 
     # -- bookkeeping --------------------------------------------------------------------------
 
@@ -487,8 +485,4 @@ class VisualOdometry:
     def _prune_landmarks(self) -> None:
         if len(self._landmarks) < 4 * self.config.max_features:
             return
-        alive: set[int] = set()
-        for f in self._window:
-            alive.update(int(i) for i in f.features.ids)
-        for track_id in [i for i in self._landmarks if i not in alive]:
-            del self._landmarks[track_id]
+        self._landmarks.retain(np.concatenate([f.features.ids for f in self._window]))

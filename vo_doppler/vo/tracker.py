@@ -115,21 +115,21 @@ class FeatureTracker:
                 flags=cv2.OPTFLOW_USE_INITIAL_FLOW,
                 **self._lk_params,
             )
-        p0_back, status_back, _ = cv2.calcOpticalFlowPyrLK(
-            image, previous_image, p1, None, **self._lk_params
-        )
         p1 = p1.reshape(-1, 2)
-        fb_error = np.linalg.norm(p0_back.reshape(-1, 2) - p0.reshape(-1, 2), axis=1)
         height, width = image.shape
         inside = (
             (p1[:, 0] >= 0) & (p1[:, 0] < width - 1) & (p1[:, 1] >= 0) & (p1[:, 1] < height - 1)
         )
-        good = (
-            (status.ravel() == 1)
-            & (status_back.ravel() == 1)
-            & (fb_error < self.config.forward_backward_max_px)
-            & inside
-        )
+        good = (status.ravel() == 1) & inside
+        if good.any():
+            # Only forward survivors are tracked back (KLT treats every point independently).
+            p0_back, status_back, _ = cv2.calcOpticalFlowPyrLK(
+                image, previous_image, p1[good].reshape(-1, 1, 2), None, **self._lk_params
+            )
+            fb_error = np.linalg.norm(p0_back.reshape(-1, 2) - p0.reshape(-1, 2)[good], axis=1)
+            good[good] = (status_back.ravel() == 1) & (
+                fb_error < self.config.forward_backward_max_px
+            )
         flow = np.linalg.norm(p1[good] - previous.points[good], axis=1)
         median_flow = float(np.median(flow)) if flow.size else float("nan")
         tracked = TrackedFeatures(p1[good].astype(np.float64), previous.ids[good])

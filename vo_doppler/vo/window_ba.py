@@ -47,6 +47,29 @@ def _rms(residuals: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum(residuals**2, axis=1)))) if len(residuals) else 0.0
 
 
+def _add_points(
+    reconstruction: pycolmap.Reconstruction, problem: BundleProblem, index_in_image: np.ndarray
+) -> np.ndarray:
+    """Add every point seen at least twice with its track; its point3D id, else −1.
+
+    The per-observation image ids and keypoint indices are listed once, sorted by point, so the
+    only Python work per observation is the ``add_element`` call itself.
+    """
+    order = np.argsort(problem.obs_point, kind="stable")
+    counts = np.bincount(problem.obs_point, minlength=len(problem.points))
+    ends = np.cumsum(counts).tolist()
+    image_ids = (problem.obs_frame[order] + 1).tolist()
+    keypoints = index_in_image[order].tolist()
+    xyz = problem.points
+    point_ids = np.full(len(problem.points), -1, dtype=np.int64)
+    for p in np.flatnonzero(counts >= 2).tolist():
+        track = pycolmap.Track()
+        for k in range(ends[p] - counts[p], ends[p]):
+            track.add_element(image_ids[k], keypoints[k])
+        point_ids[p] = reconstruction.add_point3D(xyz[p], track)
+    return point_ids
+
+
 def bundle_adjust(
     K: np.ndarray,
     problem: BundleProblem,
@@ -74,33 +97,20 @@ def bundle_adjust(
     )
     reconstruction.add_camera_with_trivial_rig(camera)
     order = np.argsort(problem.obs_frame, kind="stable")
-    frames_sorted = problem.obs_frame[order]
-    starts = np.searchsorted(frames_sorted, np.arange(n_frames + 1))
+    starts = np.searchsorted(problem.obs_frame[order], np.arange(n_frames + 1))
     index_in_image = np.empty(len(order), dtype=np.int64)
+    index_in_image[order] = np.arange(len(order)) - np.repeat(starts[:-1], np.diff(starts))
     for f in range(n_frames):
-        chunk = order[starts[f] : starts[f + 1]]
-        index_in_image[chunk] = np.arange(len(chunk))
         image = pycolmap.Image(
-            name=str(f), keypoints=problem.obs_uv[chunk], camera_id=1, image_id=f + 1
+            name=str(f),
+            keypoints=problem.obs_uv[order[starts[f] : starts[f + 1]]],
+            camera_id=1,
+            image_id=f + 1,
         )
         reconstruction.add_image_with_trivial_frame(
             image, pycolmap.Rigid3d(problem.poses_cw[f][:3, :4])
         )
-    point_order = np.argsort(problem.obs_point, kind="stable")
-    point_starts = np.searchsorted(
-        problem.obs_point[point_order], np.arange(len(problem.points) + 1)
-    )
-    point_ids = np.full(len(problem.points), -1, dtype=np.int64)
-    for p in range(len(problem.points)):
-        members = point_order[point_starts[p] : point_starts[p + 1]]
-        if len(members) < 2:
-            continue
-        track = pycolmap.Track()
-        for image_id, point2d_idx in zip(
-            (problem.obs_frame[members] + 1).tolist(), index_in_image[members].tolist(), strict=True
-        ):
-            track.add_element(image_id, point2d_idx)
-        point_ids[p] = reconstruction.add_point3D(problem.points[p], track)
+    point_ids = _add_points(reconstruction, problem, index_in_image)
     used = point_ids[problem.obs_point] >= 0
     initial_rms = _rms(reprojection_residuals(K, problem, problem.poses_cw, problem.points)[used])
     options = pycolmap.BundleAdjustmentOptions()
@@ -135,8 +145,9 @@ def bundle_adjust(
         ]
     )
     points = problem.points.copy()
-    for p in np.flatnonzero(point_ids >= 0):
-        points[p] = reconstruction.point3D(int(point_ids[p])).xyz
+    tracked = np.flatnonzero(point_ids >= 0)
+    if len(tracked):
+        points[tracked] = [reconstruction.point3D(i).xyz for i in point_ids[tracked].tolist()]
     final_rms = _rms(reprojection_residuals(K, problem, poses, points)[used])
     iterations = ceres_summary.num_successful_steps + ceres_summary.num_unsuccessful_steps
     return BundleResult(
