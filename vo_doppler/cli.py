@@ -28,6 +28,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "low-cost path mapping: two gyros + GPS dead reckoning and drift table",
     ),
     "simulate": ("simulate_command", "generate a synthetic multi-sensor sequence"),
+    "batch": (
+        "batch_command",
+        "the main job on many sequence folders, in parallel, with one aggregate table",
+    ),
 }
 """Subcommand → (module in ``vo_doppler.commands``, one-line help). A module is imported only
 when its subcommand runs, so ``vo-doppler --help`` loads none of the library."""
