@@ -33,6 +33,7 @@ import json
 import logging
 import multiprocessing
 import os
+import threading
 import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
@@ -62,6 +63,7 @@ LOG_FILE = "run.log"
 PREPARED = "prepared"
 EXECUTORS = ("local", "ray")
 TABLE_NAME = "batch_summary"
+PARENT_POLL_S = 0.5
 
 Prepare = Callable[[Path, Path], Path]
 """``prepare(source, work_dir) -> sequence folder``: imports a raw recording (module docstring)."""
@@ -253,13 +255,33 @@ def default_workers(recordings: int) -> int:
     return max(1, min(os.cpu_count() or 1, recordings))
 
 
+def _exit_with_parent(parent: int) -> None:
+    """Pool initializer: a thread that ends the worker once its parent is gone (a batch killed
+    by any signal leaves no worker computing on)."""
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
+def _pool(workers: int) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=_exit_with_parent,
+        initargs=(os.getpid(),),
+    )
+
+
 def local_outcomes(jobs: list[RecordingJob], workers: int) -> Iterator[RecordingOutcome]:
     """Run jobs on a spawn process pool, yielding outcomes as they finish. Jobs lost with a
     broken pool run again one by one, each in a pool of its own, so that only the recording
     whose worker dies again is failed."""
-    context = multiprocessing.get_context("spawn")
     lost = []
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
+    pool = _pool(workers)
     try:
         futures = {pool.submit(process_recording, job): job for job in jobs}
         for future in as_completed(futures):
@@ -274,7 +296,7 @@ def local_outcomes(jobs: list[RecordingJob], workers: int) -> Iterator[Recording
         raise
     pool.shutdown()
     for job in lost:
-        with ProcessPoolExecutor(max_workers=1, mp_context=context) as alone:
+        with _pool(1) as alone:
             try:
                 yield alone.submit(process_recording, job).result()
             except BrokenProcessPool as exc:
