@@ -12,15 +12,9 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from vo_doppler.batch import EXECUTORS, RecordingOutcome, Status, read_list, run_batch
+from vo_doppler.commands.deadreckon_command import _positive_int
 from vo_doppler.commands.run_command import add_run_options, run_config
 from vo_doppler.errors import InputError
-
-
-def positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text}: expected an integer >= 1")
-    return value
 
 
 def register(subparsers, summary: str) -> None:
@@ -48,7 +42,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--workers",
-        type=positive_int,
+        type=_positive_int,
         help="recordings run at once (default: min(CPU cores, recordings); ray on a cluster: "
         "its CPUs)",
     )
