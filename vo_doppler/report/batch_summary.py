@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import html
 from pathlib import Path
+from urllib.parse import quote
 
 import numpy as np
 
@@ -143,7 +144,8 @@ def write_batch_html(path: Path, rows: list[dict], title: str = "vo-doppler batc
         name = html.escape(row["recording"])
         overall = row["recording"] == OVERALL
         linked = not overall and row["status"] != "failed"
-        link = f"<a href='{name}/report.html'>{name}</a>" if linked else name
+        href = html.escape(quote(row["recording"]))
+        link = f"<a href='{href}/report.html'>{name}</a>" if linked else name
         cells = "".join(f"<td>{_cell(row, key, fmt)}</td>" for key, _, fmt in HTML_COLUMNS)
         parts.append(f"<tr{' class=overall' if overall else ''}><td>{link}</td>{cells}</tr>")
     parts.append("</table>")
