@@ -29,6 +29,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     ),
     "simulate": ("simulate_command", "generate a synthetic multi-sensor sequence"),
     "import": ("import_command", "convert a recording (comma2k19 segment) into a sequence folder"),
+    "batch": (
+        "batch_command",
+        "the main job on many sequence folders, in parallel, with one aggregate table",
+    ),
 }
 """Subcommand → (module in ``vo_doppler.commands``, one-line help). A module is imported only
 when its subcommand runs, so ``vo-doppler --help`` loads none of the library."""

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import sys
 from pathlib import Path
@@ -14,21 +13,13 @@ from rich.progress import Progress
 from rich.table import Table
 
 from vo_doppler.commands.vo_command import window_size
-from vo_doppler.errors import InputError
-from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
+from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
-from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.sequence import read_sequence
-from vo_doppler.io.trajectory import write_tum
-from vo_doppler.report.heading_figure import heading_figure
-from vo_doppler.report.run_report import (
-    TABLE_COLUMNS,
-    error_per_100m_figure,
-    trajectories_figure,
-    write_html_report,
-)
-from vo_doppler.run import Pipeline, RunConfig, RunResult, run_sequence
+from vo_doppler.report.run_outputs import require_tight_heading, write_run_outputs
+from vo_doppler.report.run_report import TABLE_COLUMNS
+from vo_doppler.run import RunConfig, run_sequence
 from vo_doppler.vo.config import VoConfig
 
 log = logging.getLogger(__name__)
@@ -45,6 +36,12 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("sequence", type=Path, help="folder with sequence.yaml")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    add_run_options(parser)
+    parser.set_defaults(func=run)
+
+
+def add_run_options(parser: argparse.ArgumentParser) -> None:
+    """The main job's options (shared by ``run`` and ``batch``); see :func:`run_config`."""
     parser.add_argument("--systems", default="GREJC", help="GNSS systems to use")
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
     parser.add_argument("--window", type=window_size, default=30, help="VO window (frames, >= 3)")
@@ -67,12 +64,11 @@ def register(subparsers, summary: str) -> None:
         action="store_true",
         help="kalman: forward filter only (each pose uses the headings up to its time)",
     )
-    parser.set_defaults(func=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    inputs = read_sequence(args.sequence)
-    config = RunConfig(
+def run_config(args: argparse.Namespace) -> RunConfig:
+    """The :class:`RunConfig` of the options :func:`add_run_options` added (radians inside)."""
+    return RunConfig(
         systems=args.systems.upper(),
         elevation_mask=np.radians(args.elev_mask),
         vo=VoConfig(window_size=args.window),
@@ -82,6 +78,11 @@ def run(args: argparse.Namespace) -> int:
             blend=BlendConfig(smooth=not args.causal),
         ),
     )
+
+
+def run(args: argparse.Namespace) -> int:
+    inputs = read_sequence(args.sequence)
+    config = run_config(args)
     console = Console(width=None if sys.stdout.isatty() else 150)
     console.print(
         f"{inputs.name}: {len(inputs.image_paths)} images, "
@@ -92,94 +93,16 @@ def run(args: argparse.Namespace) -> int:
         task = progress.add_task("visual odometry", total=len(inputs.image_paths))
         result = run_sequence(inputs, config, lambda _: progress.advance(task))
     out = args.output
-    out.mkdir(parents=True, exist_ok=True)
-    file_names = {Pipeline.VO: "trajectory_vo.tum", Pipeline.VO_GPS_TC: "trajectory_corrected.tum"}
-    for name, trajectory in result.trajectories.items():
-        write_tum(out / file_names.get(name, f"trajectory_{name}.tum"), trajectory)
+    summary = write_run_outputs(inputs, result, config, out)
     if result.vo is None:
         console.print(f"{inputs.name} has no camera: only the non-visual pipelines ran")
-    write_heading_csv(out / "heading.csv", result.heading)
-    summary = summarise(result)
-    summary["heading_correction"] = args.correction + (" (causal)" if args.causal else "")
-    figures = [out / "trajectories.png", out / "heading.png"]
-    truth = inputs.truth
-    errors = {}
-    shown = result.trajectories
-    if truth is not None:
-        errors, per_100m, shown = evaluate_pipelines(
-            result.trajectories, result.heading, result.tc_usable, truth
-        )
-        summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
-        error_per_100m_figure(out / "error_per_100m.png", per_100m, inputs.name)
-        figures.append(out / "error_per_100m.png")
-    truth_yaw = truth.yaw_at(result.heading.t) if truth is not None else None
-    trajectories_figure(figures[0], shown, truth, inputs.name)
-    heading_figure(figures[1], result.heading, truth_yaw, inputs.name)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
-    facts = readable_facts(summary)
-    write_html_report(out / "report.html", f"vo-doppler run: {inputs.name}", facts, errors, figures)
-    print_summary(console, summary, errors)
+    print_summary(console, summary)
     console.print(f"wrote {out}/report.html and the trajectories, heading.csv, figures")
-    if not result.heading.tc_available.any():
-        raise InputError(
-            "the tightly coupled heading was unavailable at every epoch", args.sequence
-        )
+    require_tight_heading(result, args.sequence)
     return 0
 
 
-FACT_FORMATS = {
-    "gnss_epochs": ("GNSS epochs", "{:d}"),
-    "conventional_heading_availability": ("conventional heading available", "{:.1%}"),
-    "tight_heading_availability": ("tightly coupled heading available", "{:.1%}"),
-    "tight_heading_reliable": ("tightly coupled heading reliable (gyro-consistent)", "{:.1%}"),
-    "tight_heading_used": ("tightly coupled heading used by the correction", "{:.1%}"),
-    "tight_heading_rejected_rows": ("Doppler rows rejected by the NLOS tests", "{:d}"),
-    "tight_heading_epochs_with_rejection": ("epochs with a rejection", "{:d}"),
-    "final_wheel_scale": ("wheel scale at the end", "{:.4f}"),
-    "final_gyro_bias_dps": ("gyro bias at the end", "{:+.3f} deg/s"),
-    "vo_frames": ("VO frames", "{:d}"),
-    "vo_flagged_frames": ("VO frames flagged", "{:d}"),
-    "vo_fps": ("VO speed", "{:.1f} frames/s"),
-    "heading_correction": ("heading correction", "{}"),
-}
-
-
-def readable_facts(summary: dict) -> dict[str, str]:
-    """The summary's scalars with labels and units for people (the report's list)."""
-    facts = {}
-    for key, value in summary.items():
-        if key == "evaluation":
-            continue
-        label, fmt = FACT_FORMATS.get(key, (key, "{}"))
-        facts[label] = fmt.format(value)
-    return facts
-
-
-def summarise(result: RunResult) -> dict:
-    table = result.heading
-    return {
-        "gnss_epochs": len(table),
-        "conventional_heading_availability": float(np.mean(table.conv_valid)),
-        "tight_heading_availability": float(np.mean(table.tc_available)),
-        "tight_heading_reliable": float(np.mean(table.tc_reliable)),
-        "tight_heading_used": float(np.mean(result.tc_usable)),
-        "tight_heading_rejected_rows": int(table.rejected_rows.sum()),
-        "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
-        "final_wheel_scale": float(table.wheel_scale[-1]),
-        "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
-        **(
-            {
-                "vo_frames": result.vo.stats.frames,
-                "vo_flagged_frames": len(result.vo.stats.flagged_frames),
-                "vo_fps": result.vo.stats.fps,
-            }
-            if result.vo is not None
-            else {"camera": "none: non-visual pipelines only"}
-        ),
-    }
-
-
-def print_summary(console: Console, summary: dict, errors: dict) -> None:
+def print_summary(console: Console, summary: dict) -> None:
     console.print(
         f"heading available: conventional {summary['conventional_heading_availability']:.0%}, "
         f"tightly coupled {summary['tight_heading_availability']:.0%} of "
@@ -193,14 +116,14 @@ def print_summary(console: Console, summary: dict, errors: dict) -> None:
             else "no camera"
         )
     )
+    errors = summary.get("evaluation")
     if not errors:
         return
     table = Table(title="against ground truth")
     table.add_column("pipeline")
     for _, label, _ in TABLE_COLUMNS:
         table.add_column(label, justify="right")
-    for name, row in errors.items():
-        values = row.to_dict()
+    for name, values in errors.items():
         table.add_row(
             PIPELINE_LABELS.get(name, name),
             *(fmt.format(values[key]) for key, _, fmt in TABLE_COLUMNS),

@@ -192,10 +192,9 @@ def snoop_satellites(
     a, b = np.nan_to_num(a), np.nan_to_num(b)
     K = len(w)
     shape = (K, n_groups)
-    X = np.stack([-a, -b, y], axis=-1)
-    T = np.stack([np.ones_like(tau), -tau], axis=-1)
-    Q0, XtWX, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, w)
-    theta, cost0 = minimum_cost(Q0, grid_size, iterations)
+    X, T, XtWX, XtWT, TtWT_pinv, theta, cost0 = _least_squares(
+        a, b, y, tau, w, grid_size, iterations
+    )
     flat = (np.arange(K)[:, None] * n_groups + group).ravel()
     S_w = _group_sums(w, flat, shape)
     S_X = _group_sums(w[..., None] * X, flat, shape)
@@ -270,6 +269,27 @@ def snoop_satellites(
         min_redundancy=np.min(redundancy, axis=1, initial=1.0),
         noise_scale=noise_scale,
     )
+
+
+def _least_squares(a, b, y, tau, w, grid_size, iterations):
+    """The windows' fit without bias parameters: X, T, XᵀWX, XᵀWT, (TᵀWT)⁺, θ₀ and its cost."""
+    X = np.stack([-a, -b, y], axis=-1)
+    T = np.stack([np.ones_like(tau), -tau], axis=-1)
+    Q0, XtWX, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, w)
+    theta, cost0 = minimum_cost(Q0, grid_size, iterations)
+    return X, T, XtWX, XtWT, TtWT_pinv, theta, cost0
+
+
+def noise_statistics(a, b, y, tau, w, grid_size: int, iterations: int):
+    """Per window, what :func:`receiver_noise_scale` pools: the MAD scale of the normalised
+    residuals of the least-squares fit and its degrees of freedom (arrays as in
+    :func:`snoop_satellites`; the same numbers it computes on its first pass). Windows solved
+    in several chunks share one σ₀ by pooling these over every chunk."""
+    a, b = np.nan_to_num(a), np.nan_to_num(b)
+    X, T, _, XtWT, TtWT_pinv, theta, _ = _least_squares(a, b, y, tau, w, grid_size, iterations)
+    none = np.zeros(len(w))
+    lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, (none, none))
+    return lin.mad, lin.dof
 
 
 def receiver_noise_scale(mad: np.ndarray, dof: np.ndarray) -> float:

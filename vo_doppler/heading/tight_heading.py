@@ -61,8 +61,15 @@ from vo_doppler.heading.profile import (
     weighted_gram,
     z_of,
 )
-from vo_doppler.heading.snooping import snoop_satellites
+from vo_doppler.heading.snooping import noise_statistics, receiver_noise_scale, snoop_satellites
 from vo_doppler.model.doppler import DopplerRows
+
+ROW_FLOATS = 52
+"""float64 values held per window and padded row at the peak of :func:`solve_windows`."""
+HYPOTHESIS_FLOATS = 2
+"""… per window, satellite and grid point (the cost of every single-satellite hypothesis)."""
+PROFILE_FLOATS = 8
+"""… per window and step of the profiled-cost σ (:func:`_profile_sigma`)."""
 
 
 @dataclass(frozen=True)
@@ -87,7 +94,9 @@ class TightHeadingConfig:
     reliability_gate_rad: float = np.radians(3.0)
     reliability_n_sigma: float = 3.0
     epoch_match_s: float = 1e-3
-    chunk_windows: int = 2048
+    chunk_bytes: int = 32 * 2**20
+    """Memory (bytes) for the windows solved at once: the windows are solved in chunks of as
+    many as fit (:func:`windows_per_chunk`); the headings do not depend on it."""
     profile_step_rad: float = np.radians(0.25)
     profile_max_rad: float = np.radians(30.0)
     clock_drift_walk_mps: float = 0.01
@@ -209,6 +218,7 @@ def solve_windows(
     group=None,
     scale_sigma=0.0,
     bias_sigma=0.0,
+    noise_scale=None,
 ):
     """Solve padded windows at once: arrays (K, R) of reduced observations ``y``, coefficients
     ``a``, ``b`` (model a·cos θ₀ + b·sin θ₀ + ρ₀ − α·τ), row times ``tau`` relative to the
@@ -224,7 +234,8 @@ def solve_windows(
     reflection lasts; a lone row is a blunder) the θ₀ variance allows for one more biased
     satellite (``bias_variance`` of :mod:`vo_doppler.heading.snooping`).
     ``scale_sigma`` and ``bias_sigma`` (per window or scalars) are the calibration
-    uncertainties the tests allow for.
+    uncertainties the tests allow for. ``noise_scale``: σ₀ of the tests (default: pooled over
+    these windows, :func:`vo_doppler.heading.snooping.receiver_noise_scale`).
     """
     K, R = w.shape
     X = np.stack([-a, -b, y], axis=-1)
@@ -239,7 +250,6 @@ def solve_windows(
     min_redundancy = np.zeros(K)  # untested windows are not verifiable
     todo = np.arange(K)
     verifiable_before = np.zeros(K, dtype=bool)
-    noise_scale = None
     bias_variance = np.zeros(K)
     reflection = np.zeros(K, dtype=bool)
     for rejection in range(config.outlier_passes + 1):
@@ -441,20 +451,33 @@ def tight_heading_series(
     lo = np.searchsorted(t_epoch[row_epoch], t_epoch - config.window_s, side="right")
     hi = np.searchsorted(t_epoch[row_epoch], t_epoch, side="right")
 
+    width = max(int(np.max(hi - lo)), 1)
+    n_groups = int(np.max(row_group, initial=0)) + 1
+    size = windows_per_chunk(width, n_groups, config)
+    chunks = [np.arange(start, min(start + size, m)) for start in range(0, m, size)]
+    per_epoch = (t_epoch, speed, yaw_angle, lever)
+
+    def padded(k):
+        return _padded_rows(
+            rows, (y_all, row_group), index, row_epoch, k, (lo, hi), per_epoch, width
+        )
+
+    noise_scale = None
+    if len(chunks) > 1 and config.outlier_passes:
+        pooled = []
+        for k in chunks:
+            y, a, b, tau, w, _ = padded(k)
+            pooled.append(
+                noise_statistics(a, b, y, tau, w, config.grid_size, config.gauss_newton_iterations)
+            )
+        mad, dof = (np.concatenate([p[i] for p in pooled]) for i in (0, 1))
+        noise_scale = receiver_noise_scale(mad, dof)
     solutions = []
-    for start in range(0, m, config.chunk_windows):
-        k = np.arange(start, min(start + config.chunk_windows, m))
+    for k in chunks:
+        y, a, b, tau, w, group = padded(k)
         solutions.append(
-            _solve_chunk(
-                rows,
-                (y_all, row_group),
-                index,
-                row_epoch,
-                k,
-                (lo, hi),
-                (t_epoch, speed, yaw_angle, lever),
-                (scale_sigma, bias_sigma),
-                config,
+            solve_windows(
+                y, a, b, tau, w, config, group, scale_sigma[k], bias_sigma[k], noise_scale
             )
         )
     solution = _concatenate(solutions)
@@ -467,10 +490,22 @@ def tight_heading_series(
     return _decide(solution, model_variance, t_epoch, speed, yaw_angle, n_sat_epoch, config)
 
 
-def _solve_chunk(rows, per_row, index, row_epoch, k, bounds, per_epoch, calibration, config):
+def windows_per_chunk(width: int, n_groups: int, config: TightHeadingConfig) -> int:
+    """How many windows of ``width`` padded rows and ``n_groups`` satellites fit in
+    ``config.chunk_bytes`` (at least one): the peak of :func:`solve_windows` per window is at
+    most ROW_FLOATS·width + HYPOTHESIS_FLOATS·n_groups·grid + PROFILE_FLOATS·profile steps
+    float64 values (measured with tracemalloc; the benchmark and test check the bound)."""
+    steps = round(config.profile_max_rad / config.profile_step_rad) + 1
+    floats = ROW_FLOATS * width + HYPOTHESIS_FLOATS * n_groups * config.grid_size
+    return max(1, config.chunk_bytes // (8 * (floats + PROFILE_FLOATS * steps)))
+
+
+def _padded_rows(rows, per_row, index, row_epoch, k, bounds, per_epoch, width):
+    """The rows of windows ``k`` padded to ``width`` (the widest window of the series, so that
+    a window's arrays, and so its solution, do not depend on the chunk it is solved in):
+    y, a, b, τ, w and the satellite group of :func:`solve_windows`."""
     (y_all, row_group), (lo, hi) = per_row, bounds
-    (t_epoch, speed, yaw_angle, lever), (scale_sigma, bias_sigma) = per_epoch, calibration
-    width = max(int(np.max(hi[k] - lo[k], initial=0)), 1)
+    t_epoch, speed, yaw_angle, lever = per_epoch
     slot = lo[k][:, None] + np.arange(width)[None, :]
     inside = slot < hi[k][:, None]
     slot = np.where(inside, slot, 0)
@@ -489,7 +524,7 @@ def _solve_chunk(rows, per_row, index, row_epoch, k, bounds, per_epoch, calibrat
     y = np.where(w > 0, y_all[row], 0.0)
     a, b, tau = np.where(w > 0, a, 0.0), np.where(w > 0, b, 0.0), np.where(w > 0, tau, 0.0)
     group = np.where(w > 0, row_group[row], 0)
-    return solve_windows(y, a, b, tau, w, config, group, scale_sigma[k], bias_sigma[k])
+    return y, a, b, tau, w, group
 
 
 def antenna_offset_velocity(yaw_rate: np.ndarray, lever_arm_m) -> np.ndarray:

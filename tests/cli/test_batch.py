@@ -1,0 +1,101 @@
+"""``vo-doppler batch`` end to end on tiny generated drives: each recording's outputs as
+``vo-doppler run`` writes them, a failure listed with its category, the aggregate as CSV,
+Parquet and HTML, the exit status, and ``--resume``."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from tests.helpers.batch import tiny_drive
+from vo_doppler.batch import MARKER
+from vo_doppler.cli import main
+
+
+@pytest.fixture(scope="module")
+def batch_run(tmp_path_factory):
+    drives = [tiny_drive(tmp_path_factory, seed) for seed in (1, 2)]
+    folder = tmp_path_factory.mktemp("batch_cli")
+    listing = folder / "recordings.txt"
+    listing.write_text(f"# two drives and a folder that is not there\n{drives[1]}\nmissing\n")
+    out = folder / "out"
+    command = ["batch", str(drives[0]), "--list", str(listing), "-o", str(out), "--workers", "2"]
+    assert main(command) == 1
+    return drives, out, command
+
+
+def read_rows(out):
+    with (out / "batch_summary.csv").open() as stream:
+        return list(csv.DictReader(stream))
+
+
+def test_every_recording_is_listed_with_failures_categorised(batch_run):
+    _, out, _ = batch_run
+    rows = read_rows(out)
+    assert [r["recording"] for r in rows] == ["drive1", "drive2", "missing", "all recordings"]
+    assert [r["status"] for r in rows[:3]] == ["done", "done", "failed"]
+    assert rows[2]["exit_category"] == "input-error"
+    assert "missing" in rows[2]["error"] and "sequence manifest" in rows[2]["error"]
+    assert rows[3]["status"] == "2 done, 1 failed"
+    page = (out / "batch_summary.html").read_text()
+    assert "drive1/report.html" in page and "sequence manifest" in page
+
+
+def test_rows_hold_each_runs_summary_and_the_overall_weights(batch_run):
+    _, out, _ = batch_run
+    rows = read_rows(out)
+    for row in rows[:2]:
+        summary = json.loads((out / row["recording"] / "summary.json").read_text())
+        assert float(row["final_wheel_scale"]) == summary["final_wheel_scale"]
+        assert float(row["tight_heading_availability"]) == summary["tight_heading_availability"]
+        error = summary["evaluation"]["vo_gps_tc"]["error_per_100m_m"]
+        assert float(row["vo_gps_tc_error_per_100m_m"]) == error
+    lengths = np.array([float(r["path_length_m"]) for r in rows[:2]])
+    errors = np.array([float(r["vo_error_per_100m_m"]) for r in rows[:2]])
+    overall = float(rows[3]["vo_error_per_100m_m"])
+    assert overall == pytest.approx(np.sum(errors * lengths) / np.sum(lengths), rel=1e-12)
+    epochs = np.array([int(r["gnss_epochs"]) for r in rows[:2]])
+    available = np.array([float(r["tight_heading_availability"]) for r in rows[:2]])
+    expected = np.sum(available * epochs) / np.sum(epochs)
+    assert float(rows[3]["tight_heading_availability"]) == pytest.approx(expected, rel=1e-12)
+
+
+def test_parquet_holds_the_csv_table(batch_run):
+    _, out, _ = batch_run
+    table = pq.read_table(out / "batch_summary.parquet").to_pylist()
+    for from_parquet, from_csv in zip(table, read_rows(out), strict=True):
+        assert from_parquet["recording"] == from_csv["recording"]
+        assert from_parquet["gnss_epochs"] == (
+            int(from_csv["gnss_epochs"]) if from_csv["gnss_epochs"] else None
+        )
+        scale = from_csv["final_wheel_scale"]
+        assert from_parquet["final_wheel_scale"] == (float(scale) if scale else None)
+
+
+def test_outputs_are_those_of_vo_doppler_run(batch_run, tmp_path):
+    drives, out, _ = batch_run
+    alone = tmp_path / "run"
+    assert main(["run", str(drives[0]), "-o", str(alone)]) == 0
+    batch_files = {p.name for p in (out / "drive1").iterdir()}
+    assert {p.name for p in alone.iterdir()} | {MARKER, "run.log"} == batch_files
+    ours, theirs = (json.loads((d / "summary.json").read_text()) for d in (out / "drive1", alone))
+    ours.pop("vo_fps"), theirs.pop("vo_fps")
+    assert ours == theirs
+
+
+def test_resume_skips_finished_recordings(batch_run):
+    drives, out, command = batch_run
+    markers = {d.name: (out / d.name / MARKER).stat().st_mtime_ns for d in drives}
+    assert main([*command, "--resume"]) == 1
+    rows = read_rows(out)
+    assert [r["status"] for r in rows[:3]] == ["skipped", "skipped", "failed"]
+    assert {d.name: (out / d.name / MARKER).stat().st_mtime_ns for d in drives} == markers
+
+
+def test_no_recordings_is_an_error(tmp_path, capsys):
+    assert main(["batch", "-o", str(tmp_path)]) == 1
+    assert "no recordings" in capsys.readouterr().err

@@ -1,0 +1,42 @@
+"""Helpers of the batch tests: tiny generated drives shared by a test session, and ``prepare``
+steps (importable, so spawned workers can unpickle them) that block, crash or fail on cue."""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+
+BLOCK_DIR_ENV = "VO_DOPPLER_TEST_BLOCK_DIR"
+"""Folder of flag files: while ``<name>`` exists there, recording ``<name>`` waits."""
+
+
+def tiny_drive(tmp_path_factory, seed: int) -> Path:
+    """An 8 s urban-canyon drive with 320×180 images, generated once per test session."""
+    folder = tmp_path_factory.getbasetemp() / "tiny_drives" / f"drive{seed}"
+    if not (folder / "sequence.yaml").exists():
+        config = UrbanCanyonConfig(duration_s=8.0, seed=seed, image_size=(320, 180))
+        simulate_urban_canyon(folder, config)
+    return folder
+
+
+def wait_while_blocked(source: Path, work_dir: Path) -> Path:
+    """Prepare step that writes its pid to ``<block dir>/<name>.pid`` and waits while the flag
+    file ``<block dir>/<name>`` exists; the recording is then used as it is."""
+    block_dir = Path(os.environ[BLOCK_DIR_ENV])
+    (block_dir / f"{source.name}.pid").write_text(str(os.getpid()))
+    while (block_dir / source.name).exists():
+        time.sleep(0.05)
+    return source
+
+
+def die_or_fail(source: Path, work_dir: Path) -> Path:
+    """Prepare step: the worker process dies at once for ``crash*``, raises a plain exception
+    (a bug) for ``bug*``, and returns the source (a sequence folder, or not) otherwise."""
+    if source.name.startswith("crash"):
+        os._exit(3)
+    if source.name.startswith("bug"):
+        raise RuntimeError(f"bug in the importer of {source.name}")
+    return source

@@ -1,0 +1,197 @@
+"""The batch runner (vo_doppler.batch): naming, fingerprints, completion markers, failure
+isolation across worker processes, a killed batch resumed without recomputing what finished,
+and the Ray executor giving the local executor's aggregate."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from tests.helpers.batch import BLOCK_DIR_ENV, die_or_fail, tiny_drive, wait_while_blocked
+from vo_doppler.batch import (
+    MARKER,
+    Failure,
+    Status,
+    fingerprint,
+    finished,
+    output_names,
+    plan,
+    read_list,
+    run_batch,
+)
+from vo_doppler.errors import InputError
+from vo_doppler.run import RunConfig
+from vo_doppler.vo.config import VoConfig
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+LIVENESS_S = 600.0
+"""Upper bound on waiting for a subprocess (a hang fails the test instead of the suite)."""
+
+
+def test_output_names_use_as_many_path_components_as_make_them_unique(tmp_path):
+    sources = [tmp_path / "r1" / "10", tmp_path / "r2" / "10", tmp_path / "r2" / "11"]
+    assert output_names(sources) == ["r1__10", "r2__10", "r2__11"]
+    assert output_names([tmp_path / "a", tmp_path / "b"]) == ["a", "b"]
+
+
+def test_read_list_skips_comments_and_resolves_relative_paths(tmp_path):
+    listing = tmp_path / "lists" / "drives.txt"
+    listing.parent.mkdir()
+    listing.write_text("# fleet\nd1\n\n  /abs/d2  # second\n")
+    assert read_list(listing) == [listing.parent / "d1", Path("/abs/d2")]
+    with pytest.raises(InputError, match=r"missing\.txt"):
+        read_list(tmp_path / "missing.txt")
+
+
+def test_fingerprint_follows_files_and_config(tmp_path):
+    (tmp_path / "sub").mkdir()
+    data = tmp_path / "sub" / "x.txt"
+    data.write_text("1")
+    config = RunConfig()
+    first = fingerprint(tmp_path, config, None)
+    assert fingerprint(tmp_path, RunConfig(), None) == first
+    assert fingerprint(tmp_path, replace(config, vo=VoConfig(window_size=10)), None) != first
+    assert fingerprint(tmp_path, config, die_or_fail) != first
+    data.write_text("22")
+    assert fingerprint(tmp_path, config, None) != first
+
+
+def test_a_marker_counts_only_with_its_fingerprint_and_outputs(tmp_path):
+    (job,) = plan([tmp_path / "rec"], tmp_path / "out", RunConfig())
+    job.out.mkdir(parents=True)
+    (job.out / "summary.json").write_text("{}")
+    marker = {"fingerprint": job.fingerprint, "outputs": ["summary.json"], "seconds": 1.0}
+    (job.out / MARKER).write_text(json.dumps(marker))
+    assert finished(job) == marker
+    (job.out / MARKER).write_text(json.dumps({**marker, "fingerprint": "other"}))
+    assert finished(job) is None
+    (job.out / MARKER).write_text(json.dumps(marker))
+    (job.out / "summary.json").unlink()
+    assert finished(job) is None
+
+
+def test_failures_stay_with_their_recording(tmp_path):
+    """A worker that dies fails only its own recording (the others lost with the pool run
+    again alone); a plain exception is an internal error; bad input an input error."""
+    sources = [tmp_path / name for name in ("crash", "bug", "not_a_sequence", "empty")]
+    for source in sources:
+        source.mkdir()
+    result = run_batch(sources, tmp_path / "out", workers=2, prepare=die_or_fail)
+    categories = {o.name: o.category for o in result.outcomes}
+    assert categories == {
+        "crash": Failure.WORKER_LOST,
+        "bug": Failure.INTERNAL,
+        "not_a_sequence": Failure.INPUT,
+        "empty": Failure.INPUT,
+    }
+    assert "RuntimeError: bug in the importer of bug" in result.outcomes[1].error
+    assert "sequence.yaml" in result.outcomes[2].error
+    assert result.exit_code == 1
+    assert "Traceback" in (tmp_path / "out" / "bug" / "run.log").read_text()
+    assert not any((tmp_path / "out" / s.name / MARKER).exists() for s in sources)
+
+
+def _mtimes(folder: Path) -> dict[str, int]:
+    return {p.name: p.stat().st_mtime_ns for p in folder.iterdir()}
+
+
+def _wait_for(path: Path, process: subprocess.Popen) -> None:
+    deadline = time.monotonic() + LIVENESS_S
+    while not path.exists():
+        assert process.poll() is None, f"the batch ended early ({process.returncode})"
+        assert time.monotonic() < deadline, f"{path} did not appear"
+        time.sleep(0.1)
+
+
+def _start_batch(drives, out, block_dir) -> subprocess.Popen:
+    script = (
+        "import sys; from pathlib import Path; from vo_doppler.batch import run_batch; "
+        "from tests.helpers.batch import wait_while_blocked; "
+        "run_batch([Path(p) for p in sys.argv[2:]], Path(sys.argv[1]), workers=1, "
+        "prepare=wait_while_blocked)"
+    )
+    return subprocess.Popen(
+        [sys.executable, "-c", script, str(out), *map(str, drives)],
+        cwd=REPO_ROOT,
+        env={**os.environ, BLOCK_DIR_ENV: str(block_dir)},
+        start_new_session=True,
+    )
+
+
+def test_killed_batch_resumes_without_recomputing_finished_recordings(
+    tmp_path_factory, tmp_path, monkeypatch
+):
+    """Kill the whole batch (SIGKILL to its process group: parent and workers) while the
+    second of three recordings is running; resuming recomputes the second and third only."""
+    drives = [tiny_drive(tmp_path_factory, seed) for seed in (1, 2, 3)]
+    out, block_dir = tmp_path / "out", tmp_path / "block"
+    block_dir.mkdir()
+    for drive in drives[1:]:
+        (block_dir / drive.name).touch()
+    process = _start_batch(drives, out, block_dir)
+    try:
+        _wait_for(out / drives[0].name / MARKER, process)
+        _wait_for(block_dir / f"{drives[1].name}.pid", process)
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait(LIVENESS_S)
+    first = _mtimes(out / drives[0].name)
+    assert not (out / drives[1].name / MARKER).exists()
+    for drive in drives[1:]:
+        (block_dir / drive.name).unlink()
+    monkeypatch.setenv(BLOCK_DIR_ENV, str(block_dir))
+    result = run_batch(drives, out, workers=1, resume=True, prepare=wait_while_blocked)
+    assert [o.status for o in result.outcomes] == [Status.SKIPPED, Status.DONE, Status.DONE]
+    assert _mtimes(out / drives[0].name) == first
+    assert all((out / d.name / MARKER).exists() for d in drives)
+    assert result.rows[0]["gnss_epochs"] == result.rows[1]["gnss_epochs"] > 0
+
+
+def test_terminated_batch_ends_its_workers(tmp_path):
+    """SIGTERM to the batch (not its workers): it exits and its worker does not live on."""
+    source, block_dir = tmp_path / "rec", tmp_path / "block"
+    source.mkdir()
+    block_dir.mkdir()
+    (block_dir / "rec").touch()
+    process = _start_batch([source], tmp_path / "out", block_dir)
+    try:
+        _wait_for(block_dir / "rec.pid", process)
+        worker = int((block_dir / "rec.pid").read_text())
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(LIVENESS_S) != 0
+        deadline = time.monotonic() + LIVENESS_S
+        while _alive(worker):
+            assert time.monotonic() < deadline, "the worker outlived the batch"
+            time.sleep(0.1)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return not Path(f"/proc/{pid}/stat").read_text().split(") ")[-1].startswith("Z")
+
+
+def test_ray_executor_gives_the_local_aggregate(tmp_path_factory, tmp_path):
+    pytest.importorskip("ray", reason="Ray is not installed (pip install 'vo-doppler[ray]')")
+    drives = [tiny_drive(tmp_path_factory, seed) for seed in (1, 2)]
+    local = run_batch(drives, tmp_path / "local", workers=2)
+    remote = run_batch(drives, tmp_path / "ray", executor="ray", workers=2)
+    assert [o.status for o in remote.outcomes] == [Status.DONE, Status.DONE]
+    drop = {"seconds"}
+    assert [{k: v for k, v in row.items() if k not in drop} for row in remote.rows] == [
+        {k: v for k, v in row.items() if k not in drop} for row in local.rows
+    ]
+    assert remote.rows[0]["vo_gps_tc_error_per_100m_m"] > 0

@@ -1,0 +1,443 @@
+"""The main job over many recordings: one process (or Ray task) per recording, failures kept
+to their recording, resumable, and one aggregate table.
+
+Each recording ``SOURCE`` writes what ``vo-doppler run`` writes into ``OUT/<name>/``
+(:func:`vo_doppler.report.run_outputs.write_run_outputs`), a log (``run.log``) and, last, its
+completion marker ``OUT/<name>/batch_done.json``: written atomically (a temporary file renamed
+over it) only after every output, with the fingerprint of the recording's inputs and of the
+configuration. A batch started again with ``resume=True`` skips every recording whose marker
+holds the current fingerprint and whose listed outputs still exist; a recording that was cut
+off (killed process, crash, power loss) has no marker and runs again from the start.
+
+The fingerprint hashes the package version, the configuration, the ``prepare`` step's name
+and, for every file under ``SOURCE``, its relative path, size and modification time (the quick
+check of rsync and make: touching or replacing a file re-runs the recording; files outside
+``SOURCE`` that a manifest points to are not followed).
+
+``prepare``: a picklable function ``prepare(source, work_dir) -> sequence_folder`` run in the
+worker before the job, for recordings that need importing first (e.g. a raw comma2k19 segment
+turned into a sequence folder under ``work_dir`` = ``OUT/<name>/prepared``). Without it every
+source is a sequence folder.
+
+Executors: ``local`` (default), a ``concurrent.futures`` process pool started with ``spawn``
+(no state inherited from the parent; each worker imports the package afresh); ``ray``, the
+same function as a Ray task on a local Ray instance or on the cluster at ``ray_address``
+(or ``RAY_ADDRESS``). A worker that dies (killed, out of memory, a crash in native code)
+fails only its recording: the local pool's other victims run again, each alone.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import multiprocessing
+import os
+import threading
+import time
+import traceback
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
+from enum import StrEnum
+from pathlib import Path
+
+from vo_doppler import __version__
+from vo_doppler.errors import InputError, VoDopplerError
+from vo_doppler.io.sequence import read_sequence
+from vo_doppler.io.tables import write_csv_and_parquet
+from vo_doppler.report.batch_summary import (
+    COLUMNS,
+    overall_row,
+    recording_row,
+    write_batch_html,
+)
+from vo_doppler.report.run_outputs import require_tight_heading, write_run_outputs
+from vo_doppler.run import RunConfig, run_sequence
+
+log = logging.getLogger(__name__)
+
+MARKER = "batch_done.json"
+LOG_FILE = "run.log"
+PREPARED = "prepared"
+EXECUTORS = ("local", "ray")
+TABLE_NAME = "batch_summary"
+PARENT_POLL_S = 0.5
+
+Prepare = Callable[[Path, Path], Path]
+"""``prepare(source, work_dir) -> sequence folder``: imports a raw recording (module docstring)."""
+
+
+class Status(StrEnum):
+    DONE = "done"
+    SKIPPED = "skipped"
+    """Finished by an earlier batch with the same fingerprint (``resume``)."""
+    FAILED = "failed"
+
+
+class Failure(StrEnum):
+    """Why a recording failed; ``input-error`` is what makes ``vo-doppler run`` exit 1."""
+
+    INPUT = "input-error"
+    """The toolkit's own error (:class:`~vo_doppler.errors.VoDopplerError`): unusable input."""
+    INTERNAL = "internal-error"
+    """Any other exception: a bug; the traceback is in the recording's ``run.log``."""
+    WORKER_LOST = "worker-lost"
+    """The process running it died (killed, out of memory, crash in native code)."""
+
+
+@dataclass(frozen=True)
+class RecordingJob:
+    """Everything a worker needs for one recording (picklable)."""
+
+    source: Path
+    out: Path
+    config: RunConfig
+    fingerprint: str
+    prepare: Prepare | None = None
+
+    @property
+    def name(self) -> str:
+        return self.out.name
+
+
+@dataclass
+class RecordingOutcome:
+    name: str
+    source: Path
+    status: Status
+    seconds: float
+    summary: dict | None = None
+    error: str | None = None
+    category: Failure | None = None
+
+
+@dataclass
+class BatchResult:
+    outcomes: list[RecordingOutcome]
+    """In the order the recordings were given."""
+    rows: list[dict]
+    """The aggregate: one row per recording, then the overall row."""
+    csv: Path
+    parquet: Path
+    html: Path
+    failed: list[RecordingOutcome] = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.failed = [o for o in self.outcomes if o.status is Status.FAILED]
+
+    @property
+    def exit_code(self) -> int:
+        """1 when any recording failed, else 0 (the command's exit status)."""
+        return 1 if self.failed else 0
+
+
+def read_list(path: Path) -> list[Path]:
+    """Recordings listed one per line (blank lines and ``#`` comments skipped); relative paths
+    are relative to the list's folder."""
+    try:
+        lines = path.read_text().splitlines()
+    except OSError as exc:
+        reason = exc.strerror or exc
+        raise InputError(f"cannot read the list of recordings: {reason}", path) from exc
+    entries = (line.split("#", 1)[0].strip() for line in lines)
+    return [path.parent / entry for entry in entries if entry]
+
+
+def output_names(sources: list[Path]) -> list[str]:
+    """Output folder names: the last path component, or as many last components as make every
+    name unique, joined by ``__`` (``route__10`` for segments all called ``10``)."""
+    parts = [s.resolve().parts for s in sources]
+    for depth in range(1, max((len(p) for p in parts), default=1) + 1):
+        names = ["__".join(p[-depth:]) for p in parts]
+        if len(set(names)) == len(names):
+            return names
+    raise InputError("two recordings resolve to the same path")
+
+
+def fingerprint(source: Path, config: RunConfig, prepare: Prepare | None) -> str:
+    """SHA-256 of the version, configuration, prepare step and input files (module docstring)."""
+    digest = hashlib.sha256()
+    step = None if prepare is None else f"{prepare.__module__}.{prepare.__qualname__}"
+    digest.update(repr((__version__, config, step)).encode())
+    files = sorted(p for p in source.rglob("*") if p.is_file()) if source.is_dir() else [source]
+    for path in files:
+        try:
+            stat = path.stat()
+        except OSError:
+            continue
+        relative = path.relative_to(source) if source.is_dir() else path.name
+        digest.update(f"{relative}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
+    return digest.hexdigest()
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    """Write ``text`` to a temporary file beside ``path``, flush it to disk, rename it over."""
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with temporary.open("w") as stream:
+        stream.write(text)
+        stream.flush()
+        os.fsync(stream.fileno())
+    os.replace(temporary, path)
+
+
+def finished(job: RecordingJob) -> dict | None:
+    """The marker of a recording finished with the job's fingerprint whose outputs are all still
+    there, else None."""
+    try:
+        marker = json.loads((job.out / MARKER).read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(marker, dict) or marker.get("fingerprint") != job.fingerprint:
+        return None
+    if not all((job.out / name).is_file() for name in marker.get("outputs", [])):
+        return None
+    return marker
+
+
+def _run_job(job: RecordingJob) -> dict:
+    folder = job.source if job.prepare is None else job.prepare(job.source, job.out / PREPARED)
+    sequence = read_sequence(folder)
+    result = run_sequence(sequence, job.config)
+    summary = write_run_outputs(sequence, result, job.config, job.out)
+    require_tight_heading(result, folder)
+    return summary
+
+
+def process_recording(job: RecordingJob) -> RecordingOutcome:
+    """Run one recording and write its outputs and, last, its marker; never raises for a
+    failure of the recording itself (the outcome says what failed)."""
+    start = time.perf_counter()
+    job.out.mkdir(parents=True, exist_ok=True)
+    (job.out / MARKER).unlink(missing_ok=True)
+    handler = logging.FileHandler(job.out / LOG_FILE, mode="w")
+    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    package_log = logging.getLogger("vo_doppler")
+    package_log.addHandler(handler)
+    if package_log.level == logging.NOTSET:
+        package_log.setLevel(logging.INFO)
+    try:
+        summary = _run_job(job)
+    except VoDopplerError as exc:
+        package_log.error("%s", exc)
+        return _failed(job, Failure.INPUT, str(exc), time.perf_counter() - start)
+    except Exception as exc:
+        package_log.error("%s", traceback.format_exc())
+        message = f"{type(exc).__name__}: {exc}"
+        return _failed(job, Failure.INTERNAL, message, time.perf_counter() - start)
+    finally:
+        package_log.removeHandler(handler)
+        handler.close()
+    seconds = time.perf_counter() - start
+    outputs = sorted(p.name for p in job.out.iterdir() if p.is_file() and p.name != MARKER)
+    marker = {
+        "fingerprint": job.fingerprint,
+        "source": str(job.source),
+        "seconds": seconds,
+        "outputs": outputs,
+        "summary": summary,
+    }
+    _write_atomically(job.out / MARKER, json.dumps(marker, indent=2))
+    return RecordingOutcome(job.name, job.source, Status.DONE, seconds, summary)
+
+
+def _failed(job: RecordingJob, category: Failure, message: str, seconds: float = 0.0):
+    return RecordingOutcome(job.name, job.source, Status.FAILED, seconds, None, message, category)
+
+
+def _lost(job: RecordingJob, exc: BaseException) -> RecordingOutcome:
+    return _failed(job, Failure.WORKER_LOST, f"the worker process died: {exc}")
+
+
+def default_workers(recordings: int) -> int:
+    """min(CPU cores, recordings), at least 1."""
+    return max(1, min(os.cpu_count() or 1, recordings))
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Pool initializer: a thread that ends the worker once its parent is gone (a batch killed
+    by any signal leaves no worker computing on)."""
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
+def _pool(workers: int) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=_exit_with_parent,
+        initargs=(os.getpid(),),
+    )
+
+
+def local_outcomes(jobs: list[RecordingJob], workers: int) -> Iterator[RecordingOutcome]:
+    """Run jobs on a spawn process pool, yielding outcomes as they finish. Jobs lost with a
+    broken pool run again one by one, each in a pool of its own, so that only the recording
+    whose worker dies again is failed."""
+    lost = []
+    pool = _pool(workers)
+    try:
+        futures = {pool.submit(process_recording, job): job for job in jobs}
+        for future in as_completed(futures):
+            try:
+                yield future.result()
+            except BrokenProcessPool:
+                lost.append(futures[future])
+            except Exception as exc:  # the job could not reach its worker (e.g. not picklable)
+                yield _failed(futures[future], Failure.INTERNAL, f"{type(exc).__name__}: {exc}")
+    except BaseException:
+        _stop(pool)
+        raise
+    pool.shutdown()
+    for job in lost:
+        with _pool(1) as alone:
+            try:
+                yield alone.submit(process_recording, job).result()
+            except BrokenProcessPool as exc:
+                yield _lost(job, exc)
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel what has not started and end the workers (an interrupted batch leaves none)."""
+    pool.shutdown(wait=False, cancel_futures=True)
+    for child in multiprocessing.active_children():
+        child.terminate()
+
+
+def ray_outcomes(
+    jobs: list[RecordingJob], workers: int | None, address: str | None
+) -> Iterator[RecordingOutcome]:
+    """Run jobs as Ray tasks, at most ``workers`` at a time, yielding outcomes as they finish.
+
+    Ray is started here unless already initialised: on the cluster at ``address`` (or the
+    ``RAY_ADDRESS`` environment variable), else a local instance with ``workers`` CPUs bound
+    to the loopback address. Every node must see the recordings and ``OUT`` at the same paths.
+    """
+    try:
+        import ray
+    except ImportError as exc:
+        raise InputError("the ray executor needs Ray: pip install 'vo-doppler[ray]'") from exc
+    os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+    started = not ray.is_initialized()
+    if started:
+        address = address or os.environ.get("RAY_ADDRESS")
+        options = {"include_dashboard": False, "log_to_driver": False}
+        if address:
+            ray.init(address=address, **options)
+        else:
+            cpus = workers or default_workers(len(jobs))
+            ray.init(num_cpus=cpus, _node_ip_address="127.0.0.1", **options)
+    try:
+        limit = workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
+        task = ray.remote(max_retries=0)(process_recording)
+        queue = iter(jobs)
+        running = {}
+        for job in queue:
+            running[task.remote(job)] = job
+            if len(running) >= limit:
+                break
+        while running:
+            (ref,), _ = ray.wait(list(running), num_returns=1)
+            job = running.pop(ref)
+            try:
+                yield ray.get(ref)
+            except ray.exceptions.RayError as exc:
+                yield _lost(job, exc)
+            following = next(queue, None)
+            if following is not None:
+                running[task.remote(following)] = following
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def plan(
+    sources: Iterable[Path],
+    out: Path,
+    config: RunConfig,
+    prepare: Prepare | None = None,
+) -> list[RecordingJob]:
+    """One job per distinct recording (repeats dropped), each with its output folder."""
+    unique = list(dict.fromkeys(Path(s).resolve() for s in sources))
+    names = output_names(unique)
+    return [
+        RecordingJob(source, out / name, config, fingerprint(source, config, prepare), prepare)
+        for source, name in zip(unique, names, strict=True)
+    ]
+
+
+def run_batch(
+    folders: Iterable[Path],
+    out: Path,
+    executor: str = "local",
+    workers: int | None = None,
+    resume: bool = False,
+    config: RunConfig | None = None,
+    prepare: Prepare | None = None,
+    ray_address: str | None = None,
+    on_outcome: Callable[[RecordingOutcome], None] | None = None,
+) -> BatchResult:
+    """Run the main job on every recording and write the aggregate into ``out``
+    (``batch_summary.csv``, ``.parquet``, ``.html``).
+
+    ``workers`` defaults to min(CPU cores, recordings to run); with ``resume`` the recordings
+    finished by an earlier batch with the same fingerprint are skipped (their summaries still
+    enter the aggregate). ``on_outcome`` is called in the calling process as each recording
+    ends (skipped ones first).
+    """
+    if executor not in EXECUTORS:
+        raise InputError(f"unknown executor {executor!r} (choose from {', '.join(EXECUTORS)})")
+    if workers is not None and workers < 1:
+        raise InputError(f"workers must be at least 1, got {workers}")
+    config = config or RunConfig()
+    out.mkdir(parents=True, exist_ok=True)
+    jobs = plan(folders, out, config, prepare)
+    outcomes: dict[str, RecordingOutcome] = {}
+    todo = []
+    for job in jobs:
+        marker = finished(job) if resume else None
+        if marker is None:
+            todo.append(job)
+            continue
+        outcome = RecordingOutcome(
+            job.name, job.source, Status.SKIPPED, marker["seconds"], marker["summary"]
+        )
+        outcomes[job.name] = outcome
+        if on_outcome:
+            on_outcome(outcome)
+    if todo:
+        if executor == "ray":
+            stream = ray_outcomes(todo, workers, ray_address)
+        else:
+            stream = local_outcomes(todo, workers or default_workers(len(todo)))
+        for outcome in stream:
+            outcomes[outcome.name] = outcome
+            if on_outcome:
+                on_outcome(outcome)
+    ordered = [outcomes[job.name] for job in jobs]
+    return _aggregate(ordered, out)
+
+
+def _aggregate(outcomes: list[RecordingOutcome], out: Path) -> BatchResult:
+    rows = [
+        recording_row(
+            o.name,
+            o.status.value,
+            None if o.category is None else o.category.value,
+            o.error,
+            o.seconds,
+            o.summary,
+        )
+        for o in outcomes
+    ]
+    rows.append(overall_row(rows))
+    csv, parquet, page = (out / f"{TABLE_NAME}.{ext}" for ext in ("csv", "parquet", "html"))
+    write_csv_and_parquet(COLUMNS, rows, csv, parquet)
+    write_batch_html(page, rows)
+    return BatchResult(outcomes, rows, csv, parquet, page)

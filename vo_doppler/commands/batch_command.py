@@ -1,0 +1,110 @@
+"""``vo-doppler batch SEQ_DIR... -o OUT``: the main job on many recordings, one aggregate."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from pathlib import Path
+
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from vo_doppler.batch import EXECUTORS, RecordingOutcome, Status, read_list, run_batch
+from vo_doppler.commands.deadreckon_command import _positive_int
+from vo_doppler.commands.run_command import add_run_options, run_config
+from vo_doppler.errors import InputError
+
+
+def register(subparsers, summary: str) -> None:
+    parser = subparsers.add_parser(
+        "batch",
+        help=summary,
+        description="Run what 'vo-doppler run' runs on every recording, writing each one's "
+        "outputs into OUT/<name>/, then OUT/batch_summary.csv, .parquet and .html (per "
+        "recording and overall: error per 100 m per pipeline when there is ground truth, "
+        "heading availability, calibration). A failed recording is listed and the others go "
+        "on; the exit status is 1 when any failed. --resume skips the recordings an earlier "
+        "batch finished with the same inputs and options.",
+    )
+    parser.add_argument("sequences", type=Path, nargs="*", help="sequence folders")
+    parser.add_argument(
+        "--list", type=Path, help="file listing sequence folders, one a line ('#' comments)"
+    )
+    parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    parser.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        default="local",
+        help="local: a process pool on this machine (default); ray: Ray tasks "
+        "(pip install 'vo-doppler[ray]')",
+    )
+    parser.add_argument(
+        "--workers",
+        type=_positive_int,
+        help="recordings run at once (default: min(CPU cores, recordings); ray on a cluster: "
+        "its CPUs)",
+    )
+    parser.add_argument(
+        "--resume", action="store_true", help="skip recordings already finished in OUT"
+    )
+    parser.add_argument(
+        "--ray-address",
+        help="Ray cluster to use (e.g. ray://head:10001; default: $RAY_ADDRESS, else a local "
+        "Ray instance)",
+    )
+    add_run_options(parser)
+    parser.set_defaults(func=run)
+
+
+def _terminate(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
+def run(args: argparse.Namespace) -> int:
+    sources = list(args.sequences) + (read_list(args.list) if args.list else [])
+    if not sources:
+        raise InputError("no recordings: give sequence folders or --list FILE")
+    signal.signal(signal.SIGTERM, _terminate)
+    console = Console(width=None if sys.stdout.isatty() else 150)
+    columns = (
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+    )
+    with Progress(*columns, console=console, transient=True) as progress:
+        task = progress.add_task("recordings", total=len({s.resolve() for s in sources}))
+
+        def advance(outcome: RecordingOutcome) -> None:
+            progress.advance(task)
+            if outcome.status is Status.FAILED:
+                progress.console.print(f"[red]{outcome.name} failed[/red]: {outcome.error}")
+
+        result = run_batch(
+            sources,
+            args.output,
+            executor=args.executor,
+            workers=args.workers,
+            resume=args.resume,
+            config=run_config(args),
+            ray_address=args.ray_address,
+            on_outcome=advance,
+        )
+    console.print(outcome_table(result.outcomes))
+    console.print(f"wrote {result.csv}, {result.parquet.name} and {result.html.name}")
+    return result.exit_code
+
+
+def outcome_table(outcomes: list[RecordingOutcome]) -> Table:
+    table = Table(title="recordings")
+    for column in ("recording", "status", "time [s]", "exit category", "error"):
+        table.add_column(column, justify="right" if column == "time [s]" else "left")
+    for o in outcomes:
+        category = "" if o.category is None else o.category.value
+        style = "red" if o.status is Status.FAILED else None
+        table.add_row(
+            o.name, o.status.value, f"{o.seconds:.1f}", category, o.error or "", style=style
+        )
+    return table

@@ -1,0 +1,124 @@
+"""Everything ``vo-doppler run`` writes for one recording, as one library call shared with
+``vo-doppler batch``: the trajectories (TUM), the heading table (CSV), the figures, the summary
+(JSON) and the HTML report."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from vo_doppler.errors import InputError
+from vo_doppler.eval.pipelines import evaluate_pipelines
+from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.io.trajectory import write_tum
+from vo_doppler.model.sequence import Sequence
+from vo_doppler.report.heading_figure import heading_figure
+from vo_doppler.report.run_report import (
+    error_per_100m_figure,
+    trajectories_figure,
+    write_html_report,
+)
+from vo_doppler.run import Pipeline, RunConfig, RunResult
+
+SUMMARY_FILE = "summary.json"
+
+FACT_FORMATS = {
+    "gnss_epochs": ("GNSS epochs", "{:d}"),
+    "conventional_heading_availability": ("conventional heading available", "{:.1%}"),
+    "tight_heading_availability": ("tightly coupled heading available", "{:.1%}"),
+    "tight_heading_reliable": ("tightly coupled heading reliable (gyro-consistent)", "{:.1%}"),
+    "tight_heading_used": ("tightly coupled heading used by the correction", "{:.1%}"),
+    "tight_heading_rejected_rows": ("Doppler rows rejected by the NLOS tests", "{:d}"),
+    "tight_heading_epochs_with_rejection": ("epochs with a rejection", "{:d}"),
+    "final_wheel_scale": ("wheel scale at the end", "{:.4f}"),
+    "final_gyro_bias_dps": ("gyro bias at the end", "{:+.3f} deg/s"),
+    "vo_frames": ("VO frames", "{:d}"),
+    "vo_flagged_frames": ("VO frames flagged", "{:d}"),
+    "vo_fps": ("VO speed", "{:.1f} frames/s"),
+    "heading_correction": ("heading correction", "{}"),
+}
+
+
+def correction_label(config: RunConfig) -> str:
+    """The heading correction as the summary names it, e.g. ``kalman (causal)``."""
+    correction = config.correction
+    return correction.method + ("" if correction.blend.smooth else " (causal)")
+
+
+def summarise(result: RunResult) -> dict:
+    """Heading availability, calibration and VO figures of a run (JSON-ready scalars)."""
+    table = result.heading
+    return {
+        "gnss_epochs": len(table),
+        "conventional_heading_availability": float(np.mean(table.conv_valid)),
+        "tight_heading_availability": float(np.mean(table.tc_available)),
+        "tight_heading_reliable": float(np.mean(table.tc_reliable)),
+        "tight_heading_used": float(np.mean(result.tc_usable)),
+        "tight_heading_rejected_rows": int(table.rejected_rows.sum()),
+        "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
+        "final_wheel_scale": float(table.wheel_scale[-1]),
+        "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
+        **(
+            {
+                "vo_frames": result.vo.stats.frames,
+                "vo_flagged_frames": len(result.vo.stats.flagged_frames),
+                "vo_fps": result.vo.stats.fps,
+            }
+            if result.vo is not None
+            else {"camera": "none: non-visual pipelines only"}
+        ),
+    }
+
+
+def readable_facts(summary: dict) -> dict[str, str]:
+    """The summary's scalars with labels and units for people (the report's list)."""
+    facts = {}
+    for key, value in summary.items():
+        if key == "evaluation":
+            continue
+        label, fmt = FACT_FORMATS.get(key, (key, "{}"))
+        facts[label] = fmt.format(value)
+    return facts
+
+
+def write_run_outputs(sequence: Sequence, result: RunResult, config: RunConfig, out: Path) -> dict:
+    """Write a run's outputs into ``out`` (created if missing) and return its summary.
+
+    The summary (also ``out/summary.json``) holds :func:`summarise`'s figures, the heading
+    correction used and, when the recording has ground truth, ``evaluation``: per pipeline the
+    errors of :func:`vo_doppler.eval.pipelines.evaluate_pipelines` as dictionaries.
+    """
+    out.mkdir(parents=True, exist_ok=True)
+    file_names = {Pipeline.VO: "trajectory_vo.tum", Pipeline.VO_GPS_TC: "trajectory_corrected.tum"}
+    for name, trajectory in result.trajectories.items():
+        write_tum(out / file_names.get(name, f"trajectory_{name}.tum"), trajectory)
+    write_heading_csv(out / "heading.csv", result.heading)
+    summary = summarise(result)
+    summary["heading_correction"] = correction_label(config)
+    figures = [out / "trajectories.png", out / "heading.png"]
+    truth = sequence.truth
+    errors = {}
+    shown = result.trajectories
+    if truth is not None:
+        errors, per_100m, shown = evaluate_pipelines(
+            result.trajectories, result.heading, result.tc_usable, truth
+        )
+        summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
+        error_per_100m_figure(out / "error_per_100m.png", per_100m, sequence.name)
+        figures.append(out / "error_per_100m.png")
+    truth_yaw = truth.yaw_at(result.heading.t) if truth is not None else None
+    trajectories_figure(figures[0], shown, truth, sequence.name)
+    heading_figure(figures[1], result.heading, truth_yaw, sequence.name)
+    (out / SUMMARY_FILE).write_text(json.dumps(summary, indent=2))
+    title = f"vo-doppler run: {sequence.name}"
+    write_html_report(out / "report.html", title, readable_facts(summary), errors, figures)
+    return summary
+
+
+def require_tight_heading(result: RunResult, folder: Path) -> None:
+    """A run whose tightly coupled heading was unavailable at every epoch failed: raise the
+    project's error naming the recording (after its outputs were written, to show why)."""
+    if not result.heading.tc_available.any():
+        raise InputError("the tightly coupled heading was unavailable at every epoch", folder)
