@@ -1,0 +1,119 @@
+"""Reading a text input safely: a regular file of bounded size, not binary, UTF-8, with bounded
+lines. Every failure is an :class:`InputError` naming the file (and the line for encoding and
+line-length problems), so no reader meets ``UnicodeDecodeError``, ``_csv.Error`` on a huge field,
+or a device such as ``/dev/zero`` that never ends.
+"""
+
+from __future__ import annotations
+
+import re
+import stat
+from pathlib import Path
+
+from vo_doppler.errors import InputError
+
+MIB = 1 << 20
+DATA_MAX_BYTES = 2048 * MIB
+"""Default bound on a sensor data file (a CAN log of hours stays far below it)."""
+SMALL_MAX_BYTES = 16 * MIB
+"""Bound on small configuration-like files (calibration, DBC, times, heading tables)."""
+MAX_LINE_CHARS = 64 * 1024
+"""Longest line a text reader accepts (below the csv module's 128 KiB field limit)."""
+
+# Leading bytes of binary formats a user may hand over by mistake, with their names.
+MAGIC = (
+    (b"\x89PNG\r\n\x1a\n", "PNG image"),
+    (b"\xff\xd8\xff", "JPEG image"),
+    (b"GIF8", "GIF image"),
+    (b"BM", "BMP image"),
+    (b"%PDF", "PDF document"),
+    (b"\x1f\x8b", "gzip archive"),
+    (b"PK\x03\x04", "zip archive"),
+    (b"\x7fELF", "executable"),
+    (b"LOGG", "BLF log"),
+    (b"\x93NUMPY", "numpy array"),
+)
+
+
+def regular_file(path: str | Path, what: str, max_bytes: int = DATA_MAX_BYTES) -> int:
+    """Size of ``path`` after checking it is a readable regular file of at most ``max_bytes``
+    (devices, FIFOs and folders are refused: ``/dev/zero`` would never end)."""
+    path = Path(path)
+    try:
+        info = path.stat()
+    except OSError as exc:
+        raise InputError(f"cannot read {what}: {exc.strerror or exc}", path) from exc
+    if not stat.S_ISREG(info.st_mode):
+        kind = "a folder" if stat.S_ISDIR(info.st_mode) else "not a regular file"
+        raise InputError(f"{what} is {kind}", path)
+    if info.st_size > max_bytes:
+        raise InputError(
+            f"{what} is {info.st_size} bytes, more than the {max_bytes // MIB} MiB this reader "
+            "accepts",
+            path,
+        )
+    return info.st_size
+
+
+def binary_kind(head: bytes) -> str | None:
+    """Name of the binary format ``head`` (a file's first bytes) starts, None for text."""
+    for magic, name in MAGIC:
+        if head.startswith(magic):
+            return name
+    if b"\0" in head[:8192]:
+        return "binary file (NUL bytes)"
+    return None
+
+
+def read_bytes(path: str | Path, what: str, max_bytes: int = DATA_MAX_BYTES) -> bytes:
+    """The bytes of a regular file of at most ``max_bytes`` (re-checked while reading)."""
+    regular_file(path, what, max_bytes)
+    try:
+        with Path(path).open("rb") as handle:
+            data = handle.read(max_bytes + 1)
+    except OSError as exc:
+        raise InputError(f"cannot read {what}: {exc.strerror or exc}", path) from exc
+    if len(data) > max_bytes:
+        raise InputError(f"{what} grew beyond {max_bytes // MIB} MiB while being read", path)
+    return data
+
+
+def decode_text(data: bytes, path: str | Path, what: str, max_line: int = MAX_LINE_CHARS) -> str:
+    """UTF-8 text of ``data`` (a BOM is dropped); binary content, a byte that is not UTF-8 or a
+    line longer than ``max_line`` characters is an :class:`InputError` naming the line."""
+    kind = binary_kind(data[:8192])
+    if kind is not None:
+        raise InputError(f"{what} is a {kind}, not a text file", path)
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise InputError(
+            f"{what} is not UTF-8 text (byte 0x{data[exc.start]:02X}); save it as UTF-8",
+            path,
+            line,
+        ) from exc
+    check_line_lengths(text, path, what, max_line)
+    return text
+
+
+def check_line_lengths(text: str, path: str | Path, what: str, max_line: int) -> None:
+    """Raise naming the first line longer than ``max_line`` characters (one linear scan)."""
+    if len(text) <= max_line:
+        return
+    long_line = re.search(f"[^\n]{{{max_line + 1}}}", text)
+    if long_line is not None:
+        end = text.find("\n", long_line.start())
+        length = (len(text) if end < 0 else end) - text.rfind("\n", 0, long_line.start()) - 1
+        raise InputError(
+            f"{what} line has {length} characters, more than {max_line}",
+            path,
+            text.count("\n", 0, long_line.start()) + 1,
+        )
+
+
+def read_text(
+    path: str | Path, what: str, max_bytes: int = DATA_MAX_BYTES, max_line: int = MAX_LINE_CHARS
+) -> str:
+    """The UTF-8 text of a regular text file, bounded in size and line length."""
+    return decode_text(read_bytes(path, what, max_bytes), path, what, max_line)
