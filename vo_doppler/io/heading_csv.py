@@ -19,6 +19,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import course_to_yaw
+from vo_doppler.io.textfile import read_text
 from vo_doppler.model.heading import DEFAULT_TC_WINDOW_S, HeadingTable
 
 COLUMNS = (
@@ -76,12 +77,10 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
 
 
 def read_heading_csv(path: str | Path) -> HeadingTable:
-    """Read a heading CSV; bad rows raise :class:`InputError` naming the line."""
+    """Read a heading CSV; bad rows (and times that do not increase) raise
+    :class:`InputError` naming the line."""
     path = Path(path)
-    try:
-        lines = path.read_text().splitlines()
-    except OSError as exc:
-        raise InputError(f"cannot read heading CSV: {exc.strerror or exc}", path) from exc
+    lines = read_text(path, "heading CSV").splitlines()
     if not lines:
         raise InputError("heading CSV is empty", path)
     header = [name.strip() for name in next(csv.reader([lines[0]]))]
@@ -98,6 +97,10 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
             rows.append([float(fields[i]) for i in index])
         except (ValueError, IndexError) as exc:
             raise InputError(f"bad heading row ({exc})", path, number) from exc
+        if not np.isfinite(rows[-1][0]) or (len(rows) > 1 and rows[-1][0] <= rows[-2][0]):
+            raise InputError(
+                f"gps_time_s {rows[-1][0]} is not after the previous row's", path, number
+            )
     data = np.array(rows, dtype=float).reshape(-1, len(index))
     optional = {
         c: data[:, len(COLUMNS) + i]

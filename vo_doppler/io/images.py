@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.textfile import read_text
 
 log = logging.getLogger(__name__)
 
@@ -45,10 +46,7 @@ def read_times(path: str | Path, n_images: int) -> np.ndarray:
     Times must increase strictly; the count must equal the number of images.
     """
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InputError(f"cannot read timestamps: {exc.strerror or exc}", path) from exc
+    text = read_text(path, "timestamps file")
     rows = [
         (number, line.strip())
         for number, line in enumerate(text.splitlines(), start=1)

@@ -83,7 +83,7 @@ def order_samples(
     report = TimeOrderReport(sensor, len(t))
     bad = np.flatnonzero(~np.isfinite(t))
     if bad.size:
-        raise InputError(f"{sensor} time is {t[bad[0]]}", path, _line(lines, bad[0]))
+        raise InputError(f"{sensor} time is {t[bad[0]]}", path, _line(lines, int(bad[0])))
     if len(t) > 1:
         latest = np.maximum.accumulate(t)
         late_by = np.concatenate([[0.0], latest[:-1] - t[1:]])
@@ -92,7 +92,8 @@ def order_samples(
             worst = late[np.argmax(late_by[late])] if policy == "sort" else late[0]
             if policy == "error" or late_by[worst] > max_back_s:
                 raise InputError(
-                    f"{sensor} time goes back {late_by[worst]:.6g} s (to {t[worst]:.6f} s)",
+                    f"time goes backwards by {late_by[worst]:.6g} s in the {sensor} (to "
+                    f"{t[worst]:.6f} s)",
                     path,
                     _line(lines, worst),
                 )
