@@ -93,6 +93,8 @@ class CanDecodeReport:
     undecodable_by_id: dict[int, int] = field(default_factory=dict)
     time_order: dict[str, TimeOrderReport] = field(default_factory=dict)
     """Per decoded message, what its time order needed."""
+    dbc_units: dict[str, str] = field(default_factory=dict)
+    """Unit string the DBC declares for each decoded ``MESSAGE.SIGNAL``."""
 
     def summary(self) -> str:
         ids = ", ".join(f"0x{k:X}×{v}" for k, v in sorted(self.undecodable_by_id.items()))
@@ -362,6 +364,7 @@ class _StreamDecoder:
                 except KeyError as exc:
                     raise InputError(f"signal {ref} is not in the DBC") from exc
                 self.factors[ref] = si_factor(signal.unit, str(ref))
+                report.dbc_units[str(ref)] = signal.unit or ""
             self.messages[message.frame_id] = (message, message_refs)
         self.t = {frame_id: array("d") for frame_id in self.messages}
         self.lines = {frame_id: array("q") for frame_id in self.messages}

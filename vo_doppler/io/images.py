@@ -68,7 +68,9 @@ def read_times(path: str | Path, n_images: int) -> np.ndarray:
         try:
             times[k] = float(fields[column])
         except (ValueError, IndexError) as exc:
-            raise InputError(f"timestamp is not a number: {line!r}", path, number) from exc
+            raise InputError(
+                f"timestamp is not a number (field {column + 1})", path, number
+            ) from exc
     if len(times) != n_images:
         raise InputError(f"{len(times)} timestamps for {n_images} images", path)
     steps = np.diff(times)
