@@ -13,14 +13,22 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
+from vo_doppler.checks import (
+    check_yaw_rate_unit,
+    clock_warning,
+    estimate_clock_offset,
+    origin_warning,
+)
 from vo_doppler.commands.vo_command import window_size
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
 from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.io.heading_csv import write_heading_csv
-from vo_doppler.io.sequence import read_sequence
+from vo_doppler.io.output_folder import check_output_folder, staged_output
+from vo_doppler.io.sequence import InputReport, read_sequence_with_report
 from vo_doppler.io.trajectory import write_tum
+from vo_doppler.model.sequence import Sequence
 from vo_doppler.report.heading_figure import heading_figure
 from vo_doppler.report.run_report import (
     TABLE_COLUMNS,
@@ -67,11 +75,43 @@ def register(subparsers, summary: str) -> None:
         action="store_true",
         help="kalman: forward filter only (each pose uses the headings up to its time)",
     )
+    parser.add_argument(
+        "--allow-outside-paths",
+        action="store_true",
+        help="accept manifest paths outside the sequence folder (absolute or ../)",
+    )
     parser.set_defaults(func=run)
 
 
+def input_warnings(inputs: Sequence, report: InputReport) -> list[str]:
+    """Errors raised and warnings listed before the long work: the yaw rate against its DBC
+    unit, the origin against the RINEX approximate position, each sensor's time order."""
+    check_yaw_rate_unit(inputs.yaw_rate, inputs.wheel_speed, report.yaw_rate_dbc_unit)
+    found = report.warnings()
+    origin = origin_warning(inputs.enu, inputs.observations.header.approx_position)
+    return found + ([origin] if origin else [])
+
+
+def result_warnings(inputs: Sequence, report: InputReport, result: RunResult) -> dict:
+    """The CAN clock against the GNSS Doppler speed: the estimate and a warning beyond 0.2 s."""
+    velocity = result.gnss.velocity
+    horizontal = np.where(
+        velocity.valid, np.linalg.norm(velocity.velocity_enu[:, :2], axis=1), np.nan
+    )
+    estimate = estimate_clock_offset(inputs.wheel_speed, velocity.t, horizontal)
+    warning = clock_warning("CAN", estimate, report.can_time_offset_s)
+    return {
+        "can_clock_residual_offset_s": None if estimate is None else estimate.residual_s,
+        "warnings": [warning] if warning else [],
+    }
+
+
 def run(args: argparse.Namespace) -> int:
-    inputs = read_sequence(args.sequence)
+    check_output_folder(args.output)
+    inputs, report = read_sequence_with_report(args.sequence, args.allow_outside_paths)
+    warnings = input_warnings(inputs, report)
+    for text in warnings:
+        log.warning("%s", text)
     config = RunConfig(
         systems=args.systems.upper(),
         elevation_mask=np.radians(args.elev_mask),
@@ -91,8 +131,36 @@ def run(args: argparse.Namespace) -> int:
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("visual odometry", total=len(inputs.image_paths))
         result = run_sequence(inputs, config, lambda _: progress.advance(task))
-    out = args.output
-    out.mkdir(parents=True, exist_ok=True)
+    clock = result_warnings(inputs, report, result)
+    for text in clock["warnings"]:
+        log.warning("%s", text)
+    checks = {
+        "warnings": warnings + clock["warnings"],
+        "can_clock_residual_offset_s": clock["can_clock_residual_offset_s"],
+        "time_order": {r.sensor: r.as_dict() for r in report.time_order},
+    }
+    with staged_output(args.output) as out:
+        write_results(out, args, inputs, result, console, checks)
+    console.print(f"wrote {args.output}/report.html and the trajectories, heading.csv, figures")
+    if not result.heading.tc_available.any():
+        raise InputError(
+            "the tightly coupled heading was unavailable at every epoch (the other results are "
+            f"in {args.output})",
+            args.sequence,
+        )
+    return 0
+
+
+def write_results(
+    out: Path,
+    args: argparse.Namespace,
+    inputs: Sequence,
+    result: RunResult,
+    console: Console,
+    checks: dict,
+) -> None:
+    """Trajectories, heading table, figures, the summary (with the ``checks``: warnings, clock
+    estimate, time order per sensor) and the HTML report into ``out``."""
     write_tum(out / "trajectory_vo.tum", result.trajectories[Pipeline.VO])
     write_tum(out / "trajectory_corrected.tum", result.trajectories[Pipeline.VO_GPS_TC])
     for name in (Pipeline.VO_GPS_CONV, Pipeline.DR_GPS_TC):
@@ -101,6 +169,7 @@ def run(args: argparse.Namespace) -> int:
     write_heading_csv(out / "heading.csv", result.heading)
     summary = summarise(result)
     summary["heading_correction"] = args.correction + (" (causal)" if args.causal else "")
+    summary.update(checks)
     figures = [out / "trajectories.png", out / "heading.png"]
     truth = inputs.truth
     errors = {}
@@ -119,12 +188,6 @@ def run(args: argparse.Namespace) -> int:
     facts = readable_facts(summary)
     write_html_report(out / "report.html", f"vo-doppler run: {inputs.name}", facts, errors, figures)
     print_summary(console, summary, errors)
-    console.print(f"wrote {out}/report.html and the trajectories, heading.csv, figures")
-    if not result.heading.tc_available.any():
-        raise InputError(
-            "the tightly coupled heading was unavailable at every epoch", args.sequence
-        )
-    return 0
 
 
 FACT_FORMATS = {
@@ -148,7 +211,7 @@ def readable_facts(summary: dict) -> dict[str, str]:
     """The summary's scalars with labels and units for people (the report's list)."""
     facts = {}
     for key, value in summary.items():
-        if key == "evaluation":
+        if key in ("evaluation", "time_order", "warnings"):
             continue
         label, fmt = FACT_FORMATS.get(key, (key, "{}"))
         facts[label] = fmt.format(value)

@@ -1,0 +1,145 @@
+"""Plausibility checks that turn silent input errors into named warnings or errors.
+
+Pure functions over model types and numpy (no file I/O, no stage): the callers
+(``vo-doppler run``) raise the errors before the long work and put the warnings in the run's
+summary. Each check states its threshold:
+
+* yaw rate against its DBC unit: the median |yaw rate| while the wheels turn faster than
+  2 m/s above 0.35 rad/s (20 °/s) is no car's driving; when the DBC says rad/s and the values
+  read as deg/s would be ordinary, the hint says so;
+* the CAN clock against the GNSS speed: the lag maximising the correlation of the wheel speed
+  with the horizontal Doppler speed (both on 10 Hz, ±5 s) is the residual clock offset; beyond
+  0.2 s it is a warning reporting the estimate next to the manifest's ``time_offset_s``;
+* the ENU origin against the RINEX approximate position: more than 10 km apart is a warning.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.errors import InputError
+from vo_doppler.geo import EnuFrame
+from vo_doppler.model.series import SensorSeries
+
+MOVING_SPEED_MPS = 2.0
+MAX_MEDIAN_YAW_RATE = 0.35
+"""rad/s: the median |yaw rate| of a car while moving stays far below (≈ 20 °/s)."""
+CLOCK_TOLERANCE_S = 0.2
+CLOCK_SEARCH_S = 5.0
+CLOCK_RATE_HZ = 10.0
+MIN_CORRELATION = 0.5
+"""Correlation peak below which the speed profiles are too featureless to estimate a lag."""
+ORIGIN_TOLERANCE_M = 10_000.0
+EARTH_SURFACE_M = (6.3e6, 6.4e6)
+"""Norm of an ECEF position on the ground (m): outside, the approximate position is no place."""
+
+
+@dataclass(frozen=True)
+class ClockOffsetEstimate:
+    """Residual offset (s) to add to the sensor's ``time_offset_s`` and the correlation peak."""
+
+    residual_s: float
+    correlation: float
+
+
+def moving_yaw_rate_median(yaw_rate: SensorSeries, speed: SensorSeries) -> float:
+    """Median |yaw rate| (rad/s) over the samples where the wheel speed exceeds 2 m/s (NaN when
+    the vehicle never moves)."""
+    if len(yaw_rate) == 0 or len(speed) < 2:
+        return float("nan")
+    moving = np.interp(yaw_rate.t, speed.t, speed.value, left=0.0, right=0.0) > MOVING_SPEED_MPS
+    if not moving.any():
+        return float("nan")
+    return float(np.median(np.abs(yaw_rate.value[moving])))
+
+
+def check_yaw_rate_unit(yaw_rate: SensorSeries, speed: SensorSeries, dbc_unit: str) -> None:
+    """Raise when the yaw rate is implausibly large for a moving car (module docstring)."""
+    median = moving_yaw_rate_median(yaw_rate, speed)
+    if not median > MAX_MEDIAN_YAW_RATE:
+        return
+    hint = ""
+    if dbc_unit.strip().lower().replace(" ", "") == "rad/s" and (
+        np.radians(median) <= MAX_MEDIAN_YAW_RATE
+    ):
+        hint = (
+            "; the DBC declares the signal in rad/s but the values look like deg/s: fix the "
+            "unit in the DBC"
+        )
+    raise InputError(
+        f"yaw rate implausibly large: median |yaw rate| while moving is {median:.3g} rad/s "
+        f"({np.degrees(median):.3g} °/s, DBC unit {dbc_unit!r}){hint}"
+    )
+
+
+def estimate_clock_offset(
+    speed: SensorSeries, t_gnss: np.ndarray, speed_gnss: np.ndarray
+) -> ClockOffsetEstimate | None:
+    """Residual clock offset of ``speed`` (already on GPS time by the manifest's offset) against
+    the GNSS speed: the shift s maximising corr(gnss(t), speed(t − s)), refined by a parabola
+    through the peak; None when the overlap is shorter than 4 search spans or the peak is weak.
+    """
+    good = np.isfinite(speed_gnss)
+    t_gnss, speed_gnss = np.asarray(t_gnss)[good], np.asarray(speed_gnss)[good]
+    if len(t_gnss) < 2 or len(speed) < 2:
+        return None
+    begin = max(t_gnss[0], speed.t[0]) + CLOCK_SEARCH_S
+    end = min(t_gnss[-1], speed.t[-1]) - CLOCK_SEARCH_S
+    if end - begin < 4 * CLOCK_SEARCH_S:
+        return None
+    step = 1.0 / CLOCK_RATE_HZ
+    grid = np.arange(begin, end, step)
+    reference = np.interp(grid, t_gnss, speed_gnss)
+    reference = reference - reference.mean()
+    lags = np.arange(-CLOCK_SEARCH_S, CLOCK_SEARCH_S + step / 2, step)
+    scores = np.empty(len(lags))
+    for k, lag in enumerate(lags):
+        shifted = np.interp(grid - lag, speed.t, speed.value)
+        shifted = shifted - shifted.mean()
+        norm = np.linalg.norm(shifted) * np.linalg.norm(reference)
+        scores[k] = shifted @ reference / norm if norm > 0 else 0.0
+    best = int(np.argmax(scores))
+    if scores[best] < MIN_CORRELATION:
+        return None
+    offset = 0.0
+    if 0 < best < len(lags) - 1:
+        left, mid, right = scores[best - 1 : best + 2]
+        curvature = left - 2 * mid + right
+        if curvature < 0:
+            offset = 0.5 * (left - right) / curvature
+    return ClockOffsetEstimate(float(lags[best] + offset * step), float(scores[best]))
+
+
+def clock_warning(
+    sensor: str, estimate: ClockOffsetEstimate | None, manifest_offset_s: float
+) -> str | None:
+    """A warning when the estimated residual offset exceeds 0.2 s."""
+    if estimate is None or abs(estimate.residual_s) <= CLOCK_TOLERANCE_S:
+        return None
+    return (
+        f"{sensor} clock: the wheel speed matches the GNSS Doppler speed best when shifted by "
+        f"{estimate.residual_s:+.2f} s (correlation {estimate.correlation:.2f}); the manifest's "
+        f"time_offset_s {manifest_offset_s:.3f} s should be about "
+        f"{manifest_offset_s + estimate.residual_s:.3f} s"
+    )
+
+
+def origin_warning(enu: EnuFrame, approx_position_ecef: np.ndarray | None) -> str | None:
+    """A warning when the RINEX approximate position lies more than 10 km from the ENU origin
+    (nothing when the file gives no usable approximate position)."""
+    if approx_position_ecef is None:
+        return None
+    approx = np.asarray(approx_position_ecef, dtype=float)
+    if not (np.all(np.isfinite(approx)) and EARTH_SURFACE_M[0] < np.linalg.norm(approx)):
+        return None
+    if np.linalg.norm(approx) > EARTH_SURFACE_M[1]:
+        return None
+    distance = float(np.linalg.norm(enu.ecef_to_enu(approx)[:2]))
+    if distance <= ORIGIN_TOLERANCE_M:
+        return None
+    return (
+        f"origin: the RINEX approximate position is {distance / 1000:.1f} km from the manifest's "
+        "origin (lat_deg, lon_deg); check the origin"
+    )
