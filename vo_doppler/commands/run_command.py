@@ -25,7 +25,7 @@ from vo_doppler.eval.pipelines import PIPELINE_LABELS, evaluate_pipelines
 from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.io.heading_csv import write_heading_csv
-from vo_doppler.io.output_folder import check_output_folder, staged_output
+from vo_doppler.io.output_folder import check_output_folder, staged_output, untouched
 from vo_doppler.io.sequence import InputReport, read_sequence_with_report
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.sequence import Sequence
@@ -108,6 +108,22 @@ def result_warnings(inputs: Sequence, report: InputReport, result: RunResult) ->
 
 def run(args: argparse.Namespace) -> int:
     check_output_folder(args.output)
+    try:
+        result = run_and_write(args)
+    except BaseException:
+        log.error("%s", untouched(args.output))
+        raise
+    if not result.heading.tc_available.any():
+        raise InputError(
+            "the tightly coupled heading was unavailable at every epoch (the other results are "
+            f"in {args.output})",
+            args.sequence,
+        )
+    return 0
+
+
+def run_and_write(args: argparse.Namespace) -> RunResult:
+    """Read, check, run and write the outputs in place (all or nothing)."""
     inputs, report = read_sequence_with_report(args.sequence, args.allow_outside_paths)
     warnings = input_warnings(inputs, report)
     for text in warnings:
@@ -142,13 +158,7 @@ def run(args: argparse.Namespace) -> int:
     with staged_output(args.output) as out:
         write_results(out, args, inputs, result, console, checks)
     console.print(f"wrote {args.output}/report.html and the trajectories, heading.csv, figures")
-    if not result.heading.tc_available.any():
-        raise InputError(
-            "the tightly coupled heading was unavailable at every epoch (the other results are "
-            f"in {args.output})",
-            args.sequence,
-        )
-    return 0
+    return result
 
 
 def write_results(

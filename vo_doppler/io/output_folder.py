@@ -4,7 +4,6 @@ untouched and a rerun leaves no stale files."""
 
 from __future__ import annotations
 
-import logging
 import os
 import shutil
 import tempfile
@@ -13,8 +12,6 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from vo_doppler.errors import OutputError
-
-log = logging.getLogger(__name__)
 
 
 def check_output_folder(path: str | Path) -> Path:
@@ -46,8 +43,6 @@ def staged_output(path: str | Path) -> Iterator[Path]:
         yield staging
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
-        state = "left as it was" if path.exists() else "not created"
-        log.error("nothing written: %s %s", path, state)
         raise
     previous = None
     if path.exists():
@@ -57,3 +52,9 @@ def staged_output(path: str | Path) -> Iterator[Path]:
     staging.rename(path)
     if previous is not None:
         shutil.rmtree(previous, ignore_errors=True)
+
+
+def untouched(path: str | Path) -> str:
+    """What a failed run left at ``path``: the sentence for its message."""
+    state = "left as it was" if Path(path).exists() else "not created"
+    return f"nothing written: {path} {state}"
