@@ -4,12 +4,15 @@ Pure functions over model types and numpy (no file I/O, no stage): the callers
 (``vo-doppler run``) raise the errors before the long work and put the warnings in the run's
 summary. Each check states its threshold:
 
-* yaw rate against its DBC unit: the median |yaw rate| while the wheels turn faster than
-  2 m/s above 0.35 rad/s (20 °/s) is no car's driving; when the DBC says rad/s and the values
-  read as deg/s would be ordinary, the hint says so;
+* yaw rate against its DBC unit: while the wheels turn faster than 2 m/s, a median |yaw rate|
+  above 0.35 rad/s (20 °/s) or a median lateral acceleration |yaw rate × speed| above 2.5 m/s²
+  is no car's driving; when the DBC says rad/s and the values read as deg/s would be ordinary,
+  the hint says so;
 * the CAN clock against the GNSS speed: the lag maximising the correlation of the wheel speed
-  with the horizontal Doppler speed (both on 10 Hz, ±5 s) is the residual clock offset; beyond
-  0.2 s it is a warning reporting the estimate next to the manifest's ``time_offset_s``;
+  with the horizontal Doppler speed at the valid GNSS epochs (±5 s, or a quarter of a shorter
+  record) is the residual clock
+  offset; beyond 0.2 s it is a warning reporting the estimate next to the manifest's
+  ``time_offset_s``;
 * the ENU origin against the RINEX approximate position: more than 10 km apart is a warning.
 """
 
@@ -26,6 +29,8 @@ from vo_doppler.model.series import SensorSeries
 MOVING_SPEED_MPS = 2.0
 MAX_MEDIAN_YAW_RATE = 0.35
 """rad/s: the median |yaw rate| of a car while moving stays far below (≈ 20 °/s)."""
+MAX_MEDIAN_LATERAL_ACCELERATION = 2.5
+"""m/s²: the median |yaw rate × speed| of a car while moving stays far below."""
 CLOCK_TOLERANCE_S = 0.2
 CLOCK_SEARCH_S = 5.0
 CLOCK_RATE_HZ = 10.0
@@ -44,33 +49,37 @@ class ClockOffsetEstimate:
     correlation: float
 
 
-def moving_yaw_rate_median(yaw_rate: SensorSeries, speed: SensorSeries) -> float:
-    """Median |yaw rate| (rad/s) over the samples where the wheel speed exceeds 2 m/s (NaN when
-    the vehicle never moves)."""
+def moving_yaw_rate_medians(yaw_rate: SensorSeries, speed: SensorSeries) -> tuple[float, float]:
+    """Median |yaw rate| (rad/s) and median |yaw rate × speed| (m/s²) over the yaw-rate samples
+    where the wheel speed exceeds 2 m/s (NaNs when the vehicle never moves)."""
     if len(yaw_rate) == 0 or len(speed) < 2:
-        return float("nan")
-    moving = np.interp(yaw_rate.t, speed.t, speed.value, left=0.0, right=0.0) > MOVING_SPEED_MPS
+        return float("nan"), float("nan")
+    v = np.interp(yaw_rate.t, speed.t, speed.value, left=0.0, right=0.0)
+    moving = v > MOVING_SPEED_MPS
     if not moving.any():
-        return float("nan")
-    return float(np.median(np.abs(yaw_rate.value[moving])))
+        return float("nan"), float("nan")
+    rate = np.abs(yaw_rate.value[moving])
+    return float(np.median(rate)), float(np.median(rate * v[moving]))
 
 
 def check_yaw_rate_unit(yaw_rate: SensorSeries, speed: SensorSeries, dbc_unit: str) -> None:
     """Raise when the yaw rate is implausibly large for a moving car (module docstring)."""
-    median = moving_yaw_rate_median(yaw_rate, speed)
-    if not median > MAX_MEDIAN_YAW_RATE:
+    rate, lateral = moving_yaw_rate_medians(yaw_rate, speed)
+    if not (rate > MAX_MEDIAN_YAW_RATE or lateral > MAX_MEDIAN_LATERAL_ACCELERATION):
         return
     hint = ""
+    as_degrees = np.radians([rate, lateral])
     if dbc_unit.strip().lower().replace(" ", "") == "rad/s" and (
-        np.radians(median) <= MAX_MEDIAN_YAW_RATE
+        as_degrees[0] <= MAX_MEDIAN_YAW_RATE and as_degrees[1] <= MAX_MEDIAN_LATERAL_ACCELERATION
     ):
         hint = (
             "; the DBC declares the signal in rad/s but the values look like deg/s: fix the "
             "unit in the DBC"
         )
     raise InputError(
-        f"yaw rate implausibly large: median |yaw rate| while moving is {median:.3g} rad/s "
-        f"({np.degrees(median):.3g} °/s, DBC unit {dbc_unit!r}){hint}"
+        f"yaw rate implausibly large for a moving car: median |yaw rate| {rate:.3g} rad/s "
+        f"({np.degrees(rate):.3g} °/s), median |yaw rate × speed| {lateral:.3g} m/s² while "
+        f"moving (DBC unit {dbc_unit!r}){hint}"
     )
 
 
@@ -78,25 +87,25 @@ def estimate_clock_offset(
     speed: SensorSeries, t_gnss: np.ndarray, speed_gnss: np.ndarray
 ) -> ClockOffsetEstimate | None:
     """Residual clock offset of ``speed`` (already on GPS time by the manifest's offset) against
-    the GNSS speed: the shift s maximising corr(gnss(t), speed(t − s)), refined by a parabola
-    through the peak; None when the overlap is shorter than 4 search spans or the peak is weak.
-    """
-    good = np.isfinite(speed_gnss)
-    t_gnss, speed_gnss = np.asarray(t_gnss)[good], np.asarray(speed_gnss)[good]
-    if len(t_gnss) < 2 or len(speed) < 2:
+    the GNSS speed: the shift s (0.1-s steps within ±5 s or a quarter of the record, refined by
+    a parabola through the peak) maximising the correlation of gnss(t) with speed(t − s) over
+    the valid GNSS epochs (no interpolation across GNSS gaps); None with fewer than 20 epochs
+    inside the overlap or a peak below 0.5."""
+    t_gnss, speed_gnss = np.asarray(t_gnss, dtype=float), np.asarray(speed_gnss, dtype=float)
+    if len(speed) < 2:
         return None
-    begin = max(t_gnss[0], speed.t[0]) + CLOCK_SEARCH_S
-    end = min(t_gnss[-1], speed.t[-1]) - CLOCK_SEARCH_S
-    if end - begin < 4 * CLOCK_SEARCH_S:
+    span = min(CLOCK_SEARCH_S, (speed.t[-1] - speed.t[0]) / 4)
+    inside = (
+        np.isfinite(speed_gnss) & (t_gnss >= speed.t[0] + span) & (t_gnss <= speed.t[-1] - span)
+    )
+    if np.count_nonzero(inside) < 20:
         return None
+    t, reference = t_gnss[inside], speed_gnss[inside] - speed_gnss[inside].mean()
     step = 1.0 / CLOCK_RATE_HZ
-    grid = np.arange(begin, end, step)
-    reference = np.interp(grid, t_gnss, speed_gnss)
-    reference = reference - reference.mean()
-    lags = np.arange(-CLOCK_SEARCH_S, CLOCK_SEARCH_S + step / 2, step)
+    lags = np.arange(-span, span + step / 2, step)
     scores = np.empty(len(lags))
     for k, lag in enumerate(lags):
-        shifted = np.interp(grid - lag, speed.t, speed.value)
+        shifted = np.interp(t - lag, speed.t, speed.value)
         shifted = shifted - shifted.mean()
         norm = np.linalg.norm(shifted) * np.linalg.norm(reference)
         scores[k] = shifted @ reference / norm if norm > 0 else 0.0
