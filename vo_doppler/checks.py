@@ -5,8 +5,8 @@ Pure functions over model types and numpy (no file I/O, no stage): the callers
 summary. Each check states its threshold:
 
 * yaw rate against its DBC unit: while the wheels turn faster than 2 m/s, a median |yaw rate|
-  above 0.35 rad/s (20 °/s) or a median lateral acceleration |yaw rate × speed| above 2.5 m/s²
-  is no car's driving; when the DBC says rad/s and the values read as deg/s would be ordinary,
+  above 0.2 rad/s (11.5 °/s) or a median lateral acceleration |yaw rate × speed| above
+  1.5 m/s² is no car's road driving (a skid pad would be); when the DBC says rad/s and the values read as deg/s would be ordinary,
   the hint says so;
 * the CAN clock against the GNSS speed: the lag maximising the correlation of the wheel speed
   with the horizontal Doppler speed at the valid GNSS epochs (±5 s, or a quarter of a shorter
@@ -27,10 +27,11 @@ from vo_doppler.geo import EnuFrame
 from vo_doppler.model.series import SensorSeries
 
 MOVING_SPEED_MPS = 2.0
-MAX_MEDIAN_YAW_RATE = 0.35
-"""rad/s: the median |yaw rate| of a car while moving stays far below (≈ 20 °/s)."""
-MAX_MEDIAN_LATERAL_ACCELERATION = 2.5
-"""m/s²: the median |yaw rate × speed| of a car while moving stays far below."""
+MAX_MEDIAN_YAW_RATE = 0.2
+"""rad/s (11.5 °/s): a car's median |yaw rate| while moving is a few °/s at most (road drives:
+1–2 °/s); a deg/s signal read as rad/s is 57 times its true value."""
+MAX_MEDIAN_LATERAL_ACCELERATION = 1.5
+"""m/s²: a car's median |yaw rate × speed| while moving (road drives: ≈ 0.3 m/s²)."""
 CLOCK_TOLERANCE_S = 0.2
 CLOCK_SEARCH_S = 5.0
 CLOCK_RATE_HZ = 10.0
