@@ -66,11 +66,18 @@ def binary_kind(head: bytes) -> str | None:
 
 
 def read_bytes(path: str | Path, what: str, max_bytes: int = DATA_MAX_BYTES) -> bytes:
-    """The bytes of a regular file of at most ``max_bytes`` (re-checked while reading)."""
-    regular_file(path, what, max_bytes)
+    """The bytes of a regular file of at most ``max_bytes`` (re-checked while reading: a file
+    growing past the bound is refused). Reads the size ``stat`` gave in one call, so no buffer
+    of ``max_bytes`` is ever allocated."""
+    size = regular_file(path, what, max_bytes)
     try:
         with Path(path).open("rb") as handle:
-            data = handle.read(max_bytes + 1)
+            data = handle.read(size + 1)
+            while len(data) > size and len(data) <= max_bytes:
+                more = handle.read(MIB)
+                if not more:
+                    break
+                data += more
     except OSError as exc:
         raise InputError(f"cannot read {what}: {exc.strerror or exc}", path) from exc
     if len(data) > max_bytes:
