@@ -312,7 +312,7 @@ def test_failed_run_keeps_the_previous_results_and_says_so(clean, clean_run, tmp
     assert not [p for p in tmp_path.iterdir() if ".partial-" in p.name]
 
 
-def test_duplicated_can_frames_with_other_values_are_counted_and_stale_files_go(
+def test_duplicated_can_frames_and_a_distant_origin_are_warned_and_stale_files_go(
     clean, clean_run, tmp_path, caplog
 ):
     folder = damaged_copy(clean, tmp_path)
@@ -323,6 +323,8 @@ def test_duplicated_can_frames_with_other_values_are_counted_and_stale_files_go(
         head, payload = lines[i].rstrip("\n").split("#")
         lines.insert(i + 1, f"{head}#{payload[:-2]}{(int(payload[-2:], 16) ^ 0xFF):02X}\n")
     log_path.write_text("".join(lines))
+    manifest = yaml.safe_load((folder / "sequence.yaml").read_text())
+    edit_manifest(folder, "origin", "lat_deg", manifest["origin"]["lat_deg"] + 0.2)  # 22 km
     out = tmp_path / "out"
     shutil.copytree(clean_run, out)
     (out / "stale_figure.png").write_bytes(b"old")
