@@ -6,8 +6,8 @@ summary. Each check states its threshold:
 
 * yaw rate against its DBC unit: while the wheels turn faster than 2 m/s, a median |yaw rate|
   above 0.2 rad/s (11.5 °/s) or a median lateral acceleration |yaw rate × speed| above
-  1.5 m/s² is no car's road driving (a skid pad would be); when the DBC says rad/s and the values read as deg/s would be ordinary,
-  the hint says so;
+  1.5 m/s² is no car's road driving (a skid pad would be); when the DBC says rad/s and the
+  values read as deg/s would be ordinary, the hint says so;
 * the CAN clock against the GNSS speed: the lag maximising the correlation of the wheel speed
   with the horizontal Doppler speed at the valid GNSS epochs (±5 s, or a quarter of a shorter
   record) is the residual clock

@@ -144,7 +144,7 @@ def test_asc_times_do_not_depend_on_the_reading_timezone(tmp_path):
 def test_dbc_with_a_megabyte_line_is_refused(tmp_path):
     path = tmp_path / "bus.dbc"
     path.write_text(DBC + 'CM_ "' + "x" * 1_000_000 + '";\n')
-    with pytest.raises(InputError, match=r"bus.dbc:8: CAN database line has 1000007 characters"):
+    with pytest.raises(InputError, match=r"bus.dbc:8: CAN database line has 1000007 bytes"):
         load_dbc(path)
 
 

@@ -94,7 +94,7 @@ def test_a_megabyte_line_is_bounded(tmp_path, name, file, text, reader):
         if name == "candump":
             assert read_can_log(path).n_unreadable == 1
         else:
-            with pytest.raises(InputError, match=rf"{file}:2: .*line has 1000000 characters"):
+            with pytest.raises(InputError, match=rf"{file}:2: .*line has 1000000 bytes"):
                 reader(path)
         peak = tracemalloc.get_traced_memory()[1]
     finally:

@@ -138,6 +138,10 @@ def parse_signal_list(text: str) -> list[SignalRef]:
     return [SignalRef.parse(part) for part in text.split(",") if part.strip()]
 
 
+MAX_YAW_RATE = 10.0
+"""rad/s: no car turns faster (a decoded rate beyond it is a wrong factor or unit)."""
+MAX_WHEEL_SPEED = 150.0
+"""m/s (540 km/h): no road vehicle's wheel speed beyond it."""
 MAX_UNREADABLE_LOGGED = 10
 """Unreadable lines logged one by one; the rest are only counted."""
 MAX_ARBITRATION_ID = 0x1FFFFFFF
@@ -389,7 +393,13 @@ class _StreamDecoder:
         try:
             decoded = message.decode(payload, decode_choices=False)
             sample = [float(decoded[ref.signal]) for ref in refs]
-        except (cantools.database.errors.DecodeError, KeyError, ValueError, TypeError):
+        except (
+            cantools.database.errors.DecodeError,
+            KeyError,
+            ValueError,
+            TypeError,
+            OverflowError,
+        ):
             self.undecodable[frame_id] += 1
             self.report.n_undecodable += 1
             return
@@ -541,6 +551,16 @@ def _motion(
         if bad:
             raise InputError(f"wheel-speed signals {bad} are not speeds")
         speed_series = mean_of_series(parts, "speed_mps").shifted(speed_offset_s)
+    for series, ref, limit in (
+        (yaw_series, yaw_rate, MAX_YAW_RATE),
+        (speed_series, ",".join(map(str, wheels)), MAX_WHEEL_SPEED),
+    ):
+        if series is not None and len(series) and np.abs(series.value).max() > limit:
+            worst = float(np.abs(series.value).max())
+            raise InputError(
+                f"{ref} decodes to {worst:.4g} {series.unit}, beyond any car's {limit:g} "
+                f"{series.unit}: check the DBC factor and unit"
+            )
     return CanMotion(yaw_series, speed_series, report)
 
 

@@ -6,9 +6,10 @@ or a device such as ``/dev/zero`` that never ends.
 
 from __future__ import annotations
 
-import re
 import stat
 from pathlib import Path
+
+import numpy as np
 
 from vo_doppler.errors import InputError
 
@@ -18,7 +19,7 @@ DATA_MAX_BYTES = 2048 * MIB
 SMALL_MAX_BYTES = 16 * MIB
 """Bound on small configuration-like files (calibration, DBC, times, heading tables)."""
 MAX_LINE_CHARS = 64 * 1024
-"""Longest line a text reader accepts (below the csv module's 128 KiB field limit)."""
+"""Longest line (bytes) a text reader accepts (below the csv module's 128 KiB field limit)."""
 
 # Leading bytes of binary formats a user may hand over by mistake, with their names.
 MAGIC = (
@@ -87,10 +88,11 @@ def read_bytes(path: str | Path, what: str, max_bytes: int = DATA_MAX_BYTES) -> 
 
 def decode_text(data: bytes, path: str | Path, what: str, max_line: int = MAX_LINE_CHARS) -> str:
     """UTF-8 text of ``data`` (a BOM is dropped); binary content, a byte that is not UTF-8 or a
-    line longer than ``max_line`` characters is an :class:`InputError` naming the line."""
+    line longer than ``max_line`` bytes is an :class:`InputError` naming the line."""
     kind = binary_kind(data[:8192])
     if kind is not None:
         raise InputError(f"{what} is a {kind}, not a text file", path)
+    check_line_lengths(data, path, what, max_line)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -100,22 +102,23 @@ def decode_text(data: bytes, path: str | Path, what: str, max_line: int = MAX_LI
             path,
             line,
         ) from exc
-    check_line_lengths(text, path, what, max_line)
     return text
 
 
-def check_line_lengths(text: str, path: str | Path, what: str, max_line: int) -> None:
-    """Raise naming the first line longer than ``max_line`` characters (one linear scan)."""
-    if len(text) <= max_line:
+def check_line_lengths(data: bytes, path: str | Path, what: str, max_line: int) -> None:
+    """Raise naming the first line longer than ``max_line`` bytes (one linear pass over the
+    newline positions; a character is at least a byte, so no longer line passes)."""
+    if len(data) <= max_line:
         return
-    long_line = re.search(f"[^\n]{{{max_line + 1}}}", text)
-    if long_line is not None:
-        end = text.find("\n", long_line.start())
-        length = (len(text) if end < 0 else end) - text.rfind("\n", 0, long_line.start()) - 1
+    ends = np.flatnonzero(np.frombuffer(data, dtype=np.uint8) == 10)
+    starts = np.concatenate([[0], ends + 1])
+    lengths = np.concatenate([ends, [len(data)]]) - starts
+    long = np.flatnonzero(lengths > max_line)
+    if long.size:
         raise InputError(
-            f"{what} line has {length} characters, more than {max_line}",
+            f"{what} line has {lengths[long[0]]} bytes, more than {max_line}",
             path,
-            text.count("\n", 0, long_line.start()) + 1,
+            int(long[0]) + 1,
         )
 
 

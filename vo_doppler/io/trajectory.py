@@ -51,12 +51,13 @@ def read_tum(path: str | Path) -> Trajectory:
         raise InputError(
             f"TUM time {data[k, 0]:.9f} s is not after the previous row's", path, numbers[k]
         )
-    quats = data[:, 4:8]
-    norms = np.linalg.norm(quats, axis=1)
-    bad = np.flatnonzero(norms < 1e-9)
+    scale = np.abs(data[:, 4:8]).max(axis=1, initial=0.0)
+    bad = np.flatnonzero(scale == 0.0)
     if bad.size:
         raise InputError("TUM row has a zero quaternion", path, numbers[bad[0]])
-    return Trajectory(data[:, 0], data[:, 1:4], Rotation.from_quat(quats / norms[:, None]))
+    quats = data[:, 4:8] / scale[:, None]  # scaled first: no overflow or underflow in the norm
+    quats /= np.linalg.norm(quats, axis=1)[:, None]
+    return Trajectory(data[:, 0], data[:, 1:4], Rotation.from_quat(quats))
 
 
 def write_tum(path: str | Path, trajectory: Trajectory) -> None:
