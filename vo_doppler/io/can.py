@@ -140,8 +140,8 @@ def parse_signal_list(text: str) -> list[SignalRef]:
 
 MAX_YAW_RATE = 10.0
 """rad/s: no car turns faster (a decoded rate beyond it is a wrong factor or unit)."""
-MAX_WHEEL_SPEED = 150.0
-"""m/s (540 km/h): no road vehicle's wheel speed beyond it."""
+MAX_WHEEL_SPEED = 200.0
+"""m/s (720 km/h): no road vehicle's wheel speed beyond it."""
 MAX_UNREADABLE_LOGGED = 10
 """Unreadable lines logged one by one; the rest are only counted."""
 MAX_ARBITRATION_ID = 0x1FFFFFFF
