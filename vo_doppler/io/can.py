@@ -115,6 +115,10 @@ class CanMotion:
     report: CanDecodeReport
 
 
+class SignalError(InputError):
+    """A signal reference that is malformed, not in the DBC or of the wrong kind of unit."""
+
+
 @dataclass(frozen=True)
 class SignalRef:
     """A DBC signal named ``MESSAGE.SIGNAL``."""
@@ -126,7 +130,7 @@ class SignalRef:
     def parse(cls, text: str) -> SignalRef:
         message, dot, signal = text.strip().partition(".")
         if not dot or not message or not signal:
-            raise InputError(f"signal {text!r} is not of the form MESSAGE.SIGNAL")
+            raise SignalError(f"signal {text!r} is not of the form MESSAGE.SIGNAL")
         return cls(message, signal)
 
     def __str__(self) -> str:
@@ -361,12 +365,12 @@ class _StreamDecoder:
             try:
                 message = db.get_message_by_name(message_name)
             except KeyError as exc:
-                raise InputError(f"message {message_name!r} is not in the DBC") from exc
+                raise SignalError(f"message {message_name!r} is not in the DBC") from exc
             for ref in message_refs:
                 try:
                     signal = message.get_signal_by_name(ref.signal)
                 except KeyError as exc:
-                    raise InputError(f"signal {ref} is not in the DBC") from exc
+                    raise SignalError(f"signal {ref} is not in the DBC") from exc
                 self.factors[ref] = si_factor(signal.unit, str(ref))
                 report.dbc_units[str(ref)] = signal.unit or ""
             self.messages[message.frame_id] = (message, message_refs)
@@ -540,7 +544,7 @@ def _motion(
     if yaw_rate is not None:
         raw = decoded[yaw_rate]
         if raw.unit != "rad/s":
-            raise InputError(f"yaw-rate signal {yaw_rate} is in {raw.unit}, not an angular rate")
+            raise SignalError(f"yaw-rate signal {yaw_rate} is in {raw.unit}, not an angular rate")
         yaw_series = SensorSeries(
             raw.t + yaw_rate_offset_s, yaw_rate_sign * raw.value, "yaw_rate_rad_s", "rad/s"
         )
@@ -549,7 +553,7 @@ def _motion(
         parts = [decoded[ref] for ref in wheels]
         bad = [str(ref) for ref, s in zip(wheels, parts, strict=True) if s.unit != "m/s"]
         if bad:
-            raise InputError(f"wheel-speed signals {bad} are not speeds")
+            raise SignalError(f"wheel-speed signals {bad} are not speeds")
         speed_series = mean_of_series(parts, "speed_mps").shifted(speed_offset_s)
     for series, ref, limit in (
         (yaw_series, yaw_rate, MAX_YAW_RATE),
@@ -579,17 +583,28 @@ def read_can_motion(
     frame by frame (no frame is held beyond its decoding)."""
     _check_sign(yaw_rate_sign)
     db = load_dbc(dbc_path)
-    yaw_ref = SignalRef.parse(yaw_rate) if yaw_rate else None
-    wheels = parse_signal_list(wheel_speed) if wheel_speed else []
     report = CanDecodeReport()
-    decoder = _StreamDecoder(
-        db, ([yaw_ref] if yaw_ref else []) + wheels, channel, report, short_frames, str(log_path)
-    )
+    try:
+        yaw_ref = SignalRef.parse(yaw_rate) if yaw_rate else None
+        wheels = parse_signal_list(wheel_speed) if wheel_speed else []
+        decoder = _StreamDecoder(
+            db,
+            ([yaw_ref] if yaw_ref else []) + wheels,
+            channel,
+            report,
+            short_frames,
+            str(log_path),
+        )
+    except SignalError as exc:
+        raise SignalError(str(exc), dbc_path) from exc
     for frame in iter_can_frames(log_path, report):
         decoder.add(*frame)
     decoded = decoder.finish(log_path)
-    motion = _motion(
-        decoded, report, yaw_ref, wheels, yaw_rate_sign, yaw_rate_offset_s, speed_offset_s
-    )
+    try:
+        motion = _motion(
+            decoded, report, yaw_ref, wheels, yaw_rate_sign, yaw_rate_offset_s, speed_offset_s
+        )
+    except SignalError as exc:
+        raise SignalError(str(exc), dbc_path) from exc
     log.info("%s: %s", log_path, motion.report.summary())
     return motion

@@ -21,7 +21,7 @@ import numpy as np
 from vo_doppler.errors import InputError, ManifestError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import read_camera
-from vo_doppler.io.can import CanDecodeReport, read_can_motion
+from vo_doppler.io.can import CanDecodeReport, SignalError, read_can_motion
 from vo_doppler.io.images import list_images, read_times
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
@@ -201,16 +201,19 @@ def read_sequence_with_report(
     log_path = m.file("can", "log")
     dbc_path = m.file("can", "dbc")
     yaw_name = m.string("can", "yaw_rate")
-    motion = read_can_motion(
-        log_path,
-        dbc_path,
-        yaw_name,
-        m.string("can", "wheel_speed"),
-        sign,
-        can_offset,
-        can_offset,
-        short_frames=short_frames,
-    )
+    try:
+        motion = read_can_motion(
+            log_path,
+            dbc_path,
+            yaw_name,
+            m.string("can", "wheel_speed"),
+            sign,
+            can_offset,
+            can_offset,
+            short_frames=short_frames,
+        )
+    except SignalError as exc:
+        raise m.error("can.yaw_rate / can.wheel_speed", str(exc)) from exc
     if motion.yaw_rate is None or motion.speed is None or not len(motion.speed):
         raise InputError("CAN log gave no yaw rate or wheel speed", log_path)
     report.can = motion.report
