@@ -26,10 +26,9 @@ from tests.conftest import REPO_ROOT, shared_data_dir
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.gps_fixes import read_gps_fixes
-from vo_doppler.io.gyro_csv import read_gyro_csv
 from vo_doppler.io.heading_csv import COLUMNS, read_heading_csv
 from vo_doppler.io.images import read_times
-from vo_doppler.io.sensor_csv import read_speed_csv
+from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.io.trajectory import read_trajectory
 
@@ -174,7 +173,7 @@ def gyro_seeds(seed_cls) -> list:
 
 
 def check_gyro(series, path: Path) -> list[str]:
-    return _times_ok(series.t, "gyro") + _finite(series.yaw_rate, "yaw rate")
+    return _times_ok(series.t, "gyro") + _finite(series.value, "yaw rate")
 
 
 def _nmea(sentence: str) -> str:
@@ -320,7 +319,7 @@ def register_all(register, family_cls, seed_cls) -> None:
         ("can-log", can_seeds, read_can, check_can),
         ("dbc", dbc_seeds, read_dbc_and_decode, check_dbc),
         ("sensor-csv", sensor_seeds, read_speed_csv, check_series),
-        ("gyro-csv", gyro_seeds, read_gyro_csv, check_gyro),
+        ("gyro-csv", gyro_seeds, read_yaw_rate_csv, check_gyro),
         ("gps-csv-nmea", gps_seeds, read_gps_fixes, check_gps),
         ("trajectory", trajectory_seeds, read_trajectory, check_trajectory),
         ("heading-csv", heading_seeds, read_heading_csv, check_heading),

@@ -15,10 +15,9 @@ from vo_doppler.errors import InputError
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import load_dbc, read_can_log
 from vo_doppler.io.gps_fixes import read_gps_fixes
-from vo_doppler.io.gyro_csv import read_gyro_csv
 from vo_doppler.io.heading_csv import COLUMNS, read_heading_csv
 from vo_doppler.io.images import read_times
-from vo_doppler.io.sensor_csv import read_speed_csv
+from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.sequence import read_manifest
 from vo_doppler.io.trajectory import read_kitti, read_trajectory
 
@@ -41,7 +40,7 @@ def _gga(second: int) -> str:
 # name, file name, good text, reader
 READERS: list[tuple[str, str, str, Callable[[Path], object]]] = [
     ("speed csv", "speed.csv", "t,speed_mps\n0,1.0\n1,2.0\n", read_speed_csv),
-    ("gyro csv", "gyro.csv", "t,yaw_rate_rad_s\n0,0.1\n1,0.2\n", read_gyro_csv),
+    ("gyro csv", "gyro.csv", "t,yaw_rate_rad_s\n0,0.1\n1,0.2\n", read_yaw_rate_csv),
     ("gps csv", "gps.csv", "t,lat_deg,lon_deg\n0,35,139\n1,35.0001,139\n", read_gps_fixes),
     ("nmea", "fixes.nmea", f"{_gga(0)}\n{_gga(1)}\n", read_gps_fixes),
     ("tum", "poses.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n", read_trajectory),
