@@ -1,6 +1,7 @@
 """The ``vo-doppler`` command: parses arguments and hands them to one subcommand module.
 
-Exit codes: 0 success, 1 runtime failure (bad input, failed processing), 2 usage error.
+Exit codes (:mod:`vo_doppler.errors`): 0 success, 1 bad input or failed processing, 2 usage
+error, 3 internal error. Every failure is one line on stderr; ``--debug`` adds the traceback.
 """
 
 from __future__ import annotations
@@ -9,9 +10,16 @@ import argparse
 import importlib
 import logging
 import sys
+import traceback
 
 from vo_doppler import __version__
-from vo_doppler.errors import VoDopplerError
+from vo_doppler.errors import (
+    EXIT_FAILURE,
+    EXIT_INTERNAL,
+    EXIT_OK,
+    EXIT_USAGE,
+    VoDopplerError,
+)
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "run": (
@@ -39,6 +47,13 @@ when its subcommand runs, so ``vo-doppler --help`` loads none of the library."""
 
 log = logging.getLogger("vo_doppler")
 
+EXIT_CODES_EPILOG = f"""exit codes:
+  {EXIT_OK}  success
+  {EXIT_FAILURE}  bad input or failed processing (the message names the file and line, epoch or key)
+  {EXIT_USAGE}  usage error (unknown command or option, bad option value)
+  {EXIT_INTERNAL}  internal error (a bug: rerun with --debug and report the traceback)
+"""
+
 
 def chosen_command(argv: list[str]) -> str | None:
     """The subcommand named on the command line (the first known name), if any."""
@@ -51,10 +66,15 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="vo-doppler",
         description="Monocular visual odometry with heading corrected by GNSS Doppler.",
+        epilog=EXIT_CODES_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more log output")
     parser.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
+    parser.add_argument(
+        "--debug", action="store_true", help="print the traceback of any error (for bug reports)"
+    )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, (module, summary) in SUBCOMMANDS.items():
         if command in (name, "*"):
@@ -71,13 +91,29 @@ def main(argv: list[str] | None = None) -> int:
     level = logging.WARNING if args.quiet else (logging.DEBUG if args.verbose else logging.INFO)
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     try:
-        return int(args.func(args) or 0)
+        return int(args.func(args) or EXIT_OK)
     except VoDopplerError as exc:
-        print(f"vo-doppler {args.command}: error: {exc}", file=sys.stderr)
-        return 1
+        _report(args, f"error: {exc}")
+        return EXIT_FAILURE
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # the top-level handler: anything else is a bug
+        _report(
+            args,
+            f"internal error: {type(exc).__name__}: {exc} (a bug; rerun with --debug for the "
+            "traceback)",
+        )
+        return EXIT_INTERNAL
+
+
+def _report(args: argparse.Namespace, message: str) -> None:
+    """One line on stderr (a multi-line message joined by "; "), the traceback under
+    ``--debug``."""
+    if args.debug:
+        traceback.print_exc(file=sys.stderr)
+    one_line = "; ".join(part.strip() for part in message.splitlines() if part.strip())
+    print(f"vo-doppler {args.command}: {one_line}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -1,8 +1,22 @@
-"""Exceptions raised for bad input; each one names where the problem is."""
+"""Exceptions raised for bad input; each one names where the problem is.
+
+Exit codes of the ``vo-doppler`` command (the one error contract):
+
+* ``EXIT_OK`` (0): success;
+* ``EXIT_FAILURE`` (1): bad input or failed processing — a :class:`VoDopplerError`, whose
+  message names the file and line, epoch or key;
+* ``EXIT_USAGE`` (2): the command line itself is wrong (argparse);
+* ``EXIT_INTERNAL`` (3): anything unexpected, i.e. a bug (``--debug`` shows the traceback).
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
+
+EXIT_OK = 0
+EXIT_FAILURE = 1
+EXIT_USAGE = 2
+EXIT_INTERNAL = 3
 
 
 class VoDopplerError(Exception):
@@ -22,3 +36,15 @@ class InputError(VoDopplerError):
                 where += f":{line}"
             where += ": "
         super().__init__(where + message)
+
+
+class ManifestError(InputError):
+    """A ``sequence.yaml`` value is missing, of the wrong type or out of range; names the key."""
+
+    def __init__(self, key: str, message: str, path: str | Path | None = None):
+        self.key = key
+        super().__init__(f"{key}: {message}", path)
+
+
+class OutputError(VoDopplerError):
+    """An output location is unusable (a file where a folder is wanted, not writable)."""

@@ -22,6 +22,7 @@ ALLOWED: dict[str, set[str]] = {
     "heading": BASE | {"heading", "gnss"},
     "fusion": BASE | {"fusion", "heading", "gnss", "lowcost"},
     "io": BASE | {"io"},
+    "checks": BASE,
     "sim": BASE | STAGES | {"io", "sim"},
     "run": BASE | STAGES | {"io"},
     "report": BASE | STAGES | {"io", "run", "report"},

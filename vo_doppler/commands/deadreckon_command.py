@@ -65,7 +65,11 @@ def register(subparsers, summary: str) -> None:
         "--k", type=_k_value, default=None, help="weight of gyro 2 in [0, 2], or auto (sweep)"
     )
     parser.add_argument(
-        "--tau", type=_auto_or_float, default=None, help="bias averaging time s, or auto (Allan)"
+        "--tau",
+        type=_auto_or_float,
+        default=None,
+        help="bias averaging time s, or auto: the Allan minimum over a standstill, the whole "
+        "window over a straight stretch (never longer than the window)",
     )
     window = parser.add_mutually_exclusive_group()
     window.add_argument(
@@ -126,6 +130,7 @@ def run(args: argparse.Namespace) -> int:
     paths = write_outputs(args.output, result)
 
     model = result.model
+    window = "standstill" if args.straight is None else "straight stretch"
     console = Console()
     table = Table(title=f"Heading drift (reference: {result.reference_source})")
     for header in TABLE_HEADERS:
@@ -137,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
     console.print(
         f"k used {model.k:.3f} ({choices}); τ {model.tau:.3g} s; "
         f"ε0 combined {np.degrees(model.eps0['combined']):.4g} deg/s; "
-        f"h {np.degrees(model.h):.3g} deg/s; standstill "
+        f"h {np.degrees(model.h):.3g} deg/s; {window} "
         f"{result.prepared.standstill[0]:.2f}–{result.prepared.standstill[1]:.2f} s"
     )
     skipped = gyro1.n_skipped + gyro2.n_skipped

@@ -97,8 +97,10 @@ def run(args: argparse.Namespace) -> int:
                 np.percentile(speed, 95),
             )
     skipped = len(obs.problems) + len(state_problems(nav))
-    log.info(
-        "%d of %d epochs valid; wrote %s and %s%s",
+    log.log(
+        logging.INFO if valid.all() else logging.WARNING,
+        "%d of %d epochs valid (the others: too few satellites or failing the residual test); "
+        "wrote %s and %s%s",
         int(valid.sum()),
         valid.size,
         args.output,

@@ -11,6 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.sim.urban_canyon import (
     SCENARIOS,
@@ -159,6 +160,7 @@ def _command_line(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output_folder(args.output)
     defaults = UrbanCanyonConfig()
     if set(args.systems) - set("GE") or not args.systems:
         raise InputError(f"--systems {args.systems!r}: the simulator has G and E")

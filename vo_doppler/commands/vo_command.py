@@ -20,6 +20,7 @@ from vo_doppler.io.images import (
     read_times,
     times_from_fps,
 )
+from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
 from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
 from vo_doppler.report.plots import plot_top_view
@@ -62,6 +63,7 @@ def window_size(text: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output_folder(args.output)
     files = list_images(args.images)
     camera = read_camera(args.calib)
     if args.fps is not None:
@@ -78,15 +80,26 @@ def run(args: argparse.Namespace) -> int:
             raise InputError("speed CSV needs at least two samples", args.speed)
         speed = (series.t, series.value)
     config = VoConfig(window_size=args.window)
+    decoded = [0]
+
+    def images():
+        for image in prefetch_images(files):
+            decoded[0] += image is not None
+            yield image
+
     with Progress(transient=True) as progress:
         task = progress.add_task("visual odometry", total=len(files))
         output = run_visual_odometry(
-            prefetch_images(files),
+            images(),
             times,
             camera,
             config,
             speed,
             on_frame=lambda _: progress.advance(task),
+        )
+    if decoded[0] < 2:
+        raise InputError(
+            f"only {decoded[0]} of the {len(files)} images could be decoded", args.images
         )
     args.output.mkdir(parents=True, exist_ok=True)
     write_tum(args.output / "trajectory.tum", output.trajectory)

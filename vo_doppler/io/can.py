@@ -9,14 +9,22 @@ several wheel-speed signals are averaged. Values are converted from the DBC unit
 Frames shorter than their DBC length are skipped, counted and named in a warning (their
 missing bytes would decode as made-up values); ``short_frames="pad"`` zero-pads them instead,
 for sources known to drop trailing zero bytes (comma2k19's ``raw_can`` arrays). Frames that
-cannot be decoded, and log lines that cannot be read, are counted, logged and skipped — the
-result keeps every frame that could be decoded.
+cannot be decoded, and log lines that cannot be read (including non-finite times and ids
+beyond 29 bits), are counted, logged and skipped — the result keeps every frame that could be
+decoded. After a bad line the line formats resume at the next line (linear time); ASC and BLF
+keep what came before a corrupt record. ASC times are on UTC whatever the reading machine's
+timezone. Decoding is streamed: frames are decoded as they are read into compact arrays, so
+memory grows with the decoded samples only. Time order follows the ``"sort"`` policy of
+:mod:`vo_doppler.io.time_order` per message (a frame more than 0.5 s late is an error).
 """
 
 from __future__ import annotations
 
-import io
+import calendar
+import datetime
 import logging
+import math
+from array import array
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +34,14 @@ import cantools
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.textfile import (
+    MAX_LINE_CHARS,
+    SMALL_MAX_BYTES,
+    binary_kind,
+    read_text,
+    regular_file,
+)
+from vo_doppler.io.time_order import TimeOrderReport, order_samples
 from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
@@ -75,6 +91,10 @@ class CanDecodeReport:
     n_undecodable: int = 0
     n_unreadable_lines: int = 0
     undecodable_by_id: dict[int, int] = field(default_factory=dict)
+    time_order: dict[str, TimeOrderReport] = field(default_factory=dict)
+    """Per decoded message, what its time order needed."""
+    dbc_units: dict[str, str] = field(default_factory=dict)
+    """Unit string the DBC declares for each decoded ``MESSAGE.SIGNAL``."""
 
     def summary(self) -> str:
         ids = ", ".join(f"0x{k:X}×{v}" for k, v in sorted(self.undecodable_by_id.items()))
@@ -95,6 +115,10 @@ class CanMotion:
     report: CanDecodeReport
 
 
+class SignalError(InputError):
+    """A signal reference that is malformed, not in the DBC or of the wrong kind of unit."""
+
+
 @dataclass(frozen=True)
 class SignalRef:
     """A DBC signal named ``MESSAGE.SIGNAL``."""
@@ -106,7 +130,7 @@ class SignalRef:
     def parse(cls, text: str) -> SignalRef:
         message, dot, signal = text.strip().partition(".")
         if not dot or not message or not signal:
-            raise InputError(f"signal {text!r} is not of the form MESSAGE.SIGNAL")
+            raise SignalError(f"signal {text!r} is not of the form MESSAGE.SIGNAL")
         return cls(message, signal)
 
     def __str__(self) -> str:
@@ -118,70 +142,165 @@ def parse_signal_list(text: str) -> list[SignalRef]:
     return [SignalRef.parse(part) for part in text.split(",") if part.strip()]
 
 
-def _iterate_line_format(path: Path, reader_cls) -> tuple[list[can.Message], int]:
-    """Read a line-oriented log, skipping (and counting) lines the reader rejects."""
-    text = path.read_text(errors="replace")
-    header = ""
-    if reader_cls is can.CSVReader:
-        first_newline = text.find("\n") + 1
-        header, text = text[:first_newline], text[first_newline:]
-    messages: list[can.Message] = []
-    unreadable = 0
-    position = 0
-    while position < len(text):
-        stream = io.StringIO(header + text[position:])
-        reader = reader_cls(stream)
-        try:
-            messages.extend(reader)
-            break
-        except (ValueError, IndexError, KeyError, TypeError) as exc:
-            resumed_at = stream.tell() - len(header)
-            bad_line = text.count("\n", 0, position + resumed_at)
-            log.warning("%s:%d: unreadable CAN log line skipped (%s)", path, bad_line, exc)
-            unreadable += 1
-            position += max(resumed_at, 1)
-    return messages, unreadable
+MAX_YAW_RATE = 10.0
+"""rad/s: no car turns faster (a decoded rate beyond it is a wrong factor or unit)."""
+MAX_WHEEL_SPEED = 200.0
+"""m/s (720 km/h): no road vehicle's wheel speed beyond it."""
+MAX_UNREADABLE_LOGGED = 10
+"""Unreadable lines logged one by one; the rest are only counted."""
+MAX_ARBITRATION_ID = 0x1FFFFFFF
 
 
-def _iterate_binary_or_asc(path: Path) -> tuple[list[can.Message], int]:
+class _TextLines:
+    """UTF-8 lines of a binary file handle with their 1-based numbers; over-long lines are
+    skipped and counted, a byte that is not UTF-8 is an :class:`InputError` naming the line."""
+
+    def __init__(self, handle, path: Path, report: CanDecodeReport):
+        self.handle = handle
+        self.path = path
+        self.report = report
+        self.number = 0
+        self.replay: list[str] = []
+        """Lines handed out again first (a CSV header for each new reader)."""
+
+    def __iter__(self):
+        return self
+
+    def close(self) -> None:
+        """python-can closes its file after each pass; the handle stays open for the next."""
+
+    def __next__(self) -> str:
+        if self.replay:
+            return self.replay.pop()
+        while True:
+            raw = self.handle.readline(MAX_LINE_CHARS + 2)
+            if not raw:
+                raise StopIteration
+            self.number += 1
+            if len(raw) > MAX_LINE_CHARS:
+                while raw and not raw.endswith(b"\n"):
+                    raw = self.handle.readline(MAX_LINE_CHARS)
+                _unreadable(self.report, self.path, self.number, "line too long")
+                continue
+            try:
+                return raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                raise InputError(
+                    f"CAN log is not UTF-8 text (byte 0x{raw[exc.start]:02X})",
+                    self.path,
+                    self.number,
+                ) from exc
+
+
+def _unreadable(report: CanDecodeReport, path: Path, line: int | None, why: object) -> None:
+    report.n_unreadable_lines += 1
+    if report.n_unreadable_lines <= MAX_UNREADABLE_LOGGED:
+        where = f"{path}:{line}" if line is not None else str(path)
+        log.warning("%s: unreadable CAN log line skipped (%s)", where, why)
+
+
+def _line_messages(path: Path, reader_cls, report: CanDecodeReport):
+    """Messages of a line-oriented log and their line numbers; after a line the reader rejects,
+    a new reader resumes on the following line (each line is read once)."""
+    with path.open("rb") as handle:
+        kind = binary_kind(handle.read(8192))
+        if kind is not None:
+            raise InputError(f"CAN log is a {kind}, not a text log", path)
+        handle.seek(0)
+        lines = _TextLines(handle, path, report)
+        header = next(lines, "") if reader_cls is can.CSVReader else None
+        while True:
+            lines.replay = [] if header is None else [header]
+            try:
+                for message in reader_cls(lines):
+                    yield message, lines.number
+                return
+            except (ValueError, IndexError, KeyError, TypeError, OverflowError) as exc:
+                _unreadable(report, path, lines.number, exc)
+
+
+class _UtcAscReader(can.ASCReader):
+    """python-can's ASC reader with the ``date`` header read as UTC (python-can reads it in the
+    reading machine's local timezone, so absolute times moved with ``TZ``)."""
+
+    @staticmethod
+    def _datetime_to_timestamp(datetime_string: str) -> float:
+        local = can.ASCReader._datetime_to_timestamp(datetime_string)
+        wall_clock = datetime.datetime.fromtimestamp(local)
+        return calendar.timegm(wall_clock.timetuple()) + wall_clock.microsecond * 1e-6
+
+
+def _record_messages(path: Path, report: CanDecodeReport):
     """ASC and BLF: python-can cannot resume after a corrupt record, so keep what came first.
 
-    ASC times are made absolute from the ``Begin Triggerblock`` date, like BLF times.
+    ASC times are made absolute from the ``Begin Triggerblock`` date (as UTC), like BLF times.
+    A file python-can cannot open at all is an :class:`InputError`.
     """
-    messages: list[can.Message] = []
-    reader = (
-        can.ASCReader(path, relative_timestamp=False)
-        if path.suffix.lower() == ".asc"
-        else can.BLFReader(path)
-    )
+    n = 0
     try:
+        if path.suffix.lower() == ".asc":
+            with path.open("rb") as handle:
+                kind = binary_kind(handle.read(8192))
+            if kind is not None:
+                raise InputError(f"ASC log is a {kind}, not a text log", path)
+            reader = _UtcAscReader(path, relative_timestamp=False, encoding="utf-8")
+        else:
+            reader = can.BLFReader(path)
         for message in reader:
-            messages.append(message)
+            n += 1
+            yield message, None
+    except InputError:
+        raise
     except Exception as exc:  # python-can raises many types on corrupt files
-        log.warning("%s: reading stopped after %d frames: %s", path, len(messages), exc)
-        return messages, 1
-    return messages, 0
+        if n == 0:
+            raise InputError(f"cannot read the CAN log: {type(exc).__name__}: {exc}", path) from exc
+        log.warning("%s: reading stopped after %d frames: %s", path, n, exc)
+        report.n_unreadable_lines += 1
+
+
+def iter_can_frames(path: str | Path, report: CanDecodeReport):
+    """``(time, arbitration id, payload, channel, line)`` of every usable data frame of a
+    candump ``-l``, ASC, BLF or python-can CSV log, one at a time (``line`` None for ASC/BLF).
+
+    Error and remote frames are dropped; frames with a non-finite time or an id beyond 29 bits
+    are counted as unreadable."""
+    path = Path(path)
+    regular_file(path, "CAN log")
+    suffix = path.suffix.lower()
+    if suffix in _LINE_FORMATS:
+        messages = _line_messages(path, _LINE_FORMATS[suffix], report)
+    elif suffix in (".asc", ".blf"):
+        messages = _record_messages(path, report)
+    else:
+        raise InputError(f"unknown CAN log format {suffix!r} (.log, .asc, .blf or .csv)", path)
+    for message, line in messages:
+        if message.is_error_frame or message.is_remote_frame:
+            continue
+        if not math.isfinite(message.timestamp):
+            _unreadable(report, path, line, f"time {message.timestamp}")
+            continue
+        if not 0 <= message.arbitration_id <= MAX_ARBITRATION_ID:
+            _unreadable(report, path, line, f"id 0x{message.arbitration_id:X} beyond 29 bits")
+            continue
+        channel = str(message.channel) if message.channel is not None else ""
+        yield message.timestamp, message.arbitration_id, bytes(message.data), channel, line
 
 
 def read_can_log(path: str | Path) -> CanFrames:
     """Read every data frame of a candump ``-l``, ASC, BLF or python-can CSV log."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError("CAN log not found", path)
-    suffix = path.suffix.lower()
-    if suffix in _LINE_FORMATS:
-        messages, unreadable = _iterate_line_format(path, _LINE_FORMATS[suffix])
-    elif suffix in (".asc", ".blf"):
-        messages, unreadable = _iterate_binary_or_asc(path)
-    else:
-        raise InputError(f"unknown CAN log format {suffix!r} (.log, .asc, .blf or .csv)", path)
-    frames = [m for m in messages if not (m.is_error_frame or m.is_remote_frame)]
+    report = CanDecodeReport()
+    t, ids, data, channels = array("d"), array("q"), [], []
+    for time, frame_id, payload, channel, _ in iter_can_frames(path, report):
+        t.append(time)
+        ids.append(frame_id)
+        data.append(payload)
+        channels.append(channel)
     return CanFrames(
-        t=np.array([m.timestamp for m in frames], dtype=float),
-        arbitration_id=np.array([m.arbitration_id for m in frames], dtype=np.int64),
-        data=[bytes(m.data) for m in frames],
-        channel=np.array([str(m.channel) if m.channel is not None else "" for m in frames]),
-        n_unreadable=unreadable,
+        t=np.frombuffer(t, dtype=float).copy(),
+        arbitration_id=np.frombuffer(ids, dtype=np.int64).copy(),
+        data=data,
+        channel=np.array(channels, dtype=str),
+        n_unreadable=report.n_unreadable_lines,
         source=str(path),
     )
 
@@ -196,12 +315,24 @@ def frames_from_arrays(t, address, data, channel=None, source: str = "CAN arrays
     )
 
 
+DBC_MAX_LINE_CHARS = 16 * 1024
+"""Longest DBC line accepted: cantools' parser takes seconds per megabyte-long line."""
+
+
 def load_dbc(path: str | Path) -> cantools.database.can.Database:
+    """A DBC (or other cantools format, by suffix) read as bounded UTF-8 text; any parser error
+    is an :class:`InputError` naming the file."""
     path = Path(path)
+    text = read_text(path, "CAN database", SMALL_MAX_BYTES, DBC_MAX_LINE_CHARS)
+    formats = {".dbc": "dbc", ".kcd": "kcd", ".sym": "sym", ".arxml": "arxml", ".cdd": "cdd"}
     try:
-        return cantools.database.load_file(str(path), strict=False)
-    except (OSError, cantools.database.UnsupportedDatabaseFormatError) as exc:
-        raise InputError(f"cannot load DBC: {exc}", path) from exc
+        return cantools.database.load_string(
+            text, database_format=formats.get(path.suffix.lower()), strict=False
+        )
+    except Exception as exc:  # cantools wraps its parsers' errors inconsistently
+        raise InputError(
+            f"cannot load the CAN database: {type(exc).__name__}: {exc}", path
+        ) from exc
 
 
 def si_factor(unit: str | None, where: str) -> tuple[float, str]:
@@ -210,6 +341,119 @@ def si_factor(unit: str | None, where: str) -> tuple[float, str]:
     if key not in UNIT_TO_SI:
         raise InputError(f"signal {where} has unit {unit!r}, which has no known SI conversion")
     return UNIT_TO_SI[key]
+
+
+class _StreamDecoder:
+    """Decodes frames one at a time into compact per-message arrays (time, line, one value per
+    referenced signal), counting short, undecodable and foreign-channel frames."""
+
+    def __init__(self, db, refs, channel, report, short_frames, source):
+        if short_frames not in ("skip", "pad"):
+            raise ValueError(f"short_frames must be 'skip' or 'pad', not {short_frames!r}")
+        self.channel = channel
+        self.report = report
+        self.short_frames = short_frames
+        self.source = source
+        self.first_short: tuple[float, int, int, int] | None = None
+        self.undecodable: Counter[int] = Counter(report.undecodable_by_id)
+        by_message: dict[str, list[SignalRef]] = {}
+        for ref in refs:
+            by_message.setdefault(ref.message, []).append(ref)
+        self.messages = {}
+        self.factors = {}
+        for message_name, message_refs in by_message.items():
+            try:
+                message = db.get_message_by_name(message_name)
+            except KeyError as exc:
+                raise SignalError(f"message {message_name!r} is not in the DBC") from exc
+            for ref in message_refs:
+                try:
+                    signal = message.get_signal_by_name(ref.signal)
+                except KeyError as exc:
+                    raise SignalError(f"signal {ref} is not in the DBC") from exc
+                self.factors[ref] = si_factor(signal.unit, str(ref))
+                report.dbc_units[str(ref)] = signal.unit or ""
+            self.messages[message.frame_id] = (message, message_refs)
+        self.t = {frame_id: array("d") for frame_id in self.messages}
+        self.lines = {frame_id: array("q") for frame_id in self.messages}
+        self.values = {frame_id: array("d") for frame_id in self.messages}
+
+    def add(self, t: float, frame_id: int, payload: bytes, channel: str, line: int | None):
+        if self.channel is not None and channel != self.channel:
+            return
+        self.report.n_frames += 1
+        entry = self.messages.get(frame_id)
+        if entry is None:
+            return
+        message, refs = entry
+        if len(payload) < message.length:
+            if self.first_short is None:
+                self.first_short = (t, frame_id, len(payload), message.length)
+            if self.short_frames == "skip":
+                self.report.n_short_skipped += 1
+                return
+            payload = payload + bytes(message.length - len(payload))
+            self.report.n_padded += 1
+        try:
+            decoded = message.decode(payload, decode_choices=False)
+            sample = [float(decoded[ref.signal]) for ref in refs]
+        except (
+            cantools.database.errors.DecodeError,
+            KeyError,
+            ValueError,
+            TypeError,
+            OverflowError,
+        ):
+            self.undecodable[frame_id] += 1
+            self.report.n_undecodable += 1
+            return
+        self.report.n_decoded += 1
+        self.t[frame_id].append(t)
+        self.lines[frame_id].append(-1 if line is None else line)
+        self.values[frame_id].extend(sample)
+
+    def finish(self, path: str | Path | None = None) -> dict[SignalRef, SensorSeries]:
+        """Per reference, a series in SI units in time order (the ``"sort"`` policy)."""
+        out: dict[SignalRef, SensorSeries] = {}
+        for frame_id, (message, refs) in self.messages.items():
+            t = np.frombuffer(self.t[frame_id], dtype=float)
+            lines = np.frombuffer(self.lines[frame_id], dtype=np.int64)
+            table = np.frombuffer(self.values[frame_id], dtype=float).reshape(-1, len(refs))
+            t, table, order = order_samples(
+                t,
+                table,
+                path,
+                f"CAN message {message.name}",
+                lines if path is not None and np.all(lines > 0) else None,
+                policy="sort",
+            )
+            self.report.time_order[message.name] = order
+            for k, ref in enumerate(refs):
+                factor, unit = self.factors[ref]
+                out[ref] = SensorSeries(t.copy(), table[:, k] * factor, str(ref), unit)
+        self.report.undecodable_by_id = dict(self.undecodable)
+        self._log()
+        return out
+
+    def _log(self) -> None:
+        report = self.report
+        if self.first_short is not None:
+            t, frame_id, length, expected = self.first_short
+            skip = self.short_frames == "skip"
+            log.warning(
+                "%s: %d frames shorter than their DBC length %s (first at t = %.6f s: id 0x%X, "
+                "%d of %d bytes)%s",
+                self.source,
+                report.n_short_skipped if skip else report.n_padded,
+                "skipped" if skip else "zero-padded",
+                t,
+                frame_id,
+                length,
+                expected,
+                "; short_frames='pad' if the log drops trailing zero bytes" if skip else "",
+            )
+        if report.n_undecodable:
+            log.warning("CAN decoding: %s", report.summary())
 
 
 def decode_signals(
@@ -223,81 +467,18 @@ def decode_signals(
     """Decode the referenced signals to SI units; one series per reference, sorted by time.
 
     ``short_frames``: ``"skip"`` (default) or ``"pad"`` frames shorter than the DBC length."""
-    if short_frames not in ("skip", "pad"):
-        raise ValueError(f"short_frames must be 'skip' or 'pad', not {short_frames!r}")
     report = report if report is not None else CanDecodeReport()
-    first_short: tuple[float, int, int, int] | None = None
-    by_message: dict[str, list[SignalRef]] = {}
-    for ref in refs:
-        by_message.setdefault(ref.message, []).append(ref)
-    selected = np.ones(len(frames), dtype=bool)
-    if channel is not None:
-        selected &= frames.channel == channel
-    report.n_frames += int(selected.sum())
     report.n_unreadable_lines += frames.n_unreadable
-    undecodable: Counter[int] = Counter(report.undecodable_by_id)
-    out: dict[SignalRef, SensorSeries] = {}
-    for message_name, message_refs in by_message.items():
-        try:
-            message = db.get_message_by_name(message_name)
-        except KeyError as exc:
-            raise InputError(f"message {message_name!r} is not in the DBC") from exc
-        factors = {}
-        for ref in message_refs:
-            try:
-                signal = message.get_signal_by_name(ref.signal)
-            except KeyError as exc:
-                raise InputError(f"signal {ref} is not in the DBC") from exc
-            factors[ref] = si_factor(signal.unit, str(ref))
-        rows = np.flatnonzero(selected & (frames.arbitration_id == message.frame_id))
-        times: list[float] = []
-        values: list[list[float]] = []
-        for row in rows:
-            payload = frames.data[row]
-            if len(payload) < message.length:
-                if first_short is None:
-                    first_short = (frames.t[row], message.frame_id, len(payload), message.length)
-                if short_frames == "skip":
-                    report.n_short_skipped += 1
-                    continue
-                payload = payload + bytes(message.length - len(payload))
-                report.n_padded += 1
-            try:
-                decoded = message.decode(payload, decode_choices=False)
-                sample = [float(decoded[ref.signal]) for ref in message_refs]
-            except (cantools.database.errors.DecodeError, KeyError, ValueError, TypeError):
-                undecodable[message.frame_id] += 1
-                report.n_undecodable += 1
-                continue
-            times.append(frames.t[row])
-            values.append(sample)
-        report.n_decoded += len(times)
-        order = np.argsort(times, kind="stable")
-        table = np.asarray(values, dtype=float).reshape(-1, len(message_refs))[order]
-        for k, ref in enumerate(message_refs):
-            factor, unit = factors[ref]
-            out[ref] = SensorSeries(np.asarray(times)[order], table[:, k] * factor, str(ref), unit)
-    report.undecodable_by_id = dict(undecodable)
-    if first_short is not None:
-        t, frame_id, length, expected = first_short
-        action = "skipped" if short_frames == "skip" else "zero-padded"
-        log.warning(
-            "%s: %d frames shorter than their DBC length %s (first at t = %.6f s: id 0x%X, "
-            "%d of %d bytes)%s",
-            frames.source,
-            report.n_short_skipped if short_frames == "skip" else report.n_padded,
-            action,
-            t,
-            frame_id,
-            length,
-            expected,
-            "; short_frames='pad' if the log drops trailing zero bytes"
-            if short_frames == "skip"
-            else "",
+    decoder = _StreamDecoder(db, refs, channel, report, short_frames, frames.source)
+    for row in range(len(frames)):
+        decoder.add(
+            frames.t[row],
+            int(frames.arbitration_id[row]),
+            frames.data[row],
+            str(frames.channel[row]),
+            None,
         )
-    if report.n_undecodable:
-        log.warning("CAN decoding: %s", report.summary())
-    return out
+    return decoder.finish()
 
 
 def mean_of_series(series: list[SensorSeries], name: str = "") -> SensorSeries:
@@ -333,17 +514,37 @@ def decode_motion(
     ``yaw_rate_sign`` multiplies the decoded yaw rate so that the result is counter-clockwise
     positive; ``wheel_speed`` signals are averaged (e.g. the two rear wheels).
     """
-    if yaw_rate_sign not in (1.0, -1.0):
-        raise ValueError("yaw_rate_sign must be +1 or -1")
+    _check_sign(yaw_rate_sign)
     wheels = list(wheel_speed or [])
-    refs = ([yaw_rate] if yaw_rate else []) + wheels
     report = CanDecodeReport()
-    decoded = decode_signals(frames, db, refs, channel, report, short_frames)
+    decoded = decode_signals(
+        frames, db, ([yaw_rate] if yaw_rate else []) + wheels, channel, report, short_frames
+    )
+    return _motion(
+        decoded, report, yaw_rate, wheels, yaw_rate_sign, yaw_rate_offset_s, speed_offset_s
+    )
+
+
+def _check_sign(yaw_rate_sign: float) -> None:
+    if yaw_rate_sign not in (1.0, -1.0):
+        raise InputError(f"yaw_rate_sign must be +1 or -1, not {yaw_rate_sign!r}")
+
+
+def _motion(
+    decoded: dict[SignalRef, SensorSeries],
+    report: CanDecodeReport,
+    yaw_rate: SignalRef | None,
+    wheels: list[SignalRef],
+    yaw_rate_sign: float,
+    yaw_rate_offset_s: float,
+    speed_offset_s: float,
+) -> CanMotion:
+    """Yaw rate (signed, shifted) and mean wheel speed (shifted) from decoded series."""
     yaw_series = None
     if yaw_rate is not None:
         raw = decoded[yaw_rate]
         if raw.unit != "rad/s":
-            raise InputError(f"yaw-rate signal {yaw_rate} is in {raw.unit}, not an angular rate")
+            raise SignalError(f"yaw-rate signal {yaw_rate} is in {raw.unit}, not an angular rate")
         yaw_series = SensorSeries(
             raw.t + yaw_rate_offset_s, yaw_rate_sign * raw.value, "yaw_rate_rad_s", "rad/s"
         )
@@ -352,8 +553,18 @@ def decode_motion(
         parts = [decoded[ref] for ref in wheels]
         bad = [str(ref) for ref, s in zip(wheels, parts, strict=True) if s.unit != "m/s"]
         if bad:
-            raise InputError(f"wheel-speed signals {bad} are not speeds")
+            raise SignalError(f"wheel-speed signals {bad} are not speeds")
         speed_series = mean_of_series(parts, "speed_mps").shifted(speed_offset_s)
+    for series, ref, limit in (
+        (yaw_series, yaw_rate, MAX_YAW_RATE),
+        (speed_series, ",".join(map(str, wheels)), MAX_WHEEL_SPEED),
+    ):
+        if series is not None and len(series) and np.abs(series.value).max() > limit:
+            worst = float(np.abs(series.value).max())
+            raise InputError(
+                f"{ref} decodes to {worst:.4g} {series.unit}, beyond any car's {limit:g} "
+                f"{series.unit}: check the DBC factor and unit"
+            )
     return CanMotion(yaw_series, speed_series, report)
 
 
@@ -368,19 +579,32 @@ def read_can_motion(
     channel: str | None = None,
     short_frames: str = "skip",
 ) -> CanMotion:
-    """Read a CAN log and decode yaw rate (``MSG.SIG``) and mean wheel speed (``MSG.A,MSG.B``)."""
-    frames = read_can_log(log_path)
+    """Read a CAN log and decode yaw rate (``MSG.SIG``) and mean wheel speed (``MSG.A,MSG.B``),
+    frame by frame (no frame is held beyond its decoding)."""
+    _check_sign(yaw_rate_sign)
     db = load_dbc(dbc_path)
-    motion = decode_motion(
-        frames,
-        db,
-        SignalRef.parse(yaw_rate) if yaw_rate else None,
-        parse_signal_list(wheel_speed) if wheel_speed else None,
-        yaw_rate_sign,
-        yaw_rate_offset_s,
-        speed_offset_s,
-        channel,
-        short_frames,
-    )
+    report = CanDecodeReport()
+    try:
+        yaw_ref = SignalRef.parse(yaw_rate) if yaw_rate else None
+        wheels = parse_signal_list(wheel_speed) if wheel_speed else []
+        decoder = _StreamDecoder(
+            db,
+            ([yaw_ref] if yaw_ref else []) + wheels,
+            channel,
+            report,
+            short_frames,
+            str(log_path),
+        )
+    except SignalError as exc:
+        raise SignalError(str(exc), dbc_path) from exc
+    for frame in iter_can_frames(log_path, report):
+        decoder.add(*frame)
+    decoded = decoder.finish(log_path)
+    try:
+        motion = _motion(
+            decoded, report, yaw_ref, wheels, yaw_rate_sign, yaw_rate_offset_s, speed_offset_s
+        )
+    except SignalError as exc:
+        raise SignalError(str(exc), dbc_path) from exc
     log.info("%s: %s", log_path, motion.report.summary())
     return motion

@@ -4,7 +4,8 @@ NMEA: GGA and RMC sentences through pynmeagps. Fix times become GPS time in seco
 1980-01-06 (UTC + leap seconds) once an RMC sentence has given the date; a GGA-only file has no
 date, so its times stay UTC seconds of day (logged). Sentences with a bad checksum or no fix
 (GGA quality 0, RMC status V) are skipped and counted. When GGA and RMC report the same time,
-one fix is kept (GGA position, RMC speed over ground).
+one fix is kept (GGA position, RMC speed over ground). Fix times must not go backwards (the
+``"error"`` policy of :mod:`vo_doppler.io.time_order`, naming the sentence's line).
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from pynmeagps import NMEAMessageError, NMEAParseError, NMEAReader, NMEATypeErro
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.sensor_csv import read_numeric_csv
+from vo_doppler.io.textfile import read_text, regular_file
+from vo_doppler.io.time_order import order_samples
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.model.gpstime import utc_to_gps_seconds as gpstime_utc_to_gps
 
@@ -109,17 +112,14 @@ def _parse_sentences(path: Path, lines: list[bytes]):
         if no_fix or "" in (message.lat, message.lon, message.time):
             n_nofix += 1
             continue
-        messages.append(message)
+        messages.append((number, message))
     return messages, n_bad, n_nofix
 
 
 def read_nmea(path: str | Path) -> GpsFixes:
     """Read GGA/RMC fixes from an NMEA 0183 log (midnight roll-overs follow the time of day)."""
     path = Path(path)
-    try:
-        lines = path.read_bytes().splitlines()
-    except OSError as exc:
-        raise InputError(f"cannot read NMEA file: {exc.strerror or exc}", path) from exc
+    lines = [line.encode("ascii", "replace") for line in read_text(path, "NMEA file").split("\n")]
     messages, n_bad, n_nofix = _parse_sentences(path, lines)
     if n_bad or n_nofix:
         log.warning(
@@ -127,12 +127,13 @@ def read_nmea(path: str | Path) -> GpsFixes:
         )
     if not messages:
         raise InputError("no GGA or RMC fix found in the NMEA file", path)
-    date = next((m.date for m in messages if m.msgID == "RMC" and m.date != ""), None)
+    date = next((m.date for _, m in messages if m.msgID == "RMC" and m.date != ""), None)
     if date is None:
         log.warning("%s: no RMC date, fix times are UTC seconds of day", path)
     fixes: dict[float, list[float]] = {}
+    first_line: dict[float, int] = {}
     previous = None
-    for message in messages:
+    for number, message in messages:
         if message.msgID == "RMC" and message.date != "":
             date = message.date
         elif (
@@ -147,12 +148,18 @@ def read_nmea(path: str | Path) -> GpsFixes:
         else:
             t = utc_to_gps_seconds(dt.datetime.combine(date, message.time))
         entry = fixes.setdefault(t, [np.nan, np.nan, np.nan])
+        first_line.setdefault(t, number)
         if message.msgID == "GGA" or np.isnan(entry[0]):
             entry[0], entry[1] = float(message.lat), float(message.lon)
         if message.msgID == "RMC" and message.spd != "":
             entry[2] = float(message.spd) * KNOT_MPS
-    times = np.array(list(fixes), dtype=float)
-    rows = np.array(list(fixes.values()), dtype=float)
+    times, rows, _ = order_samples(
+        np.array(list(fixes), dtype=float),
+        np.array(list(fixes.values()), dtype=float),
+        path,
+        "NMEA fixes",
+        np.array(list(first_line.values())),
+    )
     return GpsFixes(
         times,
         np.radians(rows[:, 0]),
@@ -167,6 +174,7 @@ def read_nmea(path: str | Path) -> GpsFixes:
 def read_gps_fixes(path: str | Path) -> GpsFixes:
     """Read fixes from a CSV or an NMEA file: NMEA when one of the first lines starts with $."""
     path = Path(path)
+    regular_file(path, "GPS file")
     try:
         with path.open("rb") as handle:
             head = handle.read(8192).splitlines()[:20]

@@ -19,6 +19,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import course_to_yaw
+from vo_doppler.io.textfile import read_text
 from vo_doppler.model.heading import DEFAULT_TC_WINDOW_S, HeadingTable
 
 COLUMNS = (
@@ -76,12 +77,10 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
 
 
 def read_heading_csv(path: str | Path) -> HeadingTable:
-    """Read a heading CSV; bad rows raise :class:`InputError` naming the line."""
+    """Read a heading CSV; bad rows (and times that do not increase) raise
+    :class:`InputError` naming the line."""
     path = Path(path)
-    try:
-        lines = path.read_text().splitlines()
-    except OSError as exc:
-        raise InputError(f"cannot read heading CSV: {exc.strerror or exc}", path) from exc
+    lines = read_text(path, "heading CSV").splitlines()
     if not lines:
         raise InputError("heading CSV is empty", path)
     header = [name.strip() for name in next(csv.reader([lines[0]]))]
@@ -98,7 +97,12 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
             rows.append([float(fields[i]) for i in index])
         except (ValueError, IndexError) as exc:
             raise InputError(f"bad heading row ({exc})", path, number) from exc
+        if not np.isfinite(rows[-1][0]) or (len(rows) > 1 and rows[-1][0] <= rows[-2][0]):
+            raise InputError(
+                f"gps_time_s {rows[-1][0]} is not after the previous row's", path, number
+            )
     data = np.array(rows, dtype=float).reshape(-1, len(index))
+    _check_values(data, lines, path)
     optional = {
         c: data[:, len(COLUMNS) + i]
         for i, c in enumerate(c for c in OPTIONAL_COLUMNS if c in header)
@@ -120,6 +124,22 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
         sigma_conv=np.radians(optional.get("heading_conv_sigma_deg", np.full(len(data), np.nan))),
         tc_window_s=_window_s(optional.get("tc_window_s"), path),
     )
+
+
+HEADING_COLUMNS = (1, 2, 6)
+"""Heading and sigma columns: NaN where unavailable; every other column must be finite."""
+
+
+def _check_values(data: np.ndarray, lines: list[str], path: Path) -> None:
+    """No infinite value anywhere and no NaN outside the heading columns (names the line)."""
+    optional = np.zeros(data.shape[1], dtype=bool)
+    optional[list(HEADING_COLUMNS)] = True
+    optional[len(COLUMNS) :] = True  # optional columns may hold NaN (e.g. the conventional sigma)
+    bad = np.isinf(data) | (np.isnan(data) & ~optional)
+    if bad.any():
+        row, column = (int(v) for v in np.argwhere(bad)[0])
+        number = [n for n, line in enumerate(lines[1:], start=2) if line.strip()][row]
+        raise InputError(f"heading CSV value {data[row, column]} is not usable", path, number)
 
 
 def _window_s(column: np.ndarray | None, path: Path) -> float:

@@ -15,6 +15,7 @@ import cv2
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.textfile import read_text
 
 log = logging.getLogger(__name__)
 
@@ -68,10 +69,7 @@ def read_times(path: str | Path, n_images: int) -> np.ndarray:
     Times must increase strictly; the count must equal the number of images.
     """
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InputError(f"cannot read timestamps: {exc.strerror or exc}", path) from exc
+    text = read_text(path, "timestamps file")
     rows = [
         (number, line.strip())
         for number, line in enumerate(text.splitlines(), start=1)
@@ -93,7 +91,9 @@ def read_times(path: str | Path, n_images: int) -> np.ndarray:
         try:
             times[k] = float(fields[column])
         except (ValueError, IndexError) as exc:
-            raise InputError(f"timestamp is not a number: {line!r}", path, number) from exc
+            raise InputError(
+                f"timestamp is not a number (field {column + 1})", path, number
+            ) from exc
     if len(times) != n_images:
         raise InputError(f"{len(times)} timestamps for {n_images} images", path)
     steps = np.diff(times)

@@ -3,8 +3,11 @@
 
 One header row naming the columns, then one sample per row; ``#`` comments and blank lines are
 allowed. Rows that cannot be read or hold non-finite numbers are skipped, counted and logged; a
-file without a single usable row is an error. Sensor times must not go backwards (the line is
-named); they are seconds on the sensor's clock, and a per-sensor offset maps them to GPS time.
+file without a single usable row is an error. A file with a ``t`` column follows the ``"error"``
+time-order policy of :mod:`vo_doppler.io.time_order` (a row going back raises naming its line;
+duplicate times are dropped and counted). Times are seconds on the sensor's clock, and a
+per-sensor offset maps them to GPS time. Files are read through :mod:`vo_doppler.io.textfile`
+(bounded, UTF-8, no binary).
 """
 
 from __future__ import annotations
@@ -16,6 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.textfile import read_text
+from vo_doppler.io.time_order import TimeOrderReport, order_samples
 from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
@@ -32,6 +37,7 @@ class CsvReadReport:
     skipped_lines: list[int] = field(default_factory=list)
     row_lines: list[int] = field(default_factory=list)
     """Line of every row read, in order."""
+    time_order: TimeOrderReport | None = None
 
     def log_summary(self) -> None:
         if self.n_malformed or self.n_non_finite:
@@ -47,12 +53,10 @@ class CsvReadReport:
 def read_numeric_csv(
     path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = ()
 ) -> tuple[dict[str, np.ndarray], CsvReadReport]:
-    """Columns of a headed numeric CSV by name; bad rows skipped and counted."""
+    """Columns of a headed numeric CSV by name; bad rows skipped and counted; rows in time order
+    when the file has a ``t`` column."""
     path = Path(path)
-    try:
-        lines = path.read_text().splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read CSV: {exc}", path) from exc
+    lines = read_text(path, "CSV file").splitlines()
     report = CsvReadReport(path)
     header: list[str] | None = None
     index: dict[str, int] = {}
@@ -95,15 +99,17 @@ def read_numeric_csv(
     report.n_rows = len(rows)
     report.log_summary()
     data = np.asarray(rows, dtype=float)
+    if "t" in index:
+        j = list(index).index("t")
+        _, data, report.time_order = order_samples(
+            data[:, j], data, path, f"{path.name} samples", np.asarray(report.row_lines)
+        )
     return {name: data[:, j] for j, name in enumerate(index)}, report
 
 
 def read_sensor_csv(path: str | Path, column: str, time_offset_s: float = 0.0) -> SensorSeries:
     """The ``t,<column>`` signal of a headed CSV, ``time_offset_s`` added to its times."""
     columns, report = read_numeric_csv(path, ("t", column))
-    backwards = np.flatnonzero(np.diff(columns["t"]) < 0)
-    if backwards.size:
-        raise InputError("time goes backwards", path, report.row_lines[backwards[0] + 1])
     unit = "rad/s" if column == YAW_RATE_COLUMN else "m/s" if column == SPEED_COLUMN else ""
     skipped = report.n_malformed + report.n_non_finite
     return SensorSeries(columns["t"] + time_offset_s, columns[column], column, unit, skipped)

@@ -2,34 +2,56 @@
 written by ``vo-doppler simulate``; any recording laid out the same way works) into the
 recording model :class:`~vo_doppler.model.sequence.Sequence`.
 
-Paths in the manifest are relative to its folder. Every sensor clock is mapped to GPS time by
-``gps = sensor time + time_offset_s`` of that sensor.
+Paths in the manifest are relative to its folder and must stay inside it (no ``../`` out of
+it, no absolute paths) unless paths outside are explicitly allowed; every file must be a regular
+file. Every value is checked for its type and range and a bad one names its key. Every sensor
+clock is mapped to GPS time by ``gps = sensor time + time_offset_s`` of that sensor.
 """
 
 from __future__ import annotations
 
 import logging
+import math
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
-from vo_doppler.errors import InputError
+from vo_doppler.errors import InputError, ManifestError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import read_camera
-from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.can import CanDecodeReport, SignalError, read_can_motion
 from vo_doppler.io.doppler_sigma import read_doppler_sigma
 from vo_doppler.io.images import list_images, read_times
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.satellite_states import read_satellite_states
+from vo_doppler.io.textfile import regular_file
+from vo_doppler.io.time_order import TimeOrderReport
 from vo_doppler.io.trajectory import read_tum
+from vo_doppler.io.yaml_file import load_yaml
 from vo_doppler.model.sequence import Sequence
 
 log = logging.getLogger(__name__)
 
 MANIFEST = "sequence.yaml"
 FORMAT = "vo-doppler-sequence/1"
+MANIFEST_MAX_BYTES = 1 << 20
+_REQUIRED = object()
+
+
+@dataclass
+class InputReport:
+    """What reading a sequence found besides the data: per-sensor time order, the CAN decoding,
+    the DBC unit of the yaw-rate signal and the manifest's CAN clock offset."""
+
+    time_order: list[TimeOrderReport] = field(default_factory=list)
+    can: CanDecodeReport | None = None
+    yaw_rate_dbc_unit: str = ""
+    can_time_offset_s: float = 0.0
+
+    def warnings(self) -> list[str]:
+        return [text for report in self.time_order for text in report.problems()]
 
 
 def read_manifest(folder: str | Path) -> dict[str, Any]:
@@ -37,12 +59,7 @@ def read_manifest(folder: str | Path) -> dict[str, Any]:
     path = Path(folder)
     if path.is_dir():
         path = path / MANIFEST
-    try:
-        manifest = yaml.safe_load(path.read_text())
-    except OSError as exc:
-        raise InputError(f"cannot read the sequence manifest: {exc.strerror or exc}", path) from exc
-    except yaml.YAMLError as exc:
-        raise InputError(f"sequence manifest is not valid YAML: {exc}", path) from exc
+    manifest = load_yaml(path, "the sequence manifest", MANIFEST_MAX_BYTES)
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         found = manifest.get("format") if isinstance(manifest, dict) else type(manifest).__name__
         raise InputError(f"not a {FORMAT} manifest (format: {found!r})", path)
@@ -50,102 +67,212 @@ def read_manifest(folder: str | Path) -> dict[str, Any]:
     return manifest
 
 
-def _section(manifest: dict[str, Any], name: str) -> dict[str, Any]:
-    section = manifest.get(name)
-    if not isinstance(section, dict):
-        raise InputError(f"manifest has no '{name}' section", manifest["_path"])
-    return section
+class Manifest:
+    """Typed access to a parsed manifest: every value is checked for its type and range, and
+    every path for staying inside the sequence folder (unless ``allow_outside``); a bad value is
+    a :class:`ManifestError` naming the key, never the content of a file."""
+
+    def __init__(self, manifest: dict[str, Any], allow_outside: bool = False):
+        self.data = manifest
+        self.path: Path = manifest["_path"]
+        self.root = self.path.parent
+        self.allow_outside = allow_outside
+
+    def error(self, key: str, message: str) -> ManifestError:
+        return ManifestError(key, message, self.path)
+
+    def section(self, name: str) -> dict[str, Any]:
+        section = self.data.get(name)
+        if not isinstance(section, dict):
+            raise InputError(f"manifest has no '{name}' section", self.path)
+        return section
+
+    def value(self, section: str, key: str, default: Any = _REQUIRED) -> Any:
+        values = self.section(section)
+        if key not in values:
+            if default is _REQUIRED:
+                raise InputError(f"manifest section '{section}' lacks '{key}'", self.path)
+            return default
+        return values[key]
+
+    def number(
+        self,
+        section: str,
+        key: str,
+        default: Any = _REQUIRED,
+        low: float = -math.inf,
+        high: float = math.inf,
+    ) -> float:
+        """A finite number in [low, high] (YAML booleans and strings are refused)."""
+        value = self.value(section, key, default)
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.error(f"{section}.{key}", f"{value!r} is not a number")
+        value = float(value)
+        if not math.isfinite(value):
+            raise self.error(f"{section}.{key}", f"{value} is not a finite number")
+        if not low <= value <= high:
+            raise self.error(f"{section}.{key}", f"{value:g} is outside [{low:g}, {high:g}]")
+        return value
+
+    def string(self, section: str, key: str, default: Any = _REQUIRED) -> str:
+        value = self.value(section, key, default)
+        if not isinstance(value, str) or not value.strip():
+            raise self.error(f"{section}.{key}", f"{value!r} is not a non-empty string")
+        return value
+
+    def resolve(self, key: str, relative: Any) -> Path:
+        """``relative`` (a string) as a path inside the sequence folder."""
+        if not isinstance(relative, str) or not relative.strip():
+            raise self.error(key, f"{relative!r} is not a path string")
+        path = Path(relative)
+        if not self.allow_outside:
+            if path.is_absolute():
+                raise self.error(
+                    key,
+                    "absolute paths are refused; give a path relative to the sequence "
+                    "folder (or allow paths outside it)",
+                )
+            inside = (self.root / path).resolve()
+            if not inside.is_relative_to(self.root.resolve()):
+                raise self.error(
+                    key, "the path leaves the sequence folder (allow paths outside it to use it)"
+                )
+        return self.root / path
+
+    def file(self, section: str, key: str) -> Path:
+        """A regular file inside the sequence folder (devices and folders refused)."""
+        path = self.resolve(f"{section}.{key}", self.value(section, key))
+        try:
+            regular_file(path, f"{section}.{key}")
+        except InputError as exc:
+            raise self.error(f"{section}.{key}", str(exc)) from exc
+        return path
+
+    def files(self, section: str, key: str) -> list[Path]:
+        """One path string or a non-empty list of them."""
+        value = self.value(section, key)
+        items = value if isinstance(value, list) else [value]
+        if not items:
+            raise self.error(f"{section}.{key}", "is an empty list; give at least one file")
+        out = []
+        for item in items:
+            path = self.resolve(f"{section}.{key}", item)
+            try:
+                regular_file(path, f"{section}.{key}")
+            except InputError as exc:
+                raise self.error(f"{section}.{key}", str(exc)) from exc
+            out.append(path)
+        return out
+
+    def folder(self, section: str, key: str) -> Path:
+        path = self.resolve(f"{section}.{key}", self.value(section, key))
+        if not path.is_dir():
+            raise self.error(f"{section}.{key}", f"{path} is not a folder")
+        return path
 
 
-def _entry(section: dict[str, Any], key: str, manifest: dict[str, Any], where: str):
-    if key not in section:
-        raise InputError(f"manifest section '{where}' lacks '{key}'", manifest["_path"])
-    return section[key]
-
-
-def read_sequence(folder: str | Path) -> Sequence:
+def read_sequence(folder: str | Path, allow_outside: bool = False) -> Sequence:
     """All inputs of a sequence folder, on GPS time; ground truth when the folder has one."""
-    manifest = read_manifest(folder)
-    root = manifest["_path"].parent
-    gnss_cfg = _section(manifest, "gnss")
-    can_cfg = _section(manifest, "can")
-    origin = _section(manifest, "origin")
+    return read_sequence_with_report(folder, allow_outside)[0]
+
+
+def read_sequence_with_report(
+    folder: str | Path, allow_outside: bool = False
+) -> tuple[Sequence, InputReport]:
+    """:func:`read_sequence` and what reading found (time order per sensor, CAN decoding)."""
+    m = Manifest(read_manifest(folder), allow_outside)
+    for name in ("gnss", "can", "origin"):
+        m.section(name)
+    report = InputReport()
     images, times, camera, camera_offset = [], np.zeros(0), None, 0.0
-    if "camera" in manifest:  # a recording without video has no camera section
-        camera_cfg = _section(manifest, "camera")
-        camera_offset = float(camera_cfg.get("time_offset_s", 0.0))
-        images = list_images(root / _entry(camera_cfg, "images", manifest, "camera"))
-        times = read_times(root / _entry(camera_cfg, "times", manifest, "camera"), len(images))
-        camera = read_camera(root / _entry(camera_cfg, "calib", manifest, "camera"))
-    obs = read_obs(root / _entry(gnss_cfg, "obs", manifest, "gnss"))
-    nav = _satellite_states(gnss_cfg, manifest, root)
-    sigma_file = gnss_cfg.get("doppler_sigma")
-    if float(gnss_cfg.get("time_offset_s", 0.0)) != 0.0:
-        raise InputError("GNSS observations must be on GPS time (time_offset_s 0)", root)
-    can_offset = float(can_cfg.get("time_offset_s", 0.0))
-    short_frames = str(can_cfg.get("short_frames", "skip"))
+    if "camera" in m.data:  # a recording without video has no camera section
+        images = list_images(m.folder("camera", "images"))
+        camera_offset = m.number("camera", "time_offset_s", 0.0)
+        times = read_times(m.file("camera", "times"), len(images))
+        camera = read_camera(m.file("camera", "calib"))
+    obs = read_obs(m.file("gnss", "obs"))
+    if "orbits" in m.section("gnss"):
+        clocks = m.file("gnss", "clocks") if "clocks" in m.section("gnss") else None
+        nav = read_satellite_states(orbits=m.file("gnss", "orbits"), clocks=clocks)
+    else:
+        nav = read_satellite_states(m.files("gnss", "nav"))
+    sigma = None
+    if "doppler_sigma" in m.section("gnss"):
+        sigma = read_doppler_sigma(m.file("gnss", "doppler_sigma"))
+    if m.number("gnss", "time_offset_s", 0.0) != 0.0:
+        raise m.error("gnss.time_offset_s", "GNSS observations must be on GPS time (0)")
+    can_offset = m.number("can", "time_offset_s", 0.0)
+    short_frames = m.string("can", "short_frames", "skip")
     if short_frames not in ("skip", "pad"):
-        raise InputError(f"can.short_frames is {short_frames!r}, not skip or pad", root)
-    motion = read_can_motion(
-        root / _entry(can_cfg, "log", manifest, "can"),
-        root / _entry(can_cfg, "dbc", manifest, "can"),
-        _entry(can_cfg, "yaw_rate", manifest, "can"),
-        _entry(can_cfg, "wheel_speed", manifest, "can"),
-        float(can_cfg.get("yaw_rate_sign", 1.0)),
-        can_offset,
-        can_offset,
-        short_frames=short_frames,
-    )
+        raise m.error("can.short_frames", f"can.short_frames is {short_frames!r}, not skip or pad")
+    sign = m.number("can", "yaw_rate_sign", 1.0)
+    if sign not in (1.0, -1.0):
+        raise m.error("can.yaw_rate_sign", f"{sign:g} is not +1 or -1")
+    log_path = m.file("can", "log")
+    dbc_path = m.file("can", "dbc")
+    yaw_name = m.string("can", "yaw_rate")
+    try:
+        motion = read_can_motion(
+            log_path,
+            dbc_path,
+            yaw_name,
+            m.string("can", "wheel_speed"),
+            sign,
+            can_offset,
+            can_offset,
+            short_frames=short_frames,
+        )
+    except SignalError as exc:
+        raise m.error("can.yaw_rate / can.wheel_speed", str(exc)) from exc
     if motion.yaw_rate is None or motion.speed is None or not len(motion.speed):
-        raise InputError("CAN log gave no yaw rate or wheel speed", root / can_cfg["log"])
+        raise InputError("CAN log gave no yaw rate or wheel speed", log_path)
+    report.can = motion.report
+    report.time_order.extend(motion.report.time_order.values())
+    report.yaw_rate_dbc_unit = motion.report.dbc_units.get(yaw_name.strip(), "")
+    report.can_time_offset_s = can_offset
     enu = EnuFrame(
-        np.radians(float(_entry(origin, "lat_deg", manifest, "origin"))),
-        np.radians(float(_entry(origin, "lon_deg", manifest, "origin"))),
-        float(origin.get("height_m", 0.0)),
+        np.radians(m.number("origin", "lat_deg", low=-90.0, high=90.0)),
+        np.radians(m.number("origin", "lon_deg", low=-180.0, high=180.0)),
+        m.number("origin", "height_m", 0.0, low=-1.0e3, high=1.0e4),
     )
-    lever_arm = _lever_arm(gnss_cfg.get("antenna_lever_arm_m", (0.0, 0.0, 0.0)), root)
+    lever_arm = _lever_arm(m.value("gnss", "antenna_lever_arm_m", (0.0, 0.0, 0.0)), m.path)
     truth = None
-    truth_cfg = manifest.get("ground_truth")
-    if isinstance(truth_cfg, dict) and (root / truth_cfg.get("trajectory", "")).is_file():
-        truth = read_tum(root / truth_cfg["trajectory"])
-    return Sequence(
-        name=str(manifest.get("name", root.name)),
+    truth_cfg = m.data.get("ground_truth")
+    if isinstance(truth_cfg, dict) and "trajectory" in truth_cfg:
+        truth_path = m.resolve("ground_truth.trajectory", truth_cfg["trajectory"])
+        if truth_path.exists():
+            truth = read_tum(m.file("ground_truth", "trajectory"))
+    name = m.data.get("name", m.root.name)
+    if not isinstance(name, str | int | float) or isinstance(name, bool):
+        raise m.error("name", f"{name!r} is not a name")
+    sequence = Sequence(
+        name=str(name),
         image_paths=images,
         image_times=times + camera_offset,
         camera=camera,
         observations=obs,
         navigation=nav,
-        doppler_sigma=None if sigma_file is None else read_doppler_sigma(root / sigma_file),
+        doppler_sigma=sigma,
         yaw_rate=motion.yaw_rate,
         wheel_speed=motion.speed,
         enu=enu,
         truth=truth,
         antenna_lever_arm_m=lever_arm,
-        clock_offsets_s={
-            "camera": camera_offset,
-            "can": can_offset,
-            "gnss": 0.0,
-        },
+        clock_offsets_s={"camera": camera_offset, "can": can_offset, "gnss": 0.0},
     )
+    return sequence, report
 
 
-def _satellite_states(gnss_cfg: dict[str, Any], manifest: dict[str, Any], root: Path):
-    """``gnss.orbits`` (SP3, with ``gnss.clocks``) when given, else ``gnss.nav``."""
-    if "orbits" in gnss_cfg:
-        clocks = gnss_cfg.get("clocks")
-        return read_satellite_states(
-            orbits=root / gnss_cfg["orbits"], clocks=None if clocks is None else root / clocks
-        )
-    nav_paths = _entry(gnss_cfg, "nav", manifest, "gnss")
-    return read_satellite_states([root / p for p in np.atleast_1d(nav_paths)])
-
-
-def _lever_arm(value, root: Path) -> tuple[float, float, float]:
+def _lever_arm(value, path: Path) -> tuple[float, float, float]:
     """``gnss.antenna_lever_arm_m``: three numbers (x forward, y left, z up, m)."""
     try:
-        arm = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
+        arm = tuple(float(v) for v in value) if isinstance(value, list | tuple) else ()
+    except (TypeError, ValueError, OverflowError):
         arm = ()
     if len(arm) != 3 or not all(np.isfinite(arm)):
-        raise InputError(f"gnss.antenna_lever_arm_m is {value!r}, not three numbers (m)", root)
+        raise ManifestError(
+            "gnss.antenna_lever_arm_m",
+            f"gnss.antenna_lever_arm_m is {value!r}, not three numbers (m)",
+            path,
+        )
     return arm

@@ -1,5 +1,8 @@
 """Trajectory files: TUM rows ``t x y z qx qy qz qw`` and KITTI rows (the 3×4 matrix [R | t]
 row-major; KITTI files carry no time, so times come from elsewhere or default to the row index).
+
+TUM times must increase strictly (a repeated or earlier time names its line); KITTI rotations
+must be rotations (orthonormal within 1e-3, determinant +1) before they are re-orthonormalised.
 """
 
 from __future__ import annotations
@@ -10,15 +13,14 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.textfile import read_text
 from vo_doppler.model.trajectory import Trajectory
 
 
 def _read_numeric_rows(path: Path, n_columns: int, what: str) -> np.ndarray:
     rows: list[list[float]] = []
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InputError(f"cannot read {what} file: {exc.strerror or exc}", path) from exc
+    numbers: list[int] = []
+    text = read_text(path, f"{what} file")
     for number, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
@@ -35,19 +37,27 @@ def _read_numeric_rows(path: Path, n_columns: int, what: str) -> np.ndarray:
         if not np.all(np.isfinite(values)):
             raise InputError(f"{what} row has a non-finite value", path, number)
         rows.append(values)
-    return np.array(rows, dtype=float).reshape(-1, n_columns)
+        numbers.append(number)
+    return np.array(rows, dtype=float).reshape(-1, n_columns), np.array(numbers, dtype=int)
 
 
 def read_tum(path: str | Path) -> Trajectory:
     """Read a TUM trajectory file (``t x y z qx qy qz qw``; ``#`` comments allowed)."""
     path = Path(path)
-    data = _read_numeric_rows(path, 8, "TUM")
-    quats = data[:, 4:8]
-    norms = np.linalg.norm(quats, axis=1)
-    bad = np.flatnonzero(norms < 1e-9)
+    data, numbers = _read_numeric_rows(path, 8, "TUM")
+    steps = np.diff(data[:, 0])
+    if np.any(steps <= 0):
+        k = int(np.flatnonzero(steps <= 0)[0]) + 1
+        raise InputError(
+            f"TUM time {data[k, 0]:.9f} s is not after the previous row's", path, numbers[k]
+        )
+    scale = np.abs(data[:, 4:8]).max(axis=1, initial=0.0)
+    bad = np.flatnonzero(scale == 0.0)
     if bad.size:
-        raise InputError(f"TUM row {bad[0] + 1} has a zero quaternion", path)
-    return Trajectory(data[:, 0], data[:, 1:4], Rotation.from_quat(quats / norms[:, None]))
+        raise InputError("TUM row has a zero quaternion", path, numbers[bad[0]])
+    quats = data[:, 4:8] / scale[:, None]  # scaled first: no overflow or underflow in the norm
+    quats /= np.linalg.norm(quats, axis=1)[:, None]
+    return Trajectory(data[:, 0], data[:, 1:4], Rotation.from_quat(quats))
 
 
 def write_tum(path: str | Path, trajectory: Trajectory) -> None:
@@ -60,13 +70,19 @@ def write_tum(path: str | Path, trajectory: Trajectory) -> None:
 def read_kitti(path: str | Path, times: np.ndarray | None = None) -> Trajectory:
     """Read a KITTI pose file (3×4 row-major per line); times default to the row index."""
     path = Path(path)
-    data = _read_numeric_rows(path, 12, "KITTI")
+    data, numbers = _read_numeric_rows(path, 12, "KITTI")
     poses = data.reshape(-1, 3, 4)
     if times is None:
         times = np.arange(len(poses), dtype=float)
     elif len(times) != len(poses):
         raise InputError(f"{len(poses)} poses but {len(times)} timestamps", path)
     rotations = poses[:, :, :3]
+    gram = np.einsum("nji,njk->nik", rotations, rotations) - np.eye(3)
+    bad = np.flatnonzero((np.abs(gram).max(axis=(1, 2)) > 1e-3) | (np.linalg.det(rotations) <= 0))
+    if bad.size:
+        raise InputError(
+            "KITTI pose has no rotation matrix (not orthonormal)", path, numbers[bad[0]]
+        )
     u, _, vt = np.linalg.svd(rotations)
     fixed = u @ vt
     return Trajectory(times, poses[:, :, 3], Rotation.from_matrix(fixed))
@@ -91,21 +107,17 @@ def read_trajectory(path: str | Path, fmt: str = "auto", times=None) -> Trajecto
 
 
 def _sniff_format(path: Path) -> str:
-    try:
-        with path.open() as handle:
-            for line in handle:
-                stripped = line.strip()
-                if stripped and not stripped.startswith("#"):
-                    n = len(stripped.replace(",", " ").split())
-                    if n == 8:
-                        return "tum"
-                    if n == 12:
-                        return "kitti"
-                    raise InputError(
-                        f"cannot tell the trajectory format: first row has {n} fields "
-                        "(TUM has 8, KITTI 12)",
-                        path,
-                    )
-    except OSError as exc:
-        raise InputError(f"cannot read trajectory: {exc.strerror or exc}", path) from exc
+    for line in read_text(path, "trajectory file").splitlines():
+        stripped = line.strip()
+        if stripped and not stripped.startswith("#"):
+            n = len(stripped.replace(",", " ").split())
+            if n == 8:
+                return "tum"
+            if n == 12:
+                return "kitti"
+            raise InputError(
+                f"cannot tell the trajectory format: first row has {n} fields "
+                "(TUM has 8, KITTI 12)",
+                path,
+            )
     raise InputError("trajectory file has no data rows", path)

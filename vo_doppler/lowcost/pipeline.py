@@ -36,6 +36,7 @@ from vo_doppler.lowcost.series import SeriesReport, clean_series
 from vo_doppler.lowcost.static_bias import (
     AllanDeviation,
     allan_deviation,
+    choose_tau,
     detect_standstill,
     remove_bias,
     static_bias,
@@ -224,11 +225,11 @@ def _bias_model(rates: AlignedRates, standstill, config: DeadReckonConfig) -> Bi
         name: allan_deviation(values[still], rates.report1.rate_hz)
         for name, values in series.items()
     }
-    duration = standstill[1] - standstill[0]
-    tau = allan["combined"].tau_at_minimum if config.tau_s is None else float(config.tau_s)
-    if tau > duration:
-        log.warning("τ = %.3g s is longer than the standstill; using %.3g s", tau, duration)
-        tau = duration
+    choice = choose_tau(
+        config.tau_s, allan["combined"], standstill[1] - standstill[0], config.window_is_standstill
+    )
+    log.info("%s", choice.reason)
+    tau = choice.tau
     window = (standstill[1] - tau, standstill[1])
     eps0 = {name: static_bias(rates.t, values, *window).eps0 for name, values in series.items()}
     if config.threshold is None:

@@ -3,7 +3,10 @@
 [KZ] Eq. (5): ε0 = (1/N)·Σ ω_i over the N samples of τ seconds of standstill.
 [KZ] Eq. (6): ω' = ω − ε0.
 τ is proposed at the minimum of the overlapping Allan deviation of the standstill rates: shorter
-averages are dominated by white noise, longer ones by the wandering bias.
+averages are dominated by white noise, longer ones by the wandering bias. The rule of
+:func:`choose_tau`: τ never exceeds the window, and a window of straight driving (a moving record)
+averages over its whole length — its Allan minimum measures the driving (road, steering
+corrections), not the sensor, and a short τ there turns that motion into bias.
 """
 
 from __future__ import annotations
@@ -80,3 +83,38 @@ def detect_standstill(
         for a, b in zip(starts, ends, strict=True)
         if t[b] - t[a] >= min_duration
     ]
+
+
+@dataclass(frozen=True)
+class TauChoice:
+    """τ (s) and the sentence that says why."""
+
+    tau: float
+    reason: str
+
+
+def choose_tau(
+    requested: float | None, allan: AllanDeviation, window_s: float, window_is_standstill: bool
+) -> TauChoice:
+    """τ for Eq. (5): the requested value or, for ``auto`` (None), the Allan minimum over a
+    standstill and the whole window over a straight stretch; never longer than the window."""
+    window = "standstill" if window_is_standstill else "straight stretch"
+    if requested is None and not window_is_standstill:
+        return TauChoice(
+            window_s,
+            f"τ = the whole straight stretch ({window_s:.3g} s): the Allan minimum of a moving "
+            "record measures the driving, not the sensor",
+        )
+    if requested is None:
+        tau, source = allan.tau_at_minimum, "the Allan deviation minimum"
+    else:
+        tau, source = float(requested), "as given"
+    if not tau > 0:
+        raise InputError(f"τ must be positive, got {tau:g} s")
+    if tau > window_s:
+        return TauChoice(
+            window_s,
+            f"τ = {tau:.3g} s ({source}) is longer than the {window} ({window_s:.3g} s); "
+            f"using the whole {window}",
+        )
+    return TauChoice(tau, f"τ = {tau:.3g} s ({source}) over the {window}")

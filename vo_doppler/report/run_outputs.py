@@ -76,19 +76,26 @@ def readable_facts(summary: dict) -> dict[str, str]:
     """The summary's scalars with labels and units for people (the report's list)."""
     facts = {}
     for key, value in summary.items():
-        if key == "evaluation":
+        if key in ("evaluation", "time_order", "warnings"):
             continue
         label, fmt = FACT_FORMATS.get(key, (key, "{}"))
         facts[label] = fmt.format(value)
     return facts
 
 
-def write_run_outputs(sequence: Sequence, result: RunResult, config: RunConfig, out: Path) -> dict:
+def write_run_outputs(
+    sequence: Sequence,
+    result: RunResult,
+    config: RunConfig,
+    out: Path,
+    checks: dict | None = None,
+) -> dict:
     """Write a run's outputs into ``out`` (created if missing) and return its summary.
 
     The summary (also ``out/summary.json``) holds :func:`summarise`'s figures, the heading
-    correction used and, when the recording has ground truth, ``evaluation``: per pipeline the
-    errors of :func:`vo_doppler.eval.pipelines.evaluate_pipelines` as dictionaries.
+    correction used, the input ``checks`` (warnings, clock estimate, time order per sensor)
+    and, when the recording has ground truth, ``evaluation``: per pipeline the errors of
+    :func:`vo_doppler.eval.pipelines.evaluate_pipelines` as dictionaries.
     """
     out.mkdir(parents=True, exist_ok=True)
     file_names = {Pipeline.VO: "trajectory_vo.tum", Pipeline.VO_GPS_TC: "trajectory_corrected.tum"}
@@ -97,6 +104,7 @@ def write_run_outputs(sequence: Sequence, result: RunResult, config: RunConfig, 
     write_heading_csv(out / "heading.csv", result.heading)
     summary = summarise(result)
     summary["heading_correction"] = correction_label(config)
+    summary.update(checks or {})
     figures = [out / "trajectories.png", out / "heading.png"]
     truth = sequence.truth
     errors = {}

@@ -1,0 +1,57 @@
+"""The time-order policies: exact outcomes on small series."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from vo_doppler.errors import InputError
+from vo_doppler.io.time_order import order_samples
+
+
+def test_error_policy_names_the_line_of_the_sample_going_back():
+    with pytest.raises(InputError, match=r"f.csv:12: time goes backwards by 0.5 s in the gyro"):
+        order_samples([0.0, 1.0, 0.5], [1, 2, 3], "f.csv", "gyro", np.array([10, 11, 12]))
+
+
+def test_non_finite_times_are_errors():
+    with pytest.raises(InputError, match=r"f.csv:11: gyro time is nan"):
+        order_samples([0.0, np.nan], [1, 2], "f.csv", "gyro", np.array([10, 11]))
+
+
+def test_sort_policy_sorts_small_steps_and_refuses_large_ones():
+    t, v, report = order_samples([0.0, 0.3, 0.2, 0.4], [0, 3, 2, 4], None, "can", policy="sort")
+    np.testing.assert_array_equal(t, [0.0, 0.2, 0.3, 0.4])
+    np.testing.assert_array_equal(v, [0, 2, 3, 4])
+    assert report.n_out_of_order == 1 and "1 samples out of time order" in report.problems()[0]
+    with pytest.raises(InputError, match="time goes backwards by 5 s"):
+        order_samples([0.0, 6.0, 1.0], [0, 1, 2], None, "can", policy="sort")
+
+
+def test_duplicates_identical_dropped_conflicting_counted_first_kept():
+    t, v, report = order_samples(
+        [0.0, 1.0, 1.0, 2.0, 2.0], [[0, 0], [1, 1], [1, 1], [2, 2], [9, 2]], None, "x"
+    )
+    np.testing.assert_array_equal(t, [0.0, 1.0, 2.0])
+    np.testing.assert_array_equal(v, [[0, 0], [1, 1], [2, 2]])
+    assert (report.n_duplicates, report.n_conflicting_duplicates) == (1, 1)
+    assert report.as_dict() == {
+        "samples": 5,
+        "out_of_order": 0,
+        "duplicates": 1,
+        "conflicting_duplicates": 1,
+    }
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(-1e6, 1e6, allow_nan=False), min_size=1, max_size=40))
+def test_sorted_output_is_strictly_increasing_or_the_input_was_refused(times):
+    try:
+        t, _, _ = order_samples(times, np.arange(len(times)), None, "x", policy="sort")
+    except InputError:
+        late = np.maximum.accumulate(times)[:-1] - np.asarray(times)[1:]
+        assert late.max() > 0.5
+        return
+    assert np.all(np.diff(t) > 0)

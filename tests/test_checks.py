@@ -1,0 +1,72 @@
+"""Plausibility checks on exact synthetic cases."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vo_doppler.checks import (
+    check_yaw_rate_unit,
+    clock_warning,
+    estimate_clock_offset,
+    moving_yaw_rate_medians,
+    origin_warning,
+)
+from vo_doppler.errors import InputError
+from vo_doppler.geo import EnuFrame
+from vo_doppler.model.series import SensorSeries
+
+T = np.arange(0.0, 60.0, 0.01)
+SPEED = SensorSeries(T, 10.0 + 3.0 * np.sin(0.4 * T) + 2.0 * np.sin(1.3 * T), "speed", "m/s")
+
+
+def test_ordinary_yaw_rate_passes_and_deg_read_as_rad_is_named():
+    deg_per_s = 0.3 + 2.0 * np.sin(0.2 * T)  # a drive's yaw rate in °/s
+    ordinary = SensorSeries(T, np.radians(deg_per_s), "yaw", "rad/s")
+    check_yaw_rate_unit(ordinary, SPEED, "deg/s")
+    rate, lateral = moving_yaw_rate_medians(ordinary, SPEED)
+    assert rate == pytest.approx(np.radians(np.median(np.abs(deg_per_s))))
+    assert lateral < 1.5
+    wrong = SensorSeries(T, deg_per_s, "yaw", "rad/s")
+    with pytest.raises(InputError, match="rad/s but the values look like deg/s"):
+        check_yaw_rate_unit(wrong, SPEED, "rad/s")
+    with pytest.raises(InputError, match="implausibly large") as info:
+        check_yaw_rate_unit(wrong, SPEED, "deg/s")
+    assert "look like deg/s" not in str(info.value)
+
+
+def test_standstill_only_yaw_rate_is_not_judged():
+    still = SensorSeries(T, np.zeros_like(T), "speed", "m/s")
+    check_yaw_rate_unit(SensorSeries(T, np.full_like(T, 5.0), "yaw", "rad/s"), still, "rad/s")
+
+
+@pytest.mark.parametrize("shift", [0.0, 0.35, -1.2, 4.0])
+def test_clock_offset_is_recovered(shift):
+    t_gnss = np.arange(5.0, 55.0, 0.2)
+    gnss_speed = np.interp(t_gnss, SPEED.t, SPEED.value)
+    gnss_speed[::3] = np.nan  # gaps are skipped, not interpolated
+    late = SPEED.shifted(-shift)  # the wheel clock runs `shift` s behind
+    estimate = estimate_clock_offset(late, t_gnss, gnss_speed)
+    assert estimate is not None and estimate.correlation > 0.99
+    assert estimate.residual_s == pytest.approx(shift, abs=0.01)
+    warning = clock_warning("CAN", estimate, 100.0)
+    if abs(shift) > 0.2:
+        assert f"{100.0 + shift:.1f}" in warning and "CAN clock" in warning
+    else:
+        assert warning is None
+
+
+def test_featureless_speed_gives_no_estimate():
+    flat = SensorSeries(T, np.full_like(T, 10.0), "speed", "m/s")
+    t_gnss = np.arange(5.0, 55.0, 0.2)
+    assert estimate_clock_offset(flat, t_gnss, np.full_like(t_gnss, 10.0)) is None
+
+
+def test_origin_far_from_the_approximate_position_is_a_warning():
+    enu = EnuFrame(np.radians(35.6938), np.radians(139.7034), 77.0)
+    near = enu.enu_to_ecef(np.array([3000.0, 4000.0, 0.0]))
+    assert origin_warning(enu, near) is None
+    far = enu.enu_to_ecef(np.array([30_000.0, 40_000.0, 0.0]))
+    assert "50.0 km from the manifest's origin" in origin_warning(enu, far)
+    assert origin_warning(enu, np.zeros(3)) is None
+    assert origin_warning(enu, None) is None

@@ -1,0 +1,155 @@
+"""Plausibility checks that turn silent input errors into named warnings or errors.
+
+Pure functions over model types and numpy (no file I/O, no stage): the callers
+(``vo-doppler run``) raise the errors before the long work and put the warnings in the run's
+summary. Each check states its threshold:
+
+* yaw rate against its DBC unit: while the wheels turn faster than 2 m/s, a median |yaw rate|
+  above 0.2 rad/s (11.5 °/s) or a median lateral acceleration |yaw rate × speed| above
+  1.5 m/s² is no car's road driving (a skid pad would be); when the DBC says rad/s and the
+  values read as deg/s would be ordinary, the hint says so;
+* the CAN clock against the GNSS speed: the lag maximising the correlation of the wheel speed
+  with the horizontal Doppler speed at the valid GNSS epochs (±5 s, or a quarter of a shorter
+  record) is the residual clock
+  offset; beyond 0.2 s it is a warning reporting the estimate next to the manifest's
+  ``time_offset_s``;
+* the ENU origin against the RINEX approximate position: more than 10 km apart is a warning.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.errors import InputError
+from vo_doppler.geo import EnuFrame
+from vo_doppler.model.series import SensorSeries
+
+MOVING_SPEED_MPS = 2.0
+MAX_MEDIAN_YAW_RATE = 0.2
+"""rad/s (11.5 °/s): a car's median |yaw rate| while moving is a few °/s at most (road drives:
+1–2 °/s); a deg/s signal read as rad/s is 57 times its true value."""
+MAX_MEDIAN_LATERAL_ACCELERATION = 1.5
+"""m/s²: a car's median |yaw rate × speed| while moving (road drives: ≈ 0.3 m/s²)."""
+CLOCK_TOLERANCE_S = 0.2
+CLOCK_SEARCH_S = 5.0
+CLOCK_RATE_HZ = 10.0
+MIN_CORRELATION = 0.5
+"""Correlation peak below which the speed profiles are too featureless to estimate a lag."""
+ORIGIN_TOLERANCE_M = 10_000.0
+EARTH_SURFACE_M = (6.3e6, 6.4e6)
+"""Norm of an ECEF position on the ground (m): outside, the approximate position is no place."""
+
+
+@dataclass(frozen=True)
+class ClockOffsetEstimate:
+    """Residual offset (s) to add to the sensor's ``time_offset_s`` and the correlation peak."""
+
+    residual_s: float
+    correlation: float
+
+
+def moving_yaw_rate_medians(yaw_rate: SensorSeries, speed: SensorSeries) -> tuple[float, float]:
+    """Median |yaw rate| (rad/s) and median |yaw rate × speed| (m/s²) over the yaw-rate samples
+    where the wheel speed exceeds 2 m/s (NaNs when the vehicle never moves)."""
+    if len(yaw_rate) == 0 or len(speed) < 2:
+        return float("nan"), float("nan")
+    v = np.interp(yaw_rate.t, speed.t, speed.value, left=0.0, right=0.0)
+    moving = v > MOVING_SPEED_MPS
+    if not moving.any():
+        return float("nan"), float("nan")
+    rate = np.abs(yaw_rate.value[moving])
+    return float(np.median(rate)), float(np.median(rate * v[moving]))
+
+
+def check_yaw_rate_unit(yaw_rate: SensorSeries, speed: SensorSeries, dbc_unit: str) -> None:
+    """Raise when the yaw rate is implausibly large for a moving car (module docstring)."""
+    rate, lateral = moving_yaw_rate_medians(yaw_rate, speed)
+    if not (rate > MAX_MEDIAN_YAW_RATE or lateral > MAX_MEDIAN_LATERAL_ACCELERATION):
+        return
+    hint = ""
+    as_degrees = np.radians([rate, lateral])
+    if dbc_unit.strip().lower().replace(" ", "") == "rad/s" and (
+        as_degrees[0] <= MAX_MEDIAN_YAW_RATE and as_degrees[1] <= MAX_MEDIAN_LATERAL_ACCELERATION
+    ):
+        hint = (
+            "; the DBC declares the signal in rad/s but the values look like deg/s: fix the "
+            "unit in the DBC"
+        )
+    raise InputError(
+        f"yaw rate implausibly large for a moving car: median |yaw rate| {rate:.3g} rad/s "
+        f"({np.degrees(rate):.3g} °/s), median |yaw rate × speed| {lateral:.3g} m/s² while "
+        f"moving (DBC unit {dbc_unit!r}){hint}"
+    )
+
+
+def estimate_clock_offset(
+    speed: SensorSeries, t_gnss: np.ndarray, speed_gnss: np.ndarray
+) -> ClockOffsetEstimate | None:
+    """Residual clock offset of ``speed`` (already on GPS time by the manifest's offset) against
+    the GNSS speed: the shift s (0.1-s steps within ±5 s or a quarter of the record, refined by
+    a parabola through the peak) maximising the correlation of gnss(t) with speed(t − s) over
+    the valid GNSS epochs (no interpolation across GNSS gaps); None with fewer than 20 epochs
+    inside the overlap or a peak below 0.5."""
+    t_gnss, speed_gnss = np.asarray(t_gnss, dtype=float), np.asarray(speed_gnss, dtype=float)
+    if len(speed) < 2:
+        return None
+    span = min(CLOCK_SEARCH_S, (speed.t[-1] - speed.t[0]) / 4)
+    inside = (
+        np.isfinite(speed_gnss) & (t_gnss >= speed.t[0] + span) & (t_gnss <= speed.t[-1] - span)
+    )
+    if np.count_nonzero(inside) < 20:
+        return None
+    t, reference = t_gnss[inside], speed_gnss[inside] - speed_gnss[inside].mean()
+    step = 1.0 / CLOCK_RATE_HZ
+    lags = np.arange(-span, span + step / 2, step)
+    scores = np.empty(len(lags))
+    for k, lag in enumerate(lags):
+        shifted = np.interp(t - lag, speed.t, speed.value)
+        shifted = shifted - shifted.mean()
+        norm = np.linalg.norm(shifted) * np.linalg.norm(reference)
+        scores[k] = shifted @ reference / norm if norm > 0 else 0.0
+    best = int(np.argmax(scores))
+    if scores[best] < MIN_CORRELATION:
+        return None
+    offset = 0.0
+    if 0 < best < len(lags) - 1:
+        left, mid, right = scores[best - 1 : best + 2]
+        curvature = left - 2 * mid + right
+        if curvature < 0:
+            offset = 0.5 * (left - right) / curvature
+    return ClockOffsetEstimate(float(lags[best] + offset * step), float(scores[best]))
+
+
+def clock_warning(
+    sensor: str, estimate: ClockOffsetEstimate | None, manifest_offset_s: float
+) -> str | None:
+    """A warning when the estimated residual offset exceeds 0.2 s."""
+    if estimate is None or abs(estimate.residual_s) <= CLOCK_TOLERANCE_S:
+        return None
+    return (
+        f"{sensor} clock: the wheel speed matches the GNSS Doppler speed best when shifted by "
+        f"{estimate.residual_s:+.2f} s (correlation {estimate.correlation:.2f}); the manifest's "
+        f"time_offset_s {manifest_offset_s:.3f} s should be about "
+        f"{manifest_offset_s + estimate.residual_s:.3f} s"
+    )
+
+
+def origin_warning(enu: EnuFrame, approx_position_ecef: np.ndarray | None) -> str | None:
+    """A warning when the RINEX approximate position lies more than 10 km from the ENU origin
+    (nothing when the file gives no usable approximate position)."""
+    if approx_position_ecef is None:
+        return None
+    approx = np.asarray(approx_position_ecef, dtype=float)
+    if not (np.all(np.isfinite(approx)) and EARTH_SURFACE_M[0] < np.linalg.norm(approx)):
+        return None
+    if np.linalg.norm(approx) > EARTH_SURFACE_M[1]:
+        return None
+    distance = float(np.linalg.norm(enu.ecef_to_enu(approx)[:2]))
+    if distance <= ORIGIN_TOLERANCE_M:
+        return None
+    return (
+        f"origin: the RINEX approximate position is {distance / 1000:.1f} km from the manifest's "
+        "origin (lat_deg, lon_deg); check the origin"
+    )
