@@ -1,4 +1,5 @@
-"""``vo-doppler gnss``: Doppler velocity and single-point positions from RINEX files."""
+"""``vo-doppler gnss``: Doppler velocity and single-point positions from RINEX files, u-blox UBX
+or Android logs (``vo_doppler.io.receiver_file``)."""
 
 from __future__ import annotations
 
@@ -8,12 +9,13 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.errors import VoDopplerError
+from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
 from vo_doppler.gnss.spp import solve_spp
 from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
+from vo_doppler.io.receiver_file import read_observation_file
 from vo_doppler.io.rinex_nav import read_nav
-from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
+from vo_doppler.io.rinex_obs import SYSTEMS
 from vo_doppler.report.gnss import spp_figure, velocity_figure
 
 log = logging.getLogger(__name__)
@@ -28,9 +30,17 @@ def _systems(text: str) -> str:
 
 
 def _common(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("obs", type=Path, help="RINEX 2/3 observation file (.gz / Hatanaka ok)")
     parser.add_argument(
-        "--nav", type=Path, action="append", required=True, help="RINEX navigation file (repeat)"
+        "obs",
+        type=Path,
+        help="observations: RINEX 2/3 (.gz / Hatanaka ok), u-blox UBX, Android GnssLogger "
+        "or GSDC device_gnss.csv (recognised by content)",
+    )
+    parser.add_argument(
+        "--nav",
+        type=Path,
+        action="append",
+        help="RINEX navigation file (repeat); optional for a UBX log with GPS subframes",
     )
     parser.add_argument("--systems", type=_systems, default="GREJC", help="default GREJC")
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees (default 10)")
@@ -66,8 +76,10 @@ def register(subparsers, summary: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    obs = read_obs(args.obs)
-    nav = read_nav(args.nav)
+    obs, embedded = read_observation_file(args.obs)
+    nav = read_nav(args.nav) if args.nav else embedded
+    if nav is None:
+        raise InputError("no navigation data: give --nav", args.obs)
     mask = np.deg2rad(args.elev_mask)
     figure = args.figure or args.output.with_suffix(".png")
     title = f"{args.obs.name} ({args.systems})"
