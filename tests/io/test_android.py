@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from tests.conftest import require_shared
@@ -243,3 +245,34 @@ def test_pixel6_log_with_gyro_rows():
     assert np.all((log.yaw_rate.t > raw_span[0]) & (log.yaw_rate.t < raw_span[1]))
     assert log.mounting_method == "mean accelerometer direction"
     assert log.up_axis[2] > 0.9  # the phone lay roughly flat, screen up
+
+
+BASE_LOG = HEADER + "\n" + "\n".join(synthetic_rows(0) + synthetic_rows(1)) + "\n"
+
+
+@settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    edits=st.lists(
+        st.tuples(
+            st.integers(0, len(BASE_LOG) - 1),
+            st.sampled_from([",", "x", "\n", "-", "9", "", "é", "\x00"]),
+        ),
+        min_size=1,
+        max_size=8,
+    )
+)
+def test_corrupted_logs_fail_only_with_input_errors(tmp_path, edits):
+    text = BASE_LOG
+    for position, replacement in edits:
+        text = text[:position] + replacement + text[position + 1 :]
+    path = tmp_path / "gnss_log.txt"
+    path.write_text(text, encoding="utf-8")
+    try:
+        log = read_gnsslogger(path)
+    except InputError as exc:
+        assert "gnss_log.txt" in str(exc)
+        return
+    assert np.all(np.isfinite(log.observations.value))
+    assert np.all(np.diff(log.observations.epoch_time) > 0)

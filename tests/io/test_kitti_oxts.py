@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.kitti_oxts import EARTH_RADIUS_M, OXTS_FIELDS, read_oxts
@@ -93,3 +95,24 @@ def test_file_count_must_match_timestamps(tmp_path):
     (folder / "data" / "0000000059.txt").unlink()
     with pytest.raises(InputError, match="59 OXTS data files for 60 timestamps"):
         read_oxts(folder)
+
+
+@settings(
+    max_examples=100, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    line=st.text(alphabet="0123456789.-e :xn", max_size=60),
+    stamp=st.text(alphabet="0123456789.-: ", max_size=32),
+)
+def test_damaged_packet_or_timestamp_fails_only_with_input_errors(tmp_path_factory, line, stamp):
+    folder = _write_circle(tmp_path_factory.mktemp("oxts") / "oxts")
+    (folder / "data" / "0000000003.txt").write_text(line)
+    stamps = (folder / "timestamps.txt").read_text().splitlines()
+    stamps[3] = stamp
+    (folder / "timestamps.txt").write_text("\n".join(stamps))
+    try:
+        record = read_oxts(folder)
+    except InputError as exc:
+        assert "timestamps.txt:" in str(exc) or "0000000003.txt" in str(exc)
+        return
+    assert np.all(np.isfinite(record.poses)) and np.all(np.diff(record.t) > 0)

@@ -198,3 +198,13 @@ def test_corrupted_streams_fail_only_with_input_errors(tmp_path, cuts, flips, tr
         assert "log.ubx@" in problem
     if recording.observations is not None:
         assert np.all(np.isfinite(recording.observations.value))
+
+
+def test_out_of_range_values_are_dropped_and_counted(tmp_path):
+    message = UBXMessage(
+        "RXM", "RXM-RAWX", 0, rcvTow=TOW, week=WEEK, numMeas=1, version=1, prMes_01=float("nan"),
+        doMes_01=2.0e6, gnssId_01=0, svId_01=5, cno_01=45, prValid_01=1,
+    ).serialize()  # fmt: skip
+    recording = read_ubx(write(tmp_path, message))
+    assert recording.observations.codes == ("S1C",)
+    assert any("2 RXM-RAWX values out of range" in p for p in recording.problems)

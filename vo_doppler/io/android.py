@@ -36,6 +36,7 @@ from vo_doppler.model.series import SensorSeries
 
 UNIX_TO_GPS_EPOCH_S = 315964800.0
 DOMINANCE_RATIO = 3.0
+RAW_INTEGERS = ("ConstellationType", "Svid", "TimeNanos", "FullBiasNanos", "ReceivedSvTimeNanos")
 GYRO_RECORDS = ("UncalGyro", "Gyro")
 ACCEL_RECORDS = ("UncalAccel", "Accel")
 
@@ -90,10 +91,25 @@ class Records:
     def integers(self, name: str, path: Path) -> np.ndarray | None:
         """A column as exact int64, or None when any row lacks it or is not an integer."""
         text = np.char.strip(self.text(name))
-        try:
-            return np.array([int(v) for v in text], dtype=np.int64)
-        except ValueError:
+        if not np.all(self.is_integer(name)):
             return None
+        return np.array([int(v) for v in text], dtype=np.int64)
+
+    def is_integer(self, name: str) -> np.ndarray:
+        """Rows whose field is a (signed) decimal integer of at most 19 digits."""
+        text = np.char.lstrip(np.char.strip(self.text(name)), "-")
+        return np.char.isdigit(text) & (np.char.str_len(text) <= 19)
+
+    def usable(self, names: tuple[str, ...], path: Path, problems: list[str]) -> Records:
+        """The rows whose given fields are all integers; the others are counted and dropped."""
+        keep = np.ones(len(self.line), dtype=bool)
+        for name in names:
+            keep &= self.is_integer(name)
+        if not np.any(keep):
+            raise InputError(f"no Raw row with integer {', '.join(names)}", path)
+        if not np.all(keep):
+            problems.append(f"{path}: {int(np.sum(~keep))} Raw rows without {', '.join(names)}")
+        return self.subset(keep)
 
 
 def read_gnsslogger(path: str | Path, mounting: np.ndarray | None = None) -> AndroidLog:
@@ -103,7 +119,7 @@ def read_gnsslogger(path: str | Path, mounting: np.ndarray | None = None) -> And
     if "Raw" not in records:
         raise InputError("no Raw records (GnssMeasurement rows) in the log", path)
     problems: list[str] = []
-    raw = records["Raw"]
+    raw = records["Raw"].usable(RAW_INTEGERS, path, problems)
     observations, sigma = raw_observations(raw_columns(raw, path), "Android GnssLogger", problems)
     gyro_kind = next((k for k in GYRO_RECORDS if k in records), None)
     if gyro_kind is None:

@@ -64,7 +64,7 @@ def read_device_gnss(path: str | Path) -> GsdcRecording:
         raise InputError("no row with an ArrivalTimeNanosSinceGpsEpoch", path)
     if not np.all(timed):
         problems.append(f"{path}: {int(np.sum(~timed))} Raw rows without an arrival time dropped")
-    rows = rows.subset(timed)
+    rows = rows.subset(timed).usable(("ConstellationType", "Svid"), path, problems)
     number = lambda name: rows.numbers(name, path)  # noqa: E731
     arrival_ns = number("ArrivalTimeNanosSinceGpsEpoch")
     columns = replace(

@@ -11,7 +11,8 @@ skipped with a message ``FILE@OFFSET: …`` in ``problems``; a truncated last fr
   prValid, carrier phase ``L`` (cycles) when cpValid, Doppler ``D`` (Hz, positive approaching:
   already the RINEX sign, RINEX 3.05 sec. 5.2.10), C/N0 ``S`` (dB-Hz). LLI on ``L`` rows:
   bit 0 when the lock time dropped since the signal's previous epoch, bit 1 when the half cycle
-  is not resolved (halfCyc = 0). Reported σ (prStdev 0.01·2ⁿ m, cpStdev 0.004·n cycles,
+  is not resolved (halfCyc = 0). Values outside ``VALUE_RANGES`` (or not finite) are dropped
+  and counted. Reported σ (prStdev 0.01·2ⁿ m, cpStdev 0.004·n cycles,
   doStdev 0.002·2ⁿ Hz) are kept as a :class:`RowSigma`. GLONASS channel k = freqId − 7; rows
   with an unknown GLONASS slot (svId 255) are skipped.
 - RXM-SFRBX → GPS L1 C/A LNAV subframes 1–3 decoded into ephemerides
@@ -85,6 +86,12 @@ SIGNAL_CODES: dict[tuple[int, int], str] = {
     (6, 0): "1C",
     (6, 2): "2C",
     (7, 0): "5A",
+}
+VALUE_RANGES = {  # plausible RXM-RAWX values; others (and NaN) are dropped and counted
+    "C": (1.0e6, 1.0e8),  # pseudorange, m (clock offsets of a few ms included)
+    "L": (-1.0e12, 1.0e12),  # carrier phase, cycles
+    "D": (-1.0e5, 1.0e5),  # Doppler, Hz
+    "S": (0.0, 100.0),  # C/N0, dB-Hz
 }
 PVT_TIME_TOLERANCE_S = 2.0  # iTOW vs UTC + leap seconds: a leap second unknown to the table
 _PARSE_ERRORS = (UBXParseError, UBXMessageError, UBXTypeError, ValueError, struct.error)
@@ -201,6 +208,7 @@ class _RawxRows:
         self.lock: dict[tuple[int, int, int], int] = {}
         self.week: int | None = None
         self.n_unknown = 0
+        self.n_out_of_range = 0
 
     def add(self, message, offset: int, path: Path, problems: list[str]) -> None:
         tow, week = float(message.rcvTow), int(message.week)
@@ -240,6 +248,10 @@ class _RawxRows:
         if getattr(m, "cpValid" + s):
             rows.append(("L", getattr(m, "cpMes" + s), 0.004 * getattr(m, "cpStd" + s), lli))
         for kind, value, sigma, flag in rows:
+            low, high = VALUE_RANGES[kind]
+            if not low <= value <= high:  # False for NaN too
+                self.n_out_of_range += 1
+                continue
             self.time.append(t)
             self.system.append(system)
             self.prn.append(prn)
@@ -251,6 +263,8 @@ class _RawxRows:
     def observations(self, path: Path, problems: list[str]) -> Observations:
         if self.n_unknown:
             _problem(problems, path, 0, f"{self.n_unknown} RXM-RAWX signals of unknown kind")
+        if self.n_out_of_range:
+            _problem(problems, path, 0, f"{self.n_out_of_range} RXM-RAWX values out of range")
         return observations_from_rows(
             path,
             "u-blox (UBX RXM-RAWX)",
