@@ -38,6 +38,7 @@ HEADER = "\n".join(
         "UncalGyroZRadPerSec,DriftXRadPerSec,DriftYRadPerSec,DriftZRadPerSec",
         "# UncalAccel,utcTimeMillis,elapsedRealtimeNanos,UncalAccelXMps2,UncalAccelYMps2,"
         "UncalAccelZMps2,BiasXMps2,BiasYMps2,BiasZMps2",
+        "# Nav,Svid,Type,Status,MessageId,Sub-messageId,Data(Bytes)",
         "#",
     ]
 )
@@ -83,6 +84,7 @@ def t_rx_mod(period: int) -> int:
 
 
 def synthetic_rows(epoch: int = 0) -> list[str]:
+    """Raw rows of one epoch (and a Nav row, whose data bytes outnumber its header's columns)."""
     glonass_tod = (t_rx_mod(DAY_NS) + 3 * 3600 * 10**9 - 18 * 10**9) % DAY_NS
     return [
         raw_row(7, 1, 16431, t_rx_mod(WEEK_NS) - 70_000_000, 123.456, L1, epoch, adr=-2.5e4),
@@ -91,6 +93,7 @@ def synthetic_rows(epoch: int = 0) -> list[str]:
         raw_row(4, 3, 227, glonass_tod - 68_000_000, 600.0, G1, epoch),
         raw_row(21, 6, 1 | 1024 | 2048, 12_345, -321.0, L1, epoch),
         raw_row(9, 1, 1 | 16, t_rx_mod(WEEK_NS) - 72_000_000, 10.0, L1, epoch),
+        "Nav,5,257,1,-1,4,-117,0,12,34,-56,78,90,1,2,3,4,5",
     ]  # fmt: skip
 
 
@@ -149,16 +152,16 @@ def test_reported_doppler_sigma_is_kept_in_hz(tmp_path):
 
 def test_time_going_back_names_the_line(tmp_path):
     lines = synthetic_rows(1) + synthetic_rows(0)
-    with pytest.raises(InputError, match=r"gnss_log.txt:13: Raw record earlier"):
+    with pytest.raises(InputError, match=r"gnss_log.txt:15: Raw record earlier"):
         read_gnsslogger(write_log(tmp_path, lines))
 
 
 def test_bad_number_and_unknown_record_name_the_line(tmp_path):
     lines = synthetic_rows()
     lines[2] = lines[2].replace("41.5", "4x.5")
-    with pytest.raises(InputError, match=r"gnss_log.txt:9: Cn0DbHz is not a number"):
+    with pytest.raises(InputError, match=r"gnss_log.txt:10: Cn0DbHz is not a number"):
         read_gnsslogger(write_log(tmp_path, lines))
-    with pytest.raises(InputError, match=r"gnss_log.txt:7: record type 'Bogus'"):
+    with pytest.raises(InputError, match=r"gnss_log.txt:8: record type 'Bogus'"):
         read_gnsslogger(write_log(tmp_path, ["Bogus,1,2", *synthetic_rows()]))
 
 

@@ -39,6 +39,7 @@ DOMINANCE_RATIO = 3.0
 RAW_INTEGERS = ("ConstellationType", "Svid", "TimeNanos", "FullBiasNanos", "ReceivedSvTimeNanos")
 GYRO_RECORDS = ("UncalGyro", "Gyro")
 ACCEL_RECORDS = ("UncalAccel", "Accel")
+USED_RECORDS = ("Raw", *GYRO_RECORDS, *ACCEL_RECORDS)
 
 
 @dataclass(frozen=True)
@@ -135,7 +136,9 @@ def read_gnsslogger(path: str | Path, mounting: np.ndarray | None = None) -> And
 
 
 def read_records(path: Path) -> dict[str, Records]:
-    """All record types of a GnssLogger file, columns named by their ``#`` header lines."""
+    """The record types this reader uses (``USED_RECORDS``), columns named by their ``#`` header
+    lines. Other record types (``Nav`` rows carry a variable number of data bytes, ``Fix``,
+    ``Status`` …) need a header line but are not parsed further."""
     try:
         text = path.read_bytes().decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
@@ -156,6 +159,8 @@ def read_records(path: Path) -> dict[str, Records]:
         kind = parts[0]
         if kind not in headers:
             raise InputError(f"record type {kind[:20]!r} without a header line", path, number)
+        if kind not in USED_RECORDS:
+            continue
         if len(parts) - 1 > len(headers[kind]):
             raise InputError(
                 f"{len(parts) - 1} fields for {len(headers[kind])} {kind} columns", path, number
