@@ -54,7 +54,9 @@ B1I = 1561.098e6
 L1, L5, G1 = 1575.42e6, 1176.45e6, 1602.0e6 + 3 * 0.5625e6
 
 
-def raw_row(svid, constellation, state, received, prr, frequency, epoch=0, code="C", adr=0.0):
+def raw_row(
+    svid, constellation, state, received, prr, frequency, epoch=0, code="C", adr=0.0, resets=0
+):
     values = dict.fromkeys(RAW, "")
     values.update(
         utcTimeMillis=str(1_700_000_000_000 + 1000 * epoch),
@@ -62,6 +64,7 @@ def raw_row(svid, constellation, state, received, prr, frequency, epoch=0, code=
         FullBiasNanos=str(FULL_BIAS),
         BiasNanos=str(BIAS),
         Svid=str(svid),
+        HardwareClockDiscontinuityCount=str(resets),
         TimeOffsetNanos="0.0",
         State=str(state),
         ReceivedSvTimeNanos=str(received + epoch * 10**9),
@@ -83,11 +86,12 @@ def t_rx_mod(period: int) -> int:
     return (TIME_NANOS - FULL_BIAS) % period
 
 
-def synthetic_rows(epoch: int = 0) -> list[str]:
+def synthetic_rows(epoch: int = 0, resets: int = 0) -> list[str]:
     """Raw rows of one epoch (and a Nav row, whose data bytes outnumber its header's columns)."""
+    tow = t_rx_mod(WEEK_NS)
     glonass_tod = (t_rx_mod(DAY_NS) + 3 * 3600 * 10**9 - 18 * 10**9) % DAY_NS
     return [
-        raw_row(7, 1, 16431, t_rx_mod(WEEK_NS) - 70_000_000, 123.456, L1, epoch, adr=-2.5e4),
+        raw_row(7, 1, 16431, tow - 70_000_000, 123.456, L1, epoch, adr=-2.5e4, resets=resets),
         raw_row(7, 1, 81921, t_rx_mod(WEEK_NS) - 70_000_004, 123.5, L5, epoch, code="Q"),
         raw_row(12, 5, 16431, t_rx_mod(WEEK_NS) - BDT_NS - 75_000_000, -50.0, B1I, epoch, code="I"),
         raw_row(4, 3, 227, glonass_tod - 68_000_000, 600.0, G1, epoch),
@@ -141,6 +145,12 @@ def test_doppler_round_trips_through_the_gnss_stage_sign_and_wavelength(tmp_path
             np.array([system]), np.array([prn]), code, obs.header.glonass_channels
         )
         assert -wavelength[0] * doppler == pytest.approx(prr, rel=1e-12), (system, code)
+
+
+def test_carrier_lli_after_a_clock_discontinuity(tmp_path):
+    lines = synthetic_rows(0) + synthetic_rows(1) + synthetic_rows(2, resets=1)
+    obs = read_gnsslogger(write_log(tmp_path, lines)).observations
+    np.testing.assert_array_equal(obs.select("G", "L1C").lli, [0, 0, 1])
 
 
 def test_reported_doppler_sigma_is_kept_in_hz(tmp_path):

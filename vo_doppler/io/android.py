@@ -198,6 +198,7 @@ def raw_columns(raw: Records, path: Path) -> RawColumns:
         frequency=_frequency(raw, path),
         code_type=np.char.strip(raw.text("CodeType")),
         leap_second=number("LeapSecond"),
+        clock_discontinuity=number("HardwareClockDiscontinuityCount"),
     )
 
 

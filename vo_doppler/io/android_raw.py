@@ -17,7 +17,8 @@ Google's white paper "Using GNSS raw measurements on Android devices" (2017, sec
   c/f within 3·10⁻⁸ for the phones' reported frequencies). Rows whose uncertainty is not finite
   or ≥ 1 km/s (phones write c there for "unknown") are dropped and counted.
 - Carrier phase L = AccumulatedDeltaRangeMeters·f/c when ADR_STATE_VALID (1); LLI bit 0 when
-  RESET (2) or CYCLE_SLIP (4).
+  RESET (2) or CYCLE_SLIP (4), or in an epoch whose HardwareClockDiscontinuityCount differs
+  from the previous epoch's.
 - C/N0 → ``S`` rows. The receiver-reported σ of D (PseudorangeRateUncertaintyMetersPerSecond,
   converted to Hz) and of C (ReceivedSvTimeUncertaintyNanos·c) are returned as a RowSigma.
 
@@ -96,6 +97,7 @@ class RawColumns:
     frequency: np.ndarray
     code_type: np.ndarray
     leap_second: np.ndarray
+    clock_discontinuity: np.ndarray
     arrival_ns: np.ndarray | None = None
     pseudorange_m: np.ndarray | None = None
 
@@ -140,6 +142,7 @@ def raw_observations(raw: RawColumns, receiver_type: str, problems: list[str]):
     _count(problems, path, usable & ~doppler_ok, "Doppler rows without a usable uncertainty")
     carrier_ok = (raw.adr_state.astype(np.int64) & ADR_VALID) > 0
     slip = (raw.adr_state.astype(np.int64) & (ADR_RESET | ADR_CYCLE_SLIP)) > 0
+    slip |= _clock_reset(raw.clock_discontinuity, epoch_time)
     kinds = (
         ("D", doppler, doppler_ok, raw.prr_uncertainty * f / SPEED_OF_LIGHT, -1),
         ("C", pseudorange, np.isfinite(pseudorange), raw.received_sv_time_uncertainty_nanos, -1),
@@ -220,6 +223,16 @@ def _travel_times(raw: RawColumns, system: np.ndarray) -> tuple[np.ndarray, np.n
     travel = receive - raw.received_sv_time_nanos
     travel = np.mod(travel + period // 2, period) - period // 2
     return epoch_time, (travel + raw.time_offset_nanos - raw.bias_nanos) * 1e-9
+
+
+def _clock_reset(count: np.ndarray, epoch_time: np.ndarray) -> np.ndarray:
+    """Rows of the epochs whose HardwareClockDiscontinuityCount differs from the previous
+    epoch's: the receiver clock restarted, so no carrier phase continues across it."""
+    epochs, first, index = np.unique(epoch_time, return_index=True, return_inverse=True)
+    per_epoch = count[first]
+    changed = np.zeros(epochs.size, dtype=bool)
+    changed[1:] = np.isfinite(per_epoch[1:]) & (per_epoch[1:] != per_epoch[:-1])
+    return changed[index]
 
 
 def _check_order(path: Path, line: np.ndarray, epoch_time: np.ndarray) -> None:
