@@ -17,9 +17,9 @@ from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, geodetic_to_ecef
 from vo_doppler.gnss.ephemeris import transmit_states
 from vo_doppler.gnss.spp import elevation_azimuth
+from vo_doppler.io.gnss_csv import VELOCITY_COLUMNS
 from vo_doppler.io.receiver_file import read_observation_file, sniff_format
 from vo_doppler.io.ubx import read_ubx
-from vo_doppler.report.gnss import VELOCITY_COLUMNS
 
 WEEK = 2200
 T0_SOW = 345_660.0
