@@ -289,3 +289,10 @@ def test_corrupted_logs_fail_only_with_input_errors(tmp_path, edits):
         return
     assert np.all(np.isfinite(log.observations.value))
     assert np.all(np.diff(log.observations.epoch_time) > 0)
+
+
+def test_clock_fields_that_overflow_name_the_line(tmp_path):
+    lines = synthetic_rows()
+    lines[0] = lines[0].replace(f",{FULL_BIAS},", f",{-(2**63) + 5},")
+    with pytest.raises(InputError, match=r"gnss_log.txt:8: TimeNanos − FullBiasNanos overflows"):
+        read_gnsslogger(write_log(tmp_path, lines))

@@ -97,9 +97,8 @@ class Records:
         return np.array([int(v) for v in text], dtype=np.int64)
 
     def is_integer(self, name: str) -> np.ndarray:
-        """Rows whose field is a (signed) decimal integer of at most 19 digits."""
-        text = np.char.lstrip(np.char.strip(self.text(name)), "-")
-        return np.char.isdigit(text) & (np.char.str_len(text) <= 19)
+        """Rows whose field is a decimal integer that fits in int64."""
+        return np.array([_fits_int64(str(v)) for v in self.text(name)], dtype=bool)
 
     def usable(self, names: tuple[str, ...], path: Path, problems: list[str]) -> Records:
         """The rows whose given fields are all integers; the others are counted and dropped."""
@@ -109,8 +108,18 @@ class Records:
         if not np.any(keep):
             raise InputError(f"no Raw row with integer {', '.join(names)}", path)
         if not np.all(keep):
-            problems.append(f"{path}: {int(np.sum(~keep))} Raw rows without {', '.join(names)}")
+            problems.append(
+                f"{path}: {int(np.sum(~keep))} Raw rows without integer {', '.join(names)}"
+            )
         return self.subset(keep)
+
+
+def _fits_int64(text: str) -> bool:
+    try:
+        value = int(text)
+    except ValueError:
+        return False
+    return -(2**63) <= value < 2**63
 
 
 def read_gnsslogger(path: str | Path, mounting: np.ndarray | None = None) -> AndroidLog:

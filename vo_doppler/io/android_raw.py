@@ -54,6 +54,7 @@ STATE_GLO_TOD_KNOWN = 32768
 ADR_VALID, ADR_RESET, ADR_CYCLE_SLIP = 1, 2, 4
 MAX_PRR_UNCERTAINTY_MPS = 1000.0
 TRAVEL_TIME_RANGE_S = (1e-3, 0.5)
+GPS_TIME_RANGE_S = (0.0, 3.8e9)  # 1980-01-06 … 2100
 # band centres (Hz) per system → RINEX band digit (RINEX 3.05 sec. 5.1)
 BANDS = {
     "G": ((1575.42e6, "1"), (1227.60e6, "2"), (1176.45e6, "5")),
@@ -208,6 +209,9 @@ def _times_and_ranges(raw: RawColumns, system: np.ndarray, problems: list[str]):
 def _travel_times(raw: RawColumns, system: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Epoch time and signal travel time (s) from the exact integer clock fields."""
     whole = raw.time_nanos - raw.full_bias_nanos
+    wrapped = np.abs(raw.time_nanos.astype(float) - raw.full_bias_nanos.astype(float) - whole) > 1e6
+    if np.any(wrapped):
+        raise InputError("TimeNanos − FullBiasNanos overflows", raw.path, int(raw.line[wrapped][0]))
     epoch_time = whole * 1e-9 - raw.bias_nanos * 1e-9
     glonass = system == "R"
     period = np.where(glonass, NANOS_PER_DAY, NANOS_PER_WEEK)
@@ -236,8 +240,11 @@ def _clock_reset(count: np.ndarray, epoch_time: np.ndarray) -> np.ndarray:
 
 
 def _check_order(path: Path, line: np.ndarray, epoch_time: np.ndarray) -> None:
-    if not np.all(np.isfinite(epoch_time)):
-        bad = int(line[np.flatnonzero(~np.isfinite(epoch_time))[0]])
+    """Epoch times finite, between 1980 and 2100 (``GPS_TIME_RANGE_S``), never going back."""
+    low, high = GPS_TIME_RANGE_S
+    wrong = ~((epoch_time > low) & (epoch_time < high))
+    if np.any(wrong):
+        bad = int(line[np.flatnonzero(wrong)[0]])
         raise InputError("Raw record without a usable clock (FullBiasNanos/TimeNanos)", path, bad)
     back = np.flatnonzero(np.diff(epoch_time) < -1e-6)
     if back.size:
