@@ -1,5 +1,6 @@
-"""``vo-doppler gnss``: Doppler velocity and single-point positions from RINEX files, with
-broadcast (``--nav``) or precise (``--orbits``) satellite states."""
+"""``vo-doppler gnss``: Doppler velocity and single-point positions from RINEX files, u-blox UBX
+or Android logs (``vo_doppler.io.receiver_file``), with broadcast (``--nav``, or the UBX log's own
+subframes) or precise (``--orbits``) satellite states."""
 
 from __future__ import annotations
 
@@ -10,11 +11,12 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.commands.satellite_options import add_satellite_options, satellite_states
-from vo_doppler.errors import VoDopplerError
+from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
 from vo_doppler.gnss.spp import solve_spp
 from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
-from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
+from vo_doppler.io.receiver_file import read_observation_file
+from vo_doppler.io.rinex_obs import SYSTEMS
 from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.report.gnss import spp_figure, velocity_figure
 
@@ -30,8 +32,13 @@ def _systems(text: str) -> str:
 
 
 def _common(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("obs", type=Path, help="RINEX 2/3 observation file (.gz / Hatanaka ok)")
-    add_satellite_options(parser)
+    parser.add_argument(
+        "obs",
+        type=Path,
+        help="observations: RINEX 2/3 (.gz / Hatanaka ok), u-blox UBX, Android GnssLogger "
+        "or GSDC device_gnss.csv (recognised by content)",
+    )
+    add_satellite_options(parser, required=False)
     parser.add_argument("--systems", type=_systems, default="GREJC", help="default GREJC")
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees (default 10)")
     parser.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
@@ -66,8 +73,10 @@ def register(subparsers, summary: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    obs = read_obs(args.obs)
-    nav = satellite_states(args)
+    obs, embedded = read_observation_file(args.obs)
+    nav = satellite_states(args) if args.nav or args.orbits else embedded
+    if nav is None:
+        raise InputError("no satellite states: give --nav or --orbits", args.obs)
     mask = np.deg2rad(args.elev_mask)
     figure = args.figure or args.output.with_suffix(".png")
     title = f"{args.obs.name} ({args.systems})"

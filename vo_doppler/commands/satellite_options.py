@@ -10,9 +10,17 @@ from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.precise_orbits import PreciseOrbits
 
 
-def add_satellite_options(parser: argparse.ArgumentParser) -> None:
-    choice = parser.add_mutually_exclusive_group(required=True)
-    choice.add_argument("--nav", type=Path, action="append", help="RINEX navigation file (repeat)")
+def add_satellite_options(parser: argparse.ArgumentParser, required: bool = True) -> None:
+    """``--nav`` or ``--orbits`` (one of them unless the observation file may carry its own
+    ephemerides, ``required=False``)."""
+    choice = parser.add_mutually_exclusive_group(required=required)
+    choice.add_argument(
+        "--nav",
+        type=Path,
+        action="append",
+        help="RINEX navigation file (repeat)"
+        + ("" if required else "; optional for a UBX log with GPS subframes"),
+    )
     choice.add_argument("--orbits", type=Path, help="SP3-c/d precise orbits (instead of --nav)")
     parser.add_argument("--clocks", type=Path, help="RINEX clock file beside --orbits")
 

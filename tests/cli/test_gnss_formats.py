@@ -1,0 +1,137 @@
+"""``vo-doppler gnss velocity`` on a u-blox UBX log built with pyubx2: a GPS-like constellation
+broadcast in RXM-SFRBX subframes, RXM-RAWX pseudoranges and Doppler of a receiver moving at a
+known velocity. No --nav: the ephemerides come from the log. The velocity comes back."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+from pyubx2 import UBXMessage
+
+from tests.helpers.lnav import EXAMPLE, encode_ephemeris
+from tests.io.test_android import synthetic_rows, write_log
+from vo_doppler.cli import main
+from vo_doppler.errors import InputError
+from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, geodetic_to_ecef
+from vo_doppler.gnss.ephemeris import transmit_states
+from vo_doppler.gnss.spp import elevation_azimuth
+from vo_doppler.io.gnss_csv import VELOCITY_COLUMNS
+from vo_doppler.io.receiver_file import read_observation_file, sniff_format
+from vo_doppler.io.ubx import read_ubx
+
+WEEK = 2200
+T0_SOW = 345_660.0
+LAT, LON = np.radians(35.0), np.radians(139.0)
+VELOCITY_ENU = np.array([10.0, 5.0, 0.0])
+CLOCK_BIAS_S, CLOCK_DRIFT = 1.0e-4, 2.0e-8
+L1_WAVELENGTH = SPEED_OF_LIGHT / 1575.42e6
+
+
+def _constellation() -> bytes:
+    """24 satellites, 3 planes × 8 slots, each broadcast as subframes 1–3."""
+    frames = []
+    for k in range(24):
+        plane, slot = divmod(k, 8)
+        eph = dict(EXAMPLE)
+        eph["m0"] = np.angle(np.exp(1j * (EXAMPLE["m0"] + slot * 2 * np.pi / 8 + plane * 0.5)))
+        eph["omega0"] = np.angle(np.exp(1j * (EXAMPLE["omega0"] + plane * 2 * np.pi / 3)))
+        eph["iodc"] = 10 + k
+        for words in encode_ephemeris(eph, 57599):
+            dwrd = {f"dwrd_{i + 1:02d}": w << 6 for i, w in enumerate(words)}
+            frames.append(
+                UBXMessage(
+                    "RXM", "RXM-SFRBX", 0, gnssId=0, svId=k + 1, numWords=10, version=2, **dwrd
+                ).serialize()
+            )
+    return b"".join(frames)
+
+
+def _rawx(tow: float, rows: list[tuple[int, float, float]]) -> bytes:
+    fields = {}
+    for i, (prn, pseudorange, doppler) in enumerate(rows, start=1):
+        fields |= {
+            f"prMes_{i:02d}": pseudorange, f"doMes_{i:02d}": doppler, f"gnssId_{i:02d}": 0,
+            f"svId_{i:02d}": prn, f"cno_{i:02d}": 45, f"prValid_{i:02d}": 1,
+            f"locktime_{i:02d}": 10_000,
+        }  # fmt: skip
+    return UBXMessage(
+        "RXM", "RXM-RAWX", 0, rcvTow=tow, week=WEEK, leapS=18, numMeas=len(rows), version=1,
+        **fields,
+    ).serialize()  # fmt: skip
+
+
+def _log(tmp_path):
+    subframes = _constellation()
+    dummy = tmp_path / "nav_only.ubx"
+    dummy.write_bytes(_rawx(T0_SOW, []) + subframes)
+    nav = read_ubx(dummy).navigation
+    assert len(nav.kepler) == 24
+    rotation = ecef_to_enu_rotation(LAT, LON)
+    velocity = rotation.T @ VELOCITY_ENU
+    start = geodetic_to_ecef(LAT, LON, 50.0)
+    messages = []
+    for n in range(5):
+        t = WEEK * 604800.0 + T0_SOW + n
+        receiver = start + velocity * n
+        prns = np.arange(1, 25)
+        states, _ = transmit_states(nav, "G", prns, t, receiver_ecef=receiver)
+        vector = states.position - receiver
+        distance = np.linalg.norm(vector, axis=1)
+        los = vector / distance[:, None]
+        elevation, _ = elevation_azimuth(receiver, los)
+        up = elevation > np.radians(15.0)
+        bias = CLOCK_BIAS_S + CLOCK_DRIFT * n
+        pseudorange = distance + SPEED_OF_LIGHT * (bias - states.clock_bias_s)
+        range_rate = np.einsum("ij,ij->i", los, states.velocity - velocity) + SPEED_OF_LIGHT * (
+            CLOCK_DRIFT - states.clock_drift
+        )
+        doppler = -range_rate / L1_WAVELENGTH
+        rows = [
+            (int(p), float(r), float(d))
+            for p, r, d in zip(prns[up], pseudorange[up], doppler[up], strict=True)
+        ]
+        assert len(rows) >= 6
+        messages.append(_rawx(T0_SOW + n + bias, rows))
+    path = tmp_path / "drive.ubx"
+    path.write_bytes(subframes + b"".join(messages))
+    return path
+
+
+def test_velocity_command_reads_a_ubx_log_and_recovers_the_velocity(tmp_path):
+    path = _log(tmp_path)
+    assert sniff_format(path) == "ubx"
+    out = tmp_path / "vel.csv"
+    assert main(["gnss", "velocity", str(path), "--systems", "G", "-o", str(out)]) == 0
+    with out.open() as handle:
+        rows = list(csv.reader(handle))
+    assert tuple(rows[0]) == VELOCITY_COLUMNS
+    table = np.array(rows[1:], dtype=float)
+    assert table.shape[0] == 5
+    np.testing.assert_allclose(table[:, 1:4], np.tile(VELOCITY_ENU, (5, 1)), atol=0.01)
+
+
+def test_observation_files_of_each_format_are_recognised(tmp_path):
+    logger = tmp_path / "gnss_log.txt"
+    logger.write_text("# Header Description:\n# Raw,utcTimeMillis,TimeNanos\n")
+    gsdc = tmp_path / "device_gnss.csv"
+    gsdc.write_text("MessageType,utcTimeMillis,ArrivalTimeNanosSinceGpsEpoch\n")
+    rinex = tmp_path / "rover.obs"
+    rinex.write_text(
+        "     3.04           OBSERVATION DATA    M: MIXED            RINEX VERSION / TYPE\n"
+    )
+    assert [sniff_format(p) for p in (logger, gsdc, rinex)] == ["gnsslogger", "gsdc", "rinex"]
+    with pytest.raises(InputError, match="no Raw records"):
+        read_observation_file(logger)
+    missing = tmp_path / "missing.obs"
+    with pytest.raises(InputError, match=r"missing\.obs: cannot read"):
+        sniff_format(missing)
+
+
+def test_android_log_without_nav_is_an_error_naming_the_file(tmp_path, capsys):
+    path = write_log(tmp_path, synthetic_rows())
+    assert sniff_format(path) == "gnsslogger"
+    code = main(["gnss", "velocity", str(path), "-o", str(tmp_path / "v.csv")])
+    assert code != 0
+    assert "gnss_log.txt: no navigation data: give --nav" in capsys.readouterr().err

@@ -1,0 +1,148 @@
+"""GPS LNAV subframe encoder for tests: the inverse of vo_doppler.io.gps_lnav's layout.
+
+Independent of the decoder's field table: the ICD bit positions are written out again here
+(IS-GPS-200 Figure 20-1) so a mistake in one is caught by the other and by RTKLIB.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+GPS_PI = 3.1415926535898
+SC = GPS_PI  # semicircles → rad
+
+
+def _put(bits: list[int], icd_bit: int, n_bits: int, value: int) -> None:
+    value &= (1 << n_bits) - 1
+    for k in range(n_bits):
+        n = icd_bit + k - 1
+        word, position = divmod(n, 30)
+        assert position < 24, "parity bit"
+        bits[24 * word + position] = (value >> (n_bits - 1 - k)) & 1
+
+
+def _q(value: float, scale: float) -> int:
+    return round(value / scale)
+
+
+def _words(bits: list[int]) -> tuple[int, ...]:
+    return tuple(int("".join(str(b) for b in bits[24 * w : 24 * w + 24]), 2) for w in range(10))
+
+
+def _new(subframe: int, tow_count: int) -> list[int]:
+    bits = [0] * 240
+    _put(bits, 1, 8, 0x8B)
+    _put(bits, 31, 17, tow_count)
+    _put(bits, 50, 3, subframe)
+    return bits
+
+
+def encode_ephemeris(eph: dict[str, float], tow_count: int) -> list[tuple[int, ...]]:
+    """Subframes 1, 2, 3 (24-bit data words) of one ephemeris; angles in radians."""
+    one = _new(1, tow_count)
+    _put(one, 61, 10, int(eph["week"]) % 1024)
+    _put(one, 71, 2, int(eph["codes"]))
+    _put(one, 73, 4, int(eph["ura_index"]))
+    _put(one, 77, 6, int(eph["health"]))
+    iodc = int(eph["iodc"])
+    _put(one, 83, 2, iodc >> 8)
+    _put(one, 211, 8, iodc & 0xFF)
+    _put(one, 91, 1, int(eph["l2p_flag"]))
+    _put(one, 197, 8, _q(eph["tgd"], 2.0**-31))
+    _put(one, 219, 16, _q(eph["toc_sow"], 16.0))
+    _put(one, 241, 8, _q(eph["af2"], 2.0**-55))
+    _put(one, 249, 16, _q(eph["af1"], 2.0**-43))
+    _put(one, 271, 22, _q(eph["af0"], 2.0**-31))
+    two = _new(2, tow_count + 1)
+    _put(two, 61, 8, iodc & 0xFF)
+    _put(two, 69, 16, _q(eph["crs"], 2.0**-5))
+    _put(two, 91, 16, _q(eph["delta_n"], 2.0**-43 * SC))
+    m0 = _q(eph["m0"], 2.0**-31 * SC)
+    _put(two, 107, 8, m0 >> 24)
+    _put(two, 121, 24, m0)
+    _put(two, 151, 16, _q(eph["cuc"], 2.0**-29))
+    e = _q(eph["e"], 2.0**-33)
+    _put(two, 167, 8, e >> 24)
+    _put(two, 181, 24, e)
+    _put(two, 211, 16, _q(eph["cus"], 2.0**-29))
+    sqrt_a = _q(eph["sqrt_a"], 2.0**-19)
+    _put(two, 227, 8, sqrt_a >> 24)
+    _put(two, 241, 24, sqrt_a)
+    _put(two, 271, 16, _q(eph["toe_sow"], 16.0))
+    three = _new(3, tow_count + 2)
+    _put(three, 61, 16, _q(eph["cic"], 2.0**-29))
+    omega0 = _q(eph["omega0"], 2.0**-31 * SC)
+    _put(three, 77, 8, omega0 >> 24)
+    _put(three, 91, 24, omega0)
+    _put(three, 121, 16, _q(eph["cis"], 2.0**-29))
+    i0 = _q(eph["i0"], 2.0**-31 * SC)
+    _put(three, 137, 8, i0 >> 24)
+    _put(three, 151, 24, i0)
+    _put(three, 181, 16, _q(eph["crc"], 2.0**-5))
+    omega = _q(eph["omega"], 2.0**-31 * SC)
+    _put(three, 197, 8, omega >> 24)
+    _put(three, 211, 24, omega)
+    _put(three, 241, 24, _q(eph["omega_dot"], 2.0**-43 * SC))
+    _put(three, 271, 8, iodc & 0xFF)
+    _put(three, 279, 14, _q(eph["idot"], 2.0**-43 * SC))
+    return [_words(one), _words(two), _words(three)]
+
+
+def quantised(eph: dict[str, float]) -> dict[str, float]:
+    """The values the subframes can carry (each parameter rounded to its LSB)."""
+    scales = {
+        "tgd": 2.0**-31,
+        "toc_sow": 16.0,
+        "af2": 2.0**-55,
+        "af1": 2.0**-43,
+        "af0": 2.0**-31,
+        "crs": 2.0**-5,
+        "delta_n": 2.0**-43 * SC,
+        "m0": 2.0**-31 * SC,
+        "cuc": 2.0**-29,
+        "e": 2.0**-33,
+        "cus": 2.0**-29,
+        "sqrt_a": 2.0**-19,
+        "toe_sow": 16.0,
+        "cic": 2.0**-29,
+        "omega0": 2.0**-31 * SC,
+        "cis": 2.0**-29,
+        "i0": 2.0**-31 * SC,
+        "crc": 2.0**-5,
+        "omega": 2.0**-31 * SC,
+        "omega_dot": 2.0**-43 * SC,
+        "idot": 2.0**-43 * SC,
+    }
+    return {k: (np.round(v / scales[k]) * scales[k] if k in scales else v) for k, v in eph.items()}
+
+
+EXAMPLE = {
+    # a GPS ephemeris with values of the usual magnitudes (radians, seconds, metres)
+    "week": 2200,
+    "codes": 1,
+    "ura_index": 0,
+    "health": 0,
+    "iodc": 301,
+    "l2p_flag": 0,
+    "tgd": -1.1175870895385742e-08,
+    "toc_sow": 345600.0,
+    "af2": 0.0,
+    "af1": -1.4779288903810084e-12,
+    "af0": -2.3657130077481270e-04,
+    "crs": -1.0465625e02,
+    "delta_n": 4.2337763591e-09,
+    "m0": 2.8914823472,
+    "cuc": -5.3681433200836182e-06,
+    "e": 1.2187458411790431e-02,
+    "cus": 2.7529895305633545e-06,
+    "sqrt_a": 5153.6589355468750,
+    "toe_sow": 345600.0,
+    "cic": 1.1175870895385742e-08,
+    "omega0": -1.7451372018,
+    "cis": -6.5192580223083496e-08,
+    "i0": 0.9782457389,
+    "crc": 3.2821875e02,
+    "omega": -1.9230114325,
+    "omega_dot": -8.1739833499e-09,
+    "idot": -2.3572413267e-10,
+}

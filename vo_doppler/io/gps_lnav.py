@@ -1,0 +1,194 @@
+"""GPS L1 C/A navigation message (LNAV) subframes 1–3 → broadcast ephemeris records.
+
+Bit layout and scale factors: IS-GPS-200 sec. 20.3.3.3 (subframe 1, Table 20-I) and 20.3.3.4
+(subframes 2 and 3, Table 20-III), Figure 20-1. A subframe is given here as its ten 24-bit data
+words (parity stripped); ICD bit n (1…300, parity included) is data bit
+24·⌊(n−1)/30⌋ + (n−1) mod 30 of the 240. Angles in semicircles are multiplied by the ICD's
+π = 3.1415926535898.
+
+An ephemeris is emitted when subframes 1, 2 and 3 of one satellite agree on their issue of data
+(IODE of 2 and 3 = the 8 LSBs of IODC, sec. 20.3.4.4); a repeated (PRN, IODC, toe) is emitted
+once. Not decoded: subframes 4 and 5 (almanac, ionosphere and UTC parameters, pages of
+sec. 20.3.3.5). The 10-bit week number is resolved with a full GPS week from the same recording.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.io.rinex_nav import GLONASS_FIELDS, KEPLER_FIELDS
+from vo_doppler.model.gpstime import SECONDS_PER_WEEK
+from vo_doppler.model.navigation import NavRecords
+
+GPS_PI = 3.1415926535898
+PREAMBLE = 0x8B
+URA_METERS = (2.4, 3.4, 4.85, 6.85, 9.65, 13.65, 24.0, 48.0, 96.0, 192.0, 384.0, 768.0)
+URA_METERS += (1536.0, 3072.0, 6144.0, np.nan)
+KEPLER_NAMES = (*(name for group in KEPLER_FIELDS for name in group), "toe")
+GLONASS_NAMES = tuple(name for group in GLONASS_FIELDS for name in group)
+
+# (name, first ICD bit, [(first bit, n bits) …] most significant part first, signed, scale)
+_SUBFRAME_FIELDS: dict[int, tuple[tuple[str, tuple[tuple[int, int], ...], bool, float], ...]] = {
+    1: (
+        ("week10", ((61, 10),), False, 1.0),
+        ("codes", ((71, 2),), False, 1.0),
+        ("ura_index", ((73, 4),), False, 1.0),
+        ("health", ((77, 6),), False, 1.0),
+        ("iodc", ((83, 2), (211, 8)), False, 1.0),
+        ("l2p_flag", ((91, 1),), False, 1.0),
+        ("tgd", ((197, 8),), True, 2.0**-31),
+        ("toc_sow", ((219, 16),), False, 2.0**4),
+        ("af2", ((241, 8),), True, 2.0**-55),
+        ("af1", ((249, 16),), True, 2.0**-43),
+        ("af0", ((271, 22),), True, 2.0**-31),
+    ),
+    2: (
+        ("iode", ((61, 8),), False, 1.0),
+        ("crs", ((69, 16),), True, 2.0**-5),
+        ("delta_n", ((91, 16),), True, 2.0**-43 * GPS_PI),
+        ("m0", ((107, 8), (121, 24)), True, 2.0**-31 * GPS_PI),
+        ("cuc", ((151, 16),), True, 2.0**-29),
+        ("e", ((167, 8), (181, 24)), False, 2.0**-33),
+        ("cus", ((211, 16),), True, 2.0**-29),
+        ("sqrt_a", ((227, 8), (241, 24)), False, 2.0**-19),
+        ("toe_sow", ((271, 16),), False, 2.0**4),
+        ("fit_flag", ((287, 1),), False, 1.0),
+    ),
+    3: (
+        ("cic", ((61, 16),), True, 2.0**-29),
+        ("omega0", ((77, 8), (91, 24)), True, 2.0**-31 * GPS_PI),
+        ("cis", ((121, 16),), True, 2.0**-29),
+        ("i0", ((137, 8), (151, 24)), True, 2.0**-31 * GPS_PI),
+        ("crc", ((181, 16),), True, 2.0**-5),
+        ("omega", ((197, 8), (211, 24)), True, 2.0**-31 * GPS_PI),
+        ("omega_dot", ((241, 24),), True, 2.0**-43 * GPS_PI),
+        ("iode", ((271, 8),), False, 1.0),
+        ("idot", ((279, 14),), True, 2.0**-43 * GPS_PI),
+    ),
+}
+
+
+def data_bit(icd_bit: int) -> int:
+    """Index (0…239) among the 240 data bits of ICD bit number ``icd_bit`` (1…300)."""
+    word, position = divmod(icd_bit - 1, 30)
+    if position >= 24:
+        raise ValueError(f"ICD bit {icd_bit} is a parity bit")
+    return 24 * word + position
+
+
+def _bits(words: tuple[int, ...], icd_bit: int, n_bits: int) -> int:
+    value = 0
+    for k in range(n_bits):
+        index = data_bit(icd_bit + k)
+        word, position = divmod(index, 24)
+        value = (value << 1) | ((words[word] >> (23 - position)) & 1)
+    return value
+
+
+def subframe_id(words: tuple[int, ...]) -> int:
+    """Subframe ID of the handover word (ICD bits 50–52), 0 when the preamble is wrong."""
+    if (words[0] >> 16) & 0xFF != PREAMBLE:
+        return 0
+    return _bits(words, 50, 3)
+
+
+def decode_subframe(words: tuple[int, ...]) -> dict[str, float]:
+    """Fields of subframe 1, 2 or 3 (SI units, radians), plus ``tow`` of the handover word (s)."""
+    number = subframe_id(words)
+    if number not in _SUBFRAME_FIELDS:
+        raise ValueError(f"subframe {number} is not an ephemeris subframe")
+    out = {"subframe": float(number), "tow": 6.0 * _bits(words, 31, 17)}
+    for name, parts, signed, scale in _SUBFRAME_FIELDS[number]:
+        value, width = 0, 0
+        for first, n_bits in parts:
+            value = (value << n_bits) | _bits(words, first, n_bits)
+            width += n_bits
+        if signed and value >> (width - 1):
+            value -= 1 << width
+        out[name] = value * scale
+    return out
+
+
+@dataclass
+class LnavAssembler:
+    """Collects subframes per satellite and emits complete, consistent ephemerides."""
+
+    records: list[dict[str, float]]
+    pending: dict[int, dict[int, dict[str, float]]]
+    emitted: set[tuple[int, int, float]]
+
+    @classmethod
+    def new(cls) -> LnavAssembler:
+        return cls([], {}, set())
+
+    def add(self, prn: int, words: tuple[int, ...], reference_week: int | None, where: int) -> None:
+        """One subframe of satellite ``prn``; ``where`` (e.g. a byte offset) is kept per record."""
+        fields = decode_subframe(words)
+        frames = self.pending.setdefault(prn, {})
+        frames[int(fields["subframe"])] = fields
+        if len(frames) < 3 or reference_week is None:
+            return
+        one, two, three = frames[1], frames[2], frames[3]
+        iode = int(one["iodc"]) & 0xFF
+        if not int(two["iode"]) == int(three["iode"]) == iode:
+            return
+        key = (prn, int(one["iodc"]), two["toe_sow"])
+        if key in self.emitted:
+            return
+        self.emitted.add(key)
+        self.records.append(_record(prn, one, two, three, reference_week, where))
+
+    def navrecords(self) -> NavRecords:
+        """The emitted ephemerides with the parameter names of the RINEX navigation reader."""
+        rows = self.records
+        params = {name: np.array([r[name] for r in rows], dtype=float) for name in KEPLER_NAMES}
+        return NavRecords(
+            np.full(len(rows), "G", dtype="U1"),
+            np.array([r["prn"] for r in rows], dtype=np.int16),
+            np.array([r["toc"] for r in rows], dtype=float),
+            params,
+            np.array([r["where"] for r in rows], dtype=np.int64),
+        )
+
+
+def _record(prn, one, two, three, reference_week, where) -> dict[str, float]:
+    """RINEX-named parameters; weeks resolved near ``reference_week`` (sec. 20.3.3.3.1.1)."""
+    week = reference_week - ((reference_week - int(one["week10"])) % 1024)
+    if reference_week - week > 512:
+        week += 1024
+    transmission_sow = one["tow"] - 6.0
+    t_tx = week * SECONDS_PER_WEEK + transmission_sow
+    toc = _nearest(t_tx, one["toc_sow"])
+    toe = _nearest(toc, two["toe_sow"])
+    return {
+        **{k: v for k, v in (one | two | three).items() if k in KEPLER_NAMES},
+        "iode": two["iode"],
+        "week": float(week),
+        "accuracy": URA_METERS[int(one["ura_index"])],
+        "transmission_sow": transmission_sow,
+        "fit_interval": 6.0 if two["fit_flag"] else 4.0,
+        "toe": toe,
+        "toc": toc,
+        "prn": prn,
+        "where": where,
+    }
+
+
+def _nearest(reference: float, seconds_of_week: float) -> float:
+    """The GPS time with the given second of week nearest to ``reference``."""
+    delta = seconds_of_week - np.mod(reference, SECONDS_PER_WEEK)
+    delta -= SECONDS_PER_WEEK * np.round(delta / SECONDS_PER_WEEK)
+    return float(reference + delta)
+
+
+def empty_glonass() -> NavRecords:
+    """A GLONASS record table with no rows (the UBX reader decodes GPS LNAV only)."""
+    return NavRecords(
+        np.zeros(0, dtype="U1"),
+        np.zeros(0, dtype=np.int16),
+        np.zeros(0),
+        {name: np.zeros(0) for name in GLONASS_NAMES},
+        np.zeros(0, dtype=np.int64),
+    )

@@ -1,0 +1,376 @@
+"""u-blox UBX binary logs (pyubx2): raw measurements, GPS ephemerides, the receiver's own fixes.
+
+Framing (u-blox interface description, "UBX frame structure"): sync 0xB5 0x62, class, id,
+little-endian length, payload, 8-bit Fletcher checksum over class…payload. The stream is
+scanned here so that every problem names its byte offset; bytes between frames (NMEA, RTCM)
+are skipped and counted; a frame with a bad checksum or a payload pyubx2 cannot parse is
+skipped with a message ``FILE@OFFSET: …`` in ``problems``; a truncated last frame likewise.
+
+- RXM-RAWX → :class:`Observations`, epoch = week·604800 + rcvTow (receiver time, like a RINEX
+  epoch). Per signal (gnssId, sigId → RINEX 3 code, ``SIGNAL_CODES``): pseudorange ``C`` when
+  prValid, carrier phase ``L`` (cycles) when cpValid, Doppler ``D`` (Hz, positive approaching:
+  already the RINEX sign, RINEX 3.05 sec. 5.2.10), C/N0 ``S`` (dB-Hz). LLI on ``L`` rows:
+  bit 0 when the lock time dropped since the signal's previous epoch, bit 1 when the half cycle
+  is not resolved (halfCyc = 0). Values outside ``VALUE_RANGES`` (or not finite) are dropped
+  and counted. Reported σ (prStdev 0.01·2ⁿ m, cpStdev 0.004·n cycles,
+  doStdev 0.002·2ⁿ Hz) are kept as a :class:`RowSigma`. GLONASS channel k = freqId − 7; rows
+  with an unknown GLONASS slot (svId 255) are skipped.
+- RXM-SFRBX → GPS L1 C/A LNAV subframes 1–3 decoded into ephemerides
+  (:mod:`vo_doppler.io.gps_lnav`); the data bits of each word are bits 29…6 of ``dwrd``.
+  Not decoded: GPS subframes 4–5 (almanac, ionosphere, UTC), and every other system's
+  navigation data (Galileo I/NAV, BeiDou D1/D2, GLONASS strings, QZSS, SBAS); they are counted.
+- NAV-PVT → :class:`ReceiverSolution`; the time is the GPS time whose second of week is iTOW,
+  nearest to the message's UTC date and time plus the leap seconds of that date; a message
+  whose two times disagree by more than 2 s, or without a valid date, is skipped.
+"""
+
+from __future__ import annotations
+
+import logging
+import struct
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pyubx2 import UBXMessageError, UBXParseError, UBXReader, UBXTypeError
+
+from vo_doppler.errors import InputError
+from vo_doppler.io.gps_lnav import LnavAssembler, empty_glonass, subframe_id
+from vo_doppler.io.obs_rows import observations_from_rows
+from vo_doppler.model.gpstime import SECONDS_PER_WEEK, calendar_to_gps_seconds, utc_to_gps_seconds
+from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.observations import Observations
+from vo_doppler.model.receiver_solution import ReceiverSolution
+from vo_doppler.model.row_sigma import RowSigma
+
+log = logging.getLogger(__name__)
+
+SYNC = b"\xb5\x62"
+RAWX = (0x02, 0x15)
+SFRBX = (0x02, 0x13)
+PVT = (0x01, 0x07)
+SYSTEMS = {0: "G", 1: "S", 2: "E", 3: "C", 5: "J", 6: "R", 7: "I"}
+SIGNAL_CODES: dict[tuple[int, int], str] = {
+    # (gnssId, sigId) → RINEX 3 band + attribute (u-blox F9 interface description, signal table)
+    (0, 0): "1C",
+    (0, 3): "2L",
+    (0, 4): "2S",
+    (0, 6): "5I",
+    (0, 7): "5Q",
+    (1, 0): "1C",
+    (2, 0): "1C",
+    (2, 1): "1B",
+    (2, 3): "5I",
+    (2, 4): "5Q",
+    (2, 5): "7I",
+    (2, 6): "7Q",
+    (2, 8): "6B",
+    (2, 9): "6C",
+    (2, 10): "6A",
+    (3, 0): "2I",
+    (3, 1): "2I",
+    (3, 2): "7I",
+    (3, 3): "7I",
+    (3, 4): "6I",
+    (3, 10): "6I",
+    (3, 5): "1P",
+    (3, 6): "1D",
+    (3, 7): "5P",
+    (3, 8): "5D",
+    (5, 0): "1C",
+    (5, 1): "1Z",
+    (5, 4): "2S",
+    (5, 5): "2L",
+    (5, 8): "5I",
+    (5, 9): "5Q",
+    (6, 0): "1C",
+    (6, 2): "2C",
+    (7, 0): "5A",
+}
+VALUE_RANGES = {  # plausible RXM-RAWX values; others (and NaN) are dropped and counted
+    "C": (1.0e6, 1.0e8),  # pseudorange, m (clock offsets of a few ms included)
+    "L": (-1.0e12, 1.0e12),  # carrier phase, cycles
+    "D": (-1.0e5, 1.0e5),  # Doppler, Hz
+    "S": (0.0, 100.0),  # C/N0, dB-Hz
+}
+PVT_TIME_TOLERANCE_S = 2.0  # iTOW vs UTC + leap seconds: a leap second unknown to the table
+_PARSE_ERRORS = (UBXParseError, UBXMessageError, UBXTypeError, ValueError, struct.error)
+
+
+@dataclass(frozen=True)
+class UbxRecording:
+    """What a UBX log holds: observations (None without RXM-RAWX), GPS ephemerides, the
+    receiver's fixes, the receiver-reported σ per observation row, and skipped-data messages."""
+
+    observations: Observations | None
+    navigation: Navigation
+    solution: ReceiverSolution
+    sigma: RowSigma
+    problems: tuple[str, ...]
+    path: Path
+
+
+def checksum(body: bytes) -> bytes:
+    """8-bit Fletcher checksum (CK_A, CK_B) of class, id, length and payload."""
+    a = b = 0
+    for byte in body:
+        a = (a + byte) & 0xFF
+        b = (b + a) & 0xFF
+    return bytes((a, b))
+
+
+def frames(data: bytes, path: Path, problems: list[str]):
+    """(offset, class, id, frame) of every well-formed UBX frame, in stream order."""
+    position, skipped = 0, 0
+    while True:
+        start = data.find(SYNC, position)
+        skipped += (len(data) if start < 0 else start) - position
+        if start < 0:
+            break
+        if start + 6 > len(data):
+            _problem(problems, path, start, "truncated UBX header at end of file")
+            break
+        length = int.from_bytes(data[start + 4 : start + 6], "little")
+        end = start + 8 + length
+        if end > len(data):
+            _problem(problems, path, start, f"truncated UBX frame ({length}-byte payload)")
+            break
+        if checksum(data[start + 2 : end - 2]) != data[end - 2 : end]:
+            _problem(problems, path, start, "UBX checksum mismatch: frame skipped")
+            position = start + 2
+            continue
+        yield start, data[start + 2], data[start + 3], data[start:end]
+        position = end
+    if skipped:
+        _problem(problems, path, 0, f"{skipped} bytes outside UBX frames skipped")
+
+
+def _problem(problems: list[str], path: Path, offset: int, message: str) -> None:
+    text = f"{path}@{offset}: {message}"
+    log.warning(text)
+    problems.append(text)
+
+
+def read_ubx(path: str | Path) -> UbxRecording:
+    """Read a UBX log (module docstring). Raises :class:`InputError` when nothing usable is in
+    it or when RXM-RAWX epochs go back in time."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read UBX file: {exc}", path) from exc
+    problems: list[str] = []
+    raw = _RawxRows()
+    pvt: list[dict[str, float]] = []
+    subframes: list[tuple[int, int, tuple[int, ...]]] = []
+    n_other_nav = 0
+    for offset, cls, mid, frame in frames(data, path, problems):
+        if (cls, mid) not in (RAWX, SFRBX, PVT):
+            continue
+        try:
+            message = UBXReader.parse(frame)
+        except _PARSE_ERRORS as exc:
+            _problem(problems, path, offset, f"unparsable UBX message: {exc}")
+            continue
+        if (cls, mid) == RAWX:
+            raw.add(message, offset, path, problems)
+        elif (cls, mid) == PVT:
+            fix = _pvt_fields(message, offset, path, problems)
+            if fix is not None:
+                pvt.append(fix)
+        elif message.gnssId == 0 and message.numWords == 10 and message.sigId == 0:
+            words = tuple((getattr(message, f"dwrd_{k:02d}") >> 6) & 0xFFFFFF for k in range(1, 11))
+            subframes.append((offset, message.svId, words))
+        else:
+            n_other_nav += 1
+    if not (raw.time or pvt or subframes):
+        raise InputError("no UBX RXM-RAWX, RXM-SFRBX or NAV-PVT message", path)
+    week = raw.week if raw.week is not None else _week_of(pvt)
+    navigation = _navigation(subframes, week, path, problems, n_other_nav)
+    observations = raw.observations(path, problems) if raw.time else None
+    return UbxRecording(
+        observations, navigation, _solution(pvt), raw.sigma(), tuple(problems), path
+    )
+
+
+class _RawxRows:
+    """Row lists of RXM-RAWX messages and the lock-time state behind the LLI."""
+
+    def __init__(self) -> None:
+        self.time: list[float] = []
+        self.system: list[str] = []
+        self.prn: list[int] = []
+        self.code: list[str] = []
+        self.value: list[float] = []
+        self.lli: list[int] = []
+        self.sigma_value: list[float] = []
+        self.channels: dict[int, int] = {}
+        self.lock: dict[tuple[int, int, int], int] = {}
+        self.week: int | None = None
+        self.n_unknown = 0
+        self.n_out_of_range = 0
+
+    def add(self, message, offset: int, path: Path, problems: list[str]) -> None:
+        tow, week = float(message.rcvTow), int(message.week)
+        if not (np.isfinite(tow) and 0.0 <= tow < SECONDS_PER_WEEK and 0 < week < 8192):
+            _problem(problems, path, offset, f"RXM-RAWX time out of range (week {week}, {tow})")
+            return
+        t = week * SECONDS_PER_WEEK + tow
+        if self.time and t < self.time[-1]:
+            raise InputError(
+                f"RXM-RAWX epoch {t:.3f} before the previous one {self.time[-1]:.3f}",
+                path,
+                offset,
+            )
+        self.week = week if self.week is None else self.week
+        for k in range(1, int(message.numMeas) + 1):
+            self._signal(message, f"_{k:02d}", t)
+
+    def _signal(self, m, s: str, t: float) -> None:
+        gnss, sv, sig = getattr(m, "gnssId" + s), getattr(m, "svId" + s), getattr(m, "sigId" + s)
+        band = SIGNAL_CODES.get((gnss, sig))
+        if band is None or (gnss == 6 and sv == 255):
+            self.n_unknown += 1
+            return
+        system = SYSTEMS[gnss]
+        prn = sv - 100 if system == "S" else sv
+        if system == "R":
+            self.channels[prn] = int(getattr(m, "freqId" + s)) - 7
+        lock = int(getattr(m, "locktime" + s))
+        previous = self.lock.get((gnss, sv, sig))
+        self.lock[(gnss, sv, sig)] = lock
+        slip = previous is not None and lock < previous
+        lli = int(slip) | (0 if getattr(m, "halfCyc" + s) else 2)
+        rows = [("D", getattr(m, "doMes" + s), 0.002 * 2 ** getattr(m, "doStd" + s), -1)]
+        rows.append(("S", float(getattr(m, "cno" + s)), np.nan, -1))
+        if getattr(m, "prValid" + s):
+            rows.append(("C", getattr(m, "prMes" + s), 0.01 * 2 ** getattr(m, "prStd" + s), -1))
+        if getattr(m, "cpValid" + s):
+            rows.append(("L", getattr(m, "cpMes" + s), 0.004 * getattr(m, "cpStd" + s), lli))
+        for kind, value, sigma, flag in rows:
+            low, high = VALUE_RANGES[kind]
+            if not low <= value <= high:  # False for NaN too
+                self.n_out_of_range += 1
+                continue
+            self.time.append(t)
+            self.system.append(system)
+            self.prn.append(prn)
+            self.code.append(kind + band)
+            self.value.append(float(value))
+            self.sigma_value.append(sigma)
+            self.lli.append(flag)
+
+    def observations(self, path: Path, problems: list[str]) -> Observations:
+        if self.n_unknown:
+            _problem(problems, path, 0, f"{self.n_unknown} RXM-RAWX signals of unknown kind")
+        if self.n_out_of_range:
+            _problem(problems, path, 0, f"{self.n_out_of_range} RXM-RAWX values out of range")
+        return observations_from_rows(
+            path,
+            "u-blox (UBX RXM-RAWX)",
+            np.array(self.time),
+            np.array(self.system, dtype="U1"),
+            np.array(self.prn),
+            np.array(self.code, dtype="U3"),
+            np.array(self.value),
+            np.array(self.lli),
+            self.channels,
+            tuple(problems),
+        )
+
+    def sigma(self) -> RowSigma:
+        return RowSigma(
+            np.array(self.time, dtype=float),
+            np.array(self.system, dtype="U1"),
+            np.array(self.prn, dtype=np.int16),
+            np.array(self.code, dtype="U3"),
+            np.array(self.sigma_value, dtype=float),
+        )
+
+
+def _pvt_fields(message, offset: int, path: Path, problems: list[str]) -> dict[str, float] | None:
+    """NAV-PVT in SI units and radians, or None (with a problem) when it cannot be placed."""
+    m = message
+    if not (m.validDate and m.validTime):
+        _problem(problems, path, offset, "NAV-PVT without a valid UTC date/time: skipped")
+        return None
+    if abs(m.lat) > 90 or abs(m.lon) > 180 or not 0 <= m.iTOW < SECONDS_PER_WEEK * 1000:
+        _problem(problems, path, offset, "NAV-PVT latitude, longitude or iTOW out of range")
+        return None
+    try:
+        utc = calendar_to_gps_seconds(m.year, m.month, m.day, m.hour, m.min, m.second)
+    except (ValueError, OverflowError):
+        _problem(problems, path, offset, "NAV-PVT date out of range: skipped")
+        return None
+    approx = float(utc_to_gps_seconds(utc)) + m.nano * 1e-9
+    sow = m.iTOW / 1000.0
+    delta = sow - np.mod(approx, SECONDS_PER_WEEK)
+    delta -= SECONDS_PER_WEEK * np.round(delta / SECONDS_PER_WEEK)
+    if abs(delta) > PVT_TIME_TOLERANCE_S:
+        _problem(problems, path, offset, f"NAV-PVT iTOW and UTC time disagree by {delta:.3f} s")
+        return None
+    return {
+        "t": approx + delta,
+        "lat": np.radians(m.lat),
+        "lon": np.radians(m.lon),
+        "height": m.height / 1000.0,
+        "vn": m.velN / 1000.0,
+        "ve": m.velE / 1000.0,
+        "vd": m.velD / 1000.0,
+        "speed": m.gSpeed / 1000.0,
+        "course": np.radians(m.headMot),
+        "speed_accuracy": m.sAcc / 1000.0,
+        "course_accuracy": np.radians(m.headAcc),
+        "horizontal_accuracy": m.hAcc / 1000.0,
+        "vertical_accuracy": m.vAcc / 1000.0,
+        "fix_ok": float(m.gnssFixOk),
+        "n_sat": float(m.numSV),
+    }
+
+
+def _week_of(pvt: list[dict[str, float]]) -> int | None:
+    return int(pvt[0]["t"] // SECONDS_PER_WEEK) if pvt else None
+
+
+def _solution(pvt: list[dict[str, float]]) -> ReceiverSolution:
+    def column(name: str) -> np.ndarray:
+        return np.array([p[name] for p in pvt], dtype=float)
+
+    return ReceiverSolution(
+        t=column("t"),
+        lat=column("lat"),
+        lon=column("lon"),
+        height=column("height"),
+        velocity_ned=np.stack([column("vn"), column("ve"), column("vd")], axis=1),
+        speed=column("speed"),
+        course=column("course"),
+        speed_accuracy=column("speed_accuracy"),
+        course_accuracy=column("course_accuracy"),
+        horizontal_accuracy=column("horizontal_accuracy"),
+        vertical_accuracy=column("vertical_accuracy"),
+        fix_ok=column("fix_ok").astype(bool),
+        n_sat=column("n_sat").astype(np.int64),
+    )
+
+
+def _navigation(subframes, week: int | None, path: Path, problems, n_other: int) -> Navigation:
+    """GPS ephemerides from the LNAV subframes (needs a full week from RAWX or NAV-PVT)."""
+    assembler = LnavAssembler.new()
+    n_not_ephemeris = 0
+    if subframes and week is None:
+        _problem(problems, path, subframes[0][0], "GPS subframes without a week: not decoded")
+        subframes = []
+    for offset, prn, words in subframes:
+        if subframe_id(words) in (1, 2, 3):
+            assembler.add(prn, words, week, offset)
+        else:
+            n_not_ephemeris += 1
+    if n_not_ephemeris or n_other:
+        _problem(
+            problems,
+            path,
+            0,
+            f"not decoded: {n_not_ephemeris} GPS subframes 4-5 or without preamble, "
+            f"{n_other} navigation messages of other systems or signals",
+        )
+    return Navigation(assembler.navrecords(), empty_glonass(), problems=tuple(problems))
