@@ -77,8 +77,9 @@ def _blob_texture(size: int = 256, sigma: float = 4.0) -> np.ndarray:
 
 
 def _blob_plane(x: float, y: float, z: float, texel: float = 0.01) -> Plane:
-    """A 2.56 m square facing the camera (−z), its blob centred at (x, y, z) in camera axes."""
-    half = 1.28
+    """A square of 256 texels facing the camera (−z), its blob centred at (x, y, z) in camera
+    axes."""
+    half = 128 * texel
     return Plane(
         origin=np.array([x - half, y + half, z]),
         u_axis=np.array([1.0, 0.0, 0.0]),

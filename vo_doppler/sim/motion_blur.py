@@ -10,7 +10,8 @@ the band's middle) and lasts τ collects the mean of the sharp image along the o
 
     B(p) = (1/τ) ∫ I₀(p − f(o)) do,   o ∈ [δ(p) − τ/2, δ(p) + τ/2],
 
-evaluated with one bilinear read (``cv2.remap``) per sample. The homogeneous form [K⁻¹p, 1/Z]
+evaluated with one bilinear read (``cv2.remap``) per sample at the middles of equal parts of
+the exposure. The homogeneous form [K⁻¹p, 1/Z]
 keeps the sky (Z = ∞) exact: it moves with the rotation only. Moving vehicles move with the
 camera's motion here, not their own, and a path crossing an occlusion edge reads the occluder:
 the usual image-space post-process (Potmesil & Chakravarty, "Modeling motion blur in
@@ -67,7 +68,7 @@ def expose(
     u, v = np.meshgrid(np.arange(w, dtype=np.float32), np.arange(h, dtype=np.float32))
     source = image.astype(np.float32)
     total = np.zeros((h, w), dtype=np.float32)
-    spread = np.linspace(-0.5, 0.5, samples) * exposure_s if samples > 1 else np.zeros(1)
+    spread = ((np.arange(samples) + 0.5) / samples - 0.5) * exposure_s
     for extra in spread:
         o = (row_offset_s + extra)[..., None]
         shift = (((half_span_s - o) * before + (half_span_s + o) * after) / span).astype(np.float32)
