@@ -43,9 +43,7 @@ def test_distort_is_opencv_projection():
 
 def test_maps_follow_the_true_lens_and_the_calibration():
     true = replace(PINHOLE, distortion=np.array(LENS))
-    calibration = replace(
-        PINHOLE, fx=199.0, cx=161.0, distortion=np.array(LENS) + (0.006, 0, 0, 0, 0)
-    )
+    calibration = replace(PINHOLE, fx=199.0, cx=161.0, distortion=np.add(LENS, (0.006, 0, 0, 0, 0)))
     maps = LensMaps.build(true, calibration)
     render = maps.render_camera
     # Every raw pixel reads the render where the true lens sends its ray.

@@ -11,9 +11,11 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     sequence.yaml            manifest (schema below)
     image_0/000000.png …     grey frames (``camera.fps``, default 15 Hz; .png or .jpg)
     times.txt                one frame time per line, camera clock (s, first frame at 0)
-    calib.yaml               camera calibration (write_camera_yaml: intrinsics + camera→vehicle),
-                             exact by default; ``calib_focal_error`` / ``calib_principal_offset_px``
-                             write a deliberately wrong one (true values in ``truth.camera``)
+    calib.yaml               camera calibration (write_camera_yaml: intrinsics + camera→vehicle)
+                             of the rectified frames: the calibrated pinhole, off the truth by
+                             ``calib_focal_error`` / ``calib_principal_offset_px`` (and, with
+                             ``camera_effects``, the distortion error the frames were rectified
+                             with); true values in ``truth.camera``
     gnss/rover.obs           RINEX 3.04 observations, 20 Hz: C1C D1C S1C, GPS + Galileo
     gnss/brdc.nav            RINEX 3.04 navigation (GPS + Galileo Keplerian, Klobuchar)
     gnss/visibility.csv      truth per epoch: gps_time_s,n_above_mask,n_direct,n_reflected
@@ -39,9 +41,11 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
            the timings, so the manifest is identical for identical inputs)
 
 The camera images are rendered by ``vo_doppler.sim.render`` from the city's textured ground
-and facades (``vo_doppler.sim.scene``); the vehicle follows ``loop_route``/``drive`` of
-``vo_doppler.sim.vo_sequence``. GNSS: ``gnss_observations`` (model, sign convention) with the
-``constellation``; CAN: ``can_bus``.
+and facades (``vo_doppler.sim.scene``), through the realistic camera of
+``vo_doppler.sim.camera_effects`` (lens, rolling shutter, motion blur, sensor) with moving
+vehicles (``vo_doppler.sim.traffic``) unless ``camera_effects`` is None; the vehicle follows
+``loop_route``/``drive`` of ``vo_doppler.sim.vo_sequence``. GNSS: ``gnss_observations``
+(model, sign convention) with the ``constellation``; CAN: ``can_bus``.
 """
 
 from __future__ import annotations
@@ -226,6 +230,22 @@ class VehicleDrive:
         return motion
 
 
+def build_city(config: UrbanCanyonConfig):
+    """The city scene of a configuration (``vo_doppler.sim.scene.city_scene``)."""
+    city = config.city
+    return city_scene(
+        config.seed,
+        blocks_x=city.blocks[0],
+        blocks_y=city.blocks[1],
+        block_size=city.block_size_m,
+        street_width=city.street_width_m,
+        height_range=city.height_range_m,
+        buildings_per_side=city.buildings_per_side,
+        window_facades=city.window_facades,
+        ground_contrast=city.ground_contrast,
+    )
+
+
 def simulate_urban_canyon(
     out_dir: str | Path, config: UrbanCanyonConfig, command: str = "", progress: bool = False
 ) -> UrbanCanyonSimulation:
@@ -237,18 +257,7 @@ def simulate_urban_canyon(
     clock = time.perf_counter()
     rng = np.random.default_rng(config.seed)
     gnss_rng, can_rng = (np.random.default_rng(s) for s in rng.integers(0, 2**63, 2))
-    city = config.city
-    scene = city_scene(
-        config.seed,
-        blocks_x=city.blocks[0],
-        blocks_y=city.blocks[1],
-        block_size=city.block_size_m,
-        street_width=city.street_width_m,
-        height_range=city.height_range_m,
-        buildings_per_side=city.buildings_per_side,
-        window_facades=city.window_facades,
-        ground_contrast=city.ground_contrast,
-    )
+    scene = build_city(config)
     vehicle = VehicleDrive(config, scene.layout)
     frame = EnuFrame(np.radians(config.origin[0]), np.radians(config.origin[1]), config.origin[2])
     t0, t1 = config.start_gps_s, config.start_gps_s + config.duration_s
@@ -358,7 +367,7 @@ def written_camera(camera: Camera, config: UrbanCanyonConfig) -> Camera:
     )
 
 
-def _frames(config, scene, camera, vehicle: VehicleDrive, times: np.ndarray) -> Iterator:
+def camera_frames(config, scene, camera, vehicle: VehicleDrive, times: np.ndarray) -> Iterator:
     """The camera frames at GPS ``times``: clean renders plus Gaussian noise, or frames through
     :class:`EffectsCamera` with the scene's traffic (vehicle clock: seconds since the start)."""
     if config.camera_effects is None:
@@ -395,7 +404,7 @@ def _frames(config, scene, camera, vehicle: VehicleDrive, times: np.ndarray) -> 
 def _render(out: Path, config, scene, camera, vehicle, times: np.ndarray, progress: bool) -> None:
     image_dir = out / "image_0"
     image_dir.mkdir(exist_ok=True)
-    frames = _frames(config, scene, camera, vehicle, times)
+    frames = camera_frames(config, scene, camera, vehicle, times)
     if progress:
         frames = track(frames, total=len(times), description="rendering")
     suffix = ".jpg" if config.image_format == "jpg" else ".png"
