@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tests.test_sim_lens import _blob_plane, _blob_texture, _centroid
+from tests.sim.test_lens import _blob_plane, _blob_texture, _centroid
 from vo_doppler.model.camera import Camera
 from vo_doppler.sim.camera_effects import CameraEffects, EffectsCamera
 from vo_doppler.sim.render import Renderer
