@@ -7,6 +7,10 @@ and resolves edge pixels exactly. The runs alternate so that machine load hits b
 times are medians. The baseline's images are checked to agree with the renderer's away from
 edges, so the ratio compares equal work.
 
+A second table times the frames ``vo-doppler simulate`` writes, on the urban-canyon drive:
+the realistic camera (lens, rolling shutter, motion blur, sensor, traffic: the default) against
+the clean rendering (``--clean``), frame by frame alternately, after each has built its scene.
+
     python benchmarks/render_speed.py [--frames 20] [--json FILE]
 """
 
@@ -15,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +27,12 @@ from rich.console import Console
 from rich.table import Table
 
 from vo_doppler.sim.render import NEAR_M, Renderer
+from vo_doppler.sim.urban_canyon import (
+    UrbanCanyonConfig,
+    VehicleDrive,
+    build_city,
+    camera_frames,
+)
 from vo_doppler.sim.vo_sequence import plan_vo_sequence, synthetic_camera
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -58,6 +69,27 @@ def brute_force(renderer: Renderer, T_world_camera: np.ndarray) -> np.ndarray:
         homographies[k + 1] = H.ravel()
     image = renderer._shade(index, homographies, u, v)
     return np.clip(image, 0, 255).round().astype(np.uint8)
+
+
+def simulator_frames(camera, frames: int) -> dict[str, float]:
+    """Median seconds per frame of the realistic and the clean camera of the simulator."""
+    streams = {}
+    realistic = UrbanCanyonConfig(duration_s=60.0)
+    clean_city = replace(realistic.city, window_facades=0, ground_contrast=1.0)
+    clean = replace(realistic, camera_effects=None, city=clean_city)
+    for name, config in (("realistic", realistic), ("clean", clean)):
+        scene = build_city(config)
+        vehicle = VehicleDrive(config, scene.layout)
+        times = config.start_gps_s + np.linspace(5.0, 55.0, frames + 1)
+        streams[name] = camera_frames(config, scene, camera, vehicle, times)
+        next(streams[name])
+    seconds = {name: [] for name in streams}
+    for _ in range(frames):
+        for name, stream in streams.items():
+            start = time.perf_counter()
+            next(stream)
+            seconds[name].append(time.perf_counter() - start)
+    return {name: float(np.median(values)) for name, values in seconds.items()}
 
 
 def main() -> int:
@@ -118,6 +150,16 @@ def main() -> int:
         )
     Console().print(table)
     print(f"interior pixels differing by > 1 grey level: {100 * max(mismatch):.2f} % (worst frame)")
+    simulator = simulator_frames(camera, args.frames)
+    table = Table(title=f"vo-doppler simulate frames, {args.width}×{args.height}")
+    table.add_column("camera")
+    table.add_column("median ms/frame (wall)", justify="right")
+    table.add_column("relative", justify="right")
+    for name, label in (("clean", "clean (--clean)"), ("realistic", "realistic (default)")):
+        table.add_row(
+            label, f"{simulator[name] * 1e3:.1f}", f"{simulator[name] / simulator['clean']:.2f}×"
+        )
+    Console().print(table)
 
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(
@@ -133,6 +175,8 @@ def main() -> int:
                 "brute_force_cpu_ms": median_cpu["brute_force"],
                 "speedup": ratio,
                 "interior_mismatch_fraction_max": max(mismatch),
+                "simulator_clean_ms": simulator["clean"] * 1e3,
+                "simulator_realistic_ms": simulator["realistic"] * 1e3,
             },
             indent=2,
         )

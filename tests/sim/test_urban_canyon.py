@@ -153,3 +153,44 @@ def test_route_has_turns_stops_and_a_speed_limit(tmp_path):
     assert standing == pytest.approx(config.stop_duration_s, abs=0.15)  # + creeping in and out
     assert sim.stats.stops >= 1 and sim.stats.turns >= 2
     assert sim.stats.path_length_m == pytest.approx(step.sum())
+
+
+def _manifest(out: Path, *options: str) -> dict:
+    assert main(["simulate", "--duration", "3", "--no-images", *options, "-o", str(out)]) == 0
+    return yaml.safe_load((out / "sequence.yaml").read_text())
+
+
+def test_cli_effects_switch_off_one_by_one_and_clean_restores_the_old_camera(tmp_path):
+    default = _manifest(tmp_path / "default")
+    effects = default["truth"]["camera"]["effects"]
+    assert effects["readout_s"] == pytest.approx(0.025)
+    assert effects["exposure_s"] == pytest.approx(0.004)
+    assert effects["distortion"][0] == pytest.approx(-0.30)
+    assert default["truth"]["camera"]["focal_error"] == pytest.approx(-0.005)
+    assert default["truth"]["traffic"]["vehicles_per_km"] > 0
+    assert default["city"]["window_facades"] > 0 and default["city"]["ground_contrast"] < 1
+    switched = _manifest(
+        tmp_path / "switched",
+        "--no-distortion",
+        "--no-rolling-shutter",
+        "--no-motion-blur",
+        "--no-sensor-noise",
+        "--no-exposure-changes",
+        "--no-traffic",
+        "--no-repetitive-facades",
+        "--no-asphalt",
+    )
+    effects = switched["truth"]["camera"]["effects"]
+    assert effects["distortion"] == [0.0] * 5 and effects["distortion_error"] == [0.0] * 5
+    assert effects["readout_s"] == 0.0 and effects["exposure_s"] == 0.0
+    assert effects["noise"] is False
+    assert effects["sensor"]["light_variation"] == 0.0 and effects["sensor"]["exposure_rate"] == 0
+    assert switched["truth"]["traffic"]["vehicles_per_km"] == 0.0
+    assert switched["city"]["window_facades"] == 0 and switched["city"]["ground_contrast"] == 1
+    assert "--no-traffic" in switched["command"] and "--no-asphalt" in switched["command"]
+    clean = _manifest(tmp_path / "clean", "--clean")
+    assert clean["truth"]["camera"]["effects"] is None
+    assert clean["truth"]["camera"]["focal_error"] == 0.0
+    assert clean["truth"]["camera"]["principal_offset_px"] == [0.0, 0.0]
+    assert clean["city"]["window_facades"] == 0 and clean["city"]["ground_contrast"] == 1
+    assert "--clean" in clean["command"]

@@ -13,6 +13,7 @@ from rich.table import Table
 from vo_doppler.errors import InputError
 from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
+from vo_doppler.sim.camera_effects import CameraEffects
 from vo_doppler.sim.urban_canyon import (
     SCENARIOS,
     CityConfig,
@@ -48,6 +49,55 @@ def _triple(text: str) -> tuple:
     return _numbers(text, 3)
 
 
+SWITCHES = {
+    "distortion": "lens distortion",
+    "rolling-shutter": "rolling shutter (global shutter)",
+    "motion-blur": "motion blur (instant exposure)",
+    "sensor-noise": "shot and read noise",
+    "exposure-changes": "changing light, auto exposure and vignetting",
+    "traffic": "moving vehicles",
+    "repetitive-facades": "window-grid facades",
+    "asphalt": "low-contrast asphalt (full-contrast ground)",
+}
+"""Effects of the realistic camera and city that ``--no-NAME`` switches off."""
+
+
+def _attr(flag: str) -> str:
+    return "no_" + flag.replace("-", "_")
+
+
+def _joined(values) -> str:
+    return ",".join(f"{v:.10g}" if isinstance(v, float) else str(v) for v in values)
+
+
+def _calib_error(args: argparse.Namespace) -> tuple[float, float, float]:
+    if args.calib_error is not None:
+        return tuple(args.calib_error)
+    if args.clean:
+        return (0.0, 0.0, 0.0)
+    defaults = UrbanCanyonConfig()
+    return (defaults.calib_focal_error, *defaults.calib_principal_offset_px)
+
+
+def _effects(args: argparse.Namespace, defaults: CameraEffects) -> CameraEffects | None:
+    """The camera effects the options ask for (None with --clean)."""
+    if args.clean:
+        return None
+    effects = replace(
+        defaults,
+        distortion_error=(args.distortion_error, *defaults.distortion_error[1:]),
+        readout_s=0.0 if args.no_rolling_shutter else args.readout_ms * 1e-3,
+        exposure_s=0.0 if args.no_motion_blur else args.exposure_ms * 1e-3,
+        noise=not args.no_sensor_noise,
+    )
+    if args.no_distortion:
+        effects = replace(effects, distortion=(0.0,) * 5, distortion_error=(0.0,) * 5)
+    if args.no_exposure_changes and effects.sensor is not None:
+        sensor = replace(effects.sensor, vignetting=0.0, light_variation=0.0, exposure_rate=0.0)
+        effects = replace(effects, sensor=sensor)
+    return effects
+
+
 def register(subparsers, summary: str) -> None:
     defaults = UrbanCanyonConfig()
     city = defaults.city
@@ -70,9 +120,45 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument(
         "--calib-error",
         type=_triple,
-        default=(defaults.calib_focal_error, *defaults.calib_principal_offset_px),
-        help="written-calibration error FOCAL_FRACTION,DCX_PX,DCY_PX (default 0,0,0: exact; "
-        "e.g. -0.01,3,-2 for a realistic VO heading drift)",
+        default=None,
+        help="written-calibration error FOCAL_FRACTION,DCX_PX,DCY_PX (default "
+        f"{_joined((defaults.calib_focal_error, *defaults.calib_principal_offset_px))}; "
+        "0,0,0 with --clean; 0,0,0 with --distortion-error 0 for an exact calibration)",
+    )
+    effects = defaults.camera_effects
+    parser.add_argument(
+        "--distortion-error",
+        type=float,
+        default=effects.distortion_error[0],
+        help="error of the calibrated radial coefficient k1 (true lens k1 "
+        f"{effects.distortion[0]:g}, k2 {effects.distortion[1]:g}; default %(default)g)",
+    )
+    parser.add_argument(
+        "--readout-ms",
+        type=float,
+        default=effects.readout_s * 1e3,
+        help="rolling-shutter readout time, first to last row (default %(default)g ms)",
+    )
+    parser.add_argument(
+        "--exposure-ms",
+        type=float,
+        default=effects.exposure_s * 1e3,
+        help="exposure time, for the motion blur (default %(default)g ms)",
+    )
+    parser.add_argument(
+        "--traffic",
+        type=float,
+        default=defaults.traffic.vehicles_per_km,
+        help="moving vehicles per km of lane (default %(default)g)",
+    )
+    for flag, what in SWITCHES.items():
+        parser.add_argument(f"--no-{flag}", action="store_true", help=f"render without {what}")
+    parser.add_argument(
+        "--clean",
+        action="store_true",
+        help="the clean rendering of earlier versions: pinhole frames exactly as rendered plus "
+        f"Gaussian noise ({defaults.image_noise:g} grey levels), no traffic, no repetitive "
+        "facades, full-contrast ground, exact calibration unless --calib-error is given",
     )
     parser.add_argument("--blocks", type=_int_pair, default=city.blocks, help="NX,NY blocks")
     parser.add_argument("--block-size", type=_pair, default=city.block_size_m, help="X,Y m")
@@ -132,15 +218,19 @@ def _start_gps(text: str | None, default: float) -> float:
 
 def _command_line(args: argparse.Namespace) -> str:
     """The full command that regenerates the sequence (every option spelled out)."""
-
-    def joined(values) -> str:
-        return ",".join(f"{v:.10g}" if isinstance(v, float) else str(v) for v in values)
-
+    joined = _joined
     words = ["vo-doppler", "simulate", "--scenario", args.scenario]
     words += ["--duration", f"{args.duration:g}", "--seed", str(args.seed)]
     words += ["--fps", f"{args.fps:g}", "--size", joined(args.size)]
     words += ["--image-format", args.image_format, "--jpeg-quality", str(args.jpeg_quality)]
-    words += ["--calib-error", joined(args.calib_error)]
+    words += ["--calib-error", joined(_calib_error(args))]
+    if args.clean:
+        words.append("--clean")
+    else:
+        words += ["--distortion-error", f"{args.distortion_error:g}"]
+        words += ["--readout-ms", f"{args.readout_ms:g}", "--exposure-ms", f"{args.exposure_ms:g}"]
+        words += ["--traffic", f"{args.traffic:g}"]
+        words += [f"--no-{flag}" for flag in SWITCHES if getattr(args, _attr(flag))]
     words += ["--blocks", joined(args.blocks), "--block-size", joined(args.block_size)]
     words += ["--street-width", f"{args.street_width:g}", "--heights", joined(args.heights)]
     words += ["--loop", joined([*args.loop[0], *args.loop[1]])]
@@ -176,6 +266,10 @@ def run(args: argparse.Namespace) -> int:
             street_width_m=args.street_width,
             height_range_m=args.heights,
             corner_streets=args.loop,
+            window_facades=0
+            if args.clean or args.no_repetitive_facades
+            else defaults.city.window_facades,
+            ground_contrast=1.0 if args.clean or args.no_asphalt else defaults.city.ground_contrast,
         ),
         max_speed_mps=args.max_speed / 3.6,
         initial_speed_mps=args.initial_speed / 3.6,
@@ -185,8 +279,13 @@ def run(args: argparse.Namespace) -> int:
         image_format=args.image_format,
         jpeg_quality=args.jpeg_quality,
         render=not args.no_images,
-        calib_focal_error=args.calib_error[0],
-        calib_principal_offset_px=args.calib_error[1:],
+        calib_focal_error=_calib_error(args)[0],
+        calib_principal_offset_px=_calib_error(args)[1:],
+        camera_effects=_effects(args, defaults.camera_effects),
+        traffic=replace(
+            defaults.traffic,
+            vehicles_per_km=0.0 if args.clean or args.no_traffic else args.traffic,
+        ),
         start_gps_s=_start_gps(args.start, defaults.start_gps_s),
         origin=args.origin,
         antenna_lever_arm_m=args.antenna_lever_arm,

@@ -23,13 +23,14 @@ and depth) and at four sub-samples (grey value), so silhouettes are anti-aliased
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import copy
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
 
 from vo_doppler.model.camera import Camera
-from vo_doppler.sim.scene import Scene
+from vo_doppler.sim.scene import Plane, Scene
 
 NEAR_M = 0.05
 """Near clipping distance along the optical axis."""
@@ -136,6 +137,35 @@ class _TextureAtlas:
         self.slot_origin = (corners + _PAD).astype(np.float32)
 
 
+def _plane_tables(planes: list[Plane], atlas: _TextureAtlas) -> dict[str, np.ndarray]:
+    """Per-plane geometry and texture tables (one row per plane, in order)."""
+    texture = np.array([p.texture for p in planes], dtype=np.int64)
+    extent = np.array([[p.width, p.height] for p in planes], dtype=float).reshape(-1, 2)
+    u = np.array([p.u_axis for p in planes], dtype=float).reshape(-1, 3)
+    v = np.array([p.v_axis for p in planes], dtype=float).reshape(-1, 3)
+    texel = np.array([p.texel_size for p in planes], dtype=float)
+    offset = np.array([p.offset for p in planes], dtype=float).reshape(-1, 2)
+    return {
+        "corners": np.array([p.corners for p in planes]).reshape(-1, 4, 3),
+        "origin": np.array([p.origin for p in planes], dtype=float).reshape(-1, 3),
+        "u": u,
+        "v": v,
+        "normal": np.cross(u, v),
+        "two_sided": np.array([p.two_sided for p in planes], dtype=bool),
+        "texel": texel,
+        "offset": offset,
+        "gain": np.array([p.gain for p in planes], dtype=np.float32),
+        "bias": np.array([p.bias for p in planes], dtype=np.float32),
+        "low": offset.astype(np.float32),
+        "high": (offset + extent / texel[:, None]).astype(np.float32),
+        "size_s": atlas.size[texture, 0],
+        "size_t": atlas.size[texture, 1],
+        "n_s": atlas.n_s[texture].astype(np.float32),
+        "n_t": atlas.n_t[texture].astype(np.float32),
+        "base": atlas.base[texture].astype(np.float32),
+    }
+
+
 def _clip_polygon(polygon: np.ndarray, normal: np.ndarray, offset: float) -> np.ndarray:
     """Sutherland–Hodgman: keep the part of a convex polygon (n, 3) with normal·p ≥ offset."""
     if len(polygon) == 0:
@@ -160,7 +190,13 @@ class Renderer:
     from a generator seeded by its ``seed`` argument, so images stay reproducible.
     """
 
-    def __init__(self, scene: Scene, camera: Camera, lod_bias: float = 0.5):
+    def __init__(
+        self,
+        scene: Scene,
+        camera: Camera,
+        lod_bias: float = 0.5,
+        atlas: _TextureAtlas | None = None,
+    ):
         if camera.has_distortion:
             raise ValueError("the renderer models a pinhole camera; distortion must be zero")
         if camera.width <= 0 or camera.height <= 0:
@@ -168,32 +204,9 @@ class Renderer:
         self.scene = scene
         self.camera = camera
         self.lod_bias = lod_bias
-        self.atlas = _TextureAtlas(scene.textures)
-        planes = scene.planes
-        self._corners = np.array([p.corners for p in planes]).reshape(-1, 4, 3)
-        self._origin = np.array([p.origin for p in planes], dtype=float).reshape(-1, 3)
-        self._u = np.array([p.u_axis for p in planes], dtype=float).reshape(-1, 3)
-        self._v = np.array([p.v_axis for p in planes], dtype=float).reshape(-1, 3)
-        self._normal = np.cross(self._u, self._v)
-        self._two_sided = np.array([p.two_sided for p in planes], dtype=bool)
-        self._texel = np.array([p.texel_size for p in planes], dtype=float)
-        self._offset = np.array([p.offset for p in planes], dtype=float).reshape(-1, 2)
-        texture = np.array([p.texture for p in planes], dtype=np.int64)
-        # Index 0 of every per-plane table is the sky.
-        self._gain = np.concatenate([[0.0], [p.gain for p in planes]]).astype(np.float32)
-        self._bias = np.concatenate([[scene.sky], [p.bias for p in planes]]).astype(np.float32)
-        extent = np.array([[p.width, p.height] for p in planes], dtype=float).reshape(-1, 2)
-        low = self._offset
-        high = self._offset + extent / self._texel[:, None]
-        # Texture-coordinate range of each rectangle (unwrapped); the sky's range is empty.
-        self._low = np.vstack([[np.inf, np.inf], low]).astype(np.float32)
-        self._high = np.vstack([[-np.inf, -np.inf], high]).astype(np.float32)
-        atlas = self.atlas
-        self._size_s = np.concatenate([[1.0], atlas.size[texture, 0]]).astype(np.float32)
-        self._size_t = np.concatenate([[1.0], atlas.size[texture, 1]]).astype(np.float32)
-        self._n_s = np.concatenate([[0], atlas.n_s[texture]]).astype(np.float32)
-        self._n_t = np.concatenate([[0], atlas.n_t[texture]]).astype(np.float32)
-        self._base = np.concatenate([[0], atlas.base[texture]]).astype(np.float32)
+        self.atlas = _TextureAtlas(scene.textures) if atlas is None else atlas
+        self._static = _plane_tables(scene.planes, self.atlas)
+        self._install(len(scene.planes), self._static)
         w, h = camera.width, camera.height
         self._u_pix = np.arange(w, dtype=np.float32)
         self._v_pix = np.arange(h, dtype=np.float32)
@@ -211,6 +224,48 @@ class Renderer:
             (np.array([0.0, 1.0, -y_lo]), 0.0),
             (np.array([0.0, -1.0, y_hi]), 0.0),
         ]
+
+    def _install(self, count: int, tables: dict[str, np.ndarray]) -> None:
+        """Use the ``count`` planes of these tables; index 0 of the shading tables is the sky."""
+        self._count = count
+        self._corners, self._origin = tables["corners"], tables["origin"]
+        self._u, self._v, self._normal = tables["u"], tables["v"], tables["normal"]
+        self._two_sided, self._texel = tables["two_sided"], tables["texel"]
+        self._offset = tables["offset"]
+        sky = {
+            "gain": 0.0,
+            "bias": self.scene.sky,
+            "size_s": 1.0,
+            "size_t": 1.0,
+            "n_s": 0.0,
+            "n_t": 0.0,
+            "base": 0.0,
+        }
+        for name, value in sky.items():
+            setattr(self, "_" + name, np.concatenate([[value], tables[name]]).astype(np.float32))
+        # Texture-coordinate range of each rectangle (unwrapped); the sky's range is empty.
+        self._low = np.vstack([[np.inf, np.inf], tables["low"]]).astype(np.float32)
+        self._high = np.vstack([[-np.inf, -np.inf], tables["high"]]).astype(np.float32)
+
+    def plane_tables(self, planes: list[Plane]) -> dict[str, np.ndarray]:
+        """Tables of extra planes (textures indexing ``scene.textures``) for :meth:`with_moving`;
+        rows may be selected and ``origin`` and ``corners`` translated before use."""
+        return _plane_tables(planes, self.atlas)
+
+    def with_moving(self, tables: dict[str, np.ndarray]) -> Renderer:
+        """A renderer of this one's scene plus the planes of ``tables`` (:meth:`plane_tables`;
+        moving objects at one instant), sharing the atlas and the static tables."""
+        if len(tables["origin"]) == 0:
+            return self
+        merged = {k: np.concatenate([self._static[k], tables[k]]) for k in self._static}
+        other = copy.copy(self)
+        other._install(len(self.scene.planes) + len(tables["origin"]), merged)
+        return other
+
+    def window(self, row0: int, row1: int) -> Renderer:
+        """A renderer of rows [row0, row1) of this camera's image (same scene and atlas)."""
+        camera = replace(self.camera, cy=self.camera.cy - row0, height=row1 - row0)
+        return Renderer(self.scene, camera, self.lod_bias, self.atlas)
 
     def _visible_planes(self, R_cw: np.ndarray, t_cw: np.ndarray, centre: np.ndarray) -> np.ndarray:
         """Indices of planes facing the camera with some corner inside every frustum half-space."""
@@ -233,9 +288,9 @@ class Renderer:
         h, w = cam.height, cam.width
         inv_depth = np.zeros((h, w), dtype=np.float32)
         index = np.zeros((h, w), dtype=np.int32)
-        homographies = np.zeros((len(self.scene.planes) + 1, 9), dtype=np.float32)
+        homographies = np.zeros((self._count + 1, 9), dtype=np.float32)
         homographies[0] = (0, 0, 0, 0, 0, 0, 0, 0, 1)
-        inverse_depth_planes = np.zeros((len(self.scene.planes) + 1, 3), dtype=np.float32)
+        inverse_depth_planes = np.zeros((self._count + 1, 3), dtype=np.float32)
         mask = np.zeros((h, w), dtype=np.uint8)
         for k in self._visible_planes(R_cw, t_cw, centre):
             polygon = self._corners[k] @ R_cw.T + t_cw

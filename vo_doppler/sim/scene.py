@@ -21,6 +21,8 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
+WINDOW_STREAM = 0x3D0C
+"""Second seed word of the window-facade random stream."""
 SUN_DIRECTION = np.array([0.45, -0.55, 0.70]) / np.linalg.norm([0.45, -0.55, 0.70])
 """Unit vector towards the sun (ENU), used for per-face brightness."""
 
@@ -161,6 +163,56 @@ def procedural_texture(
     return np.clip(12.0 + 231.0 * (tile - lo) / (hi - lo), 0, 255).round().astype(np.uint8)
 
 
+def window_facade_texture(
+    size: int, rng: np.random.Generator, columns: int = 16, storeys: int = 12
+) -> np.ndarray:
+    """A seamless facade tile with a regular grid of windows (size × size uint8).
+
+    ``columns`` × ``storeys`` identical bays (window spacing size/columns texels across,
+    size/storeys up: 2.56 m × 3.41 m at the default 0.04 m texel and 1024-texel tile), each a
+    dark glazed window with a lighter frame and sill on a plaster wall of faint pink noise; a
+    few windows have a blind drawn to a random height, as on real buildings. The repetition is
+    what makes real facades hard for feature tracking: a patch matches its neighbours a bay away.
+    """
+    wall = rng.uniform(0.45, 0.8)
+    tile = wall + 0.04 * _pink_noise(size, rng, 4.0 / size, 0.25)
+    glass = rng.uniform(0.08, 0.3)
+    frame = min(wall + rng.uniform(0.08, 0.2), 1.0)
+    bay_w, bay_h = size / columns, size / storeys
+    win_w = int(bay_w * rng.uniform(0.45, 0.65))
+    win_h = int(bay_h * rng.uniform(0.4, 0.6))
+    border = max(2, int(0.08 * win_w))
+    for i in range(columns):
+        for j in range(storeys):
+            x = round(i * bay_w + (bay_w - win_w) / 2)
+            y = round(j * bay_h + (bay_h - win_h) / 2)
+            cv2.rectangle(
+                tile,
+                (x - border, y - border),
+                (x + win_w + border, y + win_h + 2 * border),
+                frame,
+                -1,
+            )
+            cv2.rectangle(tile, (x, y), (x + win_w, y + win_h), glass, -1)
+            if rng.uniform() < 0.2:
+                drawn = int(win_h * rng.uniform(0.2, 0.9))
+                cv2.rectangle(tile, (x, y), (x + win_w, y + drawn), rng.uniform(0.5, 0.9), -1)
+    tile += 0.02 * _pink_noise(size, rng, 0.1, 0.5)
+    return np.clip(12.0 + 231.0 * tile, 0, 255).round().astype(np.uint8)
+
+
+def _wall_texture(
+    rng: np.random.Generator, window_rng: np.random.Generator, corner_rich: int, windows: int
+) -> int:
+    """Texture index of a wall: one of the corner-rich tiles drawn from ``rng`` (as without
+    window facades), replaced with probability windows / (corner_rich + windows) by a window
+    tile drawn from ``window_rng``."""
+    texture = 1 + int(rng.integers(corner_rich))
+    if windows and window_rng.uniform() < windows / (corner_rich + windows):
+        texture = 1 + corner_rich + int(window_rng.integers(windows))
+    return texture
+
+
 def _split(length: float, parts: int, rng: np.random.Generator) -> np.ndarray:
     """Random split points 0 = c0 < c1 < … < c_parts = length, each part ≥ length / (3·parts)."""
     weights = rng.uniform(0.5, 1.5, size=parts)
@@ -232,6 +284,8 @@ def city_scene(
     tile_size: int = 1024,
     n_facade_textures: int = 6,
     ground_margin_m: float = 2000.0,
+    window_facades: int = 0,
+    ground_contrast: float = 1.0,
 ) -> Scene:
     """A city of ``blocks_x × blocks_y`` building blocks on a street grid (deterministic per seed).
 
@@ -239,11 +293,23 @@ def city_scene(
     so block (i, j) covers [i·pitch_x + w/2, (i+1)·pitch_x − w/2] × (same in y). Each block holds
     a random grid of 1–3 × 1–3 buildings with heights drawn from ``height_range``. The ground
     (one plane, z = 0) extends ``ground_margin_m`` beyond the city so the horizon is ground.
+    ``window_facades`` adds that many repetitive window-grid tiles
+    (:func:`window_facade_texture`) to the ``n_facade_textures`` corner-rich ones; walls pick
+    among all of them, roofs among the former (0, the default, gives the scene of earlier versions).
+    ``ground_contrast`` scales the ground texture's grey levels about their mean (1: as drawn;
+    worn asphalt is a low-contrast surface, about a third of the facades' contrast).
     """
     rng = np.random.default_rng(seed)
     ground_tile = 2 * tile_size
     textures = [procedural_texture(ground_tile, rng, rect_coverage=0.1, max_rect=1 / 32)]
+    if ground_contrast != 1.0:
+        mean = float(textures[0].mean())
+        textures[0] = np.clip(mean + ground_contrast * (textures[0] - mean), 0, 255).round()
+        textures[0] = textures[0].astype(np.uint8)
     textures += [procedural_texture(tile_size, rng) for _ in range(n_facade_textures)]
+    # Window facades draw from their own stream, so the city is the same with or without them.
+    window_rng = np.random.default_rng([seed, WINDOW_STREAM])
+    textures += [window_facade_texture(tile_size, window_rng) for _ in range(window_facades)]
     layout = CityLayout(blocks_x, blocks_y, block_size, street_width)
     px, py = layout.pitch
     extent = np.array([blocks_x * px, blocks_y * py])
@@ -305,7 +371,9 @@ def city_scene(
                                     corners[(side + 1) % 4],
                                     float(below),
                                     h,
-                                    1 + int(rng.integers(n_facade_textures)),
+                                    _wall_texture(
+                                        rng, window_rng, n_facade_textures, window_facades
+                                    ),
                                     facade_texel_m,
                                     rng,
                                     tile_size,

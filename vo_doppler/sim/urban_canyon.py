@@ -11,9 +11,11 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     sequence.yaml            manifest (schema below)
     image_0/000000.png …     grey frames (``camera.fps``, default 15 Hz; .png or .jpg)
     times.txt                one frame time per line, camera clock (s, first frame at 0)
-    calib.yaml               camera calibration (write_camera_yaml: intrinsics + camera→vehicle),
-                             exact by default; ``calib_focal_error`` / ``calib_principal_offset_px``
-                             write a deliberately wrong one (true values in ``truth.camera``)
+    calib.yaml               camera calibration (write_camera_yaml: intrinsics + camera→vehicle)
+                             of the rectified frames: the calibrated pinhole, off the truth by
+                             ``calib_focal_error`` / ``calib_principal_offset_px`` (and, with
+                             ``camera_effects``, the distortion error the frames were rectified
+                             with); true values in ``truth.camera``
     gnss/rover.obs           RINEX 3.04 observations, 20 Hz: C1C D1C S1C, GPS + Galileo
     gnss/brdc.nav            RINEX 3.04 navigation (GPS + Galileo Keplerian, Klobuchar)
     gnss/visibility.csv      truth per epoch: gps_time_s,n_above_mask,n_direct,n_reflected
@@ -39,9 +41,11 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
            the timings, so the manifest is identical for identical inputs)
 
 The camera images are rendered by ``vo_doppler.sim.render`` from the city's textured ground
-and facades (``vo_doppler.sim.scene``); the vehicle follows ``loop_route``/``drive`` of
-``vo_doppler.sim.vo_sequence``. GNSS: ``gnss_observations`` (model, sign convention) with the
-``constellation``; CAN: ``can_bus``.
+and facades (``vo_doppler.sim.scene``), through the realistic camera of
+``vo_doppler.sim.camera_effects`` (lens, rolling shutter, motion blur, sensor) with moving
+vehicles (``vo_doppler.sim.traffic``) unless ``camera_effects`` is None; the vehicle follows
+``loop_route``/``drive`` of ``vo_doppler.sim.vo_sequence``. GNSS: ``gnss_observations``
+(model, sign convention) with the ``constellation``; CAN: ``can_bus``.
 """
 
 from __future__ import annotations
@@ -49,6 +53,7 @@ from __future__ import annotations
 import logging
 import shutil
 import time
+from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
@@ -63,6 +68,7 @@ from vo_doppler.io.rinex_write import write_nav, write_obs
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.camera import Camera
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.sim.camera_effects import CameraEffects, EffectsCamera
 from vo_doppler.sim.can_bus import (
     DBC_PATH,
     WHEEL_SPEED_SIGNALS,
@@ -86,6 +92,7 @@ from vo_doppler.sim.gnss_observations import (
     simulate_gnss,
 )
 from vo_doppler.sim.scene import city_scene
+from vo_doppler.sim.traffic import TrafficConfig, add_traffic
 from vo_doppler.sim.vo_sequence import (
     VehicleMotion,
     VoPlan,
@@ -103,6 +110,8 @@ DEFAULT_START_GPS_S = REFERENCE_EPOCH + 2 * 3600.0 + 600.0
 SHINJUKU = (35.69380, 139.70340, 77.0)
 """Default ENU origin: latitude, longitude (deg), ellipsoidal height (m)."""
 GROUND_TRUTH_RATE_HZ = 100.0
+TRAFFIC_STREAM = 0x7AFF1C
+"""Second seed word of the traffic's random stream (GNSS and CAN streams stay as they were)."""
 CAMERA_START_DELAY_S = 0.02
 
 
@@ -117,6 +126,11 @@ class CityConfig:
     buildings_per_side: tuple[int, int] = (1, 3)
     corner_streets: tuple[tuple[int, int], tuple[int, int]] = ((1, 1), (4, 3))
     corner_radius_m: float = 9.0
+    window_facades: int = 4
+    """Repetitive window-grid facade tiles added to the six corner-rich ones (0: none)."""
+    ground_contrast: float = 0.35
+    """Contrast of the ground texture: worn asphalt, a third of the facades' (1: the
+    full-contrast ground of earlier versions)."""
 
 
 @dataclass(frozen=True)
@@ -136,8 +150,13 @@ class UrbanCanyonConfig:
     image_format: str = "png"
     jpeg_quality: int = 90
     image_noise: float = 2.0
-    calib_focal_error: float = 0.0
-    calib_principal_offset_px: tuple[float, float] = (0.0, 0.0)
+    """Gaussian pixel noise (grey levels) of the clean rendering (``camera_effects`` None)."""
+    calib_focal_error: float = -0.005
+    calib_principal_offset_px: tuple[float, float] = (2.0, -1.5)
+    camera_effects: CameraEffects | None = field(default_factory=CameraEffects)
+    """Lens, rolling shutter and sensor (None: the clean pinhole rendering of earlier versions,
+    frames exactly as rendered plus ``image_noise``)."""
+    traffic: TrafficConfig = field(default_factory=TrafficConfig)
     render: bool = True
     start_gps_s: float = DEFAULT_START_GPS_S
     origin: tuple[float, float, float] = SHINJUKU
@@ -211,6 +230,22 @@ class VehicleDrive:
         return motion
 
 
+def build_city(config: UrbanCanyonConfig):
+    """The city scene of a configuration (``vo_doppler.sim.scene.city_scene``)."""
+    city = config.city
+    return city_scene(
+        config.seed,
+        blocks_x=city.blocks[0],
+        blocks_y=city.blocks[1],
+        block_size=city.block_size_m,
+        street_width=city.street_width_m,
+        height_range=city.height_range_m,
+        buildings_per_side=city.buildings_per_side,
+        window_facades=city.window_facades,
+        ground_contrast=city.ground_contrast,
+    )
+
+
 def simulate_urban_canyon(
     out_dir: str | Path, config: UrbanCanyonConfig, command: str = "", progress: bool = False
 ) -> UrbanCanyonSimulation:
@@ -222,16 +257,7 @@ def simulate_urban_canyon(
     clock = time.perf_counter()
     rng = np.random.default_rng(config.seed)
     gnss_rng, can_rng = (np.random.default_rng(s) for s in rng.integers(0, 2**63, 2))
-    city = config.city
-    scene = city_scene(
-        config.seed,
-        blocks_x=city.blocks[0],
-        blocks_y=city.blocks[1],
-        block_size=city.block_size_m,
-        street_width=city.street_width_m,
-        height_range=city.height_range_m,
-        buildings_per_side=city.buildings_per_side,
-    )
+    scene = build_city(config)
     vehicle = VehicleDrive(config, scene.layout)
     frame = EnuFrame(np.radians(config.origin[0]), np.radians(config.origin[1]), config.origin[2])
     t0, t1 = config.start_gps_s, config.start_gps_s + config.duration_s
@@ -294,7 +320,7 @@ def simulate_urban_canyon(
     np.savetxt(out / "times.txt", camera_clock, fmt="%.6f")
     write_camera_yaml(out / "calib.yaml", written_camera(camera, config))
     if config.render:
-        _render(out, config, scene, camera, vehicle(camera_clock + camera_offset), progress)
+        _render(out, config, scene, camera, vehicle, camera_clock + camera_offset, progress)
     seconds["camera"] = time.perf_counter() - clock
 
     stats = _stats(config, truth, gnss, n_frames, len(can.lines), seconds)
@@ -341,21 +367,46 @@ def written_camera(camera: Camera, config: UrbanCanyonConfig) -> Camera:
     )
 
 
-def _render(out: Path, config, scene, camera, motion: VehicleMotion, progress: bool) -> None:
-    image_dir = out / "image_0"
-    image_dir.mkdir(exist_ok=True)
-    plan = VoPlan(
+def camera_frames(config, scene, camera, vehicle: VehicleDrive, times: np.ndarray) -> Iterator:
+    """The camera frames at GPS ``times``: clean renders plus Gaussian noise, or frames through
+    :class:`EffectsCamera` with the scene's traffic (vehicle clock: seconds since the start)."""
+    if config.camera_effects is None:
+        motion = vehicle(times)
+        T_world_camera = motion.T_world_vehicle @ camera.T_vehicle_camera
+        plan = VoPlan(scene, camera, times, motion, T_world_camera, config.image_noise, config.seed)
+        return render_frames(plan)
+    ego = vehicle(times)
+    vehicles = add_traffic(
+        scene,
+        config.traffic,
+        np.random.default_rng([config.seed, TRAFFIC_STREAM]),
+        times - config.start_gps_s,
+        ego.xy,
+    )
+    effects = EffectsCamera(
         scene,
         camera,
-        motion.t,
-        motion,
-        motion.T_world_vehicle @ camera.T_vehicle_camera,
-        config.image_noise,
+        written_camera(camera, config),
+        config.camera_effects,
+        times,
         config.seed,
+        vehicles,
     )
-    frames = render_frames(plan)
+    band_times = effects.band_times(times)
+    band_motion = vehicle(band_times.ravel())
+    band_poses = (band_motion.T_world_vehicle @ camera.T_vehicle_camera).reshape(
+        *band_times.shape, 4, 4
+    )
+    elapsed = band_times - config.start_gps_s
+    return (effects.frame(k, band_poses[k], elapsed[k]) for k in range(len(times)))
+
+
+def _render(out: Path, config, scene, camera, vehicle, times: np.ndarray, progress: bool) -> None:
+    image_dir = out / "image_0"
+    image_dir.mkdir(exist_ok=True)
+    frames = camera_frames(config, scene, camera, vehicle, times)
     if progress:
-        frames = track(frames, total=len(motion.t), description="rendering")
+        frames = track(frames, total=len(times), description="rendering")
     suffix = ".jpg" if config.image_format == "jpg" else ".png"
     params = [cv2.IMWRITE_JPEG_QUALITY, config.jpeg_quality] if suffix == ".jpg" else []
     for k, image in enumerate(frames):
@@ -466,7 +517,15 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
                 "focal_error": config.calib_focal_error,
                 "principal_offset_px": list(config.calib_principal_offset_px),
                 "image_noise_grey_levels": config.image_noise,
+                "effects": None
+                if config.camera_effects is None
+                else _plain(asdict(config.camera_effects)),
+                "calibration_written": "rectified pinhole: the frames are resampled from the "
+                "distorted raw frames with the calibrated (wrong) intrinsics and distortion"
+                if config.camera_effects is not None
+                else "the rendering pinhole with the calibration error",
             },
+            "traffic": _plain(asdict(config.traffic)) if config.camera_effects else None,
             "wheel_scale_error": config.can.wheel_scale_error,
             "yaw_rate_bias_dps": config.can.yaw_rate_bias_dps,
             "yaw_bias_walk_dps_per_sqrt_s": config.can.yaw_bias_walk_dps,
@@ -479,6 +538,8 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
             "street_width_m": city.street_width_m,
             "height_range_m": list(city.height_range_m),
             "corner_streets": [list(p) for p in city.corner_streets],
+            "window_facades": city.window_facades,
+            "ground_contrast": city.ground_contrast,
         },
         "stats": _plain({k: v for k, v in asdict(stats).items() if k != "seconds"}),
     }
