@@ -15,7 +15,7 @@ from tests.io.test_android import synthetic_rows, write_log
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, geodetic_to_ecef
-from vo_doppler.gnss.ephemeris import transmit_states
+from vo_doppler.gnss.satellite_source import transmit_states
 from vo_doppler.gnss.spp import elevation_azimuth
 from vo_doppler.io.gnss_csv import VELOCITY_COLUMNS
 from vo_doppler.io.receiver_file import read_observation_file, sniff_format
