@@ -45,7 +45,7 @@ from pathlib import Path
 
 from vo_doppler import __version__
 from vo_doppler.errors import InputError, VoDopplerError
-from vo_doppler.io.sequence import read_sequence
+from vo_doppler.io.sequence import read_sequence_with_report
 from vo_doppler.io.tables import write_csv_and_parquet
 from vo_doppler.report.batch_summary import (
     COLUMNS,
@@ -53,7 +53,12 @@ from vo_doppler.report.batch_summary import (
     recording_row,
     write_batch_html,
 )
-from vo_doppler.report.run_outputs import require_tight_heading, write_run_outputs
+from vo_doppler.report.run_outputs import (
+    input_warnings,
+    require_tight_heading,
+    result_checks,
+    write_run_outputs,
+)
 from vo_doppler.run import RunConfig, run_sequence
 
 log = logging.getLogger(__name__)
@@ -198,9 +203,13 @@ def finished(job: RecordingJob) -> dict | None:
 
 def _run_job(job: RecordingJob) -> dict:
     folder = job.source if job.prepare is None else job.prepare(job.source, job.out / PREPARED)
-    sequence = read_sequence(folder)
+    sequence, report = read_sequence_with_report(folder)
+    warnings = input_warnings(sequence, report)
+    for text in warnings:
+        log.warning("%s", text)
     result = run_sequence(sequence, job.config)
-    summary = write_run_outputs(sequence, result, job.config, job.out)
+    checks = result_checks(sequence, report, result, warnings)
+    summary = write_run_outputs(sequence, result, job.config, job.out, checks)
     require_tight_heading(result, folder)
     return summary
 

@@ -25,7 +25,7 @@ ALLOWED: dict[str, set[str]] = {
     "checks": BASE,
     "sim": BASE | STAGES | {"io", "sim"},
     "run": BASE | STAGES | {"io"},
-    "report": BASE | STAGES | {"io", "run", "report"},
+    "report": BASE | STAGES | {"checks", "io", "run", "report"},
     "batch": BASE | STAGES | {"io", "run", "report"},
 }
 """Layer → the layers it may import. Commands and the CLI may import anything."""

@@ -12,21 +12,14 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
-from vo_doppler.checks import (
-    check_yaw_rate_unit,
-    clock_warning,
-    estimate_clock_offset,
-    origin_warning,
-)
 from vo_doppler.commands.vo_command import window_size
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.io.output_folder import check_output_folder, staged_output, untouched
-from vo_doppler.io.sequence import InputReport, read_sequence_with_report
-from vo_doppler.model.sequence import Sequence
-from vo_doppler.report.run_outputs import write_run_outputs
+from vo_doppler.io.sequence import read_sequence_with_report
+from vo_doppler.report.run_outputs import input_warnings, result_checks, write_run_outputs
 from vo_doppler.report.run_report import TABLE_COLUMNS
 from vo_doppler.run import RunConfig, RunResult, run_sequence
 from vo_doppler.vo.config import VoConfig
@@ -94,29 +87,6 @@ def run_config(args: argparse.Namespace) -> RunConfig:
     )
 
 
-def input_warnings(inputs: Sequence, report: InputReport) -> list[str]:
-    """Errors raised and warnings listed before the long work: the yaw rate against its DBC
-    unit, the origin against the RINEX approximate position, each sensor's time order."""
-    check_yaw_rate_unit(inputs.yaw_rate, inputs.wheel_speed, report.yaw_rate_dbc_unit)
-    found = report.warnings()
-    origin = origin_warning(inputs.enu, inputs.observations.header.approx_position)
-    return found + ([origin] if origin else [])
-
-
-def result_warnings(inputs: Sequence, report: InputReport, result: RunResult) -> dict:
-    """The CAN clock against the GNSS Doppler speed: the estimate and a warning beyond 0.2 s."""
-    velocity = result.gnss.velocity
-    horizontal = np.where(
-        velocity.valid, np.linalg.norm(velocity.velocity_enu[:, :2], axis=1), np.nan
-    )
-    estimate = estimate_clock_offset(inputs.wheel_speed, velocity.t, horizontal)
-    warning = clock_warning("CAN", estimate, report.can_time_offset_s)
-    return {
-        "can_clock_residual_offset_s": None if estimate is None else estimate.residual_s,
-        "warnings": [warning] if warning else [],
-    }
-
-
 def run(args: argparse.Namespace) -> int:
     check_output_folder(args.output)
     try:
@@ -149,14 +119,7 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("visual odometry", total=len(inputs.image_paths))
         result = run_sequence(inputs, config, lambda _: progress.advance(task))
-    clock = result_warnings(inputs, report, result)
-    for text in clock["warnings"]:
-        log.warning("%s", text)
-    checks = {
-        "warnings": warnings + clock["warnings"],
-        "can_clock_residual_offset_s": clock["can_clock_residual_offset_s"],
-        "time_order": {r.sensor: r.as_dict() for r in report.time_order},
-    }
+    checks = result_checks(inputs, report, result, warnings)
     with staged_output(args.output) as out:
         summary = write_run_outputs(inputs, result, config, out, checks)
     if result.vo is None:

@@ -5,13 +5,21 @@
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.checks import (
+    check_yaw_rate_unit,
+    clock_warning,
+    estimate_clock_offset,
+    origin_warning,
+)
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.io.sequence import InputReport
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.report.heading_figure import heading_figure
@@ -23,6 +31,8 @@ from vo_doppler.report.run_report import (
 from vo_doppler.run import Pipeline, RunConfig, RunResult
 
 SUMMARY_FILE = "summary.json"
+
+log = logging.getLogger(__name__)
 
 FACT_FORMATS = {
     "gnss_epochs": ("GNSS epochs", "{:d}"),
@@ -81,6 +91,36 @@ def readable_facts(summary: dict) -> dict[str, str]:
         label, fmt = FACT_FORMATS.get(key, (key, "{}"))
         facts[label] = fmt.format(value)
     return facts
+
+
+def input_warnings(inputs: Sequence, report: InputReport) -> list[str]:
+    """Errors raised and warnings listed before the long work: the yaw rate against its DBC
+    unit, the origin against the RINEX approximate position, each sensor's time order."""
+    check_yaw_rate_unit(inputs.yaw_rate, inputs.wheel_speed, report.yaw_rate_dbc_unit)
+    found = report.warnings()
+    origin = origin_warning(inputs.enu, inputs.observations.header.approx_position)
+    return found + ([origin] if origin else [])
+
+
+def result_checks(
+    inputs: Sequence, report: InputReport, result: RunResult, warnings: list[str]
+) -> dict:
+    """The summary's ``checks``: the input ``warnings`` and the CAN clock against the GNSS
+    Doppler speed (the estimate, and a warning beyond 0.2 s, logged), the time order per
+    sensor."""
+    velocity = result.gnss.velocity
+    horizontal = np.where(
+        velocity.valid, np.linalg.norm(velocity.velocity_enu[:, :2], axis=1), np.nan
+    )
+    estimate = estimate_clock_offset(inputs.wheel_speed, velocity.t, horizontal)
+    warning = clock_warning("CAN", estimate, report.can_time_offset_s)
+    if warning:
+        log.warning("%s", warning)
+    return {
+        "warnings": warnings + ([warning] if warning else []),
+        "can_clock_residual_offset_s": None if estimate is None else estimate.residual_s,
+        "time_order": {r.sensor: r.as_dict() for r in report.time_order},
+    }
 
 
 def write_run_outputs(
