@@ -20,6 +20,7 @@ import numpy as np
 from tests.conftest import REPO_ROOT, shared_data_dir
 from tests.fuzz.mutators import SHRINKING
 from tests.helpers.rinex_text import as_rinex4
+from tests.io.fuzz_families import register_all
 from vo_doppler.io.rinex_common import FIRST_YEAR, LAST_YEAR, PRN_RANGE
 from vo_doppler.io.rinex_nav import ESSENTIAL, PLAUSIBLE, read_nav
 from vo_doppler.io.rinex_obs import read_obs
@@ -277,3 +278,5 @@ register(
         {"versions": "2 (brdc, yamatogawa), 3.04 (septentrio, sample sequence), 4.01 rewrite"},
     )
 )
+
+register_all(register, Family, Seed)  # CAN, DBC, CSV, NMEA, trajectory, calibration, manifest
