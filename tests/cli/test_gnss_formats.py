@@ -134,4 +134,4 @@ def test_android_log_without_nav_is_an_error_naming_the_file(tmp_path, capsys):
     assert sniff_format(path) == "gnsslogger"
     code = main(["gnss", "velocity", str(path), "-o", str(tmp_path / "v.csv")])
     assert code != 0
-    assert "gnss_log.txt: no navigation data: give --nav" in capsys.readouterr().err
+    assert "gnss_log.txt: no satellite states: give --nav or --orbits" in capsys.readouterr().err
