@@ -13,6 +13,7 @@ import sys
 import traceback
 
 from vo_doppler import __version__
+from vo_doppler.commands.help_format import OptionsParser
 from vo_doppler.errors import (
     EXIT_FAILURE,
     EXIT_INTERNAL,
@@ -63,7 +64,7 @@ def chosen_command(argv: list[str]) -> str | None:
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The parser with every subcommand listed; ``command``'s own options are loaded (all of
     them when ``command`` is "*", for documentation and tests)."""
-    parser = argparse.ArgumentParser(
+    parser = OptionsParser(
         prog="vo-doppler",
         description="Monocular visual odometry with heading corrected by GNSS Doppler.",
         epilog=EXIT_CODES_EPILOG,
@@ -75,7 +76,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     parser.add_argument(
         "--debug", action="store_true", help="print the traceback of any error (for bug reports)"
     )
-    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    subparsers = parser.add_subparsers(
+        dest="command", metavar="COMMAND", required=True, parser_class=OptionsParser
+    )
     for name, (module, summary) in SUBCOMMANDS.items():
         if command in (name, "*"):
             importlib.import_module(f"vo_doppler.commands.{module}").register(subparsers, summary)

@@ -39,11 +39,13 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("obs", type=Path, help="RINEX observation file")
     add_satellite_options(parser)
-    parser.add_argument("--systems", default="GREJC")
+    parser.add_argument(
+        "--systems", default="GREJC", help="GNSS systems to use (RINEX letters: G, R, E, J, C)"
+    )
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
     sensors = parser.add_argument_group("vehicle sensors (CAN log + DBC, or two CSV files)")
     sensors.add_argument("--can", type=Path, help="candump -l, .asc, .blf or python-can .csv")
-    sensors.add_argument("--dbc", type=Path)
+    sensors.add_argument("--dbc", type=Path, help="DBC file decoding the CAN log's signals")
     sensors.add_argument("--yaw-rate", help="MESSAGE.SIGNAL of the yaw rate")
     sensors.add_argument("--wheel-speed", help="MESSAGE.SIGNAL[,MESSAGE.SIGNAL...] (averaged)")
     sensors.add_argument(
@@ -58,8 +60,8 @@ def register(subparsers, summary: str) -> None:
         "--can-short-frames",
         choices=("skip", "pad"),
         default="skip",
-        help="frames shorter than their DBC length: skip them (default) or zero-pad them, for "
-        "logs that drop trailing zero bytes",
+        help="frames shorter than their DBC length: skip them or zero-pad them, for logs that "
+        "drop trailing zero bytes",
     )
     sensors.add_argument("--yaw-rate-csv", type=Path, help="CSV t,yaw_rate_rad_s (ccw +)")
     sensors.add_argument("--speed-csv", type=Path, help="CSV t,speed_mps")
@@ -67,7 +69,8 @@ def register(subparsers, summary: str) -> None:
         "--time-offset-can",
         type=float,
         default=0.0,
-        help="seconds added to CAN times to give GPS time",
+        help="seconds added to CAN times to give GPS time (a log in Unix time needs the "
+        "GPS-Unix offset: -315964800 + leap seconds, e.g. -315964782 in 2017-2026)",
     )
     sensors.add_argument(
         "--time-offset-yaw",
@@ -86,7 +89,7 @@ def register(subparsers, summary: str) -> None:
         type=_lever_arm,
         default=(0.0, 0.0),
         help="GNSS antenna X,Y[,Z] m in the vehicle frame (x forward, y left) from the point "
-        "whose heading is wanted (default 0,0); the Doppler is then the antenna's in turns",
+        "whose heading is wanted; the Doppler is then the antenna's in turns",
     )
     parser.add_argument("--window-s", type=float, default=2.0, help="heading window (s)")
     parser.add_argument(
@@ -94,7 +97,13 @@ def register(subparsers, summary: str) -> None:
         action="store_true",
         help="keep every Doppler row: no data snooping for reflected (NLOS) satellites",
     )
-    parser.add_argument("--calibration", choices=CALIBRATION_METHODS, default="ls")
+    parser.add_argument(
+        "--calibration",
+        choices=CALIBRATION_METHODS,
+        default="ls",
+        help="wheel-scale and gyro-bias calibration from the conventional Doppler velocity "
+        "([TK18] sec. 3.3-3.4): ls (least squares over a sliding window), kalman, or none",
+    )
     parser.add_argument("--gyro-bias", type=float, help="fixed gyro bias (deg/s) instead")
     parser.add_argument("--wheel-scale", type=float, help="fixed wheel scale instead")
     parser.add_argument("--max-sats", type=int, help="emulated canyon: satellites kept per epoch")

@@ -50,22 +50,24 @@ def register(subparsers, summary: str) -> None:
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:
     """The main job's options (shared by ``run`` and ``batch``); see :func:`run_config`."""
-    parser.add_argument("--systems", default="GREJC", help="GNSS systems to use")
-    parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
+    parser.add_argument(
+        "--systems", default="GREJC", help="GNSS systems to use (RINEX letters: G, R, E, J, C)"
+    )
+    parser.add_argument("--elev-mask", type=float, default=10.0, help="elevation mask (deg)")
     parser.add_argument("--window", type=window_size, default=30, help="VO window (frames, >= 3)")
     parser.add_argument(
         "--reference",
         choices=("course", "orientation"),
         default="course",
-        help="heading correction compares the absolute heading with the VO's course (default) "
-        "or its orientation yaw ([TK18] sec. 3.6 as written)",
+        help="heading correction compares the absolute heading with the VO's course or its "
+        "orientation yaw (orientation: [TK18] sec. 3.6 as the paper writes it)",
     )
     parser.add_argument(
         "--correction",
         choices=CORRECTION_METHODS,
         default=CorrectionConfig().method,
-        help="heading correction: window ([TK18] Eq. 11-13) or kalman (adaptive blend, "
-        "filter and smoother on the VO heading offset); default %(default)s",
+        help="heading correction: window (the window method of [TK18], Takeyama & Kojima 2018, "
+        "Eq. 11-13) or kalman (adaptive blend: filter and smoother on the VO heading offset)",
     )
     parser.add_argument(
         "--causal",
