@@ -42,6 +42,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "batch_command",
         "the main job on many sequence folders, in parallel, with one aggregate table",
     ),
+    "kitti-speed": (
+        "kitti_speed_command",
+        "speed CSV from KITTI ground-truth poses (for vo --speed)",
+    ),
 }
 """Subcommand → (module in ``vo_doppler.commands``, one-line help). A module is imported only
 when its subcommand runs, so ``vo-doppler --help`` loads none of the library."""

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.commands.time_hints import frame_index_hint, offset_hint, span
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.correction import (
     CORRECTION_METHODS,
@@ -122,10 +123,14 @@ def run(args: argparse.Namespace) -> int:
     )
     overlap = (trajectory.t[-1] >= table.t[0]) and (trajectory.t[0] <= table.t[-1])
     if len(trajectory) == 0 or not overlap:
+        hint = frame_index_hint(trajectory.t - args.time_offset) or (
+            "; " + offset_hint(float(trajectory.t[0]), float(table.t[0]), "--time-offset")
+            if len(trajectory) and len(table)
+            else ""
+        )
         raise InputError(
-            "trajectory times do not overlap the heading epochs "
-            f"({trajectory.t[:1]}..{trajectory.t[-1:]} vs {table.t[:1]}..{table.t[-1:]}); "
-            "use --time-offset",
+            f"the trajectory's times ({span(trajectory.t)}) do not overlap the heading epochs "
+            f"({span(table.t)}, GPS time){hint}",
             args.trajectory,
         )
     config = CorrectionConfig(

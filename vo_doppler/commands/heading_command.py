@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.commands.satellite_options import add_satellite_options, satellite_states
+from vo_doppler.commands.time_hints import overlap_error
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
@@ -178,10 +179,8 @@ def run(args: argparse.Namespace) -> int:
         rows, conventional = emulated_canyon(obs, nav, args.max_sats, start, systems, mask)
     overlap = sample(speed.t, speed.value, obs.epoch_time)
     if not np.isfinite(overlap).any():
-        raise InputError(
-            f"sensor times ({speed.t[:1]}..{speed.t[-1:]}) do not overlap the GNSS epochs "
-            f"({obs.epoch_time[0]:.1f}..{obs.epoch_time[-1]:.1f} GPS s); use --time-offset-*"
-        )
+        option = "--time-offset-can" if args.can else "--time-offset-speed"
+        raise overlap_error("wheel-speed", speed.t, obs.epoch_time, option)
     tight = TightHeadingConfig(window_s=args.window_s)
     if args.no_nlos_rejection:
         tight = replace(tight, outlier_passes=0)

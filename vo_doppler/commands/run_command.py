@@ -13,6 +13,7 @@ from rich.markup import escape
 from rich.progress import Progress
 from rich.table import Table
 
+from vo_doppler.commands.time_hints import overlap_error, overlaps
 from vo_doppler.commands.vo_command import window_size
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
@@ -109,6 +110,11 @@ def run(args: argparse.Namespace) -> int:
 def run_and_write(args: argparse.Namespace) -> RunResult:
     """Read, check, run and write the outputs in place (all or nothing)."""
     inputs, report = read_sequence_with_report(args.sequence, args.allow_outside_paths)
+    if not overlaps(inputs.wheel_speed.t, inputs.observations.epoch_time):
+        option = "can: time_offset_s in sequence.yaml"
+        raise overlap_error(
+            "CAN", inputs.wheel_speed.t, inputs.observations.epoch_time, option, args.sequence
+        )
     warnings = input_warnings(inputs, report)
     for text in warnings:
         log.warning("%s", text)

@@ -77,6 +77,8 @@ def run(args: argparse.Namespace) -> int:
         times_path = args.times or find_times_file(args.images)
         if times_path is None:
             raise InputError("no timestamps: give --times FILE or --fps F", args.images)
+        if args.times is None:
+            log.info("image times from %s (found beside the images; --times overrides)", times_path)
         times = read_times(times_path, len(files))
     speed = None
     if args.speed is not None:
