@@ -115,7 +115,7 @@ def _people_value(name: str, value) -> tuple[str, str]:
     unit = ANGLE_FIELDS.get(name)
     for suffix, people in (("_rad_s", " deg/s"), ("_rad", " deg")):
         if name.endswith(suffix):
-            name, unit = name[: -len(suffix)] + people.strip().replace("/", "_"), people
+            name, unit = name[: -len(suffix)] + "_" + people.strip().replace("/", "_"), people
     if unit and isinstance(value, float) and np.isfinite(value):
         return name, f"{np.degrees(value):.4g}{unit}"
     if isinstance(value, float):

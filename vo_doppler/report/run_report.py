@@ -312,7 +312,7 @@ STYLE = (
     ".headline{font-size:1.2em;background:#f1f5f9;border-left:4px solid #d62728;padding:.6em 1em}"
     "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;"
     "text-align:right}th{background:#f1f5f9}th:first-child,td:first-child{text-align:left}"
-    "img{max-width:100%}dt{font-weight:bold}dd{margin:0 0 .5em 1.5em}"
+    "td.text{text-align:left}img{max-width:100%}dt{font-weight:bold}dd{margin:0 0 .5em 1.5em}"
     "code{background:#f1f5f9;padding:1px 4px;word-break:break-all}"
     "#map{width:100%;height:32em;border:1px solid #bbb;background:#fafafa;cursor:grab;"
     "touch-action:none}.legend .key{margin-right:1.2em;white-space:nowrap}"
@@ -327,7 +327,7 @@ def _definitions(rows: list[tuple[str, str]]) -> str:
     return (
         "<table>"
         + "".join(
-            f"<tr><th>{html.escape(k)}</th><td style='text-align:left'>{html.escape(v)}</td></tr>"
+            f"<tr><th>{html.escape(k)}</th><td class='text'>{html.escape(v)}</td></tr>"
             for k, v in rows
         )
         + "</table>"

@@ -1,0 +1,81 @@
+"""``report.html`` in a real headless browser (Chromium): it renders offline, its script runs
+(the map's scale bar is drawn), no console message at all, and a screenshot is taken. Skips,
+saying why, where no Chromium is installed (``apt-get install chromium``)."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+BROWSERS = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
+WIDTH, HEIGHT = 1280, 4000
+
+
+@pytest.fixture(scope="module")
+def browser() -> str:
+    found = next((path for path in map(shutil.which, BROWSERS) if path), None)
+    if found is None:
+        pytest.skip(f"no headless browser installed (looked for {', '.join(BROWSERS)})")
+    return found
+
+
+def headless(browser: str, profile: Path, page: Path, *options: str) -> subprocess.CompletedProcess:
+    """Run the browser headless on ``page`` offline (every host name fails to resolve), with
+    its console messages logged to stderr."""
+    command = [
+        browser,
+        "--headless",
+        "--disable-gpu",
+        f"--user-data-dir={profile}",
+        "--host-resolver-rules=MAP * ~NOTFOUND",
+        "--enable-logging=stderr",
+        "--v=0",
+        "--virtual-time-budget=3000",
+        *(["--no-sandbox"] if os.geteuid() == 0 else []),
+        *options,
+        page.as_uri(),
+    ]
+    return subprocess.run(command, capture_output=True, text=True, timeout=180, check=False)
+
+
+def console_messages(stderr: str) -> list[str]:
+    """The page's console lines Chromium logged (``…:CONSOLE…] "message", source: …``)."""
+    return [line for line in stderr.splitlines() if ":CONSOLE" in line]
+
+
+def test_report_renders_offline_without_console_messages(browser, run_report, tmp_path):
+    shot = tmp_path / "report.png"
+    result = headless(
+        browser,
+        tmp_path / "profile",
+        run_report / "report.html",
+        f"--screenshot={shot}",
+        f"--window-size={WIDTH},{HEIGHT}",
+        "--hide-scrollbars",
+    )
+    assert shot.is_file(), result.stderr[-2000:]
+    assert console_messages(result.stderr) == []
+    image = np.asarray(Image.open(shot).convert("RGB"))
+    assert image.shape == (HEIGHT, WIDTH, 3)
+    # Not a blank page: text, tables and figures give many distinct colours.
+    assert len(np.unique(image.reshape(-1, 3), axis=0)) > 500
+
+
+def test_report_script_draws_the_map_controls_and_fetches_no_tile(browser, run_report, tmp_path):
+    result = headless(browser, tmp_path / "profile", run_report / "report.html", "--dump-dom")
+    dom = result.stdout
+    assert '<svg id="map"' in dom
+    scale = re.search(
+        r'<span id="scale" class="scalebar" style="width: ([\d.]+)px;">([^<]+)</span>', dom
+    )
+    assert scale is not None, "the map script did not run"
+    assert float(scale.group(1)) > 0 and re.fullmatch(r"[\d.]+ k?m", scale.group(2))
+    assert "<image" not in dom
+    assert console_messages(result.stderr) == []
