@@ -11,6 +11,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.eval.reference_speed import speed_from_poses
+from vo_doppler.io.images import read_times
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, write_sensor_csv
 from vo_doppler.io.trajectory import read_trajectory
 
@@ -29,29 +30,15 @@ def register(subparsers, summary: str) -> None:
         type=Path,
         help="the sequence's times.txt (one time per pose; required for a KITTI poses file)",
     )
-    parser.add_argument(
-        "--format",
-        choices=("auto", "tum", "kitti"),
-        default="auto",
-        help="trajectory file format (auto: from the extension and the number of columns)",
-    )
     parser.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
     parser.set_defaults(func=run)
 
 
-def _times(path: Path | None) -> np.ndarray | None:
-    if path is None:
-        return None
-    try:
-        return np.loadtxt(path, dtype=float, ndmin=1)
-    except (OSError, ValueError) as exc:
-        raise InputError(f"cannot read times: {exc}", path) from exc
-
-
 def run(args: argparse.Namespace) -> int:
-    times = _times(args.times)
-    truth = read_trajectory(args.poses, args.format, times)
-    if times is None and len(truth) > 1 and np.array_equal(truth.t, np.arange(len(truth))):
+    truth = read_trajectory(args.poses)
+    if args.times is not None:
+        truth.t = read_times(args.times, len(truth))
+    elif len(truth) > 1 and np.array_equal(truth.t, np.arange(len(truth))):
         raise InputError(
             "a KITTI poses file has no times: pass --times with the sequence's times.txt",
             args.poses,
