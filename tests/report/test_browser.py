@@ -79,3 +79,24 @@ def test_report_script_draws_the_map_controls_and_fetches_no_tile(browser, run_r
     assert float(scale.group(1)) > 0 and re.fullmatch(r"[\d.]+ k?m", scale.group(2))
     assert "<image" not in dom
     assert console_messages(result.stderr) == []
+
+
+def test_ticking_the_background_adds_openstreetmap_tiles_over_the_view(
+    browser, run_report, tmp_path
+):
+    page = tmp_path / "report.html"
+    html = (run_report / "report.html").read_text()
+    page.write_text(
+        html.replace("</body>", "<script>document.getElementById('osm').click()</script></body>")
+    )
+    dom = headless(browser, tmp_path / "profile", page, "--dump-dom").stdout
+    tiles = re.findall(r'href="https://tile\.openstreetmap\.org/(\d+)/(\d+)/(\d+)\.png"', dom)
+    assert tiles, "no tile after ticking the box"
+    zoom = {int(z) for z, _, _ in tiles}
+    assert len(zoom) == 1 and 1 <= zoom.pop() <= 19
+    # The drive is near 35.69 N, 139.70 E: the tiles' x, y must be that place's.
+    z, x, y = map(int, tiles[0])
+    n = 2**z
+    lon = x / n * 360.0 - 180.0
+    lat = np.degrees(np.arctan(np.sinh(np.pi * (1 - 2 * y / n))))
+    assert abs(lon - 139.70) < 0.05 and abs(lat - 35.69) < 0.05
