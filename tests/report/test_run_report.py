@@ -8,12 +8,14 @@ import json
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tests.conftest import REPO_ROOT
 from vo_doppler.eval.pipelines import PipelineErrors
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
+from vo_doppler.io.sequence import read_manifest, read_sequence
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.heading_figure import build_heading_figure, continuous_course_deg
-from vo_doppler.report.provenance import config_rows, is_synthetic, main_settings
+from vo_doppler.report.provenance import config_rows, describe_data, is_synthetic, main_settings
 from vo_doppler.report.run_report import (
     heading_error_over_time,
     headline,
@@ -142,3 +144,17 @@ def test_configuration_is_in_degrees_for_people():
 def test_a_manifest_with_the_simulators_keys_is_synthetic():
     assert is_synthetic({"scenario": "urban-canyon", "command": "vo-doppler simulate"})
     assert not is_synthetic({"name": "drive"}) and not is_synthetic(None)
+
+
+def test_the_sample_is_described_as_a_synthetic_drive_with_its_sensors():
+    folder = REPO_ROOT / "sample_sequences" / "urban_canyon_small"
+    sequence, manifest = read_sequence(folder), read_manifest(folder)
+    data = describe_data(sequence, manifest)
+    assert data.kind == "synthetic" and "vo-doppler simulate --scenario urban-canyon" in data.origin
+    assert abs(data.distance_m - manifest["stats"]["path_length_m"]) < 1.0
+    assert data.distance_source == "ground truth"
+    assert abs(data.duration_s - manifest["duration_s"]) < 0.5
+    assert data.sensors[0] == "monocular camera (570 images, 15.0 frames/s)"
+    assert any(s.startswith("GNSS receiver (761 epochs, systems EG") for s in data.sensors)
+    unstated = describe_data(sequence, None, driven_m=300.0)
+    assert unstated.kind == "" and unstated.origin.startswith("not stated")

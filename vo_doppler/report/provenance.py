@@ -24,7 +24,8 @@ class DataDescription:
     """The recording as the report presents it (``None``: not known)."""
 
     name: str
-    synthetic: bool
+    kind: str
+    """One of "synthetic", "recorded" or "" (no manifest given: not stated)."""
     origin: str
     """How the data came to be, e.g. "simulated by: vo-doppler simulate …" or "recorded"."""
     sensors: list[str]
@@ -66,12 +67,14 @@ def describe_data(
         times.append(sequence.image_times)
     begin = max(float(t[0]) for t in times if len(t))
     end = min(float(t[-1]) for t in times if len(t))
-    synthetic = is_synthetic(manifest)
-    if synthetic:
+    kind = "synthetic" if is_synthetic(manifest) else "recorded" if manifest is not None else ""
+    if kind == "synthetic":
         command = " ".join(str(manifest.get("command", "")).split())
         origin = f"synthetic: simulated by {command}" if command else "synthetic (simulated)"
-    else:
+    elif kind == "recorded":
         origin = "recorded (the manifest names no simulator)"
+    else:
+        origin = "not stated (no manifest given to the report)"
     if sequence.truth is not None and len(sequence.truth) > 1:
         distance, source = float(sequence.truth.path_length), "ground truth"
     elif driven_m is not None:
@@ -80,7 +83,7 @@ def describe_data(
         distance, source = None, "unknown"
     return DataDescription(
         sequence.name,
-        synthetic,
+        kind,
         origin,
         sensors_present(sequence),
         max(end - begin, 0.0),

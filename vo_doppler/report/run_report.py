@@ -366,7 +366,7 @@ def _worst_table(worst: list[WorstEpoch]) -> str:
 def render(report: RunReport) -> str:
     """The HTML page of ``report``."""
     data = report.data
-    kind = "synthetic" if data.synthetic else "recorded"
+    kind = data.kind
     distance = (
         f"{data.distance_m:.0f} m (from the {data.distance_source})"
         if data.distance_m is not None
@@ -382,7 +382,9 @@ def render(report: RunReport) -> str:
         "<!doctype html><html lang='en'><head><meta charset='utf-8'>",
         "<meta name='viewport' content='width=device-width, initial-scale=1'>",
         f"<title>{html.escape(report.title)}</title><style>{STYLE}</style></head><body>",
-        f"<h1>{html.escape(report.title)}<span class='badge {kind}'>{kind} data</span></h1>",
+        f"<h1>{html.escape(report.title)}"
+        + (f"<span class='badge {kind}'>{kind} data</span>" if kind else "")
+        + "</h1>",
         f"<p class='headline'>{html.escape(report.headline)}</p>",
         "<h2>The data</h2>",
         _definitions(about),
