@@ -40,6 +40,8 @@ def test_headline_states_the_cut_or_says_plainly_it_did_not_help():
     worse = headline({"vo": _errors(0.2), "vo_gps_tc": _errors(0.23)}, 0.9)
     assert "did not reduce" in worse and "0.20 m per 100 m alone" in worse
     assert "No ground truth" in headline({}, 0.93) and "93%" in headline({}, 0.93)
+    no_camera = headline({"dr_gps_tc": _errors(0.4)}, 0.9)
+    assert no_camera.startswith("No camera") and "(tightly coupled) 0.40" in no_camera
 
 
 def test_vo_alone_heading_use_is_a_dash_not_zero():
