@@ -40,4 +40,7 @@ class OptionsParser(argparse.ArgumentParser):
     """An argument parser whose help shows every default (its sub-parsers too)."""
 
     def __init__(self, *args, formatter_class=DefaultsHelpFormatter, **kwargs) -> None:
+        if not issubclass(formatter_class, DefaultsHelpFormatter):
+            name = f"{formatter_class.__name__}WithDefaults"
+            formatter_class = type(name, (formatter_class, DefaultsHelpFormatter), {})
         super().__init__(*args, formatter_class=formatter_class, **kwargs)
