@@ -37,9 +37,10 @@ from rich.console import Console
 from rich.table import Table
 
 from vo_doppler.eval.metrics import attitude_roughness_deg, evaluate
+from vo_doppler.eval.reference_speed import speed_from_poses
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import list_images, prefetch_images, read_times
-from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
+from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv, write_sensor_csv
 from vo_doppler.io.trajectory import read_kitti
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.vo.baseline import FrameToFrameVO
@@ -58,17 +59,9 @@ def default_data() -> Path:
 
 
 def write_speed_csv(truth: Trajectory, path: Path) -> None:
-    """Speed samples whose trapezoidal integral between frames is the true step length."""
-    steps = np.linalg.norm(np.diff(truth.positions, axis=0), axis=1)
-    dt = np.diff(truth.t)
-    speed = np.empty(len(truth))
-    speed[0] = steps[0] / dt[0]
-    for i in range(1, len(truth)):
-        speed[i] = 2.0 * steps[i - 1] / dt[i - 1] - speed[i - 1]
-    if np.any(speed < 0):
-        speed = np.r_[steps[0] / dt[0], steps / dt]
-    rows = np.column_stack([truth.t, speed])
-    np.savetxt(path, rows, delimiter=",", header=f"t,{SPEED_COLUMN}", comments="", fmt="%.9f")
+    """Speed samples whose trapezoidal integral between frames is the true step length (what
+    ``vo-doppler kitti-speed`` writes)."""
+    write_sensor_csv(path, speed_from_poses(truth), SPEED_COLUMN)
 
 
 def travel_direction_deg(trajectory: Trajectory) -> tuple[float, float]:

@@ -43,10 +43,11 @@ def test_run_writes_every_output(run_output):
     ):
         assert (run_output / name).stat().st_size > 0, name
     report = (run_output / "report.html").read_text()
-    assert "VO + GPS (tightly coupled)" in report and "<img src='trajectories.png'" in report
+    assert "VO + GPS (tightly coupled)" in report and "data:image/png;base64," in report
+    assert "synthetic data" in report and (run_output / "trajectories.geojson").is_file()
     summary = json.loads((run_output / "summary.json").read_text())
     available = f"{summary['tight_heading_availability']:.1%}"
-    assert f"<b>tightly coupled heading available</b>: {available}" in report
+    assert f"<th>tightly coupled heading available</th><td class='text'>{available}</td>" in report
 
 
 def test_run_recovers_calibration_and_heading(sequence, run_output):

@@ -45,7 +45,7 @@ from pathlib import Path
 
 from vo_doppler import __version__
 from vo_doppler.errors import InputError, VoDopplerError
-from vo_doppler.io.sequence import read_sequence_with_report
+from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
 from vo_doppler.io.tables import write_csv_and_parquet
 from vo_doppler.report.batch_summary import (
     COLUMNS,
@@ -209,7 +209,9 @@ def _run_job(job: RecordingJob) -> dict:
         log.warning("%s", text)
     result = run_sequence(sequence, job.config)
     checks = result_checks(sequence, report, result, warnings)
-    summary = write_run_outputs(sequence, result, job.config, job.out, checks)
+    summary = write_run_outputs(
+        sequence, result, job.config, job.out, checks, read_manifest(folder)
+    )
     require_tight_heading(result, folder)
     return summary
 

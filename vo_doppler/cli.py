@@ -13,6 +13,7 @@ import sys
 import traceback
 
 from vo_doppler import __version__
+from vo_doppler.commands.help_format import OptionsParser
 from vo_doppler.errors import (
     EXIT_FAILURE,
     EXIT_INTERNAL,
@@ -41,6 +42,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "batch_command",
         "the main job on many sequence folders, in parallel, with one aggregate table",
     ),
+    "kitti-speed": (
+        "kitti_speed_command",
+        "speed CSV from KITTI ground-truth poses (for vo --speed)",
+    ),
 }
 """Subcommand → (module in ``vo_doppler.commands``, one-line help). A module is imported only
 when its subcommand runs, so ``vo-doppler --help`` loads none of the library."""
@@ -63,7 +68,7 @@ def chosen_command(argv: list[str]) -> str | None:
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The parser with every subcommand listed; ``command``'s own options are loaded (all of
     them when ``command`` is "*", for documentation and tests)."""
-    parser = argparse.ArgumentParser(
+    parser = OptionsParser(
         prog="vo-doppler",
         description="Monocular visual odometry with heading corrected by GNSS Doppler.",
         epilog=EXIT_CODES_EPILOG,
@@ -75,7 +80,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     parser.add_argument(
         "--debug", action="store_true", help="print the traceback of any error (for bug reports)"
     )
-    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    subparsers = parser.add_subparsers(
+        dest="command", metavar="COMMAND", required=True, parser_class=OptionsParser
+    )
     for name, (module, summary) in SUBCOMMANDS.items():
         if command in (name, "*"):
             importlib.import_module(f"vo_doppler.commands.{module}").register(subparsers, summary)

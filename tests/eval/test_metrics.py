@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.cli import main
 from vo_doppler.eval.alignment import umeyama
-from vo_doppler.eval.metrics import evaluate, segment_lengths_that_fit
+from vo_doppler.eval.metrics import evaluate, segment_lengths_note, segment_lengths_that_fit
 from vo_doppler.io.trajectory import write_kitti, write_tum
 from vo_doppler.model.trajectory import Trajectory
 
@@ -82,3 +82,29 @@ def test_cli_eval_kitti_row_mismatch_exit_1(tmp_path, capsys):
     write_kitti(tmp_path / "est.txt", truth.subset(slice(0, 8)))
     assert main(["eval", str(tmp_path / "est.txt"), str(tmp_path / "gt.txt")]) == 1
     assert "8 estimated poses but 10" in capsys.readouterr().err
+
+
+def test_segment_note_says_kitti_or_shorter_and_why():
+    assert segment_lengths_note((100.0, 200.0), 250.0) == (
+        "KITTI segments of 100, 200 m (those of KITTI's 100-800 m that fit the path)"
+    )
+    short = segment_lengths_note((10.0, 20.0), 25.0)
+    assert short.startswith("segments of 10, 20 m, shorter than KITTI's") and "25 m path" in short
+
+
+@pytest.mark.parametrize(
+    ("n", "expected"),
+    [(301, "KITTI segments of 100, 200 m (those of KITTI"), (60, "shorter than KITTI's 100-800 m")],
+)
+def test_cli_eval_table_states_its_segments_and_units(tmp_path, capsys, n, expected):
+    truth = straight(n=n)
+    estimate = Trajectory(truth.t, truth.positions * 1.01, truth.orientations)
+    write_tum(tmp_path / "gt.tum", truth)
+    write_tum(tmp_path / "est.tum", estimate)
+    assert (
+        main(["eval", str(tmp_path / "est.tum"), str(tmp_path / "gt.tum"), "--align", "sim3"]) == 0
+    )
+    out = " ".join(capsys.readouterr().out.split())
+    assert expected in out
+    assert "rotation [deg/100 m]" in out and "length [m]" in out
+    assert "(sim3 alignment)" not in out and "independent of the alignment" in out

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.commands.time_hints import frame_index_hint, offset_hint, span
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.correction import (
     CORRECTION_METHODS,
@@ -42,7 +43,12 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("trajectory", help="VO trajectory, TUM or KITTI (camera poses)")
     parser.add_argument("--heading", required=True, help="heading.csv from `vo-doppler heading`")
     parser.add_argument("--calib", help="camera calibration (YAML with T_vehicle_camera)")
-    parser.add_argument("--format", choices=("auto", "tum", "kitti"), default="auto")
+    parser.add_argument(
+        "--format",
+        choices=("auto", "tum", "kitti"),
+        default="auto",
+        help="trajectory file format (auto: from the extension and the number of columns)",
+    )
     parser.add_argument("--times", help="timestamps file for a KITTI trajectory (one per line)")
     parser.add_argument(
         "--time-offset", type=float, default=0.0, help="seconds added to trajectory times -> GPS"
@@ -51,47 +57,49 @@ def register(subparsers, summary: str) -> None:
         "--correction",
         choices=CORRECTION_METHODS,
         default=CorrectionConfig().method,
-        help="window: [TK18] Eq. 11-13; kalman: the adaptive blend (default: %(default)s)",
+        help="window: the window method of [TK18] (Takeyama & Kojima 2018) Eq. 11-13; kalman: "
+        "the adaptive blend",
     )
     parser.add_argument(
         "--causal",
         action="store_true",
         help="kalman: forward filter only (each pose uses the headings up to its time)",
     )
-    parser.add_argument("--window-s", type=float, default=2.0, help="window method's W")
+    parser.add_argument(
+        "--window-s", type=float, default=2.0, help="window method's W (s), [TK18] Eq. 11-13"
+    )
     parser.add_argument(
         "--source",
         choices=HEADING_SOURCES,
         default="tc+conv",
         help="absolute headings used: tightly coupled (usable: reliable and sigma < 2 deg), "
-        "conventional, or the former where usable else the latter (default: %(default)s)",
+        "conventional, or the former where usable else the latter",
     )
     parser.add_argument(
         "--world",
         choices=WORLDS,
         default="first_camera",
         help="the input's world: the first camera's frame (what VO systems write) or already "
-        "level, z up (default: %(default)s)",
+        "level, z up",
     )
     parser.add_argument(
         "--body",
         choices=("vehicle", "camera"),
         default="vehicle",
-        help="write vehicle or camera poses (default: %(default)s)",
+        help="write vehicle or camera poses",
     )
     parser.add_argument(
         "--max-gap-s",
         type=float,
         default=1.5,
-        help="longest gap (s) across which absolute headings are interpolated "
-        "(default: %(default)s)",
+        help="longest gap (s) across which absolute headings are interpolated",
     )
     parser.add_argument(
         "--reference",
         choices=REFERENCES,
         default="course",
-        help="compare the absolute heading with the VO's direction of travel (course, default) "
-        "or with its orientation yaw ([TK18] sec. 3.6 as written)",
+        help="compare the absolute heading with the VO's direction of travel (course) or with "
+        "its orientation yaw (orientation: [TK18] sec. 3.6 as the paper writes it)",
     )
     parser.add_argument("-o", "--output", required=True, help="corrected trajectory (.tum/.kitti)")
     parser.set_defaults(func=run)
@@ -115,10 +123,14 @@ def run(args: argparse.Namespace) -> int:
     )
     overlap = (trajectory.t[-1] >= table.t[0]) and (trajectory.t[0] <= table.t[-1])
     if len(trajectory) == 0 or not overlap:
+        hint = frame_index_hint(trajectory.t - args.time_offset) or (
+            "; " + offset_hint(float(trajectory.t[0]), float(table.t[0]), "--time-offset")
+            if len(trajectory) and len(table)
+            else ""
+        )
         raise InputError(
-            "trajectory times do not overlap the heading epochs "
-            f"({trajectory.t[:1]}..{trajectory.t[-1:]} vs {table.t[:1]}..{table.t[-1:]}); "
-            "use --time-offset",
+            f"the trajectory's times ({span(trajectory.t)}) do not overlap the heading epochs "
+            f"({span(table.t)}, GPS time){hint}",
             args.trajectory,
         )
     config = CorrectionConfig(

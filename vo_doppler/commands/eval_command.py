@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 import numpy as np
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from vo_doppler.errors import InputError
 from vo_doppler.eval.alignment import ALIGNMENTS
-from vo_doppler.eval.metrics import TrajectoryErrors, associate, evaluate
+from vo_doppler.eval.metrics import TrajectoryErrors, associate, evaluate, segment_lengths_note
 from vo_doppler.io.trajectory import read_trajectory
 
 UP_AXES = {"z": (0.0, 0.0, 1.0), "-y": (0.0, -1.0, 0.0), "y": (0.0, 1.0, 0.0)}
@@ -21,13 +23,26 @@ def register(subparsers, summary: str) -> None:
     parser = subparsers.add_parser(
         "eval",
         help=summary,
-        description="KITTI-devkit segment errors (translation %%, rotation deg/100 m), final "
-        "drift %% of path length, yaw error at the end and ATE RMSE.",
+        description="KITTI-devkit segment errors (translation in %, rotation in deg per 100 m) "
+        "over KITTI's 100-800 m segments (those shorter than the path; on a path shorter than "
+        "100 m, 10-80 m segments, said so in the output), final drift in % of path length, yaw "
+        "error at the end and ATE RMSE.",
     )
     parser.add_argument("estimate", help="estimated trajectory (TUM or KITTI)")
     parser.add_argument("ground_truth", help="ground-truth trajectory (TUM or KITTI)")
-    parser.add_argument("--format", choices=("auto", "tum", "kitti"), default="auto")
-    parser.add_argument("--align", choices=ALIGNMENTS, default="start")
+    parser.add_argument(
+        "--format",
+        choices=("auto", "tum", "kitti"),
+        default="auto",
+        help="trajectory file format (auto: from the extension and the number of columns)",
+    )
+    parser.add_argument(
+        "--align",
+        choices=ALIGNMENTS,
+        default="start",
+        help="how the estimate is aligned to the ground truth before the final error, end yaw "
+        "error and ATE (segment errors are relative and do not depend on it)",
+    )
     parser.add_argument(
         "--up",
         choices=("auto", *UP_AXES),
@@ -66,11 +81,14 @@ def run(args: argparse.Namespace) -> int:
 
 
 def print_errors(errors: TrajectoryErrors) -> None:
-    console = Console()
-    table = Table(title=f"Segment errors ({errors.alignment} alignment)")
-    table.add_column("length [m]", justify="right")
-    table.add_column("translation [%]", justify="right")
-    table.add_column("rotation [deg/100 m]", justify="right")
+    console = Console(width=None if sys.stdout.isatty() else 120)
+    lengths = tuple(s.length_m for s in errors.segments)
+    table = Table(
+        title="Segment errors (KITTI devkit: relative poses, independent of the alignment)",
+        caption=segment_lengths_note(lengths, errors.path_length_m),
+    )
+    for column in ("length [m]", "translation [%]", "rotation [deg/100 m]"):
+        table.add_column(escape(column), justify="right")
     table.add_column("segments", justify="right")
     for s in errors.segments:
         table.add_row(
@@ -81,7 +99,8 @@ def print_errors(errors: TrajectoryErrors) -> None:
         )
     console.print(table)
     console.print(
-        f"path {errors.path_length_m:.1f} m | final error {errors.final_position_error_m:.3f} m "
+        f"{errors.alignment} alignment: path {errors.path_length_m:.1f} m | final error "
+        f"{errors.final_position_error_m:.3f} m "
         f"({errors.final_drift_pct:.3f} % of path) | end yaw error "
         f"{errors.end_yaw_error_deg:.3f} deg | ATE RMSE {errors.ate_rmse_m:.3f} m"
     )

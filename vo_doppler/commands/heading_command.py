@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.commands.satellite_options import add_satellite_options, satellite_states
+from vo_doppler.commands.time_hints import overlap_error
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
@@ -39,11 +40,13 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("obs", type=Path, help="RINEX observation file")
     add_satellite_options(parser)
-    parser.add_argument("--systems", default="GREJC")
+    parser.add_argument(
+        "--systems", default="GREJC", help="GNSS systems to use (RINEX letters: G, R, E, J, C)"
+    )
     parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
     sensors = parser.add_argument_group("vehicle sensors (CAN log + DBC, or two CSV files)")
     sensors.add_argument("--can", type=Path, help="candump -l, .asc, .blf or python-can .csv")
-    sensors.add_argument("--dbc", type=Path)
+    sensors.add_argument("--dbc", type=Path, help="DBC file decoding the CAN log's signals")
     sensors.add_argument("--yaw-rate", help="MESSAGE.SIGNAL of the yaw rate")
     sensors.add_argument("--wheel-speed", help="MESSAGE.SIGNAL[,MESSAGE.SIGNAL...] (averaged)")
     sensors.add_argument(
@@ -58,8 +61,8 @@ def register(subparsers, summary: str) -> None:
         "--can-short-frames",
         choices=("skip", "pad"),
         default="skip",
-        help="frames shorter than their DBC length: skip them (default) or zero-pad them, for "
-        "logs that drop trailing zero bytes",
+        help="frames shorter than their DBC length: skip them or zero-pad them, for logs that "
+        "drop trailing zero bytes",
     )
     sensors.add_argument("--yaw-rate-csv", type=Path, help="CSV t,yaw_rate_rad_s (ccw +)")
     sensors.add_argument("--speed-csv", type=Path, help="CSV t,speed_mps")
@@ -67,7 +70,8 @@ def register(subparsers, summary: str) -> None:
         "--time-offset-can",
         type=float,
         default=0.0,
-        help="seconds added to CAN times to give GPS time",
+        help="seconds added to CAN times to give GPS time (a log in Unix time needs the "
+        "GPS-Unix offset: -315964800 + leap seconds, e.g. -315964782 in 2017-2026)",
     )
     sensors.add_argument(
         "--time-offset-yaw",
@@ -86,7 +90,7 @@ def register(subparsers, summary: str) -> None:
         type=_lever_arm,
         default=(0.0, 0.0),
         help="GNSS antenna X,Y[,Z] m in the vehicle frame (x forward, y left) from the point "
-        "whose heading is wanted (default 0,0); the Doppler is then the antenna's in turns",
+        "whose heading is wanted; the Doppler is then the antenna's in turns",
     )
     parser.add_argument("--window-s", type=float, default=2.0, help="heading window (s)")
     parser.add_argument(
@@ -94,7 +98,13 @@ def register(subparsers, summary: str) -> None:
         action="store_true",
         help="keep every Doppler row: no data snooping for reflected (NLOS) satellites",
     )
-    parser.add_argument("--calibration", choices=CALIBRATION_METHODS, default="ls")
+    parser.add_argument(
+        "--calibration",
+        choices=CALIBRATION_METHODS,
+        default="ls",
+        help="wheel-scale and gyro-bias calibration from the conventional Doppler velocity "
+        "([TK18] sec. 3.3-3.4): ls (least squares over a sliding window), kalman, or none",
+    )
     parser.add_argument("--gyro-bias", type=float, help="fixed gyro bias (deg/s) instead")
     parser.add_argument("--wheel-scale", type=float, help="fixed wheel scale instead")
     parser.add_argument("--max-sats", type=int, help="emulated canyon: satellites kept per epoch")
@@ -169,10 +179,8 @@ def run(args: argparse.Namespace) -> int:
         rows, conventional = emulated_canyon(obs, nav, args.max_sats, start, systems, mask)
     overlap = sample(speed.t, speed.value, obs.epoch_time)
     if not np.isfinite(overlap).any():
-        raise InputError(
-            f"sensor times ({speed.t[:1]}..{speed.t[-1:]}) do not overlap the GNSS epochs "
-            f"({obs.epoch_time[0]:.1f}..{obs.epoch_time[-1]:.1f} GPS s); use --time-offset-*"
-        )
+        option = "--time-offset-can" if args.can else "--time-offset-speed"
+        raise overlap_error("wheel-speed", speed.t, obs.epoch_time, option)
     tight = TightHeadingConfig(window_s=args.window_s)
     if args.no_nlos_rejection:
         tight = replace(tight, outlier_passes=0)

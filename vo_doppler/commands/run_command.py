@@ -9,18 +9,20 @@ from pathlib import Path
 
 import numpy as np
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import Progress
 from rich.table import Table
 
+from vo_doppler.commands.time_hints import overlap_error, overlaps
 from vo_doppler.commands.vo_command import window_size
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.io.output_folder import check_output_folder, staged_output, untouched
-from vo_doppler.io.sequence import read_sequence_with_report
+from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
 from vo_doppler.report.run_outputs import input_warnings, result_checks, write_run_outputs
-from vo_doppler.report.run_report import TABLE_COLUMNS
+from vo_doppler.report.run_report import TABLE_COLUMNS, table_cell
 from vo_doppler.run import RunConfig, RunResult, run_sequence
 from vo_doppler.vo.config import VoConfig
 
@@ -49,22 +51,24 @@ def register(subparsers, summary: str) -> None:
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:
     """The main job's options (shared by ``run`` and ``batch``); see :func:`run_config`."""
-    parser.add_argument("--systems", default="GREJC", help="GNSS systems to use")
-    parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
+    parser.add_argument(
+        "--systems", default="GREJC", help="GNSS systems to use (RINEX letters: G, R, E, J, C)"
+    )
+    parser.add_argument("--elev-mask", type=float, default=10.0, help="elevation mask (deg)")
     parser.add_argument("--window", type=window_size, default=30, help="VO window (frames, >= 3)")
     parser.add_argument(
         "--reference",
         choices=("course", "orientation"),
         default="course",
-        help="heading correction compares the absolute heading with the VO's course (default) "
-        "or its orientation yaw ([TK18] sec. 3.6 as written)",
+        help="heading correction compares the absolute heading with the VO's course or its "
+        "orientation yaw (orientation: [TK18] sec. 3.6 as the paper writes it)",
     )
     parser.add_argument(
         "--correction",
         choices=CORRECTION_METHODS,
         default=CorrectionConfig().method,
-        help="heading correction: window ([TK18] Eq. 11-13) or kalman (adaptive blend, "
-        "filter and smoother on the VO heading offset); default %(default)s",
+        help="heading correction: window (the window method of [TK18], Takeyama & Kojima 2018, "
+        "Eq. 11-13) or kalman (adaptive blend: filter and smoother on the VO heading offset)",
     )
     parser.add_argument(
         "--causal",
@@ -106,6 +110,11 @@ def run(args: argparse.Namespace) -> int:
 def run_and_write(args: argparse.Namespace) -> RunResult:
     """Read, check, run and write the outputs in place (all or nothing)."""
     inputs, report = read_sequence_with_report(args.sequence, args.allow_outside_paths)
+    if not overlaps(inputs.wheel_speed.t, inputs.observations.epoch_time):
+        option = "can: time_offset_s in sequence.yaml"
+        raise overlap_error(
+            "CAN", inputs.wheel_speed.t, inputs.observations.epoch_time, option, args.sequence
+        )
     warnings = input_warnings(inputs, report)
     for text in warnings:
         log.warning("%s", text)
@@ -121,21 +130,27 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
         result = run_sequence(inputs, config, lambda _: progress.advance(task))
     checks = result_checks(inputs, report, result, warnings)
     with staged_output(args.output) as out:
-        summary = write_run_outputs(inputs, result, config, out, checks)
+        summary = write_run_outputs(
+            inputs, result, config, out, checks, read_manifest(args.sequence)
+        )
     if result.vo is None:
         console.print(f"{inputs.name} has no camera: only the non-visual pipelines ran")
     print_summary(console, summary)
-    console.print(f"wrote {args.output}/report.html and the trajectories, heading.csv, figures")
+    console.print(
+        f"wrote {args.output}/report.html (open it in a browser) and the trajectories, figures"
+    )
     return result
 
 
 def print_summary(console: Console, summary: dict) -> None:
+    """The run's figures with the report's words: "available" (the estimator produced a
+    heading) and "used" (it corrected the VO)."""
     console.print(
-        f"heading available: conventional {summary['conventional_heading_availability']:.0%}, "
-        f"tightly coupled {summary['tight_heading_availability']:.0%} of "
-        f"{summary['gnss_epochs']} epochs ({summary['tight_heading_rejected_rows']} Doppler rows "
-        "rejected by the NLOS tests); "
-        f"wheel scale {summary['final_wheel_scale']:.4f}, "
+        f"of {summary['gnss_epochs']} GNSS epochs, heading available: conventional "
+        f"{summary['conventional_heading_availability']:.0%}, tightly coupled "
+        f"{summary['tight_heading_availability']:.0%}; tightly coupled used by the correction "
+        f"{summary['tight_heading_used']:.0%} ({summary['tight_heading_rejected_rows']} Doppler "
+        f"rows rejected by the NLOS tests); wheel scale {summary['final_wheel_scale']:.4f}, "
         f"gyro bias {summary['final_gyro_bias_dps']:+.3f} deg/s; "
         + (
             f"VO {summary['vo_frames']} frames ({summary['vo_flagged_frames']} flagged)"
@@ -146,13 +161,13 @@ def print_summary(console: Console, summary: dict) -> None:
     errors = summary.get("evaluation")
     if not errors:
         return
-    table = Table(title="against ground truth")
+    table = Table(title="against ground truth (definitions in report.html)")
     table.add_column("pipeline")
     for _, label, _ in TABLE_COLUMNS:
-        table.add_column(label, justify="right")
+        table.add_column(escape(label), justify="right")
     for name, values in errors.items():
         table.add_row(
             PIPELINE_LABELS.get(name, name),
-            *(fmt.format(values[key]) for key, _, fmt in TABLE_COLUMNS),
+            *(table_cell(name, key, values[key], fmt) for key, _, fmt in TABLE_COLUMNS),
         )
     console.print(table)

@@ -108,14 +108,16 @@ def register(subparsers, summary: str) -> None:
         "write camera images, RINEX 3 observations + navigation, a candump CAN log + DBC, "
         "ground truth and sequence.yaml (deterministic per seed).",
     )
-    parser.add_argument("--scenario", choices=SCENARIOS, default="urban-canyon")
+    parser.add_argument("--scenario", choices=SCENARIOS, default="urban-canyon", help="the drive")
     parser.add_argument("--duration", type=float, default=defaults.duration_s, help="seconds")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0, help="random seed (same seed, same data)")
     parser.add_argument("-o", "--output", required=True, help="sequence folder to write")
     parser.add_argument("--fps", type=float, default=defaults.fps, help="camera rate (Hz)")
     parser.add_argument("--size", type=_int_pair, default=defaults.image_size, help="W,H px")
-    parser.add_argument("--image-format", choices=("png", "jpg"), default="png")
-    parser.add_argument("--jpeg-quality", type=int, default=defaults.jpeg_quality)
+    parser.add_argument("--image-format", choices=("png", "jpg"), default="png", help="images")
+    parser.add_argument(
+        "--jpeg-quality", type=int, default=defaults.jpeg_quality, help="JPEG quality (1-100)"
+    )
     parser.add_argument("--no-images", action="store_true", help="skip rendering (fast)")
     parser.add_argument(
         "--calib-error",
@@ -178,12 +180,19 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument(
         "--initial-speed", type=float, default=0.0, help="km/h at the start (default: from rest)"
     )
-    parser.add_argument("--stops-per-lap", type=int, default=defaults.stops_per_lap)
+    parser.add_argument(
+        "--stops-per-lap", type=int, default=defaults.stops_per_lap, help="standstills per lap"
+    )
     parser.add_argument("--gnss-rate", type=float, default=defaults.gnss.rate_hz, help="Hz")
     parser.add_argument("--systems", default=defaults.gnss.systems, help="G, E or GE")
     parser.add_argument("--nlos", action="store_true", help="add single facade reflections")
     parser.add_argument("--no-noise", action="store_true", help="noise-free GNSS observations")
-    parser.add_argument("--wheel-scale-error", type=float, default=defaults.can.wheel_scale_error)
+    parser.add_argument(
+        "--wheel-scale-error",
+        type=float,
+        default=defaults.can.wheel_scale_error,
+        help="wheel speed scale error (fraction, 0.02: the wheels read 2 %% fast)",
+    )
     parser.add_argument(
         "--yaw-bias", type=float, default=defaults.can.yaw_rate_bias_dps, help="deg/s"
     )

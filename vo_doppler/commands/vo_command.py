@@ -43,7 +43,12 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("images", type=Path, help="folder of PNG/JPG images (sorted by name)")
     parser.add_argument("--calib", type=Path, required=True, help="KITTI calib.txt or YAML")
     timing = parser.add_mutually_exclusive_group()
-    timing.add_argument("--times", type=Path, help="times.txt or CSV with a t column")
+    timing.add_argument(
+        "--times",
+        type=Path,
+        help="times.txt or CSV with a t column (default: times.txt beside the image folder, "
+        "if there is one, else --fps)",
+    )
     timing.add_argument("--fps", type=float, help="fixed frame rate (Hz)")
     parser.add_argument("--speed", type=Path, help="CSV t,speed_mps for metric scale")
     parser.add_argument(
@@ -72,6 +77,8 @@ def run(args: argparse.Namespace) -> int:
         times_path = args.times or find_times_file(args.images)
         if times_path is None:
             raise InputError("no timestamps: give --times FILE or --fps F", args.images)
+        if args.times is None:
+            log.info("image times from %s (found beside the images; --times overrides)", times_path)
         times = read_times(times_path, len(files))
     speed = None
     if args.speed is not None:

@@ -52,6 +52,19 @@ def segment_lengths_that_fit(path_length: float) -> tuple[float, ...]:
     return (path_length / 2.0,) if path_length > 0 else ()
 
 
+def segment_lengths_note(lengths: tuple[float, ...], path_length: float) -> str:
+    """Which segment lengths the errors use, in words (KITTI's or shorter ones, and why)."""
+    if not lengths:
+        return f"no segment fits the {path_length:.0f} m path"
+    listed = ", ".join(f"{length:.0f}" for length in lengths)
+    if lengths[0] >= KITTI_SEGMENT_LENGTHS_M[0]:
+        return f"KITTI segments of {listed} m (those of KITTI's 100-800 m that fit the path)"
+    return (
+        f"segments of {listed} m, shorter than KITTI's 100-800 m: the {path_length:.0f} m "
+        "path is too short for them"
+    )
+
+
 def yaw_about(rotation: Rotation, up: np.ndarray) -> np.ndarray:
     """Signed angle (rad) about ``up`` of each rotation, from a horizontal reference axis."""
     up = np.asarray(up, dtype=float) / np.linalg.norm(up)

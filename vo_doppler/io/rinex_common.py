@@ -252,6 +252,17 @@ def label(line: str) -> str:
     return line[LABEL_COLUMN:].strip()
 
 
+RINEX_FILE_KINDS = {
+    "O": "an observation file",
+    "N": "a navigation file",
+    "G": "a GLONASS navigation file",
+    "L": "a Galileo navigation file (RINEX 2)",
+    "M": "a meteorological file",
+    "C": "a clock file",
+}
+"""RINEX 'RINEX VERSION / TYPE' file type letters in words (RINEX 3.05 Table A1)."""
+
+
 def parse_version_line(path: Path, header: list[str], expected_type: str) -> tuple[float, str, str]:
     """Format version, file type letter and system letter from 'RINEX VERSION / TYPE'."""
     first = header[0] if header else ""
@@ -265,7 +276,13 @@ def parse_version_line(path: Path, header: list[str], expected_type: str) -> tup
         raise InputError(f"unsupported RINEX version {version}", path, 1)
     file_type = first[20:21].upper()
     if file_type not in expected_type:
-        raise InputError(f"file type {file_type!r} is not one of {expected_type!r}", path, 1)
+        raise InputError(
+            f"RINEX file type {file_type!r} where {' or '.join(expected_type)!r} is expected: "
+            f"this looks like {RINEX_FILE_KINDS.get(file_type, 'another kind of file')}"
+            f"{' (observation and navigation files swapped?)' if file_type in 'ONGL' else ''}",
+            path,
+            1,
+        )
     system = first[40:41].upper() or "G"
     return version, file_type, system if system.strip() else "G"
 

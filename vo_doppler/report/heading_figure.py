@@ -1,5 +1,7 @@
-"""Figures of a heading run: satellites per epoch with heading availability (conventional vs
-tightly coupled), the headings as course, and the heading error when ground truth is given."""
+"""Figures of a heading run: satellites per epoch, heading availability as its own strip
+(conventional available, tightly coupled available, tightly coupled used by the correction),
+the headings as an unwrapped course with the tightly coupled ±2σ band, and the heading error
+with the same band when ground truth is given."""
 
 from __future__ import annotations
 
@@ -8,59 +10,103 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from vo_doppler.geo import wrap_angle
+from vo_doppler.geo import wrap_angle, yaw_to_course
 from vo_doppler.model.heading import HeadingTable
+
+CONVENTIONAL, TIGHT = "tab:blue", "tab:red"
+BAND_SIGMAS = 2.0
 
 
 def heading_figure(
-    path: str | Path, table: HeadingTable, truth_yaw: np.ndarray | None = None, title: str = ""
+    path: str | Path,
+    table: HeadingTable,
+    truth_yaw: np.ndarray | None = None,
+    title: str = "",
+    used: np.ndarray | None = None,
 ) -> None:
-    """Write the PNG; ``truth_yaw`` (rad, per epoch, NaN where unknown) adds an error panel."""
-    build_heading_figure(table, truth_yaw, title).savefig(path, dpi=110)
+    """Write the PNG; ``truth_yaw`` (rad, per epoch, NaN where unknown) adds an error panel,
+    ``used`` (per epoch) the strip of epochs whose tightly coupled heading corrected."""
+    build_heading_figure(table, truth_yaw, title, used).savefig(path, dpi=110)
+
+
+def continuous_course_deg(course: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``course`` (rad) in degrees, each value moved by whole turns to lie within 180° of the
+    unwrapped ``reference`` (rad, NaN gaps filled by interpolation): no 0/360° jumps."""
+    finite = np.isfinite(reference)
+    if not finite.any():
+        return np.degrees(course)
+    index = np.arange(len(reference))
+    unwrapped = np.interp(index, index[finite], np.unwrap(reference[finite]))
+    return np.degrees(unwrapped + wrap_angle(course - unwrapped))
+
+
+def _strip(ax, t: np.ndarray, rows: list[tuple[str, np.ndarray, str]]) -> None:
+    """One row of ticks per flag: a tick at every epoch where it holds."""
+    for k, (_, flag, colour) in enumerate(rows):
+        ax.scatter(t[flag], np.full(int(flag.sum()), k), marker="|", s=60, c=colour, lw=1)
+    ax.set_yticks(range(len(rows)), [label for label, _, _ in rows], fontsize=8)
+    ax.set_ylim(-0.6, len(rows) - 0.4)
+    ax.invert_yaxis()
+    ax.set_title("heading availability (a tick per GNSS epoch)", fontsize=9, loc="left")
 
 
 def build_heading_figure(
-    table: HeadingTable, truth_yaw: np.ndarray | None = None, title: str = ""
+    table: HeadingTable,
+    truth_yaw: np.ndarray | None = None,
+    title: str = "",
+    used: np.ndarray | None = None,
 ) -> Figure:
     """The figure of :func:`heading_figure`. The satellite curve is ``table.n_sat_epoch``, one
     step per epoch centred on it."""
     t = table.t - (table.t[0] if len(table) else 0.0)
-    panels = 3 if truth_yaw is not None else 2
-    fig = Figure(figsize=(10, 2.6 * panels + 1))
-    axes = fig.subplots(panels, 1, sharex=True)
+    panels = 4 if truth_yaw is not None else 3
+    fig = Figure(figsize=(10, 1.6 + 2.3 * panels))
+    axes = fig.subplots(
+        panels, 1, sharex=True, height_ratios=[1.0, 0.7, 1.6] + [1.6] * (panels - 3)
+    )
     ax = axes[0]
     ax.step(t, table.n_sat_epoch, where="mid", color="0.3", label="satellites")
-    ax.scatter(
-        t[table.conv_valid],
-        np.full(table.conv_valid.sum(), -0.5),
-        s=6,
-        c="tab:blue",
-        label="conventional available",
-    )
-    ax.scatter(
-        t[table.tc_available],
-        np.full(table.tc_available.sum(), -1.0),
-        s=6,
-        c="tab:red",
-        label="tightly coupled available",
-    )
-    ax.set_ylabel("satellites / epoch")
-    ax.legend(loc="upper right", fontsize=8)
-    ax = axes[1]
-    ax.plot(t, np.degrees(table.course_conv), ".", ms=3, c="tab:blue", label="conventional")
-    ax.plot(t, np.degrees(table.course_tc), ".", ms=3, c="tab:red", label="tightly coupled")
-    ax.set_ylabel("course (deg from north)")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.set_ylabel("satellites\nper epoch")
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    rows = [
+        ("conventional available", table.conv_valid, CONVENTIONAL),
+        ("tightly coupled available", table.tc_available, TIGHT),
+    ]
+    if used is not None:
+        rows.append(("tightly coupled used", np.asarray(used, bool), "darkred"))
+    _strip(axes[1], t, rows)
+    sigma = np.where(table.tc_available, table.sigma_tc, np.nan)
+    reference = yaw_to_course(truth_yaw) if truth_yaw is not None else table.course_tc
+    if not np.isfinite(reference).any():
+        reference = table.course_conv
+    ax = axes[2]
+    course_tc = continuous_course_deg(table.course_tc, reference)
+    course_conv = continuous_course_deg(table.course_conv, reference)
     if truth_yaw is not None:
-        ax = axes[2]
+        ax.plot(t, continuous_course_deg(reference, reference), c="k", lw=1, label="ground truth")
+    band = BAND_SIGMAS * np.degrees(sigma)
+    ax.fill_between(t, course_tc - band, course_tc + band, color=TIGHT, alpha=0.2, lw=0)
+    ax.plot(t, course_conv, ".", ms=3, c=CONVENTIONAL, label="conventional")
+    ax.plot(t, course_tc, ".", ms=3, c=TIGHT, label=f"tightly coupled (band ±{BAND_SIGMAS:g}σ)")
+    ax.set_ylabel("course [deg from north,\nclockwise, unwrapped]")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    if truth_yaw is not None:
+        ax = axes[3]
+        ax.fill_between(
+            t, -band, band, color=TIGHT, alpha=0.2, lw=0, label=f"±{BAND_SIGMAS:g}σ (tight)"
+        )
         for yaw, colour, label in (
-            (table.yaw_conv, "tab:blue", "conventional"),
-            (table.yaw_tc, "tab:red", "tightly coupled"),
+            (table.yaw_conv, CONVENTIONAL, "conventional"),
+            (table.yaw_tc, TIGHT, "tightly coupled"),
         ):
             ax.plot(t, np.degrees(wrap_angle(yaw - truth_yaw)), ".", ms=3, c=colour, label=label)
-        ax.set_ylabel("heading error (deg)")
-        ax.legend(loc="upper right", fontsize=8)
-    axes[-1].set_xlabel("time since first epoch (s)")
+        ax.axhline(0.0, c="k", lw=0.8)
+        ax.set_ylabel("heading error\n(estimate − truth) [deg]")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=8)
+    axes[-1].set_xlabel("time since first GNSS epoch [s]")
     fig.suptitle(title)
     fig.tight_layout()
     return fig

@@ -1,6 +1,6 @@
 """Everything ``vo-doppler run`` writes for one recording, as one library call shared with
-``vo-doppler batch``: the trajectories (TUM), the heading table (CSV), the figures, the summary
-(JSON) and the HTML report."""
+``vo-doppler batch``: the trajectories (TUM and GeoJSON), the heading table (CSV), the figures
+(PNG), the summary (JSON) and the self-contained HTML report."""
 
 from __future__ import annotations
 
@@ -17,17 +17,33 @@ from vo_doppler.checks import (
     origin_warning,
 )
 from vo_doppler.errors import InputError
+from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
 from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.sequence import InputReport
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.sequence import Sequence
-from vo_doppler.report.heading_figure import heading_figure
-from vo_doppler.report.run_report import (
-    error_per_100m_figure,
-    trajectories_figure,
-    write_html_report,
+from vo_doppler.model.timeseries import travelled_distance
+from vo_doppler.report.heading_figure import build_heading_figure
+from vo_doppler.report.provenance import (
+    command_line,
+    config_rows,
+    describe_data,
+    main_settings,
+    version,
 )
+from vo_doppler.report.run_report import (
+    TRACK_LABELS,
+    RunReport,
+    build_error_per_100m_figure,
+    build_heading_error_figure,
+    headline,
+    png_data_uri,
+    trajectories_figure,
+    worst_reliable_tight_errors,
+    write_run_report,
+)
+from vo_doppler.report.trajectory_map import TRUTH, write_geojson
 from vo_doppler.run import Pipeline, RunConfig, RunResult
 
 SUMMARY_FILE = "summary.json"
@@ -49,6 +65,7 @@ FACT_FORMATS = {
     "vo_fps": ("VO speed", "{:.1f} frames/s"),
     "heading_correction": ("heading correction", "{}"),
 }
+"""Summary key → (label with the same words as the terminal, format with the unit)."""
 
 
 def correction_label(config: RunConfig) -> str:
@@ -60,7 +77,7 @@ def correction_label(config: RunConfig) -> str:
 def summarise(result: RunResult) -> dict:
     """Heading availability, calibration and VO figures of a run (JSON-ready scalars)."""
     table = result.heading
-    return {
+    summary = {
         "gnss_epochs": len(table),
         "conventional_heading_availability": float(np.mean(table.conv_valid)),
         "tight_heading_availability": float(np.mean(table.tc_available)),
@@ -70,16 +87,14 @@ def summarise(result: RunResult) -> dict:
         "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "final_wheel_scale": float(table.wheel_scale[-1]),
         "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
-        **(
-            {
-                "vo_frames": result.vo.stats.frames,
-                "vo_flagged_frames": len(result.vo.stats.flagged_frames),
-                "vo_fps": result.vo.stats.fps,
-            }
-            if result.vo is not None
-            else {"camera": "none: non-visual pipelines only"}
-        ),
     }
+    if result.vo is not None:
+        summary["vo_frames"] = result.vo.stats.frames
+        summary["vo_flagged_frames"] = len(result.vo.stats.flagged_frames)
+        summary["vo_fps"] = result.vo.stats.fps
+    else:
+        summary["camera"] = "none: non-visual pipelines only"
+    return summary
 
 
 def readable_facts(summary: dict) -> dict[str, str]:
@@ -123,12 +138,20 @@ def result_checks(
     }
 
 
+def driven_m(result: RunResult) -> float:
+    """Distance driven by the calibrated wheel speed (m)."""
+    speed = result.calibrated_speed
+    return float(travelled_distance(speed.t, np.abs(speed.value), speed.t[-1:])[0])
+
+
 def write_run_outputs(
     sequence: Sequence,
     result: RunResult,
     config: RunConfig,
     out: Path,
     checks: dict | None = None,
+    manifest: dict | None = None,
+    command: str | None = None,
 ) -> dict:
     """Write a run's outputs into ``out`` (created if missing) and return its summary.
 
@@ -136,32 +159,66 @@ def write_run_outputs(
     correction used, the input ``checks`` (warnings, clock estimate, time order per sensor)
     and, when the recording has ground truth, ``evaluation``: per pipeline the errors of
     :func:`vo_doppler.eval.pipelines.evaluate_pipelines` as dictionaries.
+    ``manifest`` (the parsed ``sequence.yaml``) tells the report whether the drive is simulated;
+    ``command`` is the command line it shows (default: this process's).
     """
     out.mkdir(parents=True, exist_ok=True)
-    file_names = {Pipeline.VO: "trajectory_vo.tum", Pipeline.VO_GPS_TC: "trajectory_corrected.tum"}
     for name, trajectory in result.trajectories.items():
-        write_tum(out / file_names.get(name, f"trajectory_{name}.tum"), trajectory)
+        file = (
+            "trajectory_corrected.tum" if name == Pipeline.VO_GPS_TC else f"trajectory_{name}.tum"
+        )
+        write_tum(out / file, trajectory)
     write_heading_csv(out / "heading.csv", result.heading)
     summary = summarise(result)
     summary["heading_correction"] = correction_label(config)
     summary.update(checks or {})
-    figures = [out / "trajectories.png", out / "heading.png"]
-    truth = sequence.truth
-    errors = {}
+    table, truth = result.heading, sequence.truth
+    heading_t0 = float(table.t[0]) if len(table) else 0.0
+    report = RunReport(
+        title=f"vo-doppler run: {sequence.name}",
+        headline="",
+        data=describe_data(sequence, manifest, driven_m(result)),
+        command=command or command_line(),
+        version=version(),
+        settings=main_settings(config),
+        config_rows=config_rows(config),
+        facts={},
+        tracks=dict(result.trajectories),
+        enu=sequence.enu,
+        heading_figure="",
+        warnings=list(summary.get("warnings", [])),
+    )
+    truth_yaw = truth.yaw_at(table.t) if truth is not None else None
     shown = result.trajectories
     if truth is not None:
         errors, per_100m, shown = evaluate_pipelines(
-            result.trajectories, result.heading, result.tc_usable, truth
+            result.trajectories, table, result.tc_usable, truth
         )
         summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
-        error_per_100m_figure(out / "error_per_100m.png", per_100m, sequence.name)
-        figures.append(out / "error_per_100m.png")
-    truth_yaw = truth.yaw_at(result.heading.t) if truth is not None else None
-    trajectories_figure(figures[0], shown, truth, sequence.name)
-    heading_figure(figures[1], result.heading, truth_yaw, sequence.name)
+        report.errors = errors
+        report.tracks = {TRUTH: truth, **shown}
+        report.error_figure = png_data_uri(
+            build_error_per_100m_figure(per_100m, sequence.name), out / "error_per_100m.png"
+        )
+        report.heading_error_figure = png_data_uri(
+            build_heading_error_figure(shown, truth, heading_t0, sequence.name),
+            out / "heading_error.png",
+        )
+        report.worst = worst_reliable_tight_errors(table, result.tc_usable, truth_yaw)
+        lengths = segment_lengths_that_fit(truth.path_length)
+        report.segment_note = (
+            "KITTI translation error: " + segment_lengths_note(lengths, truth.path_length) + "."
+        )
+    trajectories_figure(out / "trajectories.png", shown, truth, sequence.name)
+    write_geojson(out / "trajectories.geojson", report.tracks, TRACK_LABELS, sequence.enu)
+    report.heading_figure = png_data_uri(
+        build_heading_figure(table, truth_yaw, sequence.name, result.tc_usable),
+        out / "heading.png",
+    )
+    report.headline = headline(report.errors, summary["tight_heading_used"])
+    report.facts = readable_facts(summary)
     (out / SUMMARY_FILE).write_text(json.dumps(summary, indent=2))
-    title = f"vo-doppler run: {sequence.name}"
-    write_html_report(out / "report.html", title, readable_facts(summary), errors, figures)
+    write_run_report(out / "report.html", report)
     return summary
 
 

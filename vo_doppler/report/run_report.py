@@ -1,48 +1,144 @@
-"""The run report: figures (PNG) and one self-contained HTML page with the summary table."""
+"""The run report: one self-contained HTML page (figures embedded as data URIs, the map as
+inline SVG; readable offline) and the figures as PNG files beside it.
+
+The page says what the data is, how it was run (command, version, configuration), the result
+in one sentence, the pipelines' errors with units and definitions, a zoomable map, the error
+over distance, the heading error over time, the GNSS heading figure and the largest errors of
+the tightly coupled heading on epochs the correction used.
+"""
 
 from __future__ import annotations
 
+import base64
 import html
+import io
+from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 from matplotlib.figure import Figure
 
 from vo_doppler.eval.per_distance import ErrorPerDistance
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, PipelineErrors
+from vo_doppler.geo import EnuFrame, wrap_angle
+from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.report.provenance import DataDescription
+from vo_doppler.report.trajectory_map import COLOURS, TRUTH, map_html
+
+NO_ABSOLUTE_HEADING = {"vo"}
+"""Pipelines that use no absolute heading: their heading-use column reads "—", not 0 %."""
 
 TABLE_COLUMNS = (
-    ("error_per_100m_m", "horizontal error per 100 m, mean [m]", "{:.2f}"),
-    ("error_per_100m_max_m", "max [m]", "{:.2f}"),
-    ("error_per_100m_3d_m", "3-D error per 100 m [m]", "{:.2f}"),
-    ("kitti_translation_pct", "KITTI translation [%]", "{:.2f}"),
+    ("error_per_100m_m", "error per 100 m, mean [m]", "{:.2f}"),
+    ("error_per_100m_max_m", "error per 100 m, max [m]", "{:.2f}"),
+    ("error_per_100m_3d_m", "3-D error per 100 m, mean [m]", "{:.2f}"),
+    ("kitti_translation_pct", "KITTI translation error [%]", "{:.2f}"),
     ("heading_rmse_deg", "heading RMSE [deg]", "{:.2f}"),
-    ("heading_availability", "heading availability", "{:.0%}"),
+    ("heading_availability", "absolute heading used [% of GNSS epochs]", "{:.0%}"),
     ("final_position_error_m", "final horizontal error [m]", "{:.2f}"),
 )
+"""(key of :class:`PipelineErrors`, column title with unit, format): the report's table and
+the terminal's share it (see :func:`table_cell`)."""
+
+GLOSSARY = (
+    (
+        "error per 100 m",
+        "For every 100 m stretch of the ground-truth path (one starting every metre), the "
+        "horizontal distance between where the estimate moved and where the vehicle moved over "
+        "that stretch; the mean and the largest over all stretches, in metres. 1 m per 100 m "
+        "is a 1 % drift. On a path shorter than 100 m the whole path is scaled to 100 m.",
+    ),
+    ("3-D error per 100 m", "The same with the height difference included."),
+    (
+        "KITTI translation error",
+        "The KITTI odometry benchmark's relative error: over segments of 100, 200, … 800 m "
+        "(those that fit the path) from every pose, the translation error of the relative pose "
+        "in % of the segment length, averaged.",
+    ),
+    (
+        "heading RMSE",
+        "Root mean square of the yaw difference between the pipeline's vehicle poses and the "
+        "ground truth at every pose, in degrees.",
+    ),
+    (
+        "absolute heading used",
+        "Share of GNSS epochs whose absolute (GNSS) heading corrected the pipeline. “—”: the "
+        "pipeline uses no absolute heading (VO alone).",
+    ),
+    (
+        "available",
+        "The estimator produced a heading at the epoch. Conventional: a Doppler velocity "
+        "solution (4 or more satellites) while moving. Tightly coupled: the [TK18] window "
+        "solver (Doppler of any number of satellites + gyro + wheel speed over a 2 s window) "
+        "returned a heading.",
+    ),
+    (
+        "reliable",
+        "The tightly coupled heading agrees with its neighbours propagated by the gyro.",
+    ),
+    (
+        "used by the correction",
+        "Available, reliable and with a standard deviation σ below the configured limit: only "
+        "these headings correct the VO. The terminal summary and the table use this same word.",
+    ),
+    (
+        "σ (sigma)",
+        "The standard deviation the estimator states for its heading; the heading figure "
+        "shades ±2σ.",
+    ),
+    (
+        "final horizontal error",
+        "Horizontal distance between the last pose and the ground truth at that time.",
+    ),
+    (
+        "VO alone / + GPS",
+        "VO alone: monocular visual odometry, metric scale from the calibrated wheel speed, "
+        "turned to the first absolute heading and never corrected again. VO + GPS "
+        "(conventional): VO heading corrected by the heading of the Doppler velocity. VO + GPS "
+        "(tightly coupled): corrected by the [TK18] tightly coupled Doppler heading.",
+    ),
+)
+
+WORST_EPOCHS = 8
+WORST_SEPARATION_S = 1.0
+"""The worst-errors list keeps one epoch per second: neighbours of a listed epoch are skipped."""
+
+
+def label(name: str) -> str:
+    return PIPELINE_LABELS.get(name, name)
+
+
+def table_cell(name: str, key: str, value: float, fmt: str) -> str:
+    """A table cell: "—" where the quantity does not apply (the VO alone's heading use) or is
+    unknown (NaN), else ``fmt``."""
+    if key == "heading_availability" and name in NO_ABSOLUTE_HEADING:
+        return "—"
+    if value is None or not np.isfinite(value):
+        return "—"
+    return fmt.format(value)
+
+
+def png_data_uri(fig: Figure, path: Path | None = None) -> str:
+    """The figure as a PNG data URI (also written to ``path`` when given)."""
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=100)
+    data = buffer.getvalue()
+    if path is not None:
+        path.write_bytes(data)
+    return "data:image/png;base64," + base64.b64encode(data).decode("ascii")
 
 
 def trajectories_figure(
     path: Path, trajectories: dict[str, Trajectory], truth: Trajectory | None, title: str
 ) -> None:
+    """Top view (east, north in metres) of every pipeline's trajectory and the ground truth."""
     fig = Figure(figsize=(8, 7))
     ax = fig.subplots()
     if truth is not None:
-        ax.plot(
-            truth.positions[:, 0],
-            truth.positions[:, 1],
-            "k-",
-            lw=2.5,
-            alpha=0.35,
-            label="ground truth",
-        )
+        ax.plot(*truth.positions[:, :2].T, "k-", lw=2.5, alpha=0.35, label="ground truth")
     for name, trajectory in trajectories.items():
-        ax.plot(
-            trajectory.positions[:, 0],
-            trajectory.positions[:, 1],
-            lw=1.2,
-            label=PIPELINE_LABELS.get(name, name),
-        )
+        ax.plot(*trajectory.positions[:, :2].T, lw=1.2, c=COLOURS.get(name), label=label(name))
     first = next(iter(trajectories.values()), None)
     if first is not None and len(first):
         ax.plot(*first.positions[0, :2], "ko", ms=5, label="start")
@@ -56,57 +152,307 @@ def trajectories_figure(
     fig.savefig(path, dpi=110)
 
 
-def error_per_100m_figure(path: Path, per_100m: dict[str, ErrorPerDistance], title: str) -> None:
-    fig = Figure(figsize=(9, 4))
+def build_error_per_100m_figure(per_100m: dict[str, ErrorPerDistance], title: str) -> Figure:
+    """Per pipeline, the error of each 100 m stretch against where the stretch starts."""
+    fig = Figure(figsize=(9, 3.8))
     ax = fig.subplots()
     for name, result in per_100m.items():
         ax.plot(
             result.start_distance_m,
             result.errors_m,
-            lw=1.2,
-            label=f"{PIPELINE_LABELS.get(name, name)} (mean {result.mean_m_per_100m:.2f} m)",
+            lw=1.4,
+            c=COLOURS.get(name),
+            label=f"{label(name)} (mean {result.mean_m_per_100m:.2f} m)",
         )
     window = next(iter(per_100m.values())).window_m if per_100m else 100.0
-    ax.set_xlabel("start of the window along the path [m]")
-    ax.set_ylabel(f"horizontal error after {window:.0f} m [m per 100 m]")
+    ax.set_xlabel("distance along the ground-truth path where the stretch starts [m]")
+    ax.set_ylabel(f"error after {window:.0f} m\n[m per 100 m]")
+    ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    return fig
 
 
-def write_html_report(
-    path: Path,
-    title: str,
-    facts: dict[str, str],
-    errors: dict[str, PipelineErrors],
-    figures: list[Path],
-) -> None:
-    """One HTML page: the facts list, the pipelines table (when evaluated) and the figures."""
+def error_per_100m_figure(path: Path, per_100m: dict[str, ErrorPerDistance], title: str) -> None:
+    build_error_per_100m_figure(per_100m, title).savefig(path, dpi=110)
+
+
+def heading_error_over_time(trajectory: Trajectory, truth: Trajectory) -> np.ndarray:
+    """Yaw of each pose minus the ground truth's at its time (rad, wrapped; NaN outside)."""
+    return wrap_angle(trajectory.yaw() - truth.yaw_at(trajectory.t))
+
+
+def build_heading_error_figure(
+    trajectories: dict[str, Trajectory], truth: Trajectory, t0: float, title: str
+) -> Figure:
+    """Per pipeline, the vehicle heading error (deg) over time."""
+    fig = Figure(figsize=(9, 3.8))
+    ax = fig.subplots()
+    for name, trajectory in trajectories.items():
+        error = np.degrees(heading_error_over_time(trajectory, truth))
+        ax.plot(trajectory.t - t0, error, lw=1.2, c=COLOURS.get(name), label=label(name))
+    ax.axhline(0.0, c="k", lw=0.8)
+    ax.set_xlabel("time since first GNSS epoch [s]")
+    ax.set_ylabel("heading error\n(estimate − truth) [deg]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(title)
+    fig.tight_layout()
+    return fig
+
+
+@dataclass
+class WorstEpoch:
+    time_s: float
+    """Since the first GNSS epoch."""
+    error_deg: float
+    sigma_deg: float
+    satellites: int
+    doppler_rows: int
+    """Doppler measurements in the solver's window."""
+    used: bool
+    """The correction used the heading (σ under the limit); every listed epoch is reliable."""
+
+
+def worst_reliable_tight_errors(
+    table: HeadingTable,
+    used: np.ndarray,
+    truth_yaw: np.ndarray,
+    count: int = WORST_EPOCHS,
+    separation_s: float = WORST_SEPARATION_S,
+) -> list[WorstEpoch]:
+    """The largest |tightly coupled heading − truth| on epochs flagged reliable, largest first,
+    at most one per ``separation_s`` (the neighbours of a listed epoch are skipped), each with
+    whether the correction used it."""
+    error = np.abs(wrap_angle(table.yaw_tc - truth_yaw))
+    candidates = np.flatnonzero(np.asarray(table.tc_reliable, bool) & np.isfinite(error))
+    picked: list[int] = []
+    for k in candidates[np.argsort(-error[candidates], kind="stable")]:
+        if all(abs(table.t[k] - table.t[j]) >= separation_s for j in picked):
+            picked.append(int(k))
+        if len(picked) == count:
+            break
+    return [
+        WorstEpoch(
+            float(table.t[k] - table.t[0]),
+            float(np.degrees(error[k])),
+            float(np.degrees(table.sigma_tc[k])),
+            int(table.n_sat_epoch[k]),
+            int(table.n_obs_window[k]),
+            bool(used[k]),
+        )
+        for k in picked
+    ]
+
+
+def headline(errors: dict[str, PipelineErrors], used_fraction: float) -> str:
+    """The result in one sentence: how much the tightly coupled heading changed the VO's error
+    per 100 m (or, without ground truth, how often it was used)."""
+    if errors and ("vo" not in errors or "vo_gps_tc" not in errors):
+        shown = "; ".join(f"{label(n)} {e.error_per_100m_m:.2f}" for n, e in errors.items())
+        return f"No camera, so no VO to correct: error per 100 m (m): {shown}."
+    if not errors:
+        return (
+            "No ground truth: this report shows the trajectories and headings but cannot say "
+            f"how accurate they are. The tightly coupled heading was used by the correction at "
+            f"{used_fraction:.0%} of the GNSS epochs."
+        )
+    alone = errors["vo"].error_per_100m_m
+    tight = errors["vo_gps_tc"].error_per_100m_m
+    conv = errors.get("vo_gps_conv")
+    versus = (
+        f" (the conventional Doppler heading: {conv.error_per_100m_m:.2f} m per 100 m)"
+        if conv is not None
+        else ""
+    )
+    if tight < alone:
+        return (
+            f"The tightly coupled Doppler heading cut the VO's error from {alone:.2f} to "
+            f"{tight:.2f} m per 100 m ({alone / tight:.1f}× less){versus}."
+        )
+    return (
+        f"The tightly coupled Doppler heading did not reduce the VO's error on this drive: "
+        f"{alone:.2f} m per 100 m alone, {tight:.2f} m per 100 m corrected{versus}."
+    )
+
+
+@dataclass
+class RunReport:
+    """Everything the page shows. ``errors``/``per_100m`` are empty without ground truth."""
+
+    title: str
+    headline: str
+    data: DataDescription
+    command: str
+    version: str
+    settings: list[tuple[str, str]]
+    config_rows: list[tuple[str, str]]
+    facts: dict[str, str]
+    tracks: dict[str, Trajectory]
+    """Trajectories as evaluated (and the ground truth under ``"truth"``), ENU metres."""
+    enu: EnuFrame
+    heading_figure: str
+    """Data URI of the GNSS heading figure."""
+    errors: dict[str, PipelineErrors] = field(default_factory=dict)
+    segment_note: str = ""
+    error_figure: str | None = None
+    heading_error_figure: str | None = None
+    worst: list[WorstEpoch] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    """What the input checks found (time order, clocks, origin), shown under the data."""
+
+
+STYLE = (
+    "body{font-family:system-ui,sans-serif;margin:1.5em auto;max-width:72em;padding:0 1em;"
+    "color:#222;line-height:1.4}h1{margin-bottom:.2em}.badge{display:inline-block;"
+    "padding:2px 8px;border-radius:4px;font-size:.8em;vertical-align:middle;margin-left:.5em}"
+    ".synthetic{background:#fde68a}.recorded{background:#bbf7d0}"
+    ".headline{font-size:1.2em;background:#f1f5f9;border-left:4px solid #d62728;padding:.6em 1em}"
+    "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;"
+    "text-align:right}th{background:#f1f5f9}th:first-child,td:first-child{text-align:left}"
+    "td.text{text-align:left}img{max-width:100%}dt{font-weight:bold}dd{margin:0 0 .5em 1.5em}"
+    "code{background:#f1f5f9;padding:1px 4px;word-break:break-all}"
+    "#map{width:100%;height:32em;border:1px solid #bbb;background:#fafafa;cursor:grab;"
+    "touch-action:none}.legend .key{margin-right:1.2em;white-space:nowrap}"
+    ".swatch{display:inline-block;width:1.6em;height:.35em;margin-right:.4em;"
+    "vertical-align:middle}.scalebar{display:inline-block;border:2px solid #222;"
+    "border-top:none;height:.5em;text-align:center;font-size:.8em;line-height:.4em}"
+    ".note{color:#555;font-size:.9em}.map-tools{margin:.4em 0}"
+)
+
+
+def _definitions(rows: list[tuple[str, str]]) -> str:
+    return (
+        "<table>"
+        + "".join(
+            f"<tr><th>{html.escape(k)}</th><td class='text'>{html.escape(v)}</td></tr>"
+            for k, v in rows
+        )
+        + "</table>"
+    )
+
+
+def _errors_table(report: RunReport) -> str:
+    head = "".join(f"<th>{html.escape(title)}</th>" for _, title, _ in TABLE_COLUMNS)
+    rows = []
+    for name, row in report.errors.items():
+        values = row.to_dict()
+        cells = "".join(
+            f"<td>{table_cell(name, key, values[key], fmt)}</td>" for key, _, fmt in TABLE_COLUMNS
+        )
+        rows.append(f"<tr><td>{html.escape(label(name))}</td>{cells}</tr>")
+    return f"<table><tr><th>pipeline</th>{head}</tr>{''.join(rows)}</table>"
+
+
+def _worst_table(worst: list[WorstEpoch]) -> str:
+    if not worst:
+        return "<p>No epoch flagged reliable has a known error.</p>"
+    rows = "".join(
+        f"<tr><td>{w.time_s:.2f}</td><td>{w.error_deg:.1f}</td><td>{w.sigma_deg:.2f}</td>"
+        f"<td>{w.error_deg / w.sigma_deg:.1f}</td><td>{'yes' if w.used else 'no (σ too large)'}"
+        f"</td><td>{w.satellites}</td><td>{w.doppler_rows}</td></tr>"
+        for w in worst
+    )
+    return (
+        "<table><tr><th>time since first GNSS epoch [s]</th><th>|heading error| [deg]</th>"
+        "<th>stated σ [deg]</th><th>error / σ</th><th>used by the correction</th>"
+        "<th>satellites at the epoch</th>"
+        f"<th>Doppler rows in the solver's window</th></tr>{rows}</table>"
+    )
+
+
+def render(report: RunReport) -> str:
+    """The HTML page of ``report``."""
+    data = report.data
+    kind = data.kind
+    distance = (
+        f"{data.distance_m:.0f} m (from the {data.distance_source})"
+        if data.distance_m is not None
+        else "unknown"
+    )
+    about = [
+        ("data", data.origin),
+        ("sensors", "; ".join(data.sensors)),
+        ("duration", f"{data.duration_s:.1f} s (span covered by every sensor)"),
+        ("distance driven", distance),
+    ]
     parts = [
-        "<!doctype html><html><head><meta charset='utf-8'>",
-        f"<title>{html.escape(title)}</title>",
-        "<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
-        "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:4px 8px;"
-        "text-align:right}th:first-child,td:first-child{text-align:left}img{max-width:100%}"
-        "</style></head><body>",
-        f"<h1>{html.escape(title)}</h1><ul>",
+        "<!doctype html><html lang='en'><head><meta charset='utf-8'>",
+        "<meta name='viewport' content='width=device-width, initial-scale=1'>",
+        f"<title>{html.escape(report.title)}</title><style>{STYLE}</style></head><body>",
+        f"<h1>{html.escape(report.title)}"
+        + (f"<span class='badge {kind}'>{kind} data</span>" if kind else "")
+        + "</h1>",
+        f"<p class='headline'>{html.escape(report.headline)}</p>",
+        "<h2>The data</h2>",
+        _definitions(about),
+        *(
+            ["<p>Input warnings:</p><ul>"]
+            + [f"<li>{html.escape(w)}</li>" for w in report.warnings]
+            + ["</ul>"]
+            if report.warnings
+            else []
+        ),
+        "<h2>How it was run</h2>",
+        f"<p>Command: <code>{html.escape(report.command)}</code><br>"
+        f"Version: {html.escape(report.version)}</p>",
+        _definitions(report.settings),
+        "<details><summary>Full configuration (RunConfig; angles in degrees, everything else "
+        "in SI units)</summary>",
+        _definitions(report.config_rows),
+        "</details>",
     ]
-    parts += [f"<li><b>{html.escape(k)}</b>: {html.escape(v)}</li>" for k, v in facts.items()]
-    parts.append("</ul>")
-    if errors:
-        parts.append("<h2>Pipelines against ground truth</h2><table><tr><th>pipeline</th>")
-        parts += [f"<th>{html.escape(label)}</th>" for _, label, _ in TABLE_COLUMNS]
-        parts.append("</tr>")
-        for name, row in errors.items():
-            values = row.to_dict()
-            cells = "".join(f"<td>{fmt.format(values[key])}</td>" for key, _, fmt in TABLE_COLUMNS)
-            parts.append(f"<tr><td>{html.escape(PIPELINE_LABELS.get(name, name))}</td>{cells}</tr>")
-        parts.append("</table>")
-    parts.append("<h2>Figures</h2>")
+    if report.errors:
+        parts += [
+            "<h2>Pipelines against ground truth</h2>",
+            "<p class='note'>Every trajectory starts at the ground truth's first position; the "
+            "VO alone is also turned to the truth's initial heading. Definitions below the "
+            f"figures. {html.escape(report.segment_note)}</p>",
+            _errors_table(report),
+        ]
+    parts += ["<h2>Map</h2>", map_html(report.tracks, TRACK_LABELS, report.enu)]
+    if report.error_figure is not None:
+        parts += [
+            "<h2>Error over distance</h2>",
+            f"<img alt='error per 100 m along the path' src='{report.error_figure}'>",
+        ]
+    if report.heading_error_figure is not None:
+        parts += [
+            "<h2>Heading error over time</h2>",
+            f"<img alt='heading error of each pipeline' src='{report.heading_error_figure}'>",
+        ]
     parts += [
-        f"<p><img src='{html.escape(f.name)}' alt='{html.escape(f.stem)}'></p>" for f in figures
+        "<h2>GNSS headings</h2>",
+        "<p class='note'>Satellites per epoch; when the conventional and the tightly coupled "
+        "heading were available and when the tightly coupled one was used; the headings as "
+        "course (clockwise from north, unwrapped: no jump at 0/360°) with the tightly coupled "
+        "heading's ±2σ band; with ground truth, their errors.</p>",
+        f"<img alt='GNSS heading figure' src='{report.heading_figure}'>",
     ]
-    parts.append("</body></html>")
-    path.write_text("\n".join(parts))
+    if report.errors:
+        parts += [
+            "<h2>Largest tightly coupled heading errors on epochs flagged reliable</h2>",
+            "<p class='note'>Largest error against ground truth first, at most one epoch per "
+            "second. An error of many σ on a used epoch misleads the correction; on an unused one "
+            "the σ limit kept it out.</p>",
+            _worst_table(report.worst),
+        ]
+    parts += [
+        "<h2>Run figures</h2>",
+        _definitions(list(report.facts.items())),
+        "<h2>Definitions</h2><dl>",
+        *(f"<dt>{html.escape(k)}</dt><dd>{html.escape(v)}</dd>" for k, v in GLOSSARY),
+        "</dl><p class='note'>[TK18]: Takeyama &amp; Kojima (2018), the tightly coupled Doppler "
+        "heading this toolkit implements (see docs/design.md).</p>",
+        "</body></html>",
+    ]
+    return "\n".join(parts)
+
+
+TRACK_LABELS = {TRUTH: "ground truth", **PIPELINE_LABELS}
+
+
+def write_run_report(path: Path, report: RunReport) -> None:
+    path.write_text(render(report), encoding="utf-8")

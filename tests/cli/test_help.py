@@ -1,0 +1,72 @@
+"""Every option of every subcommand has help and shows its default; help names the paper."""
+
+from __future__ import annotations
+
+import argparse
+
+import pytest
+
+from vo_doppler.cli import build_parser
+from vo_doppler.commands.help_format import has_default, shown_default
+
+
+def _parsers(parser: argparse.ArgumentParser, name: str = "vo-doppler"):
+    """``(name, parser)`` of the parser and of every sub-parser below it."""
+    yield name, parser
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub_name, sub in action.choices.items():
+                yield from _parsers(sub, f"{name} {sub_name}")
+
+
+PARSERS = dict(_parsers(build_parser("*")))
+
+
+def _options(parser: argparse.ArgumentParser):
+    return [
+        a
+        for a in parser._actions
+        if not isinstance(a, argparse._HelpAction | argparse._SubParsersAction)
+    ]
+
+
+@pytest.mark.parametrize("name", sorted(PARSERS))
+def test_every_option_has_help_and_shows_its_default(name):
+    parser = PARSERS[name]
+    for action in _options(parser):
+        assert action.help and action.help.strip(), f"{name} {action.option_strings} has no help"
+        if has_default(action) and "%(default" in action.help:
+            assert "default" in parser._get_formatter()._expand_help(action)
+        elif has_default(action):
+            rendered = parser._get_formatter()._expand_help(action)
+            expected = f"default: {shown_default(action.default)}"
+            assert expected in rendered or f"default {shown_default(action.default)}" in rendered, (
+                f"{name} {action.option_strings}: {rendered!r}"
+            )
+
+
+@pytest.mark.parametrize("name", sorted(PARSERS))
+def test_help_prints_no_escapes_and_names_the_paper(name):
+    text = PARSERS[name].format_help()
+    assert "%%" not in text
+    assert "seed's" not in text
+    assert "as written" not in text or "[TK18]" in text
+    if "Eq. 11" in text:
+        assert "[TK18]" in text
+
+
+def test_the_walk_covers_the_options_the_issue_names():
+    options = {
+        name: {o for a in _options(p) for o in a.option_strings} for name, p in PARSERS.items()
+    }
+    assert {"--nav", "--systems", "--calibration"} <= options["vo-doppler heading"]
+    assert {"--source", "--world", "--body", "--max-gap-s", "--format"} <= options[
+        "vo-doppler correct"
+    ]
+    assert "--format" in options["vo-doppler eval"]
+
+
+def test_defaults_are_shown_as_typed():
+    assert shown_default((640, 360)) == "640,360"
+    assert shown_default(((1, 1), (4, 3))) == "1,1,4,3"
+    assert shown_default(2.0) == "2.0"

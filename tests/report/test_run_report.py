@@ -1,0 +1,162 @@
+"""The run report's pieces on exact cases: headline, table cells, worst epochs, the map and
+GeoJSON, the configuration in degrees, synthetic vs recorded."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tests.conftest import REPO_ROOT
+from vo_doppler.eval.pipelines import PipelineErrors
+from vo_doppler.geo import EnuFrame, geodetic_to_ecef
+from vo_doppler.io.sequence import read_manifest, read_sequence
+from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.report.heading_figure import build_heading_figure, continuous_course_deg
+from vo_doppler.report.provenance import config_rows, describe_data, is_synthetic, main_settings
+from vo_doppler.report.run_report import (
+    heading_error_over_time,
+    headline,
+    table_cell,
+    worst_reliable_tight_errors,
+)
+from vo_doppler.report.trajectory_map import lon_lat, map_html, thinned, write_geojson
+from vo_doppler.run import RunConfig
+
+LAT, LON = 35.6938, 139.7034
+ENU = EnuFrame.from_ecef(geodetic_to_ecef(np.radians(LAT), np.radians(LON), 77.0))
+
+
+def _errors(per_100m: float) -> PipelineErrors:
+    return PipelineErrors(per_100m, 2 * per_100m, per_100m, 1.0, 0.1, 0.5, 0.9, 1.0, 300.0)
+
+
+def test_headline_states_the_cut_or_says_plainly_it_did_not_help():
+    cut = headline({"vo": _errors(1.2), "vo_gps_tc": _errors(0.3)}, 0.9)
+    assert cut.startswith("The tightly coupled Doppler heading cut the VO's error from 1.20 to")
+    assert "0.30 m per 100 m (4.0× less)" in cut
+    worse = headline({"vo": _errors(0.2), "vo_gps_tc": _errors(0.23)}, 0.9)
+    assert "did not reduce" in worse and "0.20 m per 100 m alone" in worse
+    assert "No ground truth" in headline({}, 0.93) and "93%" in headline({}, 0.93)
+    no_camera = headline({"dr_gps_tc": _errors(0.4)}, 0.9)
+    assert no_camera.startswith("No camera") and "(tightly coupled) 0.40" in no_camera
+
+
+def test_vo_alone_heading_use_is_a_dash_not_zero():
+    assert table_cell("vo", "heading_availability", 0.0, "{:.0%}") == "—"
+    assert table_cell("vo_gps_tc", "heading_availability", 0.93, "{:.0%}") == "93%"
+    assert table_cell("vo", "heading_rmse_deg", float("nan"), "{:.2f}") == "—"
+
+
+def _table(n: int = 40) -> HeadingTable:
+    t = 100.0 + 0.1 * np.arange(n)
+    return HeadingTable(
+        t=t,
+        yaw_tc=np.zeros(n),
+        sigma_tc=np.full(n, np.radians(0.5)),
+        tc_reliable=np.ones(n, bool),
+        n_obs_window=np.full(n, 60),
+        n_sat_epoch=np.full(n, 3),
+        yaw_conv=np.zeros(n),
+        conv_valid=np.zeros(n, bool),
+        gyro_bias=np.zeros(n),
+        wheel_scale=np.ones(n),
+    )
+
+
+def test_worst_errors_list_reliable_epochs_with_their_use_and_satellites():
+    table = _table()
+    truth = np.zeros(len(table))
+    truth[5], truth[6], truth[30] = np.radians(16.0), np.radians(10.0), np.radians(-3.0)
+    table.n_sat_epoch[5] = 1
+    table.tc_reliable[30] = False
+    used = np.ones(len(table), bool)
+    used[5:7] = False
+    worst = worst_reliable_tight_errors(table, used, truth, count=3)
+    assert [round(w.time_s, 2) for w in worst][:1] == [0.5]
+    first = worst[0]
+    assert abs(first.error_deg - 16.0) < 1e-9
+    assert (first.satellites, first.used) == (1, False)
+    # the neighbour 0.1 s later (10°) is within a second: skipped; the unreliable epoch too
+    assert all(abs(w.time_s - 0.6) > 1e-9 and abs(w.time_s - 3.0) > 1e-9 for w in worst)
+
+
+def test_course_is_unwrapped_across_north():
+    course = np.radians(np.array([358.0, 359.0, 0.5, 1.5, np.nan, 3.0]))
+    shown = continuous_course_deg(course, course)
+    np.testing.assert_allclose(shown[[0, 1, 2, 3, 5]], [358.0, 359.0, 360.5, 361.5, 363.0])
+
+
+def test_heading_figure_has_an_availability_strip_of_its_own():
+    table = _table()
+    figure = build_heading_figure(table, np.zeros(len(table)), "t", np.ones(len(table), bool))
+    strip = figure.axes[1]
+    labels = [tick.get_text() for tick in strip.get_yticklabels()]
+    assert labels == ["conventional available", "tightly coupled available", "tightly coupled used"]
+    assert len(figure.axes) == 4 and figure.axes[0].get_ylim()[0] == 0
+
+
+def _track(n: int = 50, heading_deg: float = 0.0) -> Trajectory:
+    t = np.arange(n, dtype=float)
+    positions = np.column_stack([10.0 * t, 5.0 * t, np.zeros(n)])
+    return Trajectory(
+        t, positions, Rotation.from_euler("z", np.full((n, 1), np.radians(heading_deg)))
+    )
+
+
+def test_heading_error_over_time_is_the_yaw_difference():
+    error = heading_error_over_time(_track(heading_deg=2.0), _track())
+    np.testing.assert_allclose(np.degrees(error), 2.0, atol=1e-9)
+
+
+def test_geojson_is_lon_lat_and_starts_at_the_origin(tmp_path):
+    track = _track()
+    track.positions -= track.positions[0]
+    write_geojson(tmp_path / "t.geojson", {"vo": track}, {"vo": "VO alone"}, ENU)
+    data = json.loads((tmp_path / "t.geojson").read_text())
+    (feature,) = data["features"]
+    assert feature["properties"] == {"name": "vo", "label": "VO alone"}
+    lon0, lat0 = feature["geometry"]["coordinates"][0]
+    assert abs(lon0 - LON) < 1e-8 and abs(lat0 - LAT) < 1e-8
+    np.testing.assert_allclose(lon_lat(ENU, np.zeros((1, 3)))[0], [LON, LAT], atol=1e-9)
+
+
+def test_map_is_inline_svg_and_loads_no_tile_until_asked():
+    page = map_html({"truth": _track(), "vo": _track()}, {"vo": "VO alone"}, ENU)
+    assert page.count("<polyline") == 2 and "<svg id='map'" in page
+    assert "tile.openstreetmap.org" in page and "<image" not in page
+    assert "if (!osm.checked) return;" in page
+
+
+def test_long_tracks_are_thinned_keeping_the_last_pose():
+    rows = thinned(np.arange(10_001.0)[:, None], 1000)
+    assert len(rows) <= 1001 and rows[-1, 0] == 10_000.0 and rows[0, 0] == 0.0
+
+
+def test_configuration_is_in_degrees_for_people():
+    rows = dict(config_rows(RunConfig()))
+    assert rows["elevation_mask"] == "10 deg"
+    assert rows["heading.gate.max_yaw_jump_deg"] == "2 deg"
+    assert rows["heading.gate.max_yaw_drift_deg_s"] == "1 deg/s"
+    assert dict(main_settings(RunConfig()))["elevation mask"] == "10.0 deg"
+
+
+def test_a_manifest_with_the_simulators_keys_is_synthetic():
+    assert is_synthetic({"scenario": "urban-canyon", "command": "vo-doppler simulate"})
+    assert not is_synthetic({"name": "drive"}) and not is_synthetic(None)
+
+
+def test_the_sample_is_described_as_a_synthetic_drive_with_its_sensors():
+    folder = REPO_ROOT / "sample_sequences" / "urban_canyon_small"
+    sequence, manifest = read_sequence(folder), read_manifest(folder)
+    data = describe_data(sequence, manifest)
+    assert data.kind == "synthetic" and "vo-doppler simulate --scenario urban-canyon" in data.origin
+    assert abs(data.distance_m - manifest["stats"]["path_length_m"]) < 1.0
+    assert data.distance_source == "ground truth"
+    assert abs(data.duration_s - manifest["duration_s"]) < 0.5
+    assert data.sensors[0] == "monocular camera (570 images, 15.0 frames/s)"
+    assert any(s.startswith("GNSS receiver (761 epochs, systems EG") for s in data.sensors)
+    unstated = describe_data(sequence, None, driven_m=300.0)
+    assert unstated.kind == "" and unstated.origin.startswith("not stated")
