@@ -107,6 +107,8 @@ ANGLE_FIELDS = {
     "tc_max_sigma": " deg",
     "gate": " deg",
     "default_measurement_sigma": " deg",
+    "init_min_parallax": " deg",
+    "triangulation_min_parallax": " deg",
     "prior_gyro_bias_sigma": " deg/s",
     "fixed_gyro_bias": " deg/s",
 }

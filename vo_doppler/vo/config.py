@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 
 @dataclass
 class VoConfig:
@@ -26,9 +28,11 @@ class VoConfig:
     klt_epsilon: float = 0.01
     forward_backward_max_px: float = 0.7
     ransac_threshold_px: float = 1.0
-    init_min_parallax_deg: float = 1.0
+    init_min_parallax: float = np.radians(1.0)
+    """Median parallax (rad) the two-view initialisation needs."""
     init_min_points: int = 60
-    triangulation_min_parallax_deg: float = 1.0
+    triangulation_min_parallax: float = np.radians(1.0)
+    """Parallax (rad) a new point needs to be triangulated."""
     max_reprojection_px: float = 2.0
     pnp_min_inliers: int = 25
     standstill_flow_px: float = 0.3

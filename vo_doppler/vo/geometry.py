@@ -48,14 +48,14 @@ def depths(T_cw: np.ndarray, points_world: np.ndarray) -> np.ndarray:
     return transform_points(T_cw, points_world)[:, 2]
 
 
-def parallax_deg(center_a: np.ndarray, center_b: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Angle (deg) at each point between the rays to two camera centres."""
+def parallax(center_a: np.ndarray, center_b: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Angle (rad) at each point between the rays to two camera centres."""
     ra = points - center_a.reshape(1, 3)
     rb = points - center_b.reshape(1, 3)
     cos = np.einsum("ij,ij->i", ra, rb) / (
         np.linalg.norm(ra, axis=1) * np.linalg.norm(rb, axis=1) + 1e-300
     )
-    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    return np.arccos(np.clip(cos, -1.0, 1.0))
 
 
 @dataclass
@@ -71,7 +71,7 @@ def triangulate(
     uv_a: np.ndarray,
     uv_b: np.ndarray,
     max_reprojection_px: float,
-    min_parallax_deg: float,
+    min_parallax: float,
 ) -> Triangulation:
     """Linear (DLT) triangulation from two views; ``valid`` checks depth, error and parallax."""
     if len(uv_a) == 0:
@@ -88,8 +88,8 @@ def triangulate(
     err_a = np.linalg.norm(project(K, T_a, points) - uv_a, axis=1)
     err_b = np.linalg.norm(project(K, T_b, points) - uv_b, axis=1)
     valid &= (err_a < max_reprojection_px) & (err_b < max_reprojection_px)
-    angle = parallax_deg(camera_center(T_a).ravel(), camera_center(T_b).ravel(), points)
-    valid &= angle >= min_parallax_deg
+    angle = parallax(camera_center(T_a).ravel(), camera_center(T_b).ravel(), points)
+    valid &= angle >= min_parallax
     return Triangulation(points, valid)
 
 
@@ -101,7 +101,7 @@ class TwoViewResult:
     points_a: np.ndarray
     """Triangulated points in view a's frame (rows of ``inliers``), NaN where invalid."""
     valid: np.ndarray
-    median_parallax_deg: float
+    median_parallax: float
 
 
 def two_view_geometry(
@@ -110,7 +110,7 @@ def two_view_geometry(
     uv_b: np.ndarray,
     ransac_threshold_px: float,
     max_reprojection_px: float,
-    min_parallax_deg: float,
+    min_parallax: float,
 ) -> TwoViewResult | None:
     """Five-point essential matrix (RANSAC) + cheirality + triangulation with parallax check."""
     if len(uv_a) < 8:
@@ -123,11 +123,11 @@ def two_view_geometry(
     _, R, t, pose_mask = cv2.recoverPose(E, uv_a, uv_b, K, mask=mask.copy())
     inliers = pose_mask.ravel() > 0
     T_ba = make_pose(R, t.ravel() / max(np.linalg.norm(t), 1e-12))
-    tri = triangulate(K, np.eye(4), T_ba, uv_a, uv_b, max_reprojection_px, min_parallax_deg=0.0)
+    tri = triangulate(K, np.eye(4), T_ba, uv_a, uv_b, max_reprojection_px, min_parallax=0.0)
     valid = tri.valid & inliers
-    angles = parallax_deg(np.zeros(3), camera_center(T_ba).ravel(), tri.points[valid])
+    angles = parallax(np.zeros(3), camera_center(T_ba).ravel(), tri.points[valid])
     median = float(np.median(angles)) if angles.size else 0.0
-    valid &= parallax_deg(np.zeros(3), camera_center(T_ba).ravel(), tri.points) >= min_parallax_deg
+    valid &= parallax(np.zeros(3), camera_center(T_ba).ravel(), tri.points) >= min_parallax
     return TwoViewResult(T_ba, inliers, tri.points, valid, median)
 
 

@@ -289,11 +289,11 @@ class VisualOdometry:
             frame.features.points[ib],
             cfg.ransac_threshold_px,
             cfg.max_reprojection_px,
-            cfg.triangulation_min_parallax_deg,
+            cfg.triangulation_min_parallax,
         )
         if (
             two_view is None
-            or two_view.median_parallax_deg < cfg.init_min_parallax_deg
+            or two_view.median_parallax < cfg.init_min_parallax
             or two_view.valid.sum() < cfg.init_min_points
         ):
             return
@@ -392,7 +392,7 @@ class VisualOdometry:
                 older.features.points[ia],
                 frame.features.points[jb],
                 cfg.max_reprojection_px,
-                cfg.triangulation_min_parallax_deg,
+                cfg.triangulation_min_parallax,
             )
             self._landmarks.set(ids[tri.valid], tri.points[tri.valid])
             wanted = np.setdiff1d(wanted, ids)
