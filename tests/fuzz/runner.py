@@ -86,10 +86,28 @@ class Outcome:
     detail: str = ""
 
 
+def _own_peak_kb() -> float:
+    """This process's peak resident memory (KiB): the kernel's high-water mark of its own
+    address space (``VmHWM``), which starts afresh at exec, unlike ``ru_maxrss``, which a
+    worker inherits from the process that started it (a large test run)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return float(line.split()[1])
+    except OSError:
+        pass
+    return float(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+
+
+_INHERITED_PEAK_KB = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+"""The ``ru_maxrss`` this process started with; a child (the Hatanaka decompressor) inherits
+it too, so a child's figure counts only above it."""
+
+
 def _rss_mb() -> float:
-    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    return max(own, children) / 1024.0
+    child_peak = children if children > _INHERITED_PEAK_KB else 0.0
+    return max(_own_peak_kb(), child_peak) / 1024.0
 
 
 class Worker:
