@@ -31,11 +31,10 @@ from rich.table import Table
 
 from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.geo import wrap_angle
-from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.run import RunConfig, sequence_heading
+from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
 
 ROOT = Path(__file__).resolve().parents[1]
 CANYON_SATS = 2
@@ -139,14 +138,7 @@ def evaluate(folder: Path, fit_noise: bool) -> dict:
     sequence = read_with_truth(folder)
     config = RunConfig()
     obs = sequence.observations
-    gnss = gnss_velocity(
-        obs,
-        sequence.navigation,
-        config.systems,
-        config.elevation_mask,
-        reported_sigma=sequence.doppler_sigma,
-        fit_noise=fit_noise,
-    )
+    gnss = sequence_gnss(sequence, config, fit_noise)
     scale_truth, bias_truth = calibration_truth(sequence)
     open_sky = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
     canyon = sequence_heading(sequence, *canyon_inputs(sequence, config), config.heading)

@@ -212,7 +212,7 @@ def _run_job(job: RecordingJob) -> dict:
     summary = write_run_outputs(
         sequence, result, job.config, job.out, checks, read_manifest(folder)
     )
-    require_tight_heading(result, folder)
+    require_tight_heading(result, folder, job.out)
     return summary
 
 

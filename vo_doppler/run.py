@@ -182,6 +182,21 @@ def correct_all(
     return trajectories
 
 
+def sequence_gnss(
+    sequence: Sequence, config: RunConfig, fit_noise: bool = False
+) -> GnssVelocityResult:
+    """The GNSS stage on a recording: SPP, Doppler rows (weighted by the receiver's reported σ
+    where the recording has it, or a σ fitted from the data) and conventional velocities."""
+    return gnss_velocity(
+        sequence.observations,
+        sequence.navigation,
+        config.systems,
+        config.elevation_mask,
+        reported_sigma=sequence.doppler_sigma,
+        fit_noise=fit_noise,
+    )
+
+
 def sequence_heading(
     sequence: Sequence,
     rows: DopplerRows,
@@ -212,13 +227,7 @@ def run_sequence(
     (e.g. frames already in memory); ``on_frame`` is called after each VO frame."""
     config = config or RunConfig()
     obs = sequence.observations
-    gnss = gnss_velocity(
-        obs,
-        sequence.navigation,
-        config.systems,
-        config.elevation_mask,
-        reported_sigma=sequence.doppler_sigma,
-    )
+    gnss = sequence_gnss(sequence, config)
     table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
     speed = table.calibrated_speed(sequence.wheel_speed)
     vo = None

@@ -15,13 +15,17 @@ from rich.table import Table
 
 from vo_doppler.commands.time_hints import overlap_error, overlaps
 from vo_doppler.commands.vo_command import window_size
-from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.io.output_folder import check_output_folder, staged_output, untouched
 from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
-from vo_doppler.report.run_outputs import input_warnings, result_checks, write_run_outputs
+from vo_doppler.report.run_outputs import (
+    input_warnings,
+    require_tight_heading,
+    result_checks,
+    write_run_outputs,
+)
 from vo_doppler.report.run_report import TABLE_COLUMNS, table_cell
 from vo_doppler.run import RunConfig, RunResult, run_sequence
 from vo_doppler.vo.config import VoConfig
@@ -98,12 +102,7 @@ def run(args: argparse.Namespace) -> int:
     except BaseException:
         log.error("%s", untouched(args.output))
         raise
-    if not result.heading.tc_available.any():
-        raise InputError(
-            "the tightly coupled heading was unavailable at every epoch (the other results are "
-            f"in {args.output})",
-            args.sequence,
-        )
+    require_tight_heading(result, args.sequence, args.output)
     return 0
 
 

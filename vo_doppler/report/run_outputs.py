@@ -222,8 +222,13 @@ def write_run_outputs(
     return summary
 
 
-def require_tight_heading(result: RunResult, folder: Path) -> None:
+def require_tight_heading(result: RunResult, folder: Path, out: Path) -> None:
     """A run whose tightly coupled heading was unavailable at every epoch failed: raise the
-    project's error naming the recording (after its outputs were written, to show why)."""
+    project's error naming the recording (after its outputs were written to ``out``, to show
+    why)."""
     if not result.heading.tc_available.any():
-        raise InputError("the tightly coupled heading was unavailable at every epoch", folder)
+        raise InputError(
+            "the tightly coupled heading was unavailable at every epoch (the other results are "
+            f"in {out})",
+            folder,
+        )
