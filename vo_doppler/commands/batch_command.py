@@ -12,7 +12,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from vo_doppler.batch import EXECUTORS, RecordingOutcome, Status, read_list, run_batch
-from vo_doppler.commands.deadreckon_command import _positive_int
+from vo_doppler.commands.arg_types import positive_int
 from vo_doppler.commands.run_command import add_run_options, run_config
 from vo_doppler.errors import InputError
 
@@ -42,7 +42,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--workers",
-        type=_positive_int,
+        type=positive_int,
         help="recordings run at once (default: min(CPU cores, recordings); ray on a cluster: "
         "its CPUs)",
     )

@@ -8,6 +8,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from vo_doppler.commands.arg_types import positive_int
 from vo_doppler.io.gps_fixes import read_gps_fixes
 from vo_doppler.io.sensor_csv import read_numeric_csv, read_yaw_rate_csv
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon
@@ -40,13 +41,6 @@ def _interval(text: str) -> tuple[float, float]:
     if t1 <= t0:
         raise argparse.ArgumentTypeError(f"the interval must end after it starts: {text!r}")
     return t0, t1
-
-
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected an integer ≥ 1, got {text!r}")
-    return value
 
 
 def register(subparsers, summary: str) -> None:
@@ -89,7 +83,7 @@ def register(subparsers, summary: str) -> None:
         type=float,
         help="threshold h (rad/s) of [KZ] Eq. 9; default 3σ of the de-biased standstill rate",
     )
-    parser.add_argument("--downsample", type=_positive_int, default=1, help="keep every M-th fix")
+    parser.add_argument("--downsample", type=positive_int, default=1, help="keep every M-th fix")
     parser.add_argument(
         "--cluster-m", type=float, default=3.0, help="drop fixes closer than this (m)"
     )
