@@ -120,6 +120,7 @@ def test_cli_writes_a_sequence(tmp_path, capsys):
     )
     assert code == 0
     manifest = yaml.safe_load((out / "sequence.yaml").read_text())
+    assert "camera" not in manifest  # no images rendered: a recording without a camera
     assert manifest["city"]["street_width_m"] == 18.0
     assert manifest["city"]["height_range_m"] == [10.0, 20.0]
     assert manifest["command"].startswith("vo-doppler simulate --scenario urban-canyon")

@@ -463,6 +463,16 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
         "dbc": "can/vehicle.dbc",
         "ground_truth": "ground_truth.tum",
     }
+    camera_section = {
+        "images": files["images"],
+        "image_format": suffix,
+        "times": files["times"],
+        "calib": files["calib"],
+        "fps": config.fps,
+        "width": config.image_size[0],
+        "height": config.image_size[1],
+        "time_offset_s": camera_offset,
+    }
     city = config.city
     manifest = {
         "format": "vo-doppler-sequence/1",
@@ -473,16 +483,7 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
         "command": command,
         "origin": dict(zip(("lat_deg", "lon_deg", "height_m"), config.origin, strict=True)),
         "start_gps_s": config.start_gps_s,
-        "camera": {
-            "images": files["images"],
-            "image_format": suffix,
-            "times": files["times"],
-            "calib": files["calib"],
-            "fps": config.fps,
-            "width": config.image_size[0],
-            "height": config.image_size[1],
-            "time_offset_s": camera_offset,
-        },
+        **({"camera": camera_section} if config.render else {}),
         "gnss": {
             "obs": files["obs"],
             "nav": [files["nav"]],
