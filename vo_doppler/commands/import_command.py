@@ -21,7 +21,8 @@ def register(subparsers, summary: str) -> None:
         description="Write RINEX 3 observations and per-row Doppler sigma from raw_gnss_ublox, "
         "the CAN log and DBC, the IMU yaw rate, global_pose as TUM ground truth on GPS time, the "
         "clock offsets and sequence.yaml. comma2k19 has no navigation file: give the day's "
-        "precise orbits (SP3). The video is not decoded (the sequence has no camera).",
+        "precise orbits (SP3). A video.hevc in the segment is decoded into grey JPEG frames "
+        "with the road camera's published intrinsics; without one the sequence has no camera.",
     )
     comma.add_argument("segment", type=Path, help="segment folder")
     comma.add_argument("--orbits", type=Path, required=True, help="SP3-c/d precise orbits")
@@ -42,6 +43,6 @@ def run(args: argparse.Namespace) -> int:
         summary.dropped_rows,
         summary.ground_truth_poses,
         summary.gps_minus_log_s,
-        "; video not decoded: no camera" if summary.has_video else "; no video: no camera",
+        "; video decoded into the camera" if summary.has_video else "; no video: no camera",
     )
     return 0

@@ -8,8 +8,9 @@ clocks) copied beside them, ``can/`` (the segment's ``can_motion.log``, or one w
 ``raw_can`` in candump format, with the DBC), ``imu/yaw_rate.csv`` (gyro yaw rate on the log
 clock, a record for ``heading --yaw-rate-csv``), ``ground_truth.tum`` (``global_pose`` as
 vehicle poses in the ENU frame of the first pose, GPS time) and the clock offsets (log
-clock → GPS time from ``global_pose``). A segment's ``video.hevc`` is not decoded: the camera
-section is left out, and ``run`` then runs the non-visual pipelines.
+clock → GPS time from ``global_pose``). A segment's ``video.hevc`` is decoded into the camera
+(``vo_doppler.io.comma2k19_video``); without one the camera section is left out, and ``run``
+then runs the non-visual pipelines.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from vo_doppler.io.comma2k19 import (
     read_raw_gnss,
     read_vehicle_poses,
 )
+from vo_doppler.io.comma2k19_video import CALIB, IMAGES, TIMES, VIDEO, decode_video
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.rinex_write import ObsEpochs, write_obs
 from vo_doppler.io.sensor_csv import YAW_RATE_COLUMN, write_sensor_csv
@@ -106,7 +108,12 @@ def import_comma2k19(
         Rotation.from_matrix(np.einsum("ij,njk->nik", rotation, vehicle_to_ecef)),
     )
     write_tum(output / "ground_truth.tum", truth)
-    has_video = (segment / "video.hevc").is_file()
+    has_video = (segment / VIDEO).is_file()
+    camera = {}
+    if has_video:
+        frame_times = load_array(segment, "global_pose", "frame_times")
+        decode_video(segment / VIDEO, frame_times, output, mount)
+        camera = {"images": IMAGES, "times": TIMES, "calib": CALIB, "time_offset_s": offset}
     manifest = {
         "format": FORMAT,
         "name": segment.name,
@@ -116,6 +123,7 @@ def import_comma2k19(
             "lon_deg": float(np.degrees(lon)),
             "height_m": height,
         },
+        **({"camera": camera} if camera else {}),
         "gnss": gnss,
         "can": {
             "log": f"can/{CAN_LOG}",
@@ -134,8 +142,6 @@ def import_comma2k19(
             "from": "global_pose frame_gps_times − frame_times",
         },
     }
-    if has_video:
-        log.warning("%s: video.hevc is not decoded; the sequence has no camera", segment)
     (output / MANIFEST).write_text(yaml.safe_dump(manifest, sort_keys=False))
     return ImportSummary(output, epochs, obs_rows, raw.n_dropped, offset, len(truth), has_video)
 
