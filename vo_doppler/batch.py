@@ -10,7 +10,8 @@ holds the current fingerprint and whose listed outputs still exist; a recording 
 off (killed process, crash, power loss) has no marker and runs again from the start.
 
 The fingerprint hashes the package version, the configuration, the ``prepare`` step's name
-and, for every file under ``SOURCE``, its relative path, size and modification time (the quick
+(or, for a callable object, its ``repr``: e.g. the orbits an importer uses) and, for every file
+under ``SOURCE``, its relative path, size and modification time (the quick
 check of rsync and make: touching or replacing a file re-runs the recording; files outside
 ``SOURCE`` that a manifest points to are not followed).
 
@@ -164,7 +165,10 @@ def output_names(sources: list[Path]) -> list[str]:
 def fingerprint(source: Path, config: RunConfig, prepare: Prepare | None) -> str:
     """SHA-256 of the version, configuration, prepare step and input files (module docstring)."""
     digest = hashlib.sha256()
-    step = None if prepare is None else f"{prepare.__module__}.{prepare.__qualname__}"
+    step = None
+    if prepare is not None:
+        name = getattr(prepare, "__qualname__", None)
+        step = f"{prepare.__module__}.{name}" if name else repr(prepare)
     digest.update(repr((__version__, config, step)).encode())
     files = sorted(p for p in source.rglob("*") if p.is_file()) if source.is_dir() else [source]
     for path in files:

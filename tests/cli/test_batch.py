@@ -11,6 +11,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from tests.conftest import require_shared
 from tests.helpers.batch import tiny_drive
 from vo_doppler.batch import MARKER
 from vo_doppler.cli import main
@@ -99,3 +100,25 @@ def test_resume_skips_finished_recordings(batch_run):
 def test_no_recordings_is_an_error(tmp_path, capsys):
     assert main(["batch", "-o", str(tmp_path)]) == 1
     assert "no recordings" in capsys.readouterr().err
+
+
+@pytest.mark.shared_data
+def test_raw_comma2k19_segments_are_imported_then_run(tmp_path):
+    segment = require_shared("comma2k19_example1")
+    orbits = tmp_path / "orbits"
+    orbits.mkdir()
+    (orbits / "day.sp3").symlink_to(segment / "Sta20124_1400_1845.sp3")
+    out = tmp_path / "out"
+    command = ["batch", str(segment), "--comma2k19", str(orbits), "-o", str(out)]
+    assert main(command) == 0
+    with (out / "batch_summary.csv").open() as stream:
+        row = next(csv.DictReader(stream))
+    assert row["recording"] == "comma2k19_example1" and row["status"] == "done"
+    assert abs(float(row["final_wheel_scale"]) - 1.0086) < 0.003  # global_pose: 1.0086
+    prepared = out / "comma2k19_example1" / "prepared"
+    assert (prepared / "sequence.yaml").is_file() and (prepared / "gnss" / "day.sp3").is_file()
+    assert (
+        main(["batch", str(segment), "--comma2k19", str(orbits), "-o", str(out), "--resume"]) == 0
+    )
+    with (out / "batch_summary.csv").open() as stream:
+        assert next(csv.DictReader(stream))["status"] == "skipped"

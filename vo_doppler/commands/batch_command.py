@@ -15,6 +15,7 @@ from vo_doppler.batch import EXECUTORS, RecordingOutcome, Status, read_list, run
 from vo_doppler.commands.arg_types import positive_int
 from vo_doppler.commands.run_command import add_run_options, run_config
 from vo_doppler.errors import InputError
+from vo_doppler.io.comma2k19_import import Comma2k19Import
 
 
 def register(subparsers, summary: str) -> None:
@@ -28,7 +29,9 @@ def register(subparsers, summary: str) -> None:
         "on; the exit status is 1 when any failed. --resume skips the recordings an earlier "
         "batch finished with the same inputs and options.",
     )
-    parser.add_argument("sequences", type=Path, nargs="*", help="sequence folders")
+    parser.add_argument(
+        "sequences", type=Path, nargs="*", help="sequence folders (or segments: --comma2k19)"
+    )
     parser.add_argument(
         "--list", type=Path, help="file listing sequence folders, one a line ('#' comments)"
     )
@@ -53,6 +56,14 @@ def register(subparsers, summary: str) -> None:
         "--ray-address",
         help="Ray cluster to use (e.g. ray://head:10001; default: $RAY_ADDRESS, else a local "
         "Ray instance)",
+    )
+    parser.add_argument(
+        "--comma2k19",
+        type=Path,
+        metavar="ORBITS",
+        help="the recordings are raw comma2k19 segments: each is imported first (as 'vo-doppler "
+        "import comma2k19' does, into OUT/<name>/prepared) with these SP3 precise orbits: a "
+        "file, or a folder of SP3 files from which each segment takes the one around its time",
     )
     add_run_options(parser)
     parser.set_defaults(func=run)
@@ -89,6 +100,7 @@ def run(args: argparse.Namespace) -> int:
             workers=args.workers,
             resume=args.resume,
             config=run_config(args),
+            prepare=None if args.comma2k19 is None else Comma2k19Import(args.comma2k19.resolve()),
             ray_address=args.ray_address,
             on_outcome=advance,
         )

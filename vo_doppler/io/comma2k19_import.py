@@ -39,8 +39,10 @@ from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.rinex_write import ObsEpochs, write_obs
 from vo_doppler.io.sensor_csv import YAW_RATE_COLUMN, write_sensor_csv
 from vo_doppler.io.sequence import FORMAT, MANIFEST
+from vo_doppler.io.sp3 import read_sp3
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.doppler_sigma import ReportedSigma
+from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
 
@@ -202,3 +204,48 @@ def _write_can(segment: Path, target: Path) -> None:
                     channel="can0",
                 )
             )
+
+
+def segment_gps_span(segment: str | Path) -> tuple[float, float]:
+    """First and last GPS time (s) of the segment's ``global_pose`` frames."""
+    gps_times = load_array(segment, "global_pose", "frame_gps_times")
+    t = gps_times[:, 0] * SECONDS_PER_WEEK + gps_times[:, 1]
+    return float(t.min()), float(t.max())
+
+
+def orbits_for_segment(segment: str | Path, orbits: str | Path) -> Path:
+    """``orbits`` if it is a file; for a folder, its SP3 file (``*.sp3``, any case) whose epochs
+    reach furthest beyond the segment on both sides (the interpolation needs epochs around it)."""
+    orbits = Path(orbits)
+    if not orbits.is_dir():
+        return orbits
+    start, end = segment_gps_span(segment)
+    margins = {}
+    for path in sorted(p for p in orbits.iterdir() if p.suffix.lower() == ".sp3"):
+        product = read_sp3(path)
+        margins[path] = min(start - product.t[0], product.t[-1] - end)
+    if not margins:
+        raise InputError("no SP3 files (*.sp3) in the orbits folder", orbits)
+    best = max(margins, key=margins.get)
+    if margins[best] < 0:
+        raise InputError(
+            f"no SP3 file covers the segment {segment} (GPS week {int(start // SECONDS_PER_WEEK)},"
+            f" seconds of week {start % SECONDS_PER_WEEK:.0f}–{end % SECONDS_PER_WEEK:.0f})",
+            orbits,
+        )
+    return best
+
+
+@dataclass(frozen=True)
+class Comma2k19Import:
+    """The ``prepare`` step of a batch over raw comma2k19 segments (``vo_doppler.batch``):
+    imports ``segment`` into ``work_dir`` (emptied first) and returns it."""
+
+    orbits: Path
+    dbc: Path | None = None
+
+    def __call__(self, segment: Path, work_dir: Path) -> Path:
+        shutil.rmtree(work_dir, ignore_errors=True)
+        orbits = orbits_for_segment(segment, self.orbits)
+        import_comma2k19(segment, work_dir, orbits, None, self.dbc)
+        return work_dir
