@@ -27,7 +27,7 @@ from vo_doppler.batch import (
     read_list,
     run_batch,
 )
-from vo_doppler.errors import InputError
+from vo_doppler.errors import InputError, OutputError
 from vo_doppler.run import RunConfig
 from vo_doppler.vo.config import VoConfig
 
@@ -97,6 +97,25 @@ def test_failures_stay_with_their_recording(tmp_path):
     assert result.exit_code == 1
     assert "Traceback" in (tmp_path / "out" / "bug" / "run.log").read_text()
     assert not any((tmp_path / "out" / s.name / MARKER).exists() for s in sources)
+
+
+def test_a_rerun_leaves_no_stale_output_beside_the_new_ones(tmp_path):
+    source = tmp_path / "bug"
+    source.mkdir()
+    stale = tmp_path / "out" / "bug" / "trajectories.png"
+    stale.parent.mkdir(parents=True)
+    stale.write_bytes(b"from an earlier run")
+    result = run_batch([source], tmp_path / "out", workers=1, prepare=die_or_fail)
+    assert result.outcomes[0].category is Failure.INTERNAL
+    assert sorted(p.name for p in stale.parent.iterdir()) == ["run.log"]
+
+
+def test_an_output_that_is_a_file_fails_before_any_work(tmp_path):
+    out = tmp_path / "out"
+    out.write_text("a file")
+    with pytest.raises(OutputError, match="exists and is not a folder"):
+        run_batch([tmp_path], out, workers=1, prepare=die_or_fail)
+    assert out.read_text() == "a file"
 
 
 def _mtimes(folder: Path) -> dict[str, int]:

@@ -34,6 +34,7 @@ import json
 import logging
 import multiprocessing
 import os
+import shutil
 import threading
 import time
 import traceback
@@ -46,6 +47,7 @@ from pathlib import Path
 
 from vo_doppler import __version__
 from vo_doppler.errors import InputError, VoDopplerError
+from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
 from vo_doppler.io.tables import write_csv_and_parquet
 from vo_doppler.report.batch_summary import (
@@ -222,10 +224,12 @@ def _run_job(job: RecordingJob) -> dict:
 
 def process_recording(job: RecordingJob) -> RecordingOutcome:
     """Run one recording and write its outputs and, last, its marker; never raises for a
-    failure of the recording itself (the outcome says what failed)."""
+    failure of the recording itself (the outcome says what failed). The recording's folder is
+    emptied first, so no output of an earlier run stays beside the new ones (a failed
+    recording's folder holds its ``run.log``)."""
     start = time.perf_counter()
+    shutil.rmtree(job.out, ignore_errors=True)
     job.out.mkdir(parents=True, exist_ok=True)
-    (job.out / MARKER).unlink(missing_ok=True)
     handler = logging.FileHandler(job.out / LOG_FILE, mode="w")
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     package_log = logging.getLogger("vo_doppler")
@@ -411,6 +415,7 @@ def run_batch(
     if workers is not None and workers < 1:
         raise InputError(f"workers must be at least 1, got {workers}")
     config = config or RunConfig()
+    check_output_folder(out)
     out.mkdir(parents=True, exist_ok=True)
     jobs = plan(folders, out, config, prepare)
     outcomes: dict[str, RecordingOutcome] = {}
