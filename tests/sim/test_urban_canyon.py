@@ -195,3 +195,12 @@ def test_cli_effects_switch_off_one_by_one_and_clean_restores_the_old_camera(tmp
     assert clean["truth"]["camera"]["principal_offset_px"] == [0.0, 0.0]
     assert clean["city"]["window_facades"] == 0 and clean["city"]["ground_contrast"] == 1
     assert "--clean" in clean["command"]
+
+
+def test_cli_receives_reflections_unless_told_not_to(tmp_path):
+    default = _manifest(tmp_path / "default")
+    assert default["truth"]["gnss"]["nlos"] is True
+    assert "--nlos" in default["command"].split()
+    direct = _manifest(tmp_path / "direct", "--no-nlos")
+    assert direct["truth"]["gnss"]["nlos"] is False
+    assert "--no-nlos" in direct["command"].split()

@@ -185,7 +185,13 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("--gnss-rate", type=float, default=defaults.gnss.rate_hz, help="Hz")
     parser.add_argument("--systems", default=defaults.gnss.systems, help="G, E or GE")
-    parser.add_argument("--nlos", action="store_true", help="add single facade reflections")
+    parser.add_argument(
+        "--nlos",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="signals of blocked satellites received by single facade reflections, as in a real "
+        "street canyon (--no-nlos: direct signals only)",
+    )
     parser.add_argument("--no-noise", action="store_true", help="noise-free GNSS observations")
     parser.add_argument(
         "--wheel-scale-error",
@@ -252,7 +258,8 @@ def _command_line(args: argparse.Namespace) -> str:
         words += ["--antenna-lever-arm", joined(args.antenna_lever_arm)]
     if args.start is not None:
         words += ["--start", args.start]
-    for flag in ("no_images", "nlos", "no_noise"):
+    words.append("--nlos" if args.nlos else "--no-nlos")
+    for flag in ("no_images", "no_noise"):
         if getattr(args, flag):
             words.append("--" + flag.replace("_", "-"))
     return shlex.join([*words, "-o", str(args.output)])
