@@ -250,6 +250,39 @@ def test_filter_and_smoother_by_hand():
     assert wrapped.x[1] == pytest.approx(np.pi)
 
 
+def test_robust_update_bounds_an_outliers_pull_and_uses_hubers_rho():
+    r, q = np.array([1e-4, 1e-4]), np.array([0.0, 1e-4])
+    for outlier in (1.0, 2.5):
+        robust = forward_filter(np.array([0.0, outlier]), r, q, huber_k=3.0)
+        # S = 3e-4, u = ν/√S > 3: δ moves by k·√S·P⁻/S = 3·2e-4/√3e-4 whatever the outlier.
+        u = outlier / np.sqrt(3e-4)
+        assert robust.x[1] == pytest.approx(6e-4 / np.sqrt(3e-4))
+        assert robust.P[1] == pytest.approx((1.0 - 2.0 / u) * 2e-4)
+        rho = 3.0 * u - 4.5
+        assert robust.log_likelihood == pytest.approx(-0.5 * np.log(2 * np.pi * 3e-4) - rho)
+    inside = forward_filter(np.array([0.0, 0.02]), r, q, huber_k=3.0)
+    plain = forward_filter(np.array([0.0, 0.02]), r, q)
+    np.testing.assert_allclose(inside.x, plain.x)
+    assert inside.log_likelihood == pytest.approx(plain.log_likelihood)
+
+
+def test_robust_update_follows_a_lasting_change_and_ignores_a_burst():
+    lasting = forward_filter(np.r_[0.0, np.full(300, 0.35)], np.ones(301), np.full(301, 1e-3), 3.0)
+    assert lasting.x[-1] == pytest.approx(0.35, abs=0.01)
+    n = 400
+    gt = _straight(n)
+    yaw = np.zeros(n)
+    yaw[150:180] = np.radians(20.0)  # three seconds of a reflected conventional heading
+    fixed = BlendConfig(sigma_distance=1e-4, sigma_turn=1e-4, measurement_scale=1.0)
+    common = {"config": fixed, "reference": "orientation"}
+    robust = blend_heading(gt, gt.t, yaw, np.radians(0.5), **common)
+    plain = blend_heading(
+        gt, gt.t, yaw, np.radians(0.5), **{**common, "config": replace(fixed, huber_k=np.inf)}
+    )
+    assert np.degrees(np.abs(robust.correction).max()) < 0.5
+    assert np.degrees(np.abs(plain.correction).max()) > 2.5
+
+
 def test_pipeline_dispatches_on_the_method():
     t, yaw, gt = _ground_truth(n=80)
     heading = AbsoluteHeading(t, yaw, np.ones(len(t), bool), np.full(len(t), 0.01), 2.0)
