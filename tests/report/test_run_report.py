@@ -17,6 +17,7 @@ from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.heading_figure import build_heading_figure, continuous_course_deg
 from vo_doppler.report.provenance import config_rows, describe_data, is_synthetic, main_settings
 from vo_doppler.report.run_report import (
+    build_heading_error_figure,
     heading_error_over_time,
     headline,
     table_cell,
@@ -109,6 +110,16 @@ def _track(n: int = 50, heading_deg: float = 0.0) -> Trajectory:
 def test_heading_error_over_time_is_the_yaw_difference():
     error = heading_error_over_time(_track(heading_deg=2.0), _track())
     np.testing.assert_allclose(np.degrees(error), 2.0, atol=1e-9)
+
+
+def test_heading_error_axis_turns_logarithmic_only_beside_much_larger_errors():
+    truth = _track()
+    close = {"vo": _track(heading_deg=0.3), "vo_gps_tc": _track(heading_deg=0.1)}
+    assert build_heading_error_figure(close, truth, 0.0, "").axes[0].get_yscale() == "linear"
+    apart = {**close, "vo_gps_conv": _track(heading_deg=25.0)}
+    ax = build_heading_error_figure(apart, truth, 0.0, "").axes[0]
+    assert ax.get_yscale() == "symlog"
+    assert any("logarithmic beyond" in text.get_text() for text in ax.texts)
 
 
 def test_geojson_is_lon_lat_and_starts_at_the_origin(tmp_path):

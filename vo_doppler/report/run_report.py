@@ -179,6 +179,9 @@ def error_per_100m_figure(path: Path, per_100m: dict[str, ErrorPerDistance], tit
     build_error_per_100m_figure(per_100m, title).savefig(path, dpi=110)
 
 
+SYMLOG_LINEAR_DEG = 1.0
+
+
 def heading_error_over_time(trajectory: Trajectory, truth: Trajectory) -> np.ndarray:
     """Yaw of each pose minus the ground truth's at its time (rad, wrapped; NaN outside)."""
     return wrap_angle(trajectory.yaw() - truth.yaw_at(trajectory.t))
@@ -187,14 +190,24 @@ def heading_error_over_time(trajectory: Trajectory, truth: Trajectory) -> np.nda
 def build_heading_error_figure(
     trajectories: dict[str, Trajectory], truth: Trajectory, t0: float, title: str
 ) -> Figure:
-    """Per pipeline, the vehicle heading error (deg) over time."""
+    """Per pipeline, the vehicle heading error (deg) over time; when one pipeline's errors
+    reach more than ten times another's, the axis is linear within ±1° and logarithmic
+    beyond, so that the small errors stay readable beside the large ones."""
     fig = Figure(figsize=(9, 3.8))
     ax = fig.subplots()
+    spread = []
     for name, trajectory in trajectories.items():
         error = np.degrees(heading_error_over_time(trajectory, truth))
         ax.plot(trajectory.t - t0, error, lw=1.2, c=COLOURS.get(name), label=label(name))
+        if np.isfinite(error).any():
+            spread.append(np.nanpercentile(np.abs(error), 99))
     ax.axhline(0.0, c="k", lw=0.8)
     ax.set_xlabel("time since first GNSS epoch [s]")
+    symlog = len(spread) > 1 and max(spread) > 10.0 * max(min(spread), 0.1)
+    if symlog:
+        ax.set_yscale("symlog", linthresh=SYMLOG_LINEAR_DEG)
+        note = f"axis linear within ±{SYMLOG_LINEAR_DEG:g}°, logarithmic beyond"
+        ax.text(0.01, 0.03, note, transform=ax.transAxes, fontsize=7, color="0.3")
     ax.set_ylabel("heading error\n(estimate − truth) [deg]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
