@@ -17,6 +17,7 @@ from vo_doppler.heading.calibration import (
     WheelScaleKalman,
     estimate_gyro_bias,
     estimate_wheel_scale,
+    huber_line,
     variation_gate,
 )
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, causal_calibration
@@ -49,6 +50,44 @@ def test_exact_wheel_scale_and_spikes_rejected():
     assert estimate.value == pytest.approx(1.0123, abs=1e-12)
     assert estimate.n_rejected == 3 and estimate.n_used == len(t) - 3
     assert estimate.sigma < 1e-10
+
+
+def test_huber_line_is_least_squares_on_clean_data_and_ignores_a_coherent_burst():
+    rng = np.random.default_rng(3)
+    x = np.linspace(-30.0, 30.0, 601)
+    y = 2.0 - 0.005 * x + rng.normal(0.0, 0.01, x.size)
+    plain = huber_line(x, y, np.zeros(x.size, int), k=np.inf)
+    xc, yc = x - x.mean(), y - y.mean()
+    assert plain.slope == pytest.approx((xc @ yc) / (xc @ xc), rel=1e-12)
+    assert huber_line(x, y, np.zeros(x.size, int)).slope == pytest.approx(-0.005, abs=1e-4)
+    burst = y.copy()
+    burst[400:460] += 0.35  # six seconds of a course 20° off, all together
+    robust = huber_line(x, burst, np.zeros(x.size, int))
+    least = huber_line(x, burst, np.zeros(x.size, int), k=np.inf)
+    assert robust.slope == pytest.approx(-0.005, abs=2e-4)
+    assert abs(least.slope + 0.005) > 10 * abs(robust.slope + 0.005)
+    assert robust.weights[400:460].max() < 0.1 and np.median(robust.weights[:400]) == 1.0
+
+
+def test_gyro_bias_and_wheel_scale_hold_through_reflected_conventional_velocities():
+    """A burst of conventional velocities from reflected signals: course 25° off and speed
+    0.8 m/s off for 4 s of a 30 s drive, passing the variation gate together."""
+    rng = np.random.default_rng(5)
+    t, speed, yaw_rate, yaw = _drive()
+    bias = np.radians(0.3)
+    phi = integral_at(t, yaw_rate + bias, t)
+    doppler_yaw = wrap_angle(yaw + rng.normal(0.0, np.radians(0.3), len(t)))
+    doppler_speed = speed + rng.normal(0.0, 0.03, len(t))
+    doppler_yaw[200:240] = wrap_angle(doppler_yaw[200:240] + np.radians(25.0))
+    doppler_speed[200:240] += 0.8
+    wheel = speed / 0.98
+    b = estimate_gyro_bias(t, doppler_yaw, phi, doppler_speed)
+    k = estimate_wheel_scale(t, doppler_speed, wheel)
+    assert b.n_rejected < 5 and k.n_rejected < 5  # the gate lets the burst through
+    assert abs(np.degrees(b.value) - 0.3) < 0.02 and abs(k.value - 0.98) < 0.001
+    least = GateConfig(huber_k=np.inf)
+    b_ls = estimate_gyro_bias(t, doppler_yaw, phi, doppler_speed, config=least)
+    assert abs(np.degrees(b_ls.value) - 0.3) > 0.2
 
 
 def test_exact_gyro_bias_across_the_wrap():
@@ -121,8 +160,9 @@ def test_kalman_variants_converge_with_noise():
 
 def test_kalman_with_the_prior_equals_least_squares_with_the_prior():
     """Linear-Gaussian case: no random walk, Kalman measurement noise equal to the residual
-    spread that least squares estimates, every sample accepted by both gates. The Kalman
-    filters started at the prior then give least squares combined with the same prior."""
+    spread that least squares estimates (the Huber fits with k = ∞), every sample accepted by
+    both gates. The Kalman filters started at the prior then give least squares combined with
+    the same prior."""
     rng = np.random.default_rng(11)
     t, speed, yaw_rate, yaw = _drive(n=100)
     bias, scale = np.radians(0.7), 1.04
@@ -131,10 +171,12 @@ def test_kalman_with_the_prior_equals_least_squares_with_the_prior():
     doppler_speed = speed + rng.normal(0.0, 0.05, len(t))
     wheel = speed / scale
     valid = np.ones(len(t), dtype=bool)
-    ls = causal_calibration(t, doppler_speed, doppler_yaw, valid, wheel, phi)
+    least_squares = GateConfig(huber_k=np.inf)
+    config = HeadingPipelineConfig(gate=least_squares)
+    ls = causal_calibration(t, doppler_speed, doppler_yaw, valid, wheel, phi, config)
 
-    fit_b = estimate_gyro_bias(t, doppler_yaw, phi, doppler_speed)
-    fit_k = estimate_wheel_scale(t, doppler_speed, wheel)
+    fit_b = estimate_gyro_bias(t, doppler_yaw, phi, doppler_speed, config=least_squares)
+    fit_k = estimate_wheel_scale(t, doppler_speed, wheel, config=least_squares)
     assert fit_b.n_used == fit_k.n_used == len(t)
     yaw_sigma = fit_b.sigma * np.sqrt(np.sum((t - t.mean()) ** 2))
     speed_sigma = fit_k.sigma * np.sqrt(wheel @ wheel)
