@@ -218,12 +218,16 @@ def snoop_satellites(
         normal, S_X[:, :, None], S_T[:, :, None], S_w[:, :, None], grid_size, iterations
     )
     lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma)
-    terms = _satellite_terms(lin, w, flat, shape)
+    terms = _satellite_terms(lin, w, group, flat, shape)
     sat_ok = (S_w > 0) & (terms.redundancy >= min_redundancy)
     if noise is None:
         noise = receiver_noise([_sample(lin, terms, sat_ok)])
     variance = noise.variance(terms)
-    row_variance = noise.scale**2 * lin.row_seen + sum(m**2 for m in lin.model_rows)
+    row_variance = (
+        noise.scale**2 * lin.row_seen
+        + noise.correlated**2 * terms.row_correlated
+        + sum(m**2 for m in lin.model_rows)
+    )
     row_ok = (w > 0) & (lin.row_seen >= min_redundancy * w)
     drop = np.clip(cost0[:, None] - single, 0.0, None)
     seen = terms.seen
@@ -270,7 +274,7 @@ def snoop_satellites(
         reject=reject & (w > 0) & (detected & identified)[:, None],
         detected=detected,
         identified=identified,
-        row_fault=detected & by_row,
+        row_fault=detected & (sat_max <= sat_critical),
         theta=theta,
         bias_variance=np.max(
             np.where(sat_ok, (terms.A @ lin.N_inv)[..., 0] ** 2 * variance, 0.0)
@@ -306,9 +310,12 @@ class _SatelliteTerms:
     model: np.ndarray
     weighted_residual: np.ndarray
     redundancy: np.ndarray
+    row_correlated: np.ndarray
+    """Per row (K, R): the part of var(w·r) from the window-constant errors of unit κ."""
+    n_rows: np.ndarray
 
 
-def _satellite_terms(lin: _Linearised, w, flat, shape) -> _SatelliteTerms:
+def _satellite_terms(lin: _Linearised, w, group, flat, shape) -> _SatelliteTerms:
     """c_jᵀW(I − H)d_k = δ_jk·Σ_j √w − A_j N⁻¹ B_kᵀ, B_k = Σ_k √w·J, is how much of satellite
     k's window-constant error (σ_i·κ on its rows) shows in satellite j's sum; squared and summed
     over k: Σ_j √w² − 2·Σ_j √w·A_j N⁻¹ B_jᵀ + A_j N⁻¹ (Σ_k B_kᵀB_k) N⁻¹ A_jᵀ."""
@@ -326,7 +333,17 @@ def _satellite_terms(lin: _Linearised, w, flat, shape) -> _SatelliteTerms:
         None,
     )
     present = S_w > 0
+    own = np.take_along_axis(B, group[..., None], axis=1)
+    row_correlated = np.clip(
+        w
+        - 2.0 * w * root * np.einsum("krj,kjl,krl->kr", lin.J, lin.N_inv, own)
+        + w**2 * np.einsum("krj,kjl,krl->kr", lin.J, spread, lin.J),
+        0.0,
+        None,
+    )
     return _SatelliteTerms(
+        row_correlated=row_correlated,
+        n_rows=_group_sums((w > 0).astype(float), flat, shape),
         A=A,
         seen=seen,
         correlated=correlated,
@@ -366,6 +383,10 @@ class NoiseSample:
 
 
 def _sample(lin: _Linearised, terms: _SatelliteTerms, tested: np.ndarray) -> NoiseSample:
+    """The numbers of :class:`NoiseSample`; κ only from satellites with several rows in windows
+    with at least ``MIN_SCALE_DOF`` degrees of freedom (a satellite's one row cannot tell a
+    window-constant error from white noise, nor a window with few rows a bias from noise)."""
+    tested = tested & (terms.n_rows >= 2) & (lin.dof >= MIN_SCALE_DOF)[:, None]
     return NoiseSample(
         mad=lin.mad,
         dof=lin.dof,
@@ -397,7 +418,7 @@ def noise_statistics(
     lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma)
     K = len(w)
     flat = (np.arange(K)[:, None] * n_groups + group).ravel()
-    terms = _satellite_terms(lin, w, flat, (K, n_groups))
+    terms = _satellite_terms(lin, w, group, flat, (K, n_groups))
     tested = (_group_sums(w, flat, (K, n_groups)) > 0) & (terms.redundancy >= min_redundancy)
     return _sample(lin, terms, tested)
 
