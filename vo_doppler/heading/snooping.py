@@ -36,8 +36,18 @@ calibration — move every row coherently (model error m_ε = a·cos θ₀ + b·
 m_b = −τ·J_θ per unit δb) and look like satellite biases: they add (c_jᵀ W Q_r W m)²·σ² to the
 variance of c_jᵀWr (Q_r the residuals' cofactor matrix), whose noise part is
 σ₀²·(Σ_j w − A_j N⁻¹ A_jᵀ); σ₀ ≥ 1, a robust scale of the normalised residuals over all
-windows (:func:`receiver_noise_scale`), guards against optimistic a-priori σ. Each
-statistic is divided by the ratio of that variance to its noise-only value.
+windows, guards against optimistic a-priori σ. Each statistic is divided by the ratio of that
+variance to its noise-only value.
+
+Real noise (variance components fitted from the data, :func:`receiver_noise`): real Doppler
+errors are correlated in time — multipath, the atmosphere, orbit errors, tracking loops, and the
+vertical velocity of a road that is not level, which the model leaves out — so over a window of
+a few seconds part of each satellite's error is a constant, κ·σ_i on its rows (d_j). Over tens
+of rows that constant does not average down as white noise would, and a test that assumed so
+would name clean satellites biased (on the comma2k19 minute it flagged three windows in four).
+It adds κ²·Σ_k (c_jᵀW(I − H)d_k)² to the variance of c_jᵀWr and κ²·Σ_k (w_i[(I − H)d_k]_i)² to
+that of w_i r_i. σ₀ and κ are pooled over every window of the recording (one receiver), so that
+a reflection cannot hide by raising its own window's scale.
 
 Decision: the false-alarm probability α of a window is split between the satellite and the row
 family and Bonferroni-shared among their tests. The largest statistic names a satellite only
@@ -62,6 +72,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
 from scipy.stats import chi2
 
 from vo_doppler.heading.profile import (
@@ -74,6 +85,10 @@ from vo_doppler.heading.profile import (
 
 MIN_SCALE_DOF = 10
 """Windows with fewer degrees of freedom do not estimate the scale of the a-priori σ."""
+CORRELATED_QUANTILE = 0.25
+"""κ matches this quantile of the satellite statistics to χ²(1)'s: it stays put while up to
+three quarters of the (window, satellite) statistics are raised by a bias (a reflection biases
+its own satellite and, through the fit, smears into every other satellite of its windows)."""
 MAX_PAIR_SATELLITES = 12
 """Two-satellite hypotheses are formed among this many satellites of largest statistic."""
 
@@ -87,10 +102,18 @@ class SnoopingResult:
     reject: np.ndarray
     detected: np.ndarray
     identified: np.ndarray
+    row_fault: np.ndarray
+    """The largest statistic of a detected fault is a row's (a blunder), not a satellite's."""
+    theta: np.ndarray
+    """θ₀ of the least-squares fit that was tested."""
     min_redundancy: np.ndarray
     bias_variance: np.ndarray
     """Largest increase of var θ₀ (rad²) if one tested satellite had its own unknown bias."""
-    noise_scale: float
+    suspect_theta: np.ndarray
+    """θ₀ (K, n_groups) under the bias hypothesis of each satellite that is a suspect: its
+    statistic is significant, or the identification odds cannot rule it out against the
+    largest (NaN for the others)."""
+    noise: ReceiverNoise
 
 
 def _group_sums(values, flat, shape):
@@ -103,8 +126,9 @@ def _group_sums(values, flat, shape):
 
 
 def _cost_with_biases(normal, S_X, S_T, S_w, grid_size, iterations):
-    """Minimum profiled cost when each window (leading axis) also fits one constant bias per
-    selected satellite: sums (K, H, n, ·) of the n disjoint satellites of H hypotheses."""
+    """θ₀ and the minimum profiled cost when each window (leading axis) also fits one constant
+    bias per selected satellite: sums (K, H, n, ·) of the n disjoint satellites of H
+    hypotheses."""
     XtWX, XtWT, TtWT = (m[:, None] for m in normal)
     lead = S_w.shape[:2]
     XtWT_h = np.concatenate(
@@ -113,7 +137,7 @@ def _cost_with_biases(normal, S_X, S_T, S_w, grid_size, iterations):
     top = np.concatenate([np.broadcast_to(TtWT, (*lead, 2, 2)), np.swapaxes(S_T, -1, -2)], -1)
     bottom = np.concatenate([S_T, S_w[..., None] * np.eye(S_w.shape[-1])], axis=-1)
     Q = project_out(XtWX, XtWT_h, np.concatenate([top, bottom], axis=-2))[0]
-    return minimum_cost(Q, grid_size, iterations)[1]
+    return minimum_cost(Q, grid_size, iterations)
 
 
 @dataclass
@@ -174,7 +198,7 @@ def snoop_satellites(
     alpha: float,
     identification_odds: float,
     min_redundancy: float,
-    noise_scale: float | None = None,
+    noise: ReceiverNoise | None = None,
 ) -> SnoopingResult:
     """Bias tests of every satellite and every row of every window (module docstring).
 
@@ -186,8 +210,8 @@ def snoop_satellites(
     half for the row tests, each half shared among the n tests (Bonferroni: α/(2n)).
     Satellites and rows whose redundancy number is below ``min_redundancy`` are not tested:
     so little of a bias would show that the statistic would measure the model's small
-    unmodelled errors rather than the observation. ``noise_scale`` σ₀ multiplies the a-priori
-    σ (default: :func:`receiver_noise_scale` of these windows).
+    unmodelled errors rather than the observation. ``noise``: σ₀ and κ of the receiver's
+    noise (default: :func:`receiver_noise` of these windows).
     """
     a, b = np.nan_to_num(a), np.nan_to_num(b)
     K = len(w)
@@ -200,25 +224,23 @@ def snoop_satellites(
     S_X = _group_sums(w[..., None] * X, flat, shape)
     S_T = _group_sums(w[..., None] * T, flat, shape)
     normal = (XtWX, XtWT, weighted_gram(T, w, T))
-    single = _cost_with_biases(
+    single_theta, single = _cost_with_biases(
         normal, S_X[:, :, None], S_T[:, :, None], S_w[:, :, None], grid_size, iterations
     )
     lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma)
-
-    A = _group_sums(w[..., None] * lin.J, flat, shape)
-    seen = np.clip(S_w - np.sum((A @ lin.N_inv) * A, axis=-1), 0.0, None)
-    if noise_scale is None:
-        noise_scale = receiver_noise_scale(lin.mad, lin.dof)
-    variance = noise_scale**2 * seen
-    row_variance = noise_scale**2 * lin.row_seen
-    for model in lin.model_rows:
-        variance += _group_sums(model, flat, shape) ** 2
-        row_variance += model**2
-    present = S_w > 0
-    redundancy = np.where(present, seen / np.where(present, S_w, 1.0), 1.0)
-    sat_ok = present & (redundancy >= min_redundancy)
+    terms = _satellite_terms(lin, w, group, flat, shape)
+    sat_ok = (S_w > 0) & (terms.redundancy >= min_redundancy)
+    if noise is None:
+        noise = receiver_noise([_sample(lin, terms, sat_ok)])
+    variance = noise.variance(terms)
+    row_variance = (
+        noise.scale**2 * lin.row_seen
+        + noise.correlated**2 * terms.row_correlated
+        + sum(m**2 for m in lin.model_rows)
+    )
     row_ok = (w > 0) & (lin.row_seen >= min_redundancy * w)
     drop = np.clip(cost0[:, None] - single, 0.0, None)
+    seen = terms.seen
     sat_stat = np.where(sat_ok, drop * seen / np.where(sat_ok, variance, 1.0), 0.0)
     row_stat = np.where(row_ok, lin.weighted_residual**2 / np.where(row_ok, row_variance, 1.0), 0.0)
     n_sat, n_row = np.count_nonzero(sat_ok, axis=1), np.count_nonzero(row_ok, axis=1)
@@ -226,9 +248,8 @@ def snoop_satellites(
     k = np.arange(K)
     sat_max, row_max = sat_stat[k, best_sat], row_stat[k, best_row]
     row_critical = chi2.isf(alpha / (2 * np.maximum(n_row, 1)), 1)
-    detected = (sat_max > chi2.isf(alpha / (2 * np.maximum(n_sat, 1)), 1)) | (
-        row_max > row_critical
-    )
+    sat_critical = chi2.isf(alpha / (2 * np.maximum(n_sat, 1)), 1)
+    detected = (sat_max > sat_critical) | (row_max > row_critical)
     by_row = row_max > sat_max
     suspect = np.where(by_row, group[k, best_row], best_sat)
     own = group == suspect[:, None]
@@ -256,18 +277,24 @@ def snoop_satellites(
         chosen = pair[pair_wins]
         reject[windows] = (group[windows] == chosen[:, :1]) | (group[windows] == chosen[:, 1:])
         identified[windows] = pair_identified[pair_wins]
+    suspects = sat_ok & (
+        (sat_stat > largest[:, None] - margin) | (sat_stat > sat_critical[:, None])
+    )
     return SnoopingResult(
         reject=reject & (w > 0) & (detected & identified)[:, None],
         detected=detected,
         identified=identified,
+        row_fault=detected & (sat_max <= sat_critical),
+        theta=theta,
         bias_variance=np.max(
-            np.where(sat_ok, (A @ lin.N_inv)[..., 0] ** 2 * variance, 0.0)
+            np.where(sat_ok, (terms.A @ lin.N_inv)[..., 0] ** 2 * variance, 0.0)
             / np.where(sat_ok, seen, 1.0) ** 2,
             axis=1,
             initial=0.0,
         ),
-        min_redundancy=np.min(redundancy, axis=1, initial=1.0),
-        noise_scale=noise_scale,
+        min_redundancy=np.min(terms.redundancy, axis=1, initial=1.0),
+        suspect_theta=np.where(suspects, single_theta, np.nan),
+        noise=noise,
     )
 
 
@@ -280,27 +307,171 @@ def _least_squares(a, b, y, tau, w, grid_size, iterations):
     return X, T, XtWX, XtWT, TtWT_pinv, theta, cost0
 
 
-def noise_statistics(a, b, y, tau, w, grid_size: int, iterations: int):
-    """Per window, what :func:`receiver_noise_scale` pools: the MAD scale of the normalised
-    residuals of the least-squares fit and its degrees of freedom (arrays as in
+@dataclass
+class _SatelliteTerms:
+    """Per (window, satellite) sums of the linearised fit (module docstring): A_j = Σ_j w·J,
+    the noise-only variance ``seen`` of c_jᵀWr (unit σ₀), its part ``correlated`` from a
+    window-constant error of unit κ on every satellite, the calibration errors' part
+    ``model``, c_jᵀWr itself and the redundancy number."""
+
+    A: np.ndarray
+    seen: np.ndarray
+    correlated: np.ndarray
+    model: np.ndarray
+    weighted_residual: np.ndarray
+    redundancy: np.ndarray
+    row_correlated: np.ndarray
+    """Per row (K, R): the part of var(w·r) from the window-constant errors of unit κ."""
+    n_rows: np.ndarray
+
+
+def _satellite_terms(lin: _Linearised, w, group, flat, shape) -> _SatelliteTerms:
+    """c_jᵀW(I − H)d_k = δ_jk·Σ_j √w − A_j N⁻¹ B_kᵀ, B_k = Σ_k √w·J, is how much of satellite
+    k's window-constant error (σ_i·κ on its rows) shows in satellite j's sum; squared and summed
+    over k: Σ_j √w² − 2·Σ_j √w·A_j N⁻¹ B_jᵀ + A_j N⁻¹ (Σ_k B_kᵀB_k) N⁻¹ A_jᵀ."""
+    S_w = _group_sums(w, flat, shape)
+    root = np.sqrt(w)
+    S_root = _group_sums(root, flat, shape)
+    A = _group_sums(w[..., None] * lin.J, flat, shape)
+    B = _group_sums(root[..., None] * lin.J, flat, shape)
+    AN = A @ lin.N_inv
+    seen = np.clip(S_w - np.sum(AN * A, axis=-1), 0.0, None)
+    spread = lin.N_inv @ (np.swapaxes(B, -1, -2) @ B) @ lin.N_inv
+    correlated = np.clip(
+        S_root**2 - 2.0 * S_root * np.sum(AN * B, axis=-1) + np.sum((A @ spread) * A, axis=-1),
+        0.0,
+        None,
+    )
+    present = S_w > 0
+    own = np.take_along_axis(B, group[..., None], axis=1)
+    row_correlated = np.clip(
+        w
+        - 2.0 * w * root * np.einsum("krj,kjl,krl->kr", lin.J, lin.N_inv, own)
+        + w**2 * np.einsum("krj,kjl,krl->kr", lin.J, spread, lin.J),
+        0.0,
+        None,
+    )
+    return _SatelliteTerms(
+        row_correlated=row_correlated,
+        n_rows=_group_sums((w > 0).astype(float), flat, shape),
+        A=A,
+        seen=seen,
+        correlated=correlated,
+        model=sum(_group_sums(m, flat, shape) ** 2 for m in lin.model_rows),
+        weighted_residual=_group_sums(lin.weighted_residual, flat, shape),
+        redundancy=np.where(present, seen / np.where(present, S_w, 1.0), 1.0),
+    )
+
+
+@dataclass(frozen=True)
+class ReceiverNoise:
+    """The receiver's Doppler noise relative to the a-priori σ_i of each row: white noise of
+    σ₀·σ_i per row plus an error of κ·σ_i constant over the window on each satellite."""
+
+    scale: float
+    """σ₀ ≥ 1, the scale of the a-priori σ (:func:`receiver_noise`)."""
+    correlated: float
+    """κ ≥ 0, the window-constant share of each satellite's noise."""
+
+    def variance(self, terms: _SatelliteTerms) -> np.ndarray:
+        """Variance of c_jᵀWr per (window, satellite): σ₀²·seen + κ²·correlated + model."""
+        return self.scale**2 * terms.seen + self.correlated**2 * terms.correlated + terms.model
+
+
+@dataclass
+class NoiseSample:
+    """What :func:`receiver_noise` pools from a set of windows: per window the MAD scale of
+    the normalised residuals and the degrees of freedom; per tested (window, satellite) the
+    squared sum (c_jᵀWr)² and the parts of its variance (:class:`_SatelliteTerms`)."""
+
+    mad: np.ndarray
+    dof: np.ndarray
+    squared_sum: np.ndarray
+    seen: np.ndarray
+    correlated: np.ndarray
+    model: np.ndarray
+
+
+def _sample(lin: _Linearised, terms: _SatelliteTerms, tested: np.ndarray) -> NoiseSample:
+    """The numbers of :class:`NoiseSample`; κ only from satellites with several rows in windows
+    with at least ``MIN_SCALE_DOF`` degrees of freedom (a satellite's one row cannot tell a
+    window-constant error from white noise, nor a window with few rows a bias from noise)."""
+    tested = tested & (terms.n_rows >= 2) & (lin.dof >= MIN_SCALE_DOF)[:, None]
+    return NoiseSample(
+        mad=lin.mad,
+        dof=lin.dof,
+        squared_sum=terms.weighted_residual[tested] ** 2,
+        seen=terms.seen[tested],
+        correlated=terms.correlated[tested],
+        model=terms.model[tested],
+    )
+
+
+def noise_statistics(
+    a,
+    b,
+    y,
+    tau,
+    w,
+    group,
+    n_groups: int,
+    calibration_sigma: tuple[np.ndarray, np.ndarray],
+    grid_size: int,
+    iterations: int,
+    min_redundancy: float,
+) -> NoiseSample:
+    """What :func:`receiver_noise` pools from these windows (arrays as in
     :func:`snoop_satellites`; the same numbers it computes on its first pass). Windows solved
-    in several chunks share one σ₀ by pooling these over every chunk."""
+    in several chunks share one noise model by pooling these over every chunk."""
     a, b = np.nan_to_num(a), np.nan_to_num(b)
     X, T, _, XtWT, TtWT_pinv, theta, _ = _least_squares(a, b, y, tau, w, grid_size, iterations)
-    none = np.zeros(len(w))
-    lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, (none, none))
-    return lin.mad, lin.dof
+    lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma)
+    K = len(w)
+    flat = (np.arange(K)[:, None] * n_groups + group).ravel()
+    terms = _satellite_terms(lin, w, group, flat, (K, n_groups))
+    tested = (_group_sums(w, flat, (K, n_groups)) > 0) & (terms.redundancy >= min_redundancy)
+    return _sample(lin, terms, tested)
 
 
-def receiver_noise_scale(mad: np.ndarray, dof: np.ndarray) -> float:
-    """σ₀ ≥ 1 of the a-priori σ: the median over windows of the MAD scale of their normalised
-    residuals, from windows with at least ``MIN_SCALE_DOF`` degrees of freedom (1 if none).
+def receiver_noise(samples: list[NoiseSample]) -> ReceiverNoise:
+    """σ₀ and κ of the receiver's noise (:class:`ReceiverNoise`), robust estimates pooled over
+    every window of the samples (variance components fitted by medians).
 
-    One value for the receiver's noise model, not one per window: in a window with little
-    redundancy a biased row smears into every residual and its own MAD would hide the bias.
+    σ₀ ≥ 1: the median over windows of the MAD scale of their normalised residuals, from
+    windows with at least ``MIN_SCALE_DOF`` degrees of freedom (1 if none). κ ≥ 0: the value
+    for which the median of the satellite statistics (c_jᵀWr)²/(σ₀²·seen + κ²·correlated +
+    model) over every tested (window, satellite) is the median of χ²(1), their distribution
+    with no biased satellite; 0 when it already is at most that. Real Doppler errors are
+    correlated in time (tracking loops, multipath, the vertical velocity and the atmosphere
+    the model leaves out), so a satellite's rows of one window do not average down as white
+    noise would, and a test that assumed so would flag clean satellites.
+
+    One value for the receiver, not one per window: in a window with little redundancy a biased
+    row smears into every residual and its own scale would hide the bias; the medians stay
+    put while fewer than half of the satellites are biased.
     """
+    mad, dof = (np.concatenate([getattr(s, f) for s in samples]) for f in ("mad", "dof"))
     usable = mad[dof >= MIN_SCALE_DOF]
-    return max(1.0, float(np.median(usable))) if usable.size else 1.0
+    scale = max(1.0, float(np.median(usable))) if usable.size else 1.0
+    parts = {
+        f: np.concatenate([getattr(s, f) for s in samples])
+        for f in ("squared_sum", "seen", "correlated", "model")
+    }
+    white = scale**2 * parts["seen"] + parts["model"]
+    target = chi2.ppf(CORRELATED_QUANTILE, 1)
+
+    def excess(kappa2: float) -> float:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = parts["squared_sum"] / (white + kappa2 * parts["correlated"])
+        ratio = np.nan_to_num(ratio, nan=0.0, posinf=0.0)
+        return float(np.quantile(ratio, CORRELATED_QUANTILE)) - target
+
+    if not parts["seen"].size or excess(0.0) <= 0.0:
+        return ReceiverNoise(scale, 0.0)
+    upper = 1.0
+    while excess(upper) > 0.0 and upper < 1e12:
+        upper *= 10.0
+    return ReceiverNoise(scale, float(np.sqrt(brentq(excess, 0.0, upper, xtol=1e-6, rtol=1e-6))))
 
 
 def _pairs(windows, sums, normal, cost_bound, solver, alpha, margin):
@@ -316,7 +487,7 @@ def _pairs(windows, sums, normal, cost_bound, solver, alpha, margin):
     u, v = np.triu_indices(ids.shape[1], 1)
     g1, g2 = ids[:, u], ids[:, v]
     k = np.arange(len(windows))[:, None]
-    cost = _cost_with_biases(
+    _, cost = _cost_with_biases(
         normal,
         np.stack([S_X[k, g1], S_X[k, g2]], axis=-2),
         np.stack([S_T[k, g1], S_T[k, g2]], axis=-2),

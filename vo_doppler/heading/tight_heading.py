@@ -35,9 +35,13 @@ with numpy.
 Reflected (NLOS) Doppler: before the robust fit, data snooping on the least-squares fit
 (:mod:`vo_doppler.heading.snooping`) tests every satellite of the window for a bias, every row
 for a blunder and, where a bias is found, every pair of satellites; it rejects what it can
-name and tests again. What it detects but cannot name makes the window *inconsistent* (no
-heading); a window where a bias on some satellite would not show is flagged *unverifiable*;
-after a rejected reflection the θ₀ variance allows for one more, undetected, biased satellite.
+name and tests again. What it detects but cannot name makes the window *inconsistent*: its
+heading is then the robust (Huber) fit's, with the θ₀ variance widened to cover every heading
+that the hypotheses it could not tell apart would give (fallback); a window where a bias on
+some satellite would not show is flagged *unverifiable*; after a rejected reflection the θ₀
+variance allows for one more, undetected, biased satellite. The tests' noise model (σ₀ and the
+window-constant share κ of each satellite's noise) is estimated from the data, pooled over every
+window (:func:`vo_doppler.heading.snooping.receiver_noise`).
 
 Reliability ([TK18] sec. 3.5): the heading at epoch k is compared with the headings of the previous
 epochs of the last ``reliability_epochs`` propagated by the gyro; it is reliable when enough of
@@ -61,7 +65,12 @@ from vo_doppler.heading.profile import (
     weighted_gram,
     z_of,
 )
-from vo_doppler.heading.snooping import noise_statistics, receiver_noise_scale, snoop_satellites
+from vo_doppler.heading.snooping import (
+    ReceiverNoise,
+    noise_statistics,
+    receiver_noise,
+    snoop_satellites,
+)
 from vo_doppler.model.doppler import DopplerRows
 
 ROW_FLOATS = 52
@@ -138,7 +147,11 @@ class TightHeadingResult:
     (``outlier_passes`` 0), are False."""
     inconsistent: np.ndarray
     """Data snooping found a bias it could not attribute (or too many, or a repair that left
-    the window unverifiable): no heading."""
+    the window unverifiable): no heading, unless the fault is a blunder (``fallback``)."""
+    fallback: np.ndarray
+    """The heading is the robust (Huber) fit's of an inconsistent window whose largest test
+    statistic is a row's (blunders the Huber weights damp, e.g. Doppler spikes on several
+    satellites), with σ widened (:func:`_fallback_variance`); not verifiable."""
 
     @property
     def course(self) -> np.ndarray:
@@ -160,6 +173,7 @@ class _WindowSolution:
     n_obs: np.ndarray
     n_rejected: np.ndarray
     inconsistent: np.ndarray
+    fallback: np.ndarray
     min_redundancy: np.ndarray
     repair_variance: np.ndarray
     profile_sigma: np.ndarray
@@ -218,7 +232,7 @@ def solve_windows(
     group=None,
     scale_sigma=0.0,
     bias_sigma=0.0,
-    noise_scale=None,
+    noise: ReceiverNoise | None = None,
 ):
     """Solve padded windows at once: arrays (K, R) of reduced observations ``y``, coefficients
     ``a``, ``b`` (model a·cos θ₀ + b·sin θ₀ + ρ₀ − α·τ), row times ``tau`` relative to the
@@ -230,12 +244,14 @@ def solve_windows(
     up to ``config.outlier_passes`` times per window; the robust fit then uses the rows left. A
     significant test that cannot name its satellite, one that still fails after the last pass,
     or a repair that leaves a verifiable window unverifiable (a satellite whose bias could no
-    longer show), makes the window inconsistent. After rejecting more than one row at once (a
+    longer show), makes the window inconsistent: its θ₀ variance then covers the headings of
+    every satellite hypothesis the tests could not rule out, and at least one more biased
+    satellite (:func:`_fallback_variance`). After rejecting more than one row at once (a
     reflection lasts; a lone row is a blunder) the θ₀ variance allows for one more biased
     satellite (``bias_variance`` of :mod:`vo_doppler.heading.snooping`).
     ``scale_sigma`` and ``bias_sigma`` (per window or scalars) are the calibration
-    uncertainties the tests allow for. ``noise_scale``: σ₀ of the tests (default: pooled over
-    these windows, :func:`vo_doppler.heading.snooping.receiver_noise_scale`).
+    uncertainties the tests allow for. ``noise``: σ₀ and κ of the tests (default: pooled over
+    these windows, :func:`vo_doppler.heading.snooping.receiver_noise`).
     """
     K, R = w.shape
     X = np.stack([-a, -b, y], axis=-1)
@@ -252,6 +268,8 @@ def solve_windows(
     verifiable_before = np.zeros(K, dtype=bool)
     bias_variance = np.zeros(K)
     reflection = np.zeros(K, dtype=bool)
+    suspects = np.full((K, n_groups + 1), np.nan)
+    blunder = np.zeros(K, dtype=bool)
     for rejection in range(config.outlier_passes + 1):
         if not (todo.size and config.outlier_passes):
             break
@@ -269,18 +287,20 @@ def solve_windows(
             config.outlier_alpha,
             config.identification_odds,
             config.testable_redundancy,
-            noise_scale,
+            noise,
         )
-        noise_scale = tests.noise_scale
+        noise = tests.noise
         if rejection == 0:
             verifiable_before = tests.min_redundancy >= config.testable_redundancy
         min_redundancy[todo] = tests.min_redundancy
         bias_variance[todo] = tests.bias_variance
         detected = tests.detected
+        failed = detected if rejection == config.outlier_passes else detected & ~tests.identified
+        inconsistent[todo[failed]] = True
+        suspects[todo[failed]] = np.column_stack([tests.suspect_theta[failed], tests.theta[failed]])
+        blunder[todo[failed]] = tests.row_fault[failed]
         if rejection == config.outlier_passes:
-            inconsistent[todo[detected]] = True
             break
-        inconsistent[todo[detected & ~tests.identified]] = True
         repair = detected & tests.identified
         todo = todo[repair]
         accepted[todo] &= ~tests.reject[repair]
@@ -294,12 +314,20 @@ def solve_windows(
     # A repair must not leave a window unverifiable that was verifiable: what remains has to be
     # able to reveal a bias (exclusion, then detection).
     lost = verifiable_before & (min_redundancy < config.testable_redundancy)
-    inconsistent |= (n_used < n_obs) & lost
+    lost &= n_used < n_obs
+    inconsistent |= lost
+    fallback = inconsistent & blunder & ~lost
     dof = n_used - (1 + fit["rank_t"])
     used_w = np.where(accepted, w, 0.0)
     mean_w = np.sum(used_w, axis=1) / np.maximum(n_used, 1)
     floor = config.sigma_floor_mps**2 * mean_w
     posterior = np.where(dof > 0, np.maximum(cost, 0) / np.maximum(dof, 1), 1.0)
+    # Fallback: the Huber weights hide the fault that could not be named, so the scatter is
+    # judged with the a-priori weights (the least-squares variance factor at the robust θ₀).
+    robust = np.flatnonzero(fallback & (dof > 0))
+    Q_prior = projected_normal_matrix(X[robust], T[robust], used_w[robust])[0]
+    unweighted = quadratic(Q_prior, z[robust], z[robust]) / dof[robust]
+    posterior[robust] = np.maximum(posterior[robust], unweighted)
     variance_factor = np.maximum(posterior, floor)
     Q = fit["Q"]
     return _WindowSolution(
@@ -316,10 +344,25 @@ def solve_windows(
         n_obs=n_obs,
         n_rejected=n_obs - n_used,
         inconsistent=inconsistent,
+        fallback=fallback,
         min_redundancy=min_redundancy,
-        repair_variance=np.where(reflection, bias_variance, 0.0),
+        repair_variance=np.where(
+            fallback,
+            _fallback_variance(suspects, theta, bias_variance),
+            np.where(reflection, bias_variance, 0.0),
+        ),
         **_error_gains(a, b, tau, weights, theta),
     )
+
+
+def _fallback_variance(suspects, theta, bias_variance):
+    """Variance added to the robust θ₀ of a window whose fault could not be named: the sum of
+    its squared distances to the θ₀ of the least-squares fit and of each suspect satellite's
+    bias hypothesis (``suspects``: those θ₀, NaN for the satellites not suspected; as if every
+    suspect were biased, the shifts independent), at least the room for one undetected
+    bias."""
+    shift = np.where(np.isfinite(suspects), wrap_angle(suspects - theta[:, None]) ** 2, 0.0)
+    return np.maximum(np.sum(shift, axis=1), bias_variance)
 
 
 def _profile_sigma(Q, theta, cost, variance_factor, config):
@@ -462,23 +505,32 @@ def tight_heading_series(
             rows, (y_all, row_group), index, row_epoch, k, (lo, hi), per_epoch, width
         )
 
-    noise_scale = None
+    noise = None
     if len(chunks) > 1 and config.outlier_passes:
-        pooled = []
+        samples = []
         for k in chunks:
-            y, a, b, tau, w, _ = padded(k)
-            pooled.append(
-                noise_statistics(a, b, y, tau, w, config.grid_size, config.gauss_newton_iterations)
+            y, a, b, tau, w, group = padded(k)
+            samples.append(
+                noise_statistics(
+                    a,
+                    b,
+                    y,
+                    tau,
+                    w,
+                    group,
+                    n_groups,
+                    (scale_sigma[k], bias_sigma[k]),
+                    config.grid_size,
+                    config.gauss_newton_iterations,
+                    config.testable_redundancy,
+                )
             )
-        mad, dof = (np.concatenate([p[i] for p in pooled]) for i in (0, 1))
-        noise_scale = receiver_noise_scale(mad, dof)
+        noise = receiver_noise(samples)
     solutions = []
     for k in chunks:
         y, a, b, tau, w, group = padded(k)
         solutions.append(
-            solve_windows(
-                y, a, b, tau, w, config, group, scale_sigma[k], bias_sigma[k], noise_scale
-            )
+            solve_windows(y, a, b, tau, w, config, group, scale_sigma[k], bias_sigma[k], noise)
         )
     solution = _concatenate(solutions)
     model_variance = (
@@ -543,7 +595,20 @@ def _unavailable(t_epoch, n_sat_epoch=None) -> TightHeadingResult:
     nan, flags, counts = np.full(m, np.nan), np.zeros(m, dtype=bool), np.zeros(m, dtype=int)
     observed = counts if n_sat_epoch is None else np.asarray(n_sat_epoch, dtype=int)
     return TightHeadingResult(
-        t_epoch, nan, nan, counts, observed, flags, flags, flags, nan, nan, counts, flags, flags
+        t_epoch,
+        nan,
+        nan,
+        counts,
+        observed,
+        flags,
+        flags,
+        flags,
+        nan,
+        nan,
+        counts,
+        flags,
+        flags,
+        flags,
     )
 
 
@@ -575,7 +640,7 @@ def _decide(
         & observable
         & np.isfinite(sol.theta)
         & (sigma <= config.max_sigma_rad)
-        & ~sol.inconsistent
+        & (sol.fallback | ~sol.inconsistent)
     )
     yaw = np.where(candidate & ~ambiguous, sol.theta, np.nan)
     available = candidate & ~ambiguous
@@ -605,8 +670,11 @@ def _decide(
         clock_drift=np.where(available, sol.rho0, np.nan),
         clock_drift_rate=np.where(available, sol.alpha, np.nan),
         n_rejected=sol.n_rejected.astype(int),
-        verifiable=available & (sol.min_redundancy >= config.testable_redundancy),
+        verifiable=available
+        & (sol.min_redundancy >= config.testable_redundancy)
+        & ~sol.inconsistent,
         inconsistent=sol.inconsistent & (sol.n_obs >= config.min_obs),
+        fallback=available & sol.fallback,
     )
 
 
