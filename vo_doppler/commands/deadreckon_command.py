@@ -8,6 +8,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from vo_doppler.checks import check_standstill_is_still
 from vo_doppler.commands.arg_types import positive_int
 from vo_doppler.io.gps_fixes import read_gps_fixes
 from vo_doppler.io.sensor_csv import read_numeric_csv, read_yaw_rate_csv
@@ -92,13 +93,14 @@ def register(subparsers, summary: str) -> None:
 
 
 def _speed_source(args, fixes):
+    """(t, speed) from the wheel-speed CSV, else the GPS speed, with the source's name."""
     if args.wheel_speed:
         columns, _ = read_numeric_csv(args.wheel_speed, ("t", "speed_mps"))
-        return columns["t"], columns["speed_mps"]
+        return (columns["t"], columns["speed_mps"]), "wheel speed"
     if np.mean(np.isfinite(fixes.speed)) > 0.9:
         good = np.isfinite(fixes.speed)
-        return fixes.t[good], fixes.speed[good]
-    return None
+        return (fixes.t[good], fixes.speed[good]), "GPS speed"
+    return None, ""
 
 
 def run(args: argparse.Namespace) -> int:
@@ -114,12 +116,11 @@ def run(args: argparse.Namespace) -> int:
         downsample=args.downsample,
         cluster_m=args.cluster_m,
     )
+    speed, source = _speed_source(args, fixes)
+    if args.standstill and speed is not None:
+        check_standstill_is_still(args.standstill, *speed, source)
     result = run_deadreckon(
-        (gyro1.t, gyro1.value),
-        (gyro2.t, gyro2.value),
-        fixes.as_tuple(),
-        config,
-        _speed_source(args, fixes),
+        (gyro1.t, gyro1.value), (gyro2.t, gyro2.value), fixes.as_tuple(), config, speed
     )
     paths = write_outputs(args.output, result)
 
