@@ -78,6 +78,6 @@ def test_standstill_that_moves_is_an_error_and_a_still_one_passes():
     speed = np.where(t < 10.0, 0.05 * np.sin(7 * t), 8.0)  # still, then 8 m/s
     check_standstill_is_still((1.0, 9.0), t, speed, "wheel speed")
     check_standstill_is_still((40.0, 50.0), t, speed, "wheel speed")  # no sample: not judged
-    moving = r"standstill 8–20 s: the wheel speed shows .*median 8\.00"
+    moving = r"standstill 8\.00–20\.00 s: the wheel speed shows .*median 8\.00"
     with pytest.raises(InputError, match=moving):
         check_standstill_is_still((8.0, 20.0), t, speed, "wheel speed")

@@ -172,7 +172,7 @@ def check_standstill_is_still(
     median = float(np.median(np.abs(inside)))
     if median > STANDSTILL_MAX_MEDIAN_SPEED_MPS:
         raise InputError(
-            f"standstill {t0:g}–{t1:g} s: the {source} shows the vehicle moving there (median "
+            f"standstill {t0:.2f}–{t1:.2f} s: the {source} shows the vehicle moving there (median "
             f"{median:.2f} m/s, up to {np.max(np.abs(inside)):.2f} m/s; a standstill is at most "
             f"{STANDSTILL_MAX_MEDIAN_SPEED_MPS} m/s); give a still interval or use --straight"
         )

@@ -94,6 +94,5 @@ def test_standstill_interval_that_moves_is_exit_1_with_the_speed(inputs, tmp_pat
     code = main(_args(paths, tmp_path / "o", "--standstill", f"{moving[0]},{moving[1]}"))
     err = capsys.readouterr().err
     assert code == 1 and "Traceback" not in err
-    assert (
-        f"standstill {moving[0]:g}–{moving[1]:g} s: the GPS speed shows the vehicle moving" in err
-    )
+    t0, t1 = (f"{t:.2f}" for t in moving)
+    assert f"standstill {t0}–{t1} s: the GPS track speed shows the vehicle moving" in err

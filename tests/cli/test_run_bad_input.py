@@ -394,7 +394,10 @@ def _garbage_glonass_slot(header, blocks):
     ("damage", "warning"),
     [
         (_month_13, r"rover\.obs:\d+: epoch date unusable \(month 13\): skipped"),
-        (_garbage_glonass_slot, r"rover\.obs:\d+: unreadable GLONASS slot/channel '@@' ignored"),
+        (
+            _garbage_glonass_slot,
+            r"rover\.obs:\d+: unreadable GLONASS slot/channel 'R01 @@' ignored",
+        ),
     ],
 )
 def test_one_unusable_rinex_record_is_skipped_and_warned_in_the_summary(
