@@ -5,9 +5,11 @@ wrong number."""
 
 from __future__ import annotations
 
+import gzip
 import json
 import logging
 import re
+import resource
 import shutil
 from datetime import datetime
 from pathlib import Path
@@ -413,3 +415,18 @@ def test_one_unusable_rinex_record_is_skipped_and_warned_in_the_summary(
     assert re.search(warning, caplog.text)
     summary = json.loads((out / "summary.json").read_text())
     assert any(re.search(warning, w) for w in summary["warnings"]), summary["warnings"]
+
+
+def test_gzip_bomb_as_the_observation_file_is_exit_1_without_filling_memory(
+    clean, tmp_path, capsys
+):
+    """2 MB of gzip (50 members of 40 MB of zeros: 2 GB expanded) refused after 80 MB."""
+    folder = damaged_copy(clean, tmp_path)
+    member = gzip.compress(b"0" * 40_000_000, compresslevel=9)
+    bomb = folder / "gnss" / "rover.obs.gz"
+    bomb.write_bytes(member * (2_000_000 // len(member)))
+    edit_manifest(folder, "gnss", "obs", "gnss/rover.obs.gz")
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    err = failing_run(folder, tmp_path, capsys)
+    assert "rover.obs.gz" in err and "decompressed data exceed" in err
+    assert (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024 < 500

@@ -2,7 +2,7 @@
 classified as a plausible success, a project error, or a failure (another exception, an
 impossible value, more than 5 s, more than 500 MB).
 
-    python -m tests.fuzz.runner --cases 1400 --workers 1 --json out/fuzz.json   # make fuzz
+    python -m tests.fuzz.runner --cases 600 --workers 1 --json out/fuzz.json   # make fuzz
     python -m tests.fuzz.runner --family rinex-obs --case 17 --show    # replay one case
 
 Cases are deterministic: case ``k`` of a family with run seed ``s`` always makes the same file.
