@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from vo_doppler.checks import (
+    check_standstill_is_still,
     check_yaw_rate_unit,
     clock_warning,
     estimate_clock_offset,
@@ -70,3 +71,13 @@ def test_origin_far_from_the_approximate_position_is_a_warning():
     assert "50.0 km from the manifest's origin" in origin_warning(enu, far)
     assert origin_warning(enu, np.zeros(3)) is None
     assert origin_warning(enu, None) is None
+
+
+def test_standstill_that_moves_is_an_error_and_a_still_one_passes():
+    t = np.arange(0.0, 30.0, 0.1)
+    speed = np.where(t < 10.0, 0.05 * np.sin(7 * t), 8.0)  # still, then 8 m/s
+    check_standstill_is_still((1.0, 9.0), t, speed, "wheel speed")
+    check_standstill_is_still((40.0, 50.0), t, speed, "wheel speed")  # no sample: not judged
+    moving = r"standstill 8\.00–20\.00 s: the wheel speed shows .*median 8\.00"
+    with pytest.raises(InputError, match=moving):
+        check_standstill_is_still((8.0, 20.0), t, speed, "wheel speed")

@@ -13,7 +13,10 @@ summary. Each check states its threshold:
   record) is the residual clock
   offset; beyond 0.2 s it is a warning reporting the estimate next to the manifest's
   ``time_offset_s``;
-* the ENU origin against the RINEX approximate position: more than 10 km apart is a warning.
+* the ENU origin against the RINEX approximate position: more than 10 km apart is a warning;
+* a standstill interval given by hand against the measured speed: a median speed above
+  0.5 m/s inside it (GNSS speed noise at rest is a few cm/s to 0.2 m/s) is an error, since the
+  gyro bias and the gyro combination of a moving "standstill" are the driving's.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ CLOCK_SEARCH_S = 5.0
 CLOCK_RATE_HZ = 10.0
 MIN_CORRELATION = 0.5
 """Correlation peak below which the speed profiles are too featureless to estimate a lag."""
+STANDSTILL_MAX_MEDIAN_SPEED_MPS = 0.5
 ORIGIN_TOLERANCE_M = 10_000.0
 EARTH_SURFACE_M = (6.3e6, 6.4e6)
 """Norm of an ECEF position on the ground (m): outside, the approximate position is no place."""
@@ -153,3 +157,22 @@ def origin_warning(enu: EnuFrame, approx_position_ecef: np.ndarray | None) -> st
         f"origin: the RINEX approximate position is {distance / 1000:.1f} km from the manifest's "
         "origin (lat_deg, lon_deg); check the origin"
     )
+
+
+def check_standstill_is_still(
+    interval: tuple[float, float], t: np.ndarray, speed: np.ndarray, source: str
+) -> None:
+    """Raise when the speed inside a standstill interval given by hand shows the vehicle moving
+    (median above ``STANDSTILL_MAX_MEDIAN_SPEED_MPS``); nothing when no sample falls inside."""
+    t0, t1 = interval
+    inside = np.asarray(speed, dtype=float)[(np.asarray(t) >= t0) & (np.asarray(t) <= t1)]
+    inside = inside[np.isfinite(inside)]
+    if inside.size == 0:
+        return
+    median = float(np.median(np.abs(inside)))
+    if median > STANDSTILL_MAX_MEDIAN_SPEED_MPS:
+        raise InputError(
+            f"standstill {t0:.2f}–{t1:.2f} s: the {source} shows the vehicle moving there (median "
+            f"{median:.2f} m/s, up to {np.max(np.abs(inside)):.2f} m/s; a standstill is at most "
+            f"{STANDSTILL_MAX_MEDIAN_SPEED_MPS} m/s); give a still interval or use --straight"
+        )

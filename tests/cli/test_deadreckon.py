@@ -85,3 +85,14 @@ def test_cli_bad_input_exit_codes(inputs, tmp_path, capsys):
         with pytest.raises(SystemExit) as info:
             main(_args(paths, tmp_path / "o2", *extra))
         assert info.value.code == 2
+
+
+def test_standstill_interval_that_moves_is_exit_1_with_the_speed(inputs, tmp_path, capsys):
+    record, paths = inputs
+    _, t1 = record.standstill
+    moving = (t1 + 20.0, t1 + 40.0)  # the drive after the standstill
+    code = main(_args(paths, tmp_path / "o", "--standstill", f"{moving[0]},{moving[1]}"))
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err
+    t0, t1 = (f"{t:.2f}" for t in moving)
+    assert f"standstill {t0}–{t1} s: the GPS track speed shows the vehicle moving" in err

@@ -5,9 +5,11 @@ wrong number."""
 
 from __future__ import annotations
 
+import gzip
 import json
 import logging
 import re
+import resource
 import shutil
 from datetime import datetime
 from pathlib import Path
@@ -358,9 +360,6 @@ def rinex_case(clean: Path, tmp_path: Path, damage) -> Path:
     return folder
 
 
-RINEX_BRANCH = "RINEX validation on branch rinex-robust"
-
-
 def _swap_epochs(header, blocks):
     blocks[50], blocks[60] = blocks[60], blocks[50]
     return header + "".join(blocks)
@@ -368,6 +367,18 @@ def _swap_epochs(header, blocks):
 
 def _duplicate_epochs(header, blocks):
     return header + "".join(blocks[:80] + blocks[60:80] + blocks[80:])
+
+
+def _no_satellites(header, blocks):
+    return header + "".join(b.splitlines()[0][:-3] + "  0\n" for b in blocks)
+
+
+@pytest.mark.parametrize("damage", [_swap_epochs, _duplicate_epochs, _no_satellites])
+def test_damaged_rinex_content_is_exit_1_naming_the_file(clean, tmp_path, capsys, damage):
+    folder = rinex_case(clean, tmp_path, damage)
+    code = main(["run", str(folder), "-o", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == EXIT_FAILURE and "rover.obs" in err and "Traceback" not in err
 
 
 def _month_13(header, blocks):
@@ -381,16 +392,41 @@ def _garbage_glonass_slot(header, blocks):
     return header[:at] + line + header[at:] + "".join(blocks)
 
 
-def _no_satellites(header, blocks):
-    return header + "".join(b.splitlines()[0][:-3] + "  0\n" for b in blocks)
-
-
-@pytest.mark.xfail(strict=False, reason=RINEX_BRANCH)
 @pytest.mark.parametrize(
-    "damage", [_swap_epochs, _duplicate_epochs, _month_13, _garbage_glonass_slot, _no_satellites]
+    ("damage", "warning"),
+    [
+        (_month_13, r"rover\.obs:\d+: epoch date unusable \(month 13\): skipped"),
+        (
+            _garbage_glonass_slot,
+            r"rover\.obs:\d+: unreadable GLONASS slot/channel 'R01 @@' ignored",
+        ),
+    ],
 )
-def test_damaged_rinex_content_is_exit_1_naming_the_file(clean, tmp_path, capsys, damage):
+def test_one_unusable_rinex_record_is_skipped_and_warned_in_the_summary(
+    clean, tmp_path, caplog, damage, warning
+):
+    """Policy: a record the reader cannot use (an epoch with an impossible calendar value, a
+    header line it cannot read) is skipped, the run goes on without it (exit 0) and the warning,
+    naming the file and line, is in the log and in summary.json."""
     folder = rinex_case(clean, tmp_path, damage)
-    code = main(["run", str(folder), "-o", str(tmp_path / "out")])
-    err = capsys.readouterr().err
-    assert code == EXIT_FAILURE and "rover.obs" in err and "Traceback" not in err
+    code, out = run(folder, tmp_path, caplog)
+    assert code == EXIT_OK
+    assert_full_outputs(out, n_images(folder))
+    assert re.search(warning, caplog.text)
+    summary = json.loads((out / "summary.json").read_text())
+    assert any(re.search(warning, w) for w in summary["warnings"]), summary["warnings"]
+
+
+def test_gzip_bomb_as_the_observation_file_is_exit_1_without_filling_memory(
+    clean, tmp_path, capsys
+):
+    """2 MB of gzip (50 members of 40 MB of zeros: 2 GB expanded) refused after 80 MB."""
+    folder = damaged_copy(clean, tmp_path)
+    member = gzip.compress(b"0" * 40_000_000, compresslevel=9)
+    bomb = folder / "gnss" / "rover.obs.gz"
+    bomb.write_bytes(member * (2_000_000 // len(member)))
+    edit_manifest(folder, "gnss", "obs", "gnss/rover.obs.gz")
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    err = failing_run(folder, tmp_path, capsys)
+    assert "rover.obs.gz" in err and "decompressed data exceed" in err
+    assert (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024 < 500

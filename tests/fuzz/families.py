@@ -18,6 +18,7 @@ import hatanaka
 import numpy as np
 
 from tests.conftest import REPO_ROOT, shared_data_dir
+from tests.fuzz.gnss_families import register_gnss
 from tests.fuzz.mutators import SHRINKING
 from tests.helpers.rinex_text import as_rinex4
 from tests.io.fuzz_families import register_all
@@ -95,7 +96,8 @@ def _existing(relatives: tuple[str, ...], extra: Path) -> list[Path]:
 
 
 def obs_seeds() -> list[Seed]:
-    """Observation files as plain text, gzip, Hatanaka and Hatanaka + gzip.
+    """Observation files as plain text, gzip, Hatanaka and Hatanaka + gzip, and the sample's
+    file relabelled RINEX 4.
 
     Text mutations of the Hatanaka seeds change the Compact RINEX text. Its values are
     differences from the epochs before, so a lost line inside it shifts later values without
@@ -110,7 +112,18 @@ def obs_seeds() -> list[Seed]:
             Seed(path.stem + ".crx", _crx(load), suffix=".crx", shrinking=CUT_END),
             Seed(path.stem + ".crx.gz", _crx(load), _gz, ".crx.gz", shrinking=CUT_END),
         ]
-    return seeds
+    sample = SAMPLE_GNSS / "rover.obs"
+    return [
+        Seed("rover.obs as RINEX 4", lambda: as_rinex4_obs(sample.read_bytes()), suffix=".rnx"),
+        *seeds,
+    ]
+
+
+def as_rinex4_obs(v3: bytes) -> bytes:
+    """A RINEX 3 observation file relabelled 4.01: the epoch and record layout is unchanged
+    (RINEX 4.01 sec. 5.2), the version number is what the reader dispatches on."""
+    first, _, rest = v3.partition(b"\n")
+    return b"     4.01" + first[9:] + b"\n" + rest
 
 
 def nav_seeds() -> list[Seed]:
@@ -280,3 +293,4 @@ register(
 )
 
 register_all(register, Family, Seed)  # CAN, DBC, CSV, NMEA, trajectory, calibration, manifest
+register_gnss(register, Family, Seed, check_observations, check_navigation)  # SP3 … raw_gnss

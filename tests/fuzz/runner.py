@@ -2,7 +2,7 @@
 classified as a plausible success, a project error, or a failure (another exception, an
 impossible value, more than 5 s, more than 500 MB).
 
-    python -m tests.fuzz.runner --cases 6000 --json out/fuzz.json      # long run (make fuzz)
+    python -m tests.fuzz.runner --cases 600 --workers 1 --json out/fuzz.json   # make fuzz
     python -m tests.fuzz.runner --family rinex-obs --case 17 --show    # replay one case
 
 Cases are deterministic: case ``k`` of a family with run seed ``s`` always makes the same file.
@@ -244,14 +244,23 @@ class Report:
             if self.progress:
                 self.progress(self)
 
+    def totals(self) -> Counter:
+        """Outcome counts over every family."""
+        return sum(self.counts.values(), Counter())
+
     def table(self) -> str:
+        """Cases and outcomes per family, slowest case and largest peak memory, and a total."""
         kinds = ("ok", "error", *FAILURES)
-        rows = [f"{'family':<10} {'cases':>6} " + " ".join(f"{k:>9}" for k in kinds)]
+        rows = [f"{'family':<15} {'cases':>6} " + " ".join(f"{k:>9}" for k in kinds)]
         rows[0] += f" {'max s':>6} {'max MB':>7}"
-        for family, counts in sorted(self.counts.items()):
-            row = f"{family:<10} {sum(counts.values()):>6} "
+        lines = [(f, c, self.max_seconds[f], self.max_rss_mb[f]) for f, c in self.counts.items()]
+        if lines:
+            top = (max(x[2] for x in lines), max(x[3] for x in lines))
+            lines = [*sorted(lines), ("total", self.totals(), *top)]
+        for family, counts, seconds, megabytes in lines:
+            row = f"{family:<15} {sum(counts.values()):>6} "
             row += " ".join(f"{counts.get(k, 0):>9}" for k in kinds)
-            row += f" {self.max_seconds[family]:>6.2f} {self.max_rss_mb[family]:>7.0f}"
+            row += f" {seconds:>6.2f} {megabytes:>7.0f}"
             rows.append(row)
         return "\n".join(rows)
 
@@ -344,7 +353,10 @@ def main(argv: list[str] | None = None) -> int:
                 "cases_done": report.done(),
                 "seconds": round(time.perf_counter() - started, 1),
                 "limits": {"seconds": TIME_LIMIT_S, "memory_mb": MEMORY_LIMIT_MB},
-                "counts": {f: dict(c) for f, c in report.counts.items()},
+                "families": len(report.counts),
+                "cases_by_family": {f: sum(c.values()) for f, c in sorted(report.counts.items())},
+                "totals": dict(report.totals()),
+                "counts": {f: dict(c) for f, c in sorted(report.counts.items())},
                 "by_mutation": {m: dict(c) for m, c in report.by_mutation.items()},
                 "max_seconds": report.max_seconds,
                 "max_rss_mb": report.max_rss_mb,

@@ -7,6 +7,7 @@ Independent of the decoder's field table: the ICD bit positions are written out 
 from __future__ import annotations
 
 import numpy as np
+from pyubx2 import UBXMessage
 
 GPS_PI = 3.1415926535898
 SC = GPS_PI  # semicircles → rad
@@ -146,3 +147,12 @@ EXAMPLE = {
     "omega_dot": -8.1739833499e-09,
     "idot": -2.3572413267e-10,
 }
+
+
+def sfrbx(prn: int, words: tuple[int, ...]) -> bytes:
+    """A UBX RXM-SFRBX frame carrying one GPS L1 C/A subframe (24-bit data words, each in bits
+    29…6 of its ``dwrd`` with parity bits set)."""
+    dwrd = {f"dwrd_{k + 1:02d}": (word << 6) | 0x15 for k, word in enumerate(words)}
+    return UBXMessage(
+        "RXM", "RXM-SFRBX", 0, gnssId=0, svId=prn, sigId=0, numWords=10, chn=4, version=2, **dwrd
+    ).serialize()

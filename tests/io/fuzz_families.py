@@ -13,6 +13,7 @@ check)`` and ``Seed(name, load, pack=..., suffix=...)``).
 
 from __future__ import annotations
 
+import contextlib
 import io
 import tempfile
 from collections.abc import Callable
@@ -49,22 +50,35 @@ def _file(path: Path) -> Callable[[], bytes]:
     return path.read_bytes
 
 
+WRITABLE_TIMESTAMPS_S = (0.0, 4.0e9)
+"""Timestamps every python-can writer can store (BLF keeps calendar dates, up to 2096)."""
+
+
 def _as_format(suffix: str) -> Callable[[bytes], bytes]:
-    """Pack candump text as another python-can format (the text is what gets mutated)."""
+    """Pack candump text as another python-can format (the text is what gets mutated). A
+    message whose timestamp the format cannot store is left out when writing fails on it."""
 
     def pack(data: bytes) -> bytes:
         with tempfile.TemporaryDirectory() as folder:
             source, target = Path(folder) / "in.log", Path(folder) / f"out{suffix}"
             source.write_bytes(data)
-            with can.Logger(str(target)) as writer:
-                try:
-                    for message in can.CanutilsLogReader(str(source)):
-                        writer.on_message_received(message)
-                except (ValueError, IndexError, UnicodeDecodeError):
-                    pass  # a mutation made the text unreadable: pack what came before
+            messages = []
+            with contextlib.suppress(ValueError, IndexError, UnicodeDecodeError):
+                messages.extend(can.CanutilsLogReader(str(source)))  # stops where unreadable
+            try:
+                _write(target, messages)
+            except (OverflowError, ValueError, OSError):
+                low, high = WRITABLE_TIMESTAMPS_S
+                _write(target, [m for m in messages if low <= m.timestamp <= high])
             return target.read_bytes()
 
     return pack
+
+
+def _write(target: Path, messages: list) -> None:
+    with can.Logger(str(target)) as writer:
+        for message in messages:
+            writer.on_message_received(message)
 
 
 def _times_ok(t: np.ndarray, what: str) -> list[str]:

@@ -36,7 +36,9 @@ def test_sp3_round_trip(tmp_path_factory, n_epochs, seed, crlf, n_sats):
     rng = np.random.default_rng(seed)
     sats = [f"{'GREC'[k % 4]}{k // 4 + 1:02d}" for k in range(n_sats)]
     t = T0 + 900.0 * np.arange(n_epochs)
-    position = np.round(rng.uniform(-4e7, 4e7, (n_epochs, n_sats, 3)), 3)
+    direction = rng.normal(size=(n_epochs, n_sats, 3))
+    radius = rng.uniform(2.0e7, 4.5e7, (n_epochs, n_sats, 1))  # MEO to GEO
+    position = np.round(radius * direction / np.linalg.norm(direction, axis=2, keepdims=True), 3)
     clock = np.round(rng.uniform(-1e-3, 1e-3, (n_epochs, n_sats)), 12)
     position[rng.random((n_epochs, n_sats)) < 0.1] = np.nan
     clock[rng.random((n_epochs, n_sats)) < 0.1] = np.nan

@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pyubx2 import UBXMessage
 
-from tests.helpers.lnav import EXAMPLE, encode_ephemeris, quantised
+from tests.helpers.lnav import EXAMPLE, encode_ephemeris, quantised, sfrbx
 from vo_doppler.errors import InputError
 from vo_doppler.gnss.ephemeris import satellite_states
 from vo_doppler.io.ubx import read_ubx
@@ -43,13 +43,6 @@ def pvt() -> bytes:
         hMSL=471_000, hAcc=1520, vAcc=2250, velN=12_340, velE=-5_670, velD=120, gSpeed=13_580,
         headMot=335.75, sAcc=85, headAcc=0.75,
     ).serialize()  # fmt: skip
-
-
-def sfrbx(prn: int, words: tuple[int, ...]) -> bytes:
-    dwrd = {f"dwrd_{k + 1:02d}": (word << 6) | 0x15 for k, word in enumerate(words)}
-    return UBXMessage(
-        "RXM", "RXM-SFRBX", 0, gnssId=0, svId=prn, sigId=0, numWords=10, chn=4, version=2, **dwrd
-    ).serialize()
 
 
 def write(tmp_path: Path, data: bytes) -> Path:

@@ -8,10 +8,12 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from vo_doppler.checks import check_standstill_is_still
 from vo_doppler.commands.arg_types import positive_int
+from vo_doppler.geo import EnuFrame
 from vo_doppler.io.gps_fixes import read_gps_fixes
 from vo_doppler.io.sensor_csv import read_numeric_csv, read_yaw_rate_csv
-from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon
+from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon, smoothed_track_speed
 from vo_doppler.report.deadreckon import drift_table_rows, write_outputs
 
 TABLE_HEADERS = ("variant", "drift °/min", "final error °", "gap m", "gap %", "length m")
@@ -92,13 +94,25 @@ def register(subparsers, summary: str) -> None:
 
 
 def _speed_source(args, fixes):
+    """(t, speed) from the wheel-speed CSV, else the GPS speed, with the source's name."""
     if args.wheel_speed:
         columns, _ = read_numeric_csv(args.wheel_speed, ("t", "speed_mps"))
-        return columns["t"], columns["speed_mps"]
+        return (columns["t"], columns["speed_mps"]), "wheel speed"
     if np.mean(np.isfinite(fixes.speed)) > 0.9:
         good = np.isfinite(fixes.speed)
-        return fixes.t[good], fixes.speed[good]
-    return None
+        return (fixes.t[good], fixes.speed[good]), "GPS speed"
+    return None, ""
+
+
+def _track_speed(fixes) -> tuple[np.ndarray, np.ndarray]:
+    """(t, speed) of the fixes from their positions (for the standstill check when the file
+    gives no speed)."""
+    good = np.isfinite(fixes.lat) & np.isfinite(fixes.lon)
+    t, lat, lon = fixes.t[good], fixes.lat[good], fixes.lon[good]
+    if t.size < 2:
+        return t, np.zeros_like(t)
+    enu = EnuFrame(float(lat[0]), float(lon[0]), 0.0).geodetic_to_enu(lat, lon, 0.0)
+    return t, smoothed_track_speed(t, enu[:, 0], enu[:, 1])
 
 
 def run(args: argparse.Namespace) -> int:
@@ -114,12 +128,12 @@ def run(args: argparse.Namespace) -> int:
         downsample=args.downsample,
         cluster_m=args.cluster_m,
     )
+    speed, source = _speed_source(args, fixes)
+    if args.standstill:
+        measured = speed if speed is not None else _track_speed(fixes)
+        check_standstill_is_still(args.standstill, *measured, source or "GPS track speed")
     result = run_deadreckon(
-        (gyro1.t, gyro1.value),
-        (gyro2.t, gyro2.value),
-        fixes.as_tuple(),
-        config,
-        _speed_source(args, fixes),
+        (gyro1.t, gyro1.value), (gyro2.t, gyro2.value), fixes.as_tuple(), config, speed
     )
     paths = write_outputs(args.output, result)
 

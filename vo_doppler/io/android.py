@@ -29,6 +29,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.android_raw import RawColumns, raw_observations
+from vo_doppler.io.textfile import read_text
 from vo_doppler.model.gpstime import gps_minus_utc
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.row_sigma import RowSigma
@@ -40,6 +41,7 @@ RAW_INTEGERS = ("ConstellationType", "Svid", "TimeNanos", "FullBiasNanos", "Rece
 GYRO_RECORDS = ("UncalGyro", "Gyro")
 ACCEL_RECORDS = ("UncalAccel", "Accel")
 USED_RECORDS = ("Raw", *GYRO_RECORDS, *ACCEL_RECORDS)
+MAX_FIELD_CHARS = 64
 
 
 @dataclass(frozen=True)
@@ -148,10 +150,7 @@ def read_records(path: Path) -> dict[str, Records]:
     """The record types this reader uses (``USED_RECORDS``), columns named by their ``#`` header
     lines. Other record types (``Nav`` rows carry a variable number of data bytes, ``Fix``,
     ``Status`` …) need a header line but are not parsed further."""
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read GnssLogger file: {exc}", path) from exc
+    text = read_text(path, "GnssLogger file")
     headers: dict[str, tuple[str, ...]] = {}
     rows: dict[str, list[list[str]]] = {}
     lines: dict[str, list[int]] = {}
@@ -176,10 +175,19 @@ def read_records(path: Path) -> dict[str, Records]:
             )
         rows.setdefault(kind, []).append(parts[1:] + [""] * (len(headers[kind]) + 1 - len(parts)))
         lines.setdefault(kind, []).append(number)
-    return {
-        kind: Records(headers[kind], np.array(rows[kind], dtype=str), np.array(lines[kind]))
-        for kind in rows
-    }
+    return {kind: records(headers[kind], rows[kind], lines[kind], path) for kind in rows}
+
+
+def records(names: tuple[str, ...], rows: list[list[str]], lines: list[int], path: Path) -> Records:
+    """The rows as a :class:`Records` table; a field longer than ``MAX_FIELD_CHARS`` names its
+    line (the table's string width is its longest field, times every row and column)."""
+    for row, number in zip(rows, lines, strict=True):
+        longest = max(row, key=len, default="")
+        if len(longest) > MAX_FIELD_CHARS:
+            raise InputError(
+                f"a field of {len(longest)} characters (at most {MAX_FIELD_CHARS})", path, number
+            )
+    return Records(names, np.array(rows, dtype=str), np.array(lines))
 
 
 def raw_columns(raw: Records, path: Path) -> RawColumns:

@@ -129,16 +129,32 @@ class RawGnss:
 
 
 def read_raw_gnss(base: str | Path) -> RawGnss:
+    """The rows of ``raw_gnss_ublox/value``. A row without a valid GPS week and time of week, or
+    earlier than the row before it, is an :class:`InputError` naming the row; rows of other
+    systems or with an impossible measurement (``_plausible``) are dropped and counted."""
+    path = Path(base).joinpath(*RAW_GNSS, "value")
     value = load_array(base, *RAW_GNSS, "value")
-    if value.ndim != 2 or value.shape[1] < 10:
-        raise InputError(f"raw_gnss_ublox/value has shape {value.shape}, not (N, 10)", base)
-    number = value[:, 0].astype(np.int64)
+    if value.ndim != 2 or value.shape[1] < 10 or value.dtype.kind not in "iuf":
+        raise InputError(f"array of shape {value.shape} and type {value.dtype}, not (N, 10)", path)
+    value = value.astype(float)
+    week, tow = value[:, 1], value[:, 2]
+    timed = (week == np.round(week)) & (week >= 0) & (week < 8192)
+    timed &= (tow >= 0) & (tow < SECONDS_PER_WEEK)  # False for NaN too
+    if not np.all(timed):
+        row = int(np.flatnonzero(~timed)[0])
+        raise InputError(f"row {row}: GPS week {week[row]}, time of week {tow[row]}", path)
+    t = week * SECONDS_PER_WEEK + tow
+    back = np.flatnonzero(np.diff(t) < 0)
+    if back.size:
+        raise InputError(f"row {int(back[0]) + 1}: time before the previous row's", path)
+    number = np.where(np.isfinite(value[:, 0]), value[:, 0], 0).astype(np.int64)
+    number[value[:, 0] != number] = 0
     gps = (number >= 1) & (number <= 32)
     glonass = (number > GLONASS_PRN_OFFSET) & (number <= GLONASS_PRN_OFFSET + 24)
-    keep = (gps | glonass) & np.isfinite(value[:, 6])
+    keep = (gps | glonass) & _plausible(value, glonass)
     rows = value[keep]
     return RawGnss(
-        t=rows[:, 1] * SECONDS_PER_WEEK + rows[:, 2],
+        t=t[keep],
         system=np.where(gps[keep], "G", "R"),
         prn=np.where(gps[keep], number[keep], number[keep] - GLONASS_PRN_OFFSET),
         glonass_channel=rows[:, 3],
@@ -150,6 +166,18 @@ def read_raw_gnss(base: str | Path) -> RawGnss:
         carrier_phase=rows[:, 9],
         n_dropped=int((~keep).sum()),
     )
+
+
+def _plausible(value: np.ndarray, glonass: np.ndarray) -> np.ndarray:
+    """Rows whose measurements can be real (every comparison is False for NaN): pseudorange
+    rate finite within 10 km/s and its σ positive, pseudorange within 1,000–100,000 km or
+    missing, C/N0 within 0–100 dB-Hz, carrier phase finite or missing, GLONASS channel −7…6."""
+    channel, pseudorange, carrier = value[:, 3], value[:, 4], value[:, 9]
+    ok = (np.abs(value[:, 6]) < 1.0e4) & (value[:, 7] > 0) & np.isfinite(value[:, 7])
+    ok &= np.isnan(pseudorange) | ((pseudorange > 1.0e6) & (pseudorange < 1.0e8))
+    ok &= (value[:, 8] >= 0) & (value[:, 8] <= 100)
+    ok &= ~np.isinf(carrier)
+    return ok & (~glonass | ((channel >= -7) & (channel <= 6) & (channel == np.round(channel))))
 
 
 def gps_minus_mono(base: str | Path) -> float:

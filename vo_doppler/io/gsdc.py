@@ -14,6 +14,7 @@ and satellite), so no navigation file is needed.
 from __future__ import annotations
 
 import csv
+import io
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -21,8 +22,9 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT
-from vo_doppler.io.android import Records, raw_columns
+from vo_doppler.io.android import Records, raw_columns, records
 from vo_doppler.io.android_raw import raw_observations, satellite_ids
+from vo_doppler.io.textfile import read_text
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.row_sigma import RowSigma
 from vo_doppler.model.satellite_table import SatelliteTable
@@ -36,6 +38,8 @@ REQUIRED = (
     "SvClockDriftMetersPerSecond",
 )
 ORBIT_RADIUS_RANGE_M = (1.0e7, 5.0e7)
+EARTH_RADIUS_RANGE_M = (6.0e6, 7.0e6)
+"""Geocentric distances of a receiver on or near the ground (m)."""
 
 
 @dataclass(frozen=True)
@@ -78,6 +82,14 @@ def read_device_gnss(path: str | Path) -> GsdcRecording:
     observations, sigma = raw_observations(columns, "Android (GSDC device_gnss.csv)", problems)
     satellites = _satellite_table(rows, path, arrival_ns)
     wls = np.stack([number(f"WlsPosition{a}EcefMeters") for a in "XYZ"], axis=1)
+    radius = np.linalg.norm(wls, axis=1)
+    off = np.isfinite(radius) & (
+        (radius < EARTH_RADIUS_RANGE_M[0]) | (radius > EARTH_RADIUS_RANGE_M[1])
+    )
+    if np.any(off):
+        raise InputError(
+            "WLS receiver position off the Earth's surface", path, int(rows.line[off][0])
+        )
     epoch = np.searchsorted(observations.epoch_time, arrival_ns * 1e-9)
     receiver = np.full((observations.epoch_time.size, 3), np.nan)
     good = np.isfinite(wls).all(axis=1) & (epoch < receiver.shape[0])
@@ -86,10 +98,10 @@ def read_device_gnss(path: str | Path) -> GsdcRecording:
 
 
 def _read_csv(path: Path) -> Records:
+    text = read_text(path, "GSDC device_gnss.csv")
     try:
-        with path.open(encoding="utf-8", newline="") as handle:
-            table = list(csv.reader(handle))
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        table = list(csv.reader(io.StringIO(text, newline="")))
+    except csv.Error as exc:
         raise InputError(f"cannot read CSV: {exc}", path) from exc
     if not table:
         raise InputError("empty file", path)
@@ -104,7 +116,7 @@ def _read_csv(path: Path) -> Records:
         lines.append(number)
     if not body:
         raise InputError("no Raw rows", path)
-    return Records(names, np.array(body, dtype=str), np.array(lines))
+    return records(names, body, lines, path)
 
 
 def _satellite_table(rows: Records, path: Path, arrival_ns: np.ndarray) -> SatelliteTable:

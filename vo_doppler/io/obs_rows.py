@@ -2,8 +2,10 @@
 
 Readers of binary or CSV formats collect one row per (epoch, satellite, observable) with a
 RINEX 3 observable code (``C1C``, ``L1C``, ``D1C``, ``S1C`` …) and pass them here: rows with a
-non-finite value are dropped, the rest sorted by epoch, system, PRN and code, and a RINEX-3-like
-header is synthesised (version 3.05, mixed system, signal strength in dB-Hz, GPS time).
+non-finite value are dropped, the rest sorted by epoch, system, PRN and code, a row repeating an
+earlier row's (epoch, satellite, code) is dropped and counted in ``problems`` (the file's first
+value kept), and a RINEX-3-like header is synthesised (version 3.05, mixed system, signal
+strength in dB-Hz, GPS time).
 """
 
 from __future__ import annotations
@@ -42,7 +44,17 @@ def observations_from_rows(
     code = np.asarray(code, dtype="U3")[keep]
     codes = tuple(sorted({str(c) for c in code}))
     code_index = np.searchsorted(np.array(codes, dtype="U3"), code).astype(np.int16)
-    order = np.lexsort((code_index, prn, system, time))
+    order = np.lexsort((code_index, prn, system, time))  # stable: file order among equals
+    key = (time[order], system[order], prn[order], code_index[order])
+    repeat = np.zeros(order.size, dtype=bool)
+    repeat[1:] = np.logical_and.reduce([k[1:] == k[:-1] for k in key])
+    if np.any(repeat):
+        problems = (
+            *problems,
+            f"{path}: {int(repeat.sum())} repeated observations (same epoch, satellite and "
+            "signal) dropped, the first kept",
+        )
+        order = order[~repeat]
     obs_types = {
         str(s): tuple(sorted({str(c) for c in code[system == s]})) for s in np.unique(system)
     }

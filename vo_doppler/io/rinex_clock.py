@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.errors import InputError
-from vo_doppler.io.sp3 import TIME_SYSTEMS, satellite_id, text_lines, to_gps_seconds
+from vo_doppler.io.rinex_common import parse_calendar
+from vo_doppler.io.sp3 import MAX_CLOCK_S, TIME_SYSTEMS, satellite_id, text_lines, to_gps_seconds
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.model.precise_orbits import SatelliteClocks
 
@@ -71,11 +72,13 @@ def _record(path: Path, line: int, fields: list[str]) -> tuple[str, tuple[float,
     """Satellite, calendar epoch, number of values and clock bias (s) of one AS record."""
     try:
         sat = satellite_id(fields[1].ljust(3))
-        epoch = tuple(float(v) for v in fields[2:8])
+        epoch = tuple(float(v) for v in parse_calendar(" ".join(fields[2:8]).encode()))
         n_values = int(fields[8])
         value = float(fields[9].replace("D", "E"))
-    except (ValueError, IndexError):
-        raise InputError(f"bad clock record {' '.join(fields)!r}", path, line) from None
-    if len(epoch) != 6 or not 1 <= n_values <= MAX_VALUES:
+    except (ValueError, IndexError) as exc:
+        raise InputError(f"bad clock record {' '.join(fields)!r}: {exc}", path, line) from None
+    if not 1 <= n_values <= MAX_VALUES:
         raise InputError(f"bad clock record {' '.join(fields)!r}", path, line)
+    if not abs(value) < MAX_CLOCK_S:
+        raise InputError(f"clock bias {value} s beyond ±{MAX_CLOCK_S} s", path, line)
     return sat, epoch, n_values, value

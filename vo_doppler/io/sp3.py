@@ -16,10 +16,16 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.rinex_common import PRN_RANGE, parse_calendar, prn_in_range
 from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, calendar_to_gps_seconds, utc_to_gps_seconds
 from vo_doppler.model.precise_orbits import PreciseOrbits
 
 BAD_CLOCK_US = 999999.0
+MAX_CLOCK_S = 0.1
+"""Satellite clocks are steered to within a few ms of system time (7 ms seen in an IGS product):
+a larger value in a clock field is a damaged file."""
+ORBIT_RADIUS_M = (1.0e7, 5.0e7)
+"""Geocentric distances of GNSS satellites (MEO about 2.6e7 m, GEO/IGSO 4.2e7 m)."""
 TAI_MINUS_GPST_S = 19.0
 GLONASS_TIME_MINUS_UTC_S = 3 * 3600.0
 TIME_SYSTEMS = ("GPS", "GAL", "QZS", "IRN", "BDT", "TAI", "UTC", "GLO")
@@ -42,9 +48,13 @@ def to_gps_seconds(calendar_seconds: np.ndarray, time_system: str) -> np.ndarray
 
 
 def satellite_id(text: str) -> str:
-    """'G05' from an SP3 satellite field ('G05', 'G 5', ' 5' = GPS in old files)."""
+    """'G05' from an SP3 satellite field ('G05', 'G 5', ' 5' = GPS in old files); ValueError
+    for a system or number that does not exist (``PRN_RANGE``)."""
     letter = text[0] if text[0] != " " else "G"
-    return f"{letter}{int(text[1:3]):02d}"
+    number = int(text[1:3])
+    if letter not in PRN_RANGE or not prn_in_range(letter, number):
+        raise ValueError(f"no satellite {text!r}")
+    return f"{letter}{number:02d}"
 
 
 def text_lines(path: Path, what: str) -> list[str]:
@@ -64,6 +74,9 @@ def read_sp3(path: str | Path) -> PreciseOrbits:
     first = lines[0]
     declared_epochs = _int(first[32:39], path, 1, "number of epochs")
     sats, time_system, body = _header(path, lines)
+    n_epoch_lines = sum(1 for line in lines[body:] if line[:1] == "*")
+    if n_epoch_lines != declared_epochs:
+        raise InputError(f"{n_epoch_lines} epochs, header declares {declared_epochs}", path, 1)
     column = {sat: i for i, sat in enumerate(sats)}
     calendar: list[tuple[float, ...]] = []
     positions = np.full((declared_epochs, len(sats), 3), np.nan)
@@ -75,8 +88,6 @@ def read_sp3(path: str | Path) -> PreciseOrbits:
             break
         if tag == "*":
             calendar.append(_epoch(path, number + 1, line))
-            if len(calendar) > declared_epochs:
-                raise InputError(f"more epochs than the {declared_epochs} declared", path, 1)
         elif tag == "P":
             if not calendar:
                 raise InputError("position record before the first epoch line", path, number + 1)
@@ -85,7 +96,7 @@ def read_sp3(path: str | Path) -> PreciseOrbits:
             clocks[len(calendar) - 1, sat] = _clock(path, number + 1, line)
         elif tag not in ("V", "E", "/", ""):
             raise InputError(f"unexpected record {line[:2]!r}", path, number + 1)
-    if len(calendar) != declared_epochs:
+    if len(calendar) != declared_epochs:  # epoch lines after an 'EOF' line
         raise InputError(f"{len(calendar)} epochs, header declares {declared_epochs}", path, 1)
     times = to_gps_seconds(calendar_to_gps_seconds(*np.array(calendar).T), time_system)
     if np.any(np.diff(times) <= 0):
@@ -141,22 +152,25 @@ def _int(text: str, path: Path, line: int, what: str) -> int:
 
 
 def _epoch(path: Path, line_number: int, line: str) -> tuple[float, ...]:
-    fields = line[1:].split()
     try:
-        year, month, day, hour, minute = (int(v) for v in fields[:5])
-        second = float(fields[5])
-    except (ValueError, IndexError):
-        raise InputError(f"bad epoch line {line.strip()!r}", path, line_number) from None
-    return float(year), float(month), float(day), float(hour), float(minute), second
+        return tuple(float(v) for v in parse_calendar(line[1:].encode()))
+    except ValueError as exc:
+        raise InputError(f"bad epoch line {line.strip()!r}: {exc}", path, line_number) from None
 
 
 def _position(path: Path, line_number: int, line: str) -> np.ndarray:
-    """ECEF metres, NaN for the missing-value mark 0.000000."""
+    """ECEF metres, NaN for the missing-value mark 0.000000; a satellite off any GNSS orbit
+    (``ORBIT_RADIUS_M``) names the line."""
     try:
         xyz = np.array([float(line[4:18]), float(line[18:32]), float(line[32:46])])
     except ValueError:
         raise InputError(f"bad position in {line.strip()!r}", path, line_number) from None
-    return 1000.0 * xyz if np.any(xyz != 0.0) else np.full(3, np.nan)
+    if np.all(xyz == 0.0):
+        return np.full(3, np.nan)
+    radius = float(np.linalg.norm(xyz)) * 1000.0 if np.all(np.abs(xyz) < 1e9) else np.nan
+    if not ORBIT_RADIUS_M[0] < radius < ORBIT_RADIUS_M[1]:
+        raise InputError(f"position off any GNSS orbit in {line.strip()!r}", path, line_number)
+    return 1000.0 * xyz
 
 
 def _clock(path: Path, line_number: int, line: str) -> float:
@@ -166,7 +180,11 @@ def _clock(path: Path, line_number: int, line: str) -> float:
         microseconds = float(text) if text else np.nan
     except ValueError:
         raise InputError(f"bad clock {text!r}", path, line_number) from None
-    return 1e-6 * microseconds if microseconds < BAD_CLOCK_US else np.nan
+    if np.isnan(microseconds) or microseconds >= BAD_CLOCK_US:
+        return np.nan
+    if not abs(microseconds) < 1e6 * MAX_CLOCK_S:
+        raise InputError(f"clock {text} µs beyond ±{MAX_CLOCK_S} s", path, line_number)
+    return 1e-6 * microseconds
 
 
 def _known(path: Path, line_number: int, line: str, column: dict[str, int]) -> int:

@@ -21,7 +21,8 @@ skipped with a message ``FILE@OFFSET: …`` in ``problems``; a truncated last fr
   navigation data (Galileo I/NAV, BeiDou D1/D2, GLONASS strings, QZSS, SBAS); they are counted.
 - NAV-PVT → :class:`ReceiverSolution`; the time is the GPS time whose second of week is iTOW,
   nearest to the message's UTC date and time plus the leap seconds of that date; a message
-  whose two times disagree by more than 2 s, or without a valid date, is skipped.
+  whose two times disagree by more than 2 s, or without a valid date, is skipped, and so is one
+  repeating the previous fix's time; a fix earlier than the previous one is an error.
 """
 
 from __future__ import annotations
@@ -176,7 +177,7 @@ def read_ubx(path: str | Path) -> UbxRecording:
             raw.add(message, offset, path, problems)
         elif (cls, mid) == PVT:
             fix = _pvt_fields(message, offset, path, problems)
-            if fix is not None:
+            if fix is not None and _in_order(pvt, fix["t"], offset, path, problems):
                 pvt.append(fix)
         elif message.gnssId == 0 and message.numWords == 10 and message.sigId == 0:
             words = tuple((getattr(message, f"dwrd_{k:02d}") >> 6) & 0xFFFFFF for k in range(1, 11))
@@ -326,6 +327,19 @@ def _pvt_fields(message, offset: int, path: Path, problems: list[str]) -> dict[s
         "fix_ok": float(m.gnssFixOk),
         "n_sat": float(m.numSV),
     }
+
+
+def _in_order(pvt: list[dict[str, float]], t: float, offset: int, path: Path, problems) -> bool:
+    """Whether a NAV-PVT fix comes after the previous one: a repeated time is skipped with a
+    problem, an earlier one is an :class:`InputError` naming the offset (as for RXM-RAWX)."""
+    if not pvt or t > pvt[-1]["t"]:
+        return True
+    if t == pvt[-1]["t"]:
+        _problem(problems, path, offset, "NAV-PVT repeats the previous fix's time: skipped")
+        return False
+    raise InputError(
+        f"NAV-PVT time {t:.3f} before the previous one {pvt[-1]['t']:.3f}", path, offset
+    )
 
 
 def _week_of(pvt: list[dict[str, float]]) -> int | None:

@@ -1,5 +1,6 @@
 """YAML inputs without alias bombs: aliases (``*name``) are refused, so a few hundred bytes
-cannot expand into gigabytes, and the text itself is bounded by :mod:`vo_doppler.io.textfile`."""
+cannot expand into gigabytes, and the text itself is bounded by :mod:`vo_doppler.io.textfile`.
+An integer longer than Python converts from text (4,300 digits) is a YAML error at its line."""
 
 from __future__ import annotations
 
@@ -22,6 +23,21 @@ class NoAliasLoader(yaml.SafeLoader):
                 None, None, "YAML aliases (*name) are not accepted in inputs", mark
             )
         return super().compose_node(parent, index)
+
+    def construct_yaml_int(self, node):
+        try:
+            return super().construct_yaml_int(node)
+        except ValueError:
+            digits = len(str(node.value))
+            raise yaml.constructor.ConstructorError(
+                None,
+                None,
+                f"an integer of {digits} characters is not a usable number",
+                node.start_mark,
+            ) from None
+
+
+NoAliasLoader.add_constructor("tag:yaml.org,2002:int", NoAliasLoader.construct_yaml_int)
 
 
 def load_yaml(path: str | Path, what: str, max_bytes: int = SMALL_MAX_BYTES) -> Any:

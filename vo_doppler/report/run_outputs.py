@@ -20,6 +20,7 @@ from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
 from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.io.sequence import InputReport
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.sequence import Sequence
@@ -47,6 +48,7 @@ from vo_doppler.report.trajectory_map import TRUTH, write_geojson
 from vo_doppler.run import Pipeline, RunConfig, RunResult
 
 SUMMARY_FILE = "summary.json"
+MAX_PROBLEMS_PER_FILE = 20
 
 log = logging.getLogger(__name__)
 
@@ -120,9 +122,9 @@ def input_warnings(inputs: Sequence, report: InputReport) -> list[str]:
 def result_checks(
     inputs: Sequence, report: InputReport, result: RunResult, warnings: list[str]
 ) -> dict:
-    """The summary's ``checks``: the input ``warnings`` and the CAN clock against the GNSS
-    Doppler speed (the estimate, and a warning beyond 0.2 s, logged), the time order per
-    sensor."""
+    """The summary's ``checks``: the input ``warnings``, what the GNSS readers skipped
+    (:func:`file_problems`, already logged by them), the CAN clock against the GNSS Doppler
+    speed (the estimate, and a warning beyond 0.2 s, logged), the time order per sensor."""
     velocity = result.gnss.velocity
     horizontal = np.where(
         velocity.valid, np.linalg.norm(velocity.velocity_enu[:, :2], axis=1), np.nan
@@ -132,10 +134,26 @@ def result_checks(
     if warning:
         log.warning("%s", warning)
     return {
-        "warnings": warnings + ([warning] if warning else []),
+        "warnings": warnings + file_problems(inputs) + ([warning] if warning else []),
         "can_clock_residual_offset_s": None if estimate is None else estimate.residual_s,
         "time_order": {r.sensor: r.as_dict() for r in report.time_order},
     }
+
+
+def file_problems(inputs: Sequence) -> list[str]:
+    """The records the observation and navigation readers skipped, each named by file and line
+    (a damaged epoch, an unreadable header value): the first ``MAX_PROBLEMS_PER_FILE`` of each
+    kind, then how many more."""
+    found = []
+    for what, problems in (
+        ("observation", inputs.observations.problems),
+        ("navigation", state_problems(inputs.navigation)),
+    ):
+        found += problems[:MAX_PROBLEMS_PER_FILE]
+        if len(problems) > MAX_PROBLEMS_PER_FILE:
+            more = len(problems) - MAX_PROBLEMS_PER_FILE
+            found.append(f"{more} more {what}-file problems (see the log)")
+    return found
 
 
 def driven_m(result: RunResult) -> float:

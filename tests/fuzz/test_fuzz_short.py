@@ -1,4 +1,4 @@
-"""Short fuzz run of the RINEX readers (the long one is ``make fuzz``), and the runner's own
+"""Short fuzz run of every reader family (the long one is ``make fuzz``), and the runner's own
 classification of outcomes."""
 
 from __future__ import annotations
@@ -11,22 +11,27 @@ from tests.fuzz.mutators import TEXT_MUTATIONS
 from tests.fuzz.runner import FAILURES, Worker, run
 from vo_doppler.errors import InputError
 
+SHORT_CASES = 20
 
-def test_short_fuzz_of_the_rinex_readers():
-    """240 mutated files: each read plausibly or refused with the project's error naming the
-    file, within 500 MB. The 5-s limit is ``make fuzz``'s (tests do not depend on timing: a
+
+def test_short_fuzz_of_every_reader_family():
+    """20 mutated files of every registered family (380 with the shared data, 240 without the
+    families seeded from it): each read plausibly or refused with the project's error naming
+    the file, within 500 MB. The 5-s limit is ``make fuzz``'s (tests do not depend on timing: a
     loaded machine may be slow); a case killed at the runner's hard timeout still fails."""
-    report = run(["rinex-nav", "rinex-obs"], cases=120, run_seed=12, workers=2)
+    families = sorted(FAMILIES)
+    report = run(families, cases=SHORT_CASES, run_seed=12, workers=2)
     failures = [
-        (f["kind"], f["case"]["family"], f["case"]["number"])
+        (f["kind"], f["case"]["family"], f["case"]["number"], f["detail"][:200])
         for f in report.failures
         if f["kind"] != "slow"
     ]
     assert failures == []
-    for family in ("rinex-nav", "rinex-obs"):
+    assert sorted(report.counts) == families
+    for family in families:
         counts = report.counts[family]
-        assert sum(counts.values()) == 120
-        assert counts["ok"] > 20 and counts["error"] > 10
+        assert sum(counts.values()) == SHORT_CASES, family
+        assert counts["ok"] > 0 and counts["error"] > 0, (family, dict(counts))
 
 
 def _sample_obs_seed() -> Seed:
