@@ -16,23 +16,18 @@ from benchmarks.real_heading import (
     truth_velocity,
 )
 from tests.conftest import require_shared
+from tests.helpers.comma2k19 import COMMA, imported_comma2k19
 from vo_doppler.geo import ecef_to_enu_rotation
 from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.io.comma2k19 import read_vehicle_poses
-from vo_doppler.io.comma2k19_import import import_comma2k19
-from vo_doppler.io.sequence import read_sequence
 from vo_doppler.run import RunConfig, sequence_heading
 
 pytestmark = pytest.mark.shared_data
-COMMA = "comma2k19_example1"
-SP3 = f"{COMMA}/Sta20124_1400_1845.sp3"
 
 
 @pytest.fixture(scope="module")
 def comma(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("comma") / "sequence"
-    import_comma2k19(require_shared(COMMA), folder, require_shared(SP3))
-    sequence = read_sequence(folder)
+    sequence = imported_comma2k19(tmp_path_factory)
     config = RunConfig()
     gnss = gnss_velocity(
         sequence.observations,

@@ -33,10 +33,10 @@ class VelocitySolution:
 
     ``covariance`` 4×4 of (v_x, v_y, v_z, b) in ECEF; ``dop`` columns (GDOP, PDOP, HDOP, VDOP,
     TDOP) of the velocity geometry (unweighted). Integrity: ``verified`` epochs have redundancy
-    (≥ 5 satellites after exclusion) and pass the chi-square test; ``valid`` epochs are the
-    verified ones plus the solved four-satellite epochs, whose fault cannot be detected (the
-    weaker flag: valid, not verified). An epoch whose residuals still fail the test after the
-    allowed exclusions is not valid (its values are kept for inspection). Unsolved epochs: NaN.
+    (≥ 5 satellites after exclusion) and pass the chi-square test, and only they are ``valid``
+    (the two flags agree; a solved four-satellite epoch, whose fault cannot be detected, and an
+    epoch whose residuals still fail the test after the allowed exclusions keep their values
+    for inspection but are not valid). Unsolved epochs: NaN.
     """
 
     t: np.ndarray
