@@ -20,8 +20,9 @@ class SppSolution:
     valid: np.ndarray
     n_no_ephemeris: int
     verified: np.ndarray | None = None
-    """Redundant and passing the chi-square test (``valid`` adds the solved epochs without
-    redundancy; an epoch still failing the test after the allowed exclusions is not valid)."""
+    """Redundant and passing the chi-square test, the same as ``valid`` (a solved epoch without
+    redundancy, or still failing the test after the allowed exclusions, keeps its position but
+    is not valid)."""
     hdop: np.ndarray | None = None
     horizontal_sigma_m: np.ndarray | None = None
     """√(σ_e² + σ_n²) of the position from the weighted covariance (m)."""
