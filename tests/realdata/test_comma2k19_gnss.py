@@ -11,7 +11,7 @@ import pytest
 from benchmarks.real_heading import conventional_figures, truth_velocity
 from tests.helpers.comma2k19 import imported_comma2k19
 from vo_doppler.report.run_outputs import doppler_noise_summary
-from vo_doppler.run import RunConfig, sequence_gnss
+from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
 
 pytestmark = pytest.mark.shared_data
 
@@ -72,3 +72,17 @@ def test_conventional_velocity_with_fitted_noise(comma):
     assert figures["course_error_deg"]["median"] <= 0.3
     assert figures["course_error_deg"]["p95"] <= 1.5
     assert figures["valid_course_beyond_bound"] <= 1
+
+
+def test_heading_table_carries_the_conventional_sigma_and_dop(comma):
+    """heading.csv's conventional speed σ and HDOP are the velocity solution's, on its valid
+    epochs (measured median 0.038 m/s and 0.72 on this minute)."""
+    sequence, gnss = comma
+    velocity = gnss.velocity
+    table = sequence_heading(sequence, gnss.rows, velocity, RunConfig().heading)
+    valid = table.conv_valid
+    assert valid.mean() > 0.9
+    np.testing.assert_array_equal(table.speed_sigma_conv[valid], velocity.speed_sigma_mps[valid])
+    np.testing.assert_array_equal(table.hdop_conv[valid], velocity.dop[valid, 2])
+    assert np.isnan(table.speed_sigma_conv[~valid]).all()
+    assert 0.01 < np.median(table.speed_sigma_conv[valid]) < 0.1
