@@ -4,8 +4,8 @@ Columns: gps_time_s, heading_tc_deg, heading_tc_sigma_deg, tc_reliable, n_obs_wi
 n_sat_epoch, heading_conv_deg, conv_valid, gyro_bias_dps, wheel_scale, then rejected_rows (rows
 of the window rejected as biased, NLOS) and tc_verifiable (a bias on any satellite used would
 have shown), tc_window_s (the tight heading's window, the same on every row),
-heading_conv_sigma_deg (the conventional heading's standard deviation), conv_speed_sigma_mps
-and conv_hdop (the conventional velocity's speed standard deviation and horizontal DOP).
+conv_speed_sigma_mps and conv_hdop (the conventional velocity's speed standard deviation and
+horizontal DOP) and heading_conv_sigma_deg (the conventional heading's standard deviation).
 Unavailable headings are written as ``nan``; flags as 0/1. Reading converts back to yaw (rad,
 counter-clockwise from east); the last six columns are optional (files written before they
 existed read as zero, or NaN for the standard deviations and the DOP).
@@ -39,9 +39,9 @@ OPTIONAL_COLUMNS = (
     "rejected_rows",
     "tc_verifiable",
     "tc_window_s",
-    "heading_conv_sigma_deg",
     "conv_speed_sigma_mps",
     "conv_hdop",
+    "heading_conv_sigma_deg",
 )
 
 
@@ -60,9 +60,9 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         table.rejected_rows.astype(int),
         table.tc_verifiable.astype(int),
         np.full(len(table), table.tc_window_s),
-        np.degrees(table.sigma_conv),
         table.speed_sigma_conv,
         table.hdop_conv,
+        np.degrees(table.sigma_conv),
     ]
     formats = (
         "{:.3f}",
@@ -79,8 +79,8 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         "{:d}",
         "{:g}",
         "{:.4f}",
-        "{:.4f}",
         "{:.3f}",
+        "{:.4f}",
     )
     with Path(path).open("w", newline="") as handle:
         handle.write(",".join(COLUMNS + OPTIONAL_COLUMNS) + "\n")
