@@ -54,3 +54,19 @@ def test_static_septentrio_spp(systems):
     assert np.median(np.linalg.norm(enu[:, :2], axis=1)) < 5.0
     assert np.median(np.abs(enu[:, 2])) < 5.0
     assert np.all(np.std(enu, axis=0) < 1.0)
+
+
+@pytest.mark.shared_data
+def test_spp_without_redundancy_is_solved_but_not_valid():
+    """Four GPS satellites: the position is computed (no redundancy, nothing to test) and not
+    valid; with every satellite valid and verified agree."""
+    obs = read_obs(require_shared("septentrio_static/rover.obs"))
+    nav = read_nav(require_shared("septentrio_static/base.nav"))
+    four = (obs.system == "G") & np.isin(obs.prn, [5, 13, 15, 20])  # above the mask throughout
+    solution = solve_spp(obs.subset(four), nav, "G")
+    solved = np.isfinite(solution.position_ecef[:, 0])
+    assert solved.mean() > 0.9
+    assert not solution.valid.any() and not solution.verified.any()
+    everything = solve_spp(obs, nav, "G")
+    np.testing.assert_array_equal(everything.valid, everything.verified)
+    assert everything.valid.all()

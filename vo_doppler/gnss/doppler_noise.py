@@ -1,16 +1,18 @@
-"""Doppler noise estimated from the data: the σ of each range rate from the residuals of the
-conventional solutions, per satellite and signal, refreshed as the data arrive.
+"""Doppler noise estimated from the data, per satellite: the σ of each range rate from the
+residuals of the conventional solutions, per satellite and signal, refreshed as the data arrive.
 
 For each (satellite, Doppler code) the residuals r = y − H x̂ of the solved epochs over the
-last ``window_s`` seconds (causal: only rows up to the current one) give a robust scale,
-σ = 1.4826 · median |r − median r| (the normalised median absolute deviation, consistent with
-a Gaussian σ and unmoved by up to half of the rows being faults, e.g. reflections). Until a
-satellite has ``min_rows`` residuals its σ stays the prior one (receiver-reported or the
-C/N0 model). Each residual is first divided by √r_i, r_i = 1 − h_ii its redundancy number
-(h_ii the diagonal of the weighted hat matrix H (HᵀWH)⁻¹ HᵀW of its epoch): a least-squares
-residual has variance r_i σ_i², so the raw residuals would understate σ. A floor keeps one
-quiet satellite from dominating. The residuals include the
-fault rows the exclusion removed, so a satellite that keeps faulting gets a large σ.
+last ``window_s`` seconds (causal: only rows up to the current one), each divided by the row's
+``reference`` σ (1 m/s, or the C/N0 model's σ of ``noise_model``), give a robust scale
+k = 1.4826 · median |z − median z| (the normalised median absolute deviation, consistent with
+a Gaussian σ and unmoved by up to half of the rows being faults, e.g. reflections); the row's
+σ is k times its reference, so that a satellite's multipath scales the C/N0 law instead of
+replacing it. Until a satellite has ``min_rows`` residuals its σ stays the prior one. Each
+residual is first divided by √r_i, r_i = 1 − h_ii its redundancy number (h_ii the diagonal of
+the weighted hat matrix H (HᵀWH)⁻¹ HᵀW of its epoch): a least-squares residual has variance
+r_i σ_i², so the raw residuals would understate σ. A floor keeps one quiet satellite from
+dominating. The residuals include the fault rows the exclusion removed, so a satellite that
+keeps faulting gets a large σ.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ def fitted_sigma(
     rows,
     solution,
     prior_sigma: np.ndarray,
+    reference_sigma: np.ndarray | float = 1.0,
     window_s: float = WINDOW_S,
     min_rows: int = MIN_ROWS,
     floor_mps: float = FLOOR_MPS,
@@ -35,8 +38,9 @@ def fitted_sigma(
     satellites with too few residuals keep ``prior_sigma``)."""
     state = np.column_stack([solution.velocity_ecef, solution.clock_drift_mps])[rows.epoch]
     predicted = -np.einsum("ij,ij->i", rows.los, state[:, :3]) + state[:, 3]
-    redundancy = _redundancy(rows, rows.sigma())
-    residual = (rows.reduced() - predicted) / np.sqrt(redundancy)
+    redundancy = redundancy_numbers(rows, rows.sigma())
+    reference = np.broadcast_to(np.asarray(reference_sigma, dtype=float), (len(rows),))
+    residual = (rows.reduced() - predicted) / np.sqrt(redundancy) / reference
     sigma = np.asarray(prior_sigma, dtype=float).copy()
     signal = np.char.add(np.char.add(rows.system, rows.prn.astype(str)), rows.code)
     for name in np.unique(signal):
@@ -49,11 +53,11 @@ def fitted_sigma(
                 continue
             recent = residual[members[start[k] : k + 1]]
             spread = MAD_TO_SIGMA * np.median(np.abs(recent - np.median(recent)))
-            sigma[row] = max(spread, floor_mps)
+            sigma[row] = max(spread * reference[row], floor_mps)
     return sigma
 
 
-def _redundancy(rows, sigma: np.ndarray) -> np.ndarray:
+def redundancy_numbers(rows, sigma: np.ndarray) -> np.ndarray:
     """r_i = 1 − h_ii per row with all of its epoch's rows in the design (NaN without
     redundancy)."""
     out = np.full(len(rows), np.nan)

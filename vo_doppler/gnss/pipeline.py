@@ -7,7 +7,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.gnss.doppler_velocity import DopplerRows, doppler_velocity
+from vo_doppler.gnss.doppler_velocity import (
+    DopplerRows,
+    doppler_rows,
+    solve_velocity,
+    solve_with_fitted_noise,
+)
+from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
 from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
@@ -18,12 +24,17 @@ from vo_doppler.model.observations import Observations
 
 @dataclass(frozen=True)
 class GnssVelocityResult:
-    """Velocity solution, the Doppler rows it used, the SPP fixes and the positions used."""
+    """Velocity solution, the Doppler rows it used, the SPP fixes, the positions used and the
+    Doppler noise models fitted per signal (``noise_model``)."""
 
     velocity: VelocitySolution
     rows: DopplerRows
     spp: SppSolution
     receiver_ecef: np.ndarray
+    noise_models: dict[tuple[str, str], NoiseModel]
+    noise_fitted: bool
+    """True when the rows' σ are the fitted ones; else the models are fitted for the record
+    (one pass on the residuals of the solution as weighted) and not applied."""
 
 
 RANGE_RATE_SOURCES = ("doppler", "phase")
@@ -44,7 +55,8 @@ def gnss_velocity(
     nearest one, or ``receiver_ecef`` / the RINEX approximate position when SPP fails);
     ``range_rate`` 'phase' replaces the Doppler by the carrier-phase rate (``phase_rate``);
     ``reported_sigma`` the receiver's σ of the range rates (weights where present);
-    ``fit_noise`` re-solves with σ fitted to the residuals (``doppler_noise``)."""
+    ``fit_noise`` re-solves with σ fitted to the residuals (``solve_with_fitted_noise``);
+    without it the σ models are still fitted, for the record."""
     if range_rate not in RANGE_RATE_SOURCES:
         raise ValueError(f"range_rate must be one of {RANGE_RATE_SOURCES}")
     spp = solve_spp(obs, source, systems, elevation_mask_rad)
@@ -55,7 +67,7 @@ def gnss_velocity(
         else receiver_positions(spp, fallback)
     )
     measured = carrier_phase_doppler(obs) if range_rate == "phase" else obs
-    velocity, rows = doppler_velocity(
+    rows = doppler_rows(
         measured,
         source,
         position,
@@ -63,6 +75,10 @@ def gnss_velocity(
         bands=bands,
         elevation_mask_rad=elevation_mask_rad,
         reported_sigma=reported_sigma,
-        fit_noise=fit_noise,
     )
-    return GnssVelocityResult(velocity, rows, spp, np.asarray(position))
+    if fit_noise:
+        velocity, rows, models = solve_with_fitted_noise(rows, obs.epoch_time)
+    else:
+        velocity = solve_velocity(rows, obs.epoch_time)
+        models = fit_noise_models(rows, velocity)
+    return GnssVelocityResult(velocity, rows, spp, np.asarray(position), models, fit_noise)

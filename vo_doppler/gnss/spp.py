@@ -125,8 +125,7 @@ def solve_spp(
         if result is None:
             continue
         x, clock, used, residuals, dop, fit = result
-        valid[k] = fit.passed or fit.dof == 0
-        verified[k] = fit.passed
+        valid[k] = verified[k] = fit.passed
         quality[k] = _horizontal_quality(x, fit.design, fit.covariance[:3, :3])
         position[k] = x
         for s, value in clock.items():

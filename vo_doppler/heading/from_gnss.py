@@ -86,8 +86,9 @@ def heading_from_gnss(
     antenna_lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0),
 ) -> HeadingTable:
     """The heading stage ([TK18] sec. 3.3–3.5) from the GNSS stage's Doppler rows and
-    conventional velocities: what ``run``, ``heading`` and the benchmarks all call."""
-    return heading_pipeline(
+    conventional velocities: what ``run``, ``heading`` and the benchmarks all call. The table
+    carries the conventional solution's speed σ and HDOP on its valid epochs."""
+    table = heading_pipeline(
         epoch_time,
         rows.in_enu(),
         velocity.velocity_enu,
@@ -99,3 +100,6 @@ def heading_from_gnss(
         conventional_yaw_sigma=conventional_heading_sigma(velocity, enu),
         antenna_lever_arm_m=antenna_lever_arm_m,
     )
+    table.speed_sigma_conv = np.where(table.conv_valid, velocity.speed_sigma_mps, np.nan)
+    table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)
+    return table

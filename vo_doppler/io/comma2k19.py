@@ -45,7 +45,8 @@ def read_gyro_yaw_rate(base: str | Path, signal: str = "gyro") -> tuple[np.ndarr
 class GroundTruth:
     """``global_pose`` on the monotonic clock: yaw (rad, CCW, unwrapped) of the velocity and
     body yaw of the device's forward axis (a constant mounting offset apart, the same heading
-    when the vehicle does not slip), lat/lon (rad)."""
+    when the vehicle does not slip), lat/lon (rad); ``gps_minus_mono_s`` = GPS seconds of week
+    − monotonic clock (``gps_minus_log`` within the pose's GPS week)."""
 
     t: np.ndarray
     yaw: np.ndarray
@@ -69,7 +70,7 @@ def read_ground_truth(base: str | Path) -> GroundTruth:
     device_to_ecef = Rotation.from_quat(quaternion_wxyz[:, [1, 2, 3, 0]]).as_matrix()
     forward = np.einsum("nij,nj->ni", rotation, device_to_ecef[:, :, 0])
     body_yaw = np.unwrap(np.arctan2(forward[:, 1], forward[:, 0]))
-    offset = float(np.median(gps_times[:, 1] - t))
+    offset = gps_minus_log(base) - float(np.median(gps_times[:, 0])) * SECONDS_PER_WEEK
     return GroundTruth(t, yaw, body_yaw, lat, lon, height, offset)
 
 
@@ -181,16 +182,38 @@ def _plausible(value: np.ndarray, glonass: np.ndarray) -> np.ndarray:
 
 
 def gps_minus_mono(base: str | Path) -> float:
-    """GPS time (s since 1980) − the logs' monotonic clock, from ``global_pose``'s paired
-    ``frame_times`` and ``frame_gps_times`` (their spread is checked below 1 ms)."""
-    t = load_array(base, "global_pose", "frame_times")
-    gps_times = load_array(base, "global_pose", "frame_gps_times")
-    offsets = gps_times[:, 0] * SECONDS_PER_WEEK + gps_times[:, 1] - t
-    if np.ptp(offsets) > 1e-3:
-        raise InputError(
-            f"global_pose frame_gps_times − frame_times varies by {np.ptp(offsets):.3f} s",
-            Path(base, "global_pose"),
-        )
+    """GPS time (s since 1980) − the logs' monotonic clock as ``global_pose`` states it, from
+    its paired ``frame_times`` and ``frame_gps_times`` (spread checked below 1 ms). Kept for
+    the record only: ``gps_minus_log`` is the offset to use (its docstring says why)."""
+    return _constant_offset(
+        load_array(base, "global_pose", "frame_gps_times"),
+        load_array(base, "global_pose", "frame_times"),
+        Path(base, "global_pose"),
+    )
+
+
+def gps_minus_log(base: str | Path) -> float:
+    """GPS time (s since 1980) − the logs' monotonic clock, from ``raw_gnss_ublox``: each
+    row's receiver time tag (GPS week, time of week; the receiver clock error of a few ms
+    apart) against its log time ``t`` (spread checked below 1 ms).
+
+    ``global_pose``'s own ``frame_gps_times`` put the same clock 0.126 s later on the example
+    segment, and they are the ones that are wrong: the pose agrees with the IMU on the log
+    clock (gyro and accelerometer lag ≤ 0.01 s against the pose's rotation rate and
+    acceleration), while the Doppler velocity, solved on the receiver's time tags, agrees with
+    the pose velocity only when the pose is shifted by 0.129 ± 0.004 s (fitted as the speed
+    error per unit acceleration), i.e. put on GPS time through this offset.
+    """
+    value = load_array(base, *RAW_GNSS, "value")
+    return _constant_offset(value[:, 1:3], load_array(base, *RAW_GNSS, "t"), Path(base, *RAW_GNSS))
+
+
+def _constant_offset(week_and_seconds: np.ndarray, log_t: np.ndarray, path: Path) -> float:
+    """Median of (week × 604800 + seconds of week) − log time; InputError when it varies."""
+    offsets = week_and_seconds[:, 0] * SECONDS_PER_WEEK + week_and_seconds[:, 1] - log_t
+    if offsets.size == 0 or np.ptp(offsets) > 1e-3:
+        spread = np.ptp(offsets) if offsets.size else np.nan
+        raise InputError(f"GPS time − log time varies by {spread:.3f} s (or no rows)", path)
     return float(np.median(offsets))
 
 
@@ -198,8 +221,9 @@ MOVING_MPS = 5.0
 
 
 def read_vehicle_poses(base: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """``global_pose`` as vehicle poses: GPS times (s), ECEF positions (m), vehicle→ECEF
-    rotation matrices (vehicle x forward, y left, z up) and the device's mounting yaw (rad).
+    """``global_pose`` as vehicle poses: times on the log clock (``frame_times``, s; add
+    ``gps_minus_log`` for GPS time), ECEF positions (m), vehicle→ECEF rotation matrices
+    (vehicle x forward, y left, z up) and the device's mounting yaw (rad).
 
     ``frame_orientations`` (w, x, y, z) rotate the device frame (x forward, y right, z down)
     into ECEF: checked, its x axis follows ``frame_velocities`` to within the mounting angle.
@@ -207,7 +231,7 @@ def read_vehicle_poses(base: str | Path) -> tuple[np.ndarray, np.ndarray, np.nda
     median angle from the device's forward axis to the velocity while moving (> 5 m/s; a car
     does not slip), so that the vehicle's x axis is its direction of travel.
     """
-    gps_times = load_array(base, "global_pose", "frame_gps_times")
+    t = load_array(base, "global_pose", "frame_times")
     positions = load_array(base, "global_pose", "frame_positions")
     velocity = load_array(base, "global_pose", "frame_velocities")
     quaternion_wxyz = load_array(base, "global_pose", "frame_orientations")
@@ -221,4 +245,4 @@ def read_vehicle_poses(base: str | Path) -> tuple[np.ndarray, np.ndarray, np.nda
     mount = float(np.median(np.angle(np.exp(1j * offset[moving])))) if moving.any() else 0.0
     turn = Rotation.from_euler("z", mount).as_matrix()
     vehicle_to_ecef = (device_to_ecef * np.array([1.0, -1.0, -1.0])) @ turn
-    return gps_times[:, 0] * SECONDS_PER_WEEK + gps_times[:, 1], positions, vehicle_to_ecef, mount
+    return t, positions, vehicle_to_ecef, mount

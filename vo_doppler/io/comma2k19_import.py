@@ -7,8 +7,11 @@ receiver's σ of each pseudorange rate, ``gnss.doppler_sigma``), the precise orb
 clocks) copied beside them, ``can/`` (the segment's ``can_motion.log``, or one written from
 ``raw_can`` in candump format, with the DBC), ``imu/yaw_rate.csv`` (gyro yaw rate on the log
 clock, a record for ``heading --yaw-rate-csv``), ``ground_truth.tum`` (``global_pose`` as
-vehicle poses in the ENU frame of the first pose, GPS time) and the clock offsets (log
-clock → GPS time from ``global_pose``). A segment's ``video.hevc`` is decoded into the camera
+vehicle poses in the ENU frame of the first pose) and the clock offsets. Every log-clock
+time (CAN, IMU, the poses' and the video's ``frame_times``) goes to GPS time through one
+offset, the GNSS receiver's time tags against their log times (``comma2k19.gps_minus_log``;
+``global_pose``'s own ``frame_gps_times``, 0.126 s later on the example segment, are recorded
+but not used). A segment's ``video.hevc`` is decoded into the camera
 (``vo_doppler.io.comma2k19_video``); without one the camera section is left out, and ``run``
 then runs the non-visual pipelines.
 """
@@ -28,6 +31,7 @@ from scipy.spatial.transform import Rotation
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.io.comma2k19 import (
+    gps_minus_log,
     gps_minus_mono,
     load_array,
     read_gyro_yaw_rate,
@@ -83,7 +87,8 @@ def import_comma2k19(
         raise InputError("no DBC for the CAN log (give --dbc)", dbc)
     for folder in ("gnss", "can", "imu"):
         (output / folder).mkdir(parents=True, exist_ok=True)
-    offset = gps_minus_mono(segment)
+    offset = gps_minus_log(segment)
+    pose_offset = gps_minus_mono(segment)
     raw = read_raw_gnss(segment)
     t_pose, ecef, vehicle_to_ecef, mount = read_vehicle_poses(segment)
     lat, lon, height = (float(v) for v in ecef_to_geodetic(ecef[0]))
@@ -105,7 +110,7 @@ def import_comma2k19(
     )
     rotation = ecef_to_enu_rotation(lat, lon)
     truth = Trajectory(
-        t_pose,
+        t_pose + offset,
         (ecef - ecef[0]) @ rotation.T,
         Rotation.from_matrix(np.einsum("ij,njk->nik", rotation, vehicle_to_ecef)),
     )
@@ -141,7 +146,8 @@ def import_comma2k19(
         },
         "clock_offsets": {
             "log_to_gps_s": offset,
-            "from": "global_pose frame_gps_times − frame_times",
+            "from": "raw_gnss_ublox receiver time tags minus log times",
+            "global_pose_frame_gps_times_minus_log_s": pose_offset,
         },
     }
     (output / MANIFEST).write_text(yaml.safe_dump(manifest, sort_keys=False))

@@ -3,11 +3,12 @@
 Columns: gps_time_s, heading_tc_deg, heading_tc_sigma_deg, tc_reliable, n_obs_window,
 n_sat_epoch, heading_conv_deg, conv_valid, gyro_bias_dps, wheel_scale, then rejected_rows (rows
 of the window rejected as biased, NLOS) and tc_verifiable (a bias on any satellite used would
-have shown), tc_window_s (the tight heading's window, the same on every row) and
-heading_conv_sigma_deg (the conventional heading's standard deviation).
+have shown), tc_window_s (the tight heading's window, the same on every row),
+conv_speed_sigma_mps and conv_hdop (the conventional velocity's speed standard deviation and
+horizontal DOP) and heading_conv_sigma_deg (the conventional heading's standard deviation).
 Unavailable headings are written as ``nan``; flags as 0/1. Reading converts back to yaw (rad,
-counter-clockwise from east); the last four columns are optional (files written before they
-existed read as zero, or NaN for the standard deviation).
+counter-clockwise from east); the last six columns are optional (files written before they
+existed read as zero, or NaN for the standard deviations and the DOP).
 """
 
 from __future__ import annotations
@@ -34,7 +35,14 @@ COLUMNS = (
     "gyro_bias_dps",
     "wheel_scale",
 )
-OPTIONAL_COLUMNS = ("rejected_rows", "tc_verifiable", "tc_window_s", "heading_conv_sigma_deg")
+OPTIONAL_COLUMNS = (
+    "rejected_rows",
+    "tc_verifiable",
+    "tc_window_s",
+    "conv_speed_sigma_mps",
+    "conv_hdop",
+    "heading_conv_sigma_deg",
+)
 
 
 def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
@@ -52,6 +60,8 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         table.rejected_rows.astype(int),
         table.tc_verifiable.astype(int),
         np.full(len(table), table.tc_window_s),
+        table.speed_sigma_conv,
+        table.hdop_conv,
         np.degrees(table.sigma_conv),
     ]
     formats = (
@@ -68,6 +78,8 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         "{:d}",
         "{:d}",
         "{:g}",
+        "{:.4f}",
+        "{:.3f}",
         "{:.4f}",
     )
     with Path(path).open("w", newline="") as handle:
@@ -122,6 +134,8 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
         rejected_rows=optional.get("rejected_rows", np.zeros(len(data))).astype(int),
         tc_verifiable=optional.get("tc_verifiable", np.zeros(len(data))) > 0.5,
         sigma_conv=np.radians(optional.get("heading_conv_sigma_deg", np.full(len(data), np.nan))),
+        speed_sigma_conv=optional.get("conv_speed_sigma_mps", np.full(len(data), np.nan)),
+        hdop_conv=optional.get("conv_hdop", np.full(len(data), np.nan)),
         tc_window_s=_window_s(optional.get("tc_window_s"), path),
     )
 

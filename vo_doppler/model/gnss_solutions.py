@@ -20,8 +20,9 @@ class SppSolution:
     valid: np.ndarray
     n_no_ephemeris: int
     verified: np.ndarray | None = None
-    """Redundant and passing the chi-square test (``valid`` adds the solved epochs without
-    redundancy; an epoch still failing the test after the allowed exclusions is not valid)."""
+    """Redundant and passing the chi-square test, the same as ``valid`` (a solved epoch without
+    redundancy, or still failing the test after the allowed exclusions, keeps its position but
+    is not valid)."""
     hdop: np.ndarray | None = None
     horizontal_sigma_m: np.ndarray | None = None
     """√(σ_e² + σ_n²) of the position from the weighted covariance (m)."""
@@ -33,10 +34,10 @@ class VelocitySolution:
 
     ``covariance`` 4×4 of (v_x, v_y, v_z, b) in ECEF; ``dop`` columns (GDOP, PDOP, HDOP, VDOP,
     TDOP) of the velocity geometry (unweighted). Integrity: ``verified`` epochs have redundancy
-    (≥ 5 satellites after exclusion) and pass the chi-square test; ``valid`` epochs are the
-    verified ones plus the solved four-satellite epochs, whose fault cannot be detected (the
-    weaker flag: valid, not verified). An epoch whose residuals still fail the test after the
-    allowed exclusions is not valid (its values are kept for inspection). Unsolved epochs: NaN.
+    (≥ 5 satellites after exclusion) and pass the chi-square test, and only they are ``valid``
+    (the two flags agree; a solved four-satellite epoch, whose fault cannot be detected, and an
+    epoch whose residuals still fail the test after the allowed exclusions keep their values
+    for inspection but are not valid). Unsolved epochs: NaN.
     """
 
     t: np.ndarray

@@ -35,6 +35,11 @@ class HeadingTable:
     residuals (False where it could hide, and where the heading is unavailable)."""
     sigma_conv: np.ndarray | None = None
     """Standard deviation (rad) of the conventional heading, NaN where unknown or invalid."""
+    speed_sigma_conv: np.ndarray | None = None
+    """Standard deviation (m/s) of the conventional horizontal speed, NaN where unknown or
+    invalid."""
+    hdop_conv: np.ndarray | None = None
+    """Horizontal DOP of the conventional velocity's geometry, NaN where unknown or invalid."""
     tc_window_s: float = DEFAULT_TC_WINDOW_S
     """The tightly coupled solver's window (s): its headings' errors are correlated over it."""
 
@@ -44,8 +49,9 @@ class HeadingTable:
             self.rejected_rows = np.zeros(n, dtype=int)
         if self.tc_verifiable is None:
             self.tc_verifiable = np.zeros(n, dtype=bool)
-        if self.sigma_conv is None:
-            self.sigma_conv = np.full(n, np.nan)
+        for name in ("sigma_conv", "speed_sigma_conv", "hdop_conv"):
+            if getattr(self, name) is None:
+                setattr(self, name, np.full(n, np.nan))
 
     def __len__(self) -> int:
         return len(self.t)

@@ -89,6 +89,7 @@ def summarise(result: RunResult) -> dict:
         "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "final_wheel_scale": float(table.wheel_scale[-1]),
         "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
+        "doppler_noise": doppler_noise_summary(result),
     }
     if result.vo is not None:
         summary["vo_frames"] = result.vo.stats.frames
@@ -99,11 +100,21 @@ def summarise(result: RunResult) -> dict:
     return summary
 
 
+def doppler_noise_summary(result: RunResult) -> dict:
+    """The Doppler σ(C/N0, elevation) model fitted per receiver signal (``gnss.noise_model``)
+    and whether the run weighted the Doppler with it."""
+    gnss = result.gnss
+    return {
+        "applied": gnss.noise_fitted,
+        "models": [model.to_dict() for model in gnss.noise_models.values()],
+    }
+
+
 def readable_facts(summary: dict) -> dict[str, str]:
     """The summary's scalars with labels and units for people (the report's list)."""
     facts = {}
     for key, value in summary.items():
-        if key in ("evaluation", "time_order", "warnings"):
+        if key in ("evaluation", "time_order", "warnings", "doppler_noise"):
             continue
         label, fmt = FACT_FORMATS.get(key, (key, "{}"))
         facts[label] = fmt.format(value)
