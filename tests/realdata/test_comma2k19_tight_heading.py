@@ -11,7 +11,7 @@ import pytest
 from benchmarks.heading_real_noise import row_cases
 from benchmarks.real_heading import MOVING_MPS, calibration_truth, tight_figures, truth_velocity
 from tests.conftest import require_shared
-from tests.realdata.test_comma2k19 import COMMA, SP3
+from tests.helpers.comma2k19 import COMMA, SP3
 from vo_doppler.heading.tight_heading import tight_heading_series
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.sequence import read_sequence
