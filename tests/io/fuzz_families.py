@@ -26,6 +26,7 @@ import yaml
 from tests.conftest import REPO_ROOT, shared_data_dir
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.doppler_sigma import read_doppler_sigma
 from vo_doppler.io.gps_fixes import read_gps_fixes
 from vo_doppler.io.heading_csv import COLUMNS, read_heading_csv
 from vo_doppler.io.images import read_times
@@ -291,6 +292,35 @@ def check_times(times, path: Path) -> list[str]:
     return _times_ok(times, "image")
 
 
+def doppler_sigma_text() -> bytes:
+    rows = ["gps_time_s,sat,code,sigma_mps"]
+    for epoch in range(40):
+        for sat in ("G05", "G13", "E24", "C11"):
+            rows.append(f"{1.4e9 + 0.1 * epoch:.3f},{sat},D1C,{0.02 + 0.001 * epoch:.6g}")
+    return ("\n".join(rows) + "\n").encode()
+
+
+def doppler_sigma_seeds(seed_cls) -> list:
+    return [seed_cls("doppler_sigma.csv", doppler_sigma_text, suffix=".csv")]
+
+
+def check_doppler_sigma(table, path: Path) -> list[str]:
+    bad = _finite(table.t, "epoch") + _finite(table.sigma_mps, "sigma")
+    if table.sigma_mps.size and not (table.sigma_mps > 0).all():
+        bad.append("sigma not positive")
+    keys = list(
+        zip(
+            np.round(table.t * 1e3).tolist(),
+            table.sat_id.tolist(),
+            table.code.tolist(),
+            strict=True,
+        )
+    )
+    if len(set(keys)) != len(keys):
+        bad.append("repeated (epoch, satellite, code)")
+    return bad
+
+
 def manifest_text() -> bytes:
     """The sample's manifest with its paths made absolute (read with outside paths allowed)."""
     manifest = yaml.safe_load((SAMPLE / "sequence.yaml").read_text())
@@ -340,5 +370,6 @@ def register_all(register, family_cls, seed_cls) -> None:
         ("calibration", calibration_seeds, read_camera, check_camera),
         ("times", times_seeds, read_times_any_count, check_times),
         ("manifest", manifest_seeds, read_manifest_sequence, check_sequence),
+        ("doppler-sigma", doppler_sigma_seeds, read_doppler_sigma, check_doppler_sigma),
     ):
         register(family_cls(name, seeds(make), read, check))
