@@ -22,12 +22,12 @@ from vo_doppler.heading.calibration import (
 )
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, causal_calibration
 from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.comma2k19 import gps_minus_log
 from vo_doppler.model.timeseries import integral_at, sample
 
 COMMA = "comma2k19_example1"
 GPS_MINUS_UTC_2018_S = 18.0
 GPS_EPOCH_UNIX_S = 315964800.0
-SECONDS_PER_WEEK = 604800.0
 
 
 def _drive(n=300, rate_hz=10.0, seed=0):
@@ -240,8 +240,7 @@ def _comma_ground_truth():
     rotation = np.stack([ecef_to_enu_rotation(a, b) for a, b in zip(lat, lon, strict=True)])
     enu = np.einsum("nij,nj->ni", rotation, velocity)
     yaw = np.unwrap(np.arctan2(enu[:, 1], enu[:, 0]))
-    gps_minus_mono = np.load(gp / "frame_gps_times")[:, 1] - t
-    return t, yaw, np.linalg.norm(velocity, axis=1), gps_minus_mono
+    return t, yaw, np.linalg.norm(velocity, axis=1)
 
 
 @pytest.mark.shared_data
@@ -253,11 +252,10 @@ def test_comma_can_bias_and_scale_from_receiver_doppler():
         "KINEMATICS.YAW_RATE",  # counter-clockwise positive as decoded (checked vs the gyro)
         "WHEEL_SPEEDS.WHEEL_SPEED_RL,WHEEL_SPEEDS.WHEEL_SPEED_RR",
     )
-    t_gt, yaw_gt, speed_gt, gps_minus_mono = _comma_ground_truth()
+    t_gt, yaw_gt, speed_gt = _comma_ground_truth()
     # Time bases: CAN log stamps and processed_log/global_pose `t` share the logger's
-    # monotonic clock (CAN wheel-speed times equal processed_log's to 1 µs, see test_can).
-    # global_pose maps it to GPS time with a constant offset (spread < 1 µs here).
-    assert np.ptp(gps_minus_mono) < 1e-5
+    # monotonic clock (CAN wheel-speed times equal processed_log's to 1 µs, see test_can);
+    # the receiver's own time tags map it to GPS time (io.comma2k19.gps_minus_log).
 
     # Ground-truth values, fitted with the same models the calibration uses.
     phi_gt = integral_at(motion.yaw_rate.t, motion.yaw_rate.value, t_gt)
@@ -270,11 +268,11 @@ def test_comma_can_bias_and_scale_from_receiver_doppler():
     assert np.degrees(bias_gt) == pytest.approx(-0.41, abs=0.02)  # README: ≈0.4 deg/s
 
     # Doppler reference: the receiver's own speed/course. Its fixes carry UTC time (ms); the
-    # fix epoch on the monotonic clock is GPS time − (GPS − mono offset of global_pose).
+    # fix epoch on the monotonic clock is GPS time − (GPS − log clock).
     gnss = require_shared(f"{COMMA}/processed_log/GNSS/live_gnss_ublox")
     fixes = np.load(gnss / "value")
     gps_s = fixes[:, 3] / 1000.0 - GPS_EPOCH_UNIX_S + GPS_MINUS_UTC_2018_S
-    t_fix = np.mod(gps_s, SECONDS_PER_WEEK) - np.mean(gps_minus_mono)
+    t_fix = gps_s - gps_minus_log(base)
     log_delay = np.load(gnss / "t") - t_fix
     assert 0.0 < np.median(log_delay) < 0.5  # fixes are logged ≈0.2 s after their epoch
     doppler_speed = fixes[:, 2]
