@@ -8,11 +8,11 @@ summary. Each check states its threshold:
   above 0.2 rad/s (11.5 °/s) or a median lateral acceleration |yaw rate × speed| above
   1.5 m/s² is no car's road driving (a skid pad would be); when the DBC says rad/s and the
   values read as deg/s would be ordinary, the hint says so;
-* the CAN clock against the GNSS speed: the lag maximising the correlation of the wheel speed
-  with the horizontal Doppler speed at the valid GNSS epochs (±5 s, or a quarter of a shorter
-  record) is the residual clock
-  offset; beyond 0.2 s it is a warning reporting the estimate next to the manifest's
-  ``time_offset_s``;
+* the CAN clock against the GNSS speed: the lag (±5 s, or a quarter of a shorter record) at
+  which the scaled wheel speed agrees best with the horizontal Doppler speed at the valid GNSS
+  epochs, by the median absolute difference (robust to the reflected epochs that pass the
+  velocity's own tests, up to half of them), is the residual clock offset; beyond 0.2 s it is a
+  warning reporting the estimate next to the manifest's ``time_offset_s``;
 * the ENU origin against the RINEX approximate position: more than 10 km apart is a warning;
 * a standstill interval given by hand against the measured speed: a median speed above
   0.5 m/s inside it (GNSS speed noise at rest is a few cm/s to 0.2 m/s) is an error, since the
@@ -38,8 +38,9 @@ MAX_MEDIAN_LATERAL_ACCELERATION = 1.5
 CLOCK_TOLERANCE_S = 0.2
 CLOCK_SEARCH_S = 5.0
 CLOCK_RATE_HZ = 10.0
-MIN_CORRELATION = 0.5
-"""Correlation peak below which the speed profiles are too featureless to estimate a lag."""
+MIN_CLOCK_CONTRAST = 0.1
+"""Share of its largest value by which the agreement must vary over the lags: below, the speed
+profile is too featureless (a constant speed) to estimate a lag."""
 STANDSTILL_MAX_MEDIAN_SPEED_MPS = 0.5
 ORIGIN_TOLERANCE_M = 10_000.0
 EARTH_SURFACE_M = (6.3e6, 6.4e6)
@@ -48,10 +49,12 @@ EARTH_SURFACE_M = (6.3e6, 6.4e6)
 
 @dataclass(frozen=True)
 class ClockOffsetEstimate:
-    """Residual offset (s) to add to the sensor's ``time_offset_s`` and the correlation peak."""
+    """Residual offset (s) to add to the sensor's ``time_offset_s``; the median absolute
+    difference (m/s) of the GNSS and the scaled wheel speed at that shift and unshifted."""
 
     residual_s: float
-    correlation: float
+    difference_mps: float
+    unshifted_difference_mps: float
 
 
 def moving_yaw_rate_medians(yaw_rate: SensorSeries, speed: SensorSeries) -> tuple[float, float]:
@@ -93,9 +96,11 @@ def estimate_clock_offset(
 ) -> ClockOffsetEstimate | None:
     """Residual clock offset of ``speed`` (already on GPS time by the manifest's offset) against
     the GNSS speed: the shift s (0.1-s steps within ±5 s or a quarter of the record, refined by
-    a parabola through the peak) maximising the correlation of gnss(t) with speed(t − s) over
-    the valid GNSS epochs (no interpolation across GNSS gaps); None with fewer than 20 epochs
-    inside the overlap or a peak below 0.5."""
+    a parabola through the best step) minimising median |gnss(t) − k·speed(t − s)| over the
+    valid GNSS epochs (no interpolation across GNSS gaps), k the median ratio of the two speeds
+    where the wheels turn faster than 2 m/s (the wheel scale error). None with fewer than 20
+    epochs inside the overlap, without moving epochs, or when the agreement hardly depends on
+    the shift (``MIN_CLOCK_CONTRAST``)."""
     t_gnss, speed_gnss = np.asarray(t_gnss, dtype=float), np.asarray(speed_gnss, dtype=float)
     if len(speed) < 2:
         return None
@@ -105,25 +110,36 @@ def estimate_clock_offset(
     )
     if np.count_nonzero(inside) < 20:
         return None
-    t, reference = t_gnss[inside], speed_gnss[inside] - speed_gnss[inside].mean()
+    t, reference = t_gnss[inside], speed_gnss[inside]
     step = 1.0 / CLOCK_RATE_HZ
     lags = np.arange(-span, span + step / 2, step)
-    scores = np.empty(len(lags))
-    for k, lag in enumerate(lags):
-        shifted = np.interp(t - lag, speed.t, speed.value)
-        shifted = shifted - shifted.mean()
-        norm = np.linalg.norm(shifted) * np.linalg.norm(reference)
-        scores[k] = shifted @ reference / norm if norm > 0 else 0.0
-    best = int(np.argmax(scores))
-    if scores[best] < MIN_CORRELATION:
+    costs = np.array([_speed_difference(speed, t, reference, lag) for lag in lags])
+    if not np.isfinite(costs).all() or np.ptp(costs) <= MIN_CLOCK_CONTRAST * costs.max():
         return None
+    best = int(np.argmin(costs))
     offset = 0.0
     if 0 < best < len(lags) - 1:
-        left, mid, right = scores[best - 1 : best + 2]
+        left, mid, right = costs[best - 1 : best + 2]
         curvature = left - 2 * mid + right
-        if curvature < 0:
+        if curvature > 0:
             offset = 0.5 * (left - right) / curvature
-    return ClockOffsetEstimate(float(lags[best] + offset * step), float(scores[best]))
+    residual = float(lags[best] + offset * step)
+    return ClockOffsetEstimate(
+        residual,
+        _speed_difference(speed, t, reference, residual),
+        _speed_difference(speed, t, reference, 0.0),
+    )
+
+
+def _speed_difference(speed: SensorSeries, t: np.ndarray, reference: np.ndarray, lag: float):
+    """median |reference − k·speed(t − lag)| with k the median ratio over moving epochs; NaN
+    without a moving epoch."""
+    shifted = np.interp(t - lag, speed.t, speed.value)
+    moving = shifted > MOVING_SPEED_MPS
+    if not moving.any():
+        return float("nan")
+    scale = np.median(reference[moving] / shifted[moving])
+    return float(np.median(np.abs(reference - scale * shifted)))
 
 
 def clock_warning(
@@ -134,7 +150,8 @@ def clock_warning(
         return None
     return (
         f"{sensor} clock: the wheel speed matches the GNSS Doppler speed best when shifted by "
-        f"{estimate.residual_s:+.2f} s (correlation {estimate.correlation:.2f}); the manifest's "
+        f"{estimate.residual_s:+.2f} s (median difference {estimate.difference_mps:.2f} m/s, "
+        f"{estimate.unshifted_difference_mps:.2f} m/s unshifted); the manifest's "
         f"time_offset_s {manifest_offset_s:.3f} s should be about "
         f"{manifest_offset_s + estimate.residual_s:.3f} s"
     )

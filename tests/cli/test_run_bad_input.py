@@ -430,3 +430,17 @@ def test_gzip_bomb_as_the_observation_file_is_exit_1_without_filling_memory(
     err = failing_run(folder, tmp_path, capsys)
     assert "rover.obs.gz" in err and "decompressed data exceed" in err
     assert (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024 < 500
+
+
+def test_can_clock_off_by_most_of_a_second_is_warned_with_the_fix(tmp_path, caplog):
+    folder = tmp_path / "drive"
+    simulate = ["simulate", "--duration", "30", "--seed", "1", "--no-images", "-o", str(folder)]
+    assert main(simulate) == EXIT_OK  # with reflected signals (default)
+    offset = yaml.safe_load((folder / "sequence.yaml").read_text())["can"]["time_offset_s"]
+    edit_manifest(folder, "can", "time_offset_s", offset + 0.8)
+    code, out = run(folder, tmp_path, caplog)
+    assert code == EXIT_OK
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["can_clock_residual_offset_s"] == pytest.approx(-0.8, abs=0.1)
+    warning = next(w for w in summary["warnings"] if w.startswith("CAN clock"))
+    assert f"should be about {offset:.1f}" in warning
