@@ -6,8 +6,13 @@ import numpy as np
 import pytest
 
 from tests.conftest import require_shared
-from vo_doppler.geo import SPEED_OF_LIGHT
-from vo_doppler.gnss.doppler_velocity import doppler_rows, doppler_velocity, solve_velocity
+from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.gnss.doppler_velocity import (
+    doppler_rows,
+    doppler_velocity,
+    solve_velocity,
+    vertical_velocity_plausible,
+)
 from vo_doppler.gnss.satellite_source import transmit_states
 from vo_doppler.gnss.signals import wavelengths
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
@@ -17,7 +22,8 @@ from vo_doppler.model.observations import Observations, ObsHeader
 
 RECEIVER = np.array([-3817680.9841, 3562840.0688, 3650158.4543])
 T0 = 1403252400.0  # 2024-06-24 08:20:00 GPST
-VELOCITY = np.array([12.5, -7.25, 0.5])
+ENU_TO_ECEF = ecef_to_enu_rotation(*(float(a) for a in ecef_to_geodetic(RECEIVER)[:2])).T
+VELOCITY = ENU_TO_ECEF @ np.array([-3.2, 8.5, 0.3])  # a car at 9.1 m/s up a 3.3 % grade
 DRIFT_MPS = -135.0
 SATELLITES = {"G": (5, 6, 7, 11, 13, 20), "E": (4, 10, 12), "R": (1, 3, 11), "C": (23, 25, 32)}
 CODES = {"G": ("D1C", "D2W", "D5Q"), "E": ("D1C", "D7Q"), "R": ("D1C", "D2C"), "C": ("D2I",)}
@@ -29,8 +35,9 @@ def nav():
     return read_nav(require_shared("septentrio_static/base.nav"))
 
 
-def _synthetic_obs(nav, n_epochs=3, satellites=SATELLITES) -> Observations:
-    """Noise-free Doppler of a receiver at RECEIVER moving at VELOCITY with clock drift."""
+def _synthetic_obs(nav, n_epochs=3, satellites=SATELLITES, velocity=VELOCITY) -> Observations:
+    """Noise-free Doppler of a receiver at RECEIVER moving at ``velocity`` (ECEF) with clock
+    drift."""
     codes = sorted({c for cs in CODES.values() for c in cs})
     rows = {k: [] for k in ("time", "system", "prn", "code", "value")}
     for k in range(n_epochs):
@@ -41,7 +48,7 @@ def _synthetic_obs(nav, n_epochs=3, satellites=SATELLITES) -> Observations:
             e = states.position - RECEIVER
             e /= np.linalg.norm(e, axis=1, keepdims=True)
             rate = (
-                np.einsum("ij,ij->i", e, states.velocity - VELOCITY)
+                np.einsum("ij,ij->i", e, states.velocity - velocity)
                 + DRIFT_MPS
                 - SPEED_OF_LIGHT * states.clock_drift
             )
@@ -105,6 +112,32 @@ def test_exact_synthetic_doppler_is_inverted(nav):
     np.testing.assert_allclose(solution.speed_mps, speed, atol=1e-6)
 
 
+@pytest.mark.parametrize(
+    "up_mps, plausible",
+    [(0.0, True), (2.7, True), (-2.7, True), (2.8, False), (-11.2, False)],
+)
+def test_a_car_does_not_climb_steeper_than_its_road(nav, up_mps, plausible):
+    """At 9.1 m/s with σ 0.1·speed + 0.1 m/s the gate is 3·0.914 = 2.74 m/s (a 30 % grade): a
+    velocity solved exactly that climbs or falls beyond it is not valid."""
+    velocity = ENU_TO_ECEF @ np.array([-3.2, 8.5, up_mps])
+    obs = _synthetic_obs(nav, n_epochs=1, velocity=velocity)
+    solution, _ = doppler_velocity(obs, nav, RECEIVER, systems="GREC", elevation_mask_rad=-1.0)
+    np.testing.assert_allclose(solution.velocity_enu[0], [-3.2, 8.5, up_mps], atol=1e-6)
+    assert bool(solution.valid[0]) == plausible == bool(solution.verified[0])
+
+
+def test_the_vertical_gate_widens_with_speed_and_with_the_solutions_own_sigma():
+    still = np.zeros((3, 3))
+    assert vertical_velocity_plausible(np.array([0.0, 0.0, 0.29]), still)
+    assert not vertical_velocity_plausible(np.array([0.0, 0.0, 0.31]), still)
+    gate = 3.0 * np.hypot(3.0, 0.1)  # at 30 m/s
+    assert vertical_velocity_plausible(np.array([30.0, 0.0, gate - 0.01]), still)
+    assert not vertical_velocity_plausible(np.array([30.0, 0.0, gate + 0.01]), still)
+    uncertain = np.diag([0.0, 0.0, 4.0])
+    assert vertical_velocity_plausible(np.array([0.0, 0.0, 5.9]), uncertain)
+    assert not vertical_velocity_plausible(np.array([0.0, 0.0, 6.1]), uncertain)
+
+
 def test_one_faulty_satellite_is_excluded(nav):
     obs = _synthetic_obs(nav, n_epochs=1)
     value = obs.value.copy()
@@ -165,7 +198,11 @@ def test_yamatogawa_walk_speeds():
     solution, _ = doppler_velocity(obs, nav, position, systems="G")
     t = solution.t - solution.t[0]
     speed = solution.speed_mps
-    assert solution.valid.all()
+    # Three noisy epochs (residual RMS 0.12-0.32 m/s, 2-3 times their neighbours') climb or
+    # fall at 0.6-1.1 m/s while walking at 0.8 m/s: not valid, by the vertical test alone.
+    invalid = ~solution.valid
+    assert np.count_nonzero(invalid) == 3 and solution.n_sat[invalid].min() >= 5
+    assert np.all(np.abs(solution.velocity_enu[invalid, 2]) > 0.6)
     walking = speed[t > 70]
     assert 0.4 <= np.median(walking) <= 2.0
     assert np.percentile(walking, 90) <= 2.0

@@ -14,8 +14,15 @@ where it reports one, or σ fitted to the residuals (``doppler_noise``). Fault d
 exclusion: chi-square test, iterated (``lsq.lsq_with_exclusion``). Fewer than four satellites
 (after mask and exclusion) → the epoch is unavailable (NaN), never guessed. ``valid`` only where
 the solution could be tested and passed: at least five satellites left after the exclusion
-(redundancy) and the chi-square test accepting them; a four-satellite solution is given, with
-its σ, but not valid.
+(redundancy), the chi-square test accepting them, and a vertical velocity that a land vehicle
+can have (:func:`vertical_velocity_plausible`); a four-satellite solution is given, with its σ,
+but not valid.
+
+The vertical test adds the one fact about a car that the GNSS-only solution leaves out: it
+climbs no steeper than its road. Reflected (NLOS) Doppler from several satellites at once can
+be fitted by a wrong velocity that passes the chi-square test (with five or six satellites it
+has one or two degrees of freedom), but the wrong velocity then rarely stays horizontal
+(docs/design.md (2a): measured on simulated canyons and the real recordings).
 """
 
 from __future__ import annotations
@@ -44,6 +51,12 @@ CN0_REFERENCE_DBHZ = 45.0
 CN0_DEFAULT_DBHZ = 40.0
 MIN_SATELLITES = 4
 NOISE_PASSES = 3
+GRADE_SIGMA = 0.1
+"""σ of a land vehicle's vertical over its horizontal speed: a road's grade of 10 %, so that
+the 3σ gate is a 30 % grade, steeper than public roads (the steepest streets are 30–35 %)."""
+VERTICAL_FLOOR_MPS = 0.1
+"""σ of the vertical velocity at any speed: suspension, a walker's gait, a phone in a hand."""
+VERTICAL_GATE = 3.0
 
 
 def range_rate_sigma(cn0: np.ndarray, elevation: np.ndarray, sigma0: float) -> np.ndarray:
@@ -212,8 +225,6 @@ def solve_velocity(
         n_sat[k] = np.unique(satellite[r][result.used]).size if result.valid else 0
         if not result.valid:
             continue
-        verified[k] = result.passed and n_sat[k] > MIN_SATELLITES
-        valid[k] = verified[k]
         velocity[k] = result.x[:3]
         drift[k] = result.x[3]
         covariance[k] = result.covariance
@@ -223,10 +234,15 @@ def solve_velocity(
         lat, lon, _ = ecef_to_geodetic(rows.receiver_ecef[r[0]])
         rotation = ecef_to_enu_rotation(float(lat), float(lon))
         velocity_enu[k] = rotation @ result.x[:3]
+        covariance_enu = rotation @ result.covariance[:3, :3] @ rotation.T
         dop[k] = _dop(H[result.used], rotation)
-        horizontal_sigma[k] = speed_course_sigma(
-            velocity_enu[k], rotation @ result.covariance[:3, :3] @ rotation.T
+        horizontal_sigma[k] = speed_course_sigma(velocity_enu[k], covariance_enu)
+        verified[k] = (
+            result.passed
+            and n_sat[k] > MIN_SATELLITES
+            and vertical_velocity_plausible(velocity_enu[k], covariance_enu)
         )
+        valid[k] = verified[k]
     return VelocitySolution(
         t=epoch_time,
         velocity_ecef=velocity,
@@ -244,6 +260,15 @@ def solve_velocity(
         speed_sigma_mps=horizontal_sigma[:, 0],
         course_sigma_rad=horizontal_sigma[:, 1],
     )
+
+
+def vertical_velocity_plausible(velocity_enu: np.ndarray, covariance_enu: np.ndarray) -> bool:
+    """Whether the vertical velocity v_u is one a land vehicle can have:
+    |v_u| ≤ 3·√(P_uu + σ_g²), σ_g = √((g·s)² + f²) with s the horizontal speed, g
+    ``GRADE_SIGMA`` and f ``VERTICAL_FLOOR_MPS``; P_uu the solution's own vertical variance."""
+    speed = np.hypot(velocity_enu[0], velocity_enu[1])
+    prior = (GRADE_SIGMA * speed) ** 2 + VERTICAL_FLOOR_MPS**2
+    return bool(abs(velocity_enu[2]) <= VERTICAL_GATE * np.sqrt(covariance_enu[2, 2] + prior))
 
 
 def speed_course_sigma(velocity_enu: np.ndarray, covariance_enu: np.ndarray) -> np.ndarray:
