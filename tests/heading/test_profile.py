@@ -59,3 +59,25 @@ def test_a_mirror_ambiguous_cost_has_two_grid_minima():
     best, second = grid_minima(Q, 360)
     found = sorted(wrap_angle(np.array([best[0], second[0]])))
     np.testing.assert_allclose(found, [-0.6, 0.6], atol=np.radians(1.0))
+
+
+def test_prior_is_a_weighted_pseudo_observation():
+    """A Gaussian prior p₁ ~ N(μ, σ²) on the linear parameters gives the cost of the rows plus
+    (p₁ − μ)²/σ², minimised over p: the same Q as one more row [0, 0, μ] with T-row e₁ and
+    weight 1/σ²."""
+    X, T, w = _window(0.7, (2.0, -0.3), seed=6)
+    X = X.copy()
+    X[0, :, 2] += np.random.default_rng(3).normal(0.0, 0.1, X.shape[1])
+    mu, sigma = 0.2, 0.05
+    prior = (np.array([[[0.0, 0.0, mu]]]), np.array([[[0.0, 1.0]]]), np.array([[sigma**-2]]))
+    Q, *_ = projected_normal_matrix(X, T, w, prior)
+    appended = [np.concatenate(pair, axis=1) for pair in zip((X, T, w), prior, strict=True)]
+    Q_rows, *_ = projected_normal_matrix(*appended)
+    np.testing.assert_allclose(Q, Q_rows, rtol=1e-12, atol=1e-12)
+    theta = np.array(0.4)
+    r_theta = X[0] @ z_of(theta)
+    W = np.diag(w[0])
+    normal = T[0].T @ W @ T[0] + np.diag([0.0, sigma**-2])
+    p = np.linalg.solve(normal, T[0].T @ W @ r_theta + np.array([0.0, mu * sigma**-2]))
+    direct = (r_theta - T[0] @ p) @ W @ (r_theta - T[0] @ p) + ((p[1] - mu) / sigma) ** 2
+    assert quadratic(Q, z_of(theta), z_of(theta))[0] == pytest.approx(direct, rel=1e-10)

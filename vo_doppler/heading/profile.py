@@ -1,9 +1,10 @@
 """The tightly coupled heading's profiled cost ([TK18] sec. 3.5) and its minimisation, per window.
 
 With the model y = a·cos θ₀ + b·sin θ₀ + T·p (p the parameters that enter linearly: clock drift
-and its rate, and any bias being tested), the observation matrix X = [−a, −b, y] and
-z = [cos θ₀, sin θ₀, 1], the weighted residual sum of squares minimised over p is zᵀQz with
-Q = XᵀWX − XᵀWT (TᵀWT)⁺ TᵀWX (variable projection): a trigonometric polynomial of degree 2 in
+and its rate, the road grade, and any bias being tested), the observation matrix
+X = [−a, −b, y] and z = [cos θ₀, sin θ₀, 1], the weighted residual sum of squares minimised over
+p is zᵀQz with Q = XᵀWX − XᵀWT (TᵀWT)⁺ TᵀWX (variable projection; a Gaussian prior on p enters
+as weighted pseudo-observations in the three sums): a trigonometric polynomial of degree 2 in
 θ₀ with at most two minima, found on a grid and refined by Gauss–Newton. Arrays carry any
 number of leading axes (windows, hypotheses); the last ones are rows and vector components.
 """
@@ -27,12 +28,22 @@ def weighted_gram(U, w, V):
     return np.swapaxes(U * w[..., None], -1, -2) @ V
 
 
-def projected_normal_matrix(X, T, w):
+def projected_normal_matrix(X, T, w, prior=None):
     """Q per window from rows (K, R, ·) with weights (K, R), plus XᵀWX, XᵀWT, (TᵀWT)⁺ and
-    rank(TᵀWT)."""
+    rank(TᵀWT), the normal matrices including ``prior``.
+
+    ``prior``: pseudo-observations (X_p, T_p, w_p) of shapes (K, P, 3), (K, P, p), (K, P) — a
+    Gaussian prior on the linear parameters, e.g. X_p = [0, 0, μ], T_p = e_j, w_p = 1/σ² for
+    p_j ~ N(μ, σ²) — added to the normal matrices; they take no robust weight (default:
+    none)."""
     XtW = np.swapaxes(X * w[..., None], -1, -2)
     XtWX, XtWT = XtW @ X, XtW @ T
     TtWT = weighted_gram(T, w, T)
+    if prior is not None:
+        Xp, Tp, wp = prior
+        XtWX = XtWX + weighted_gram(Xp, wp, Xp)
+        XtWT = XtWT + weighted_gram(Xp, wp, Tp)
+        TtWT = TtWT + weighted_gram(Tp, wp, Tp)
     Q, TtWT_pinv, rank = project_out(XtWX, XtWT, TtWT)
     return Q, XtWX, XtWT, TtWT_pinv, rank
 

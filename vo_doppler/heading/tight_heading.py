@@ -3,27 +3,37 @@
 For the window of epochs t ∈ (t_k − W, t_k] ending at epoch k, every Doppler row (see
 :mod:`vo_doppler.heading.rows`) gives one equation in three unknowns:
 
-    y = −G·v_t + ρ_t,    v_t = s_t · [cos θ_t, sin θ_t, 0],
+    y = −G·v_t + ρ_t,    v_t = s_t · [cos θ_t, sin θ_t, g],
     θ_t = θ₀ + Φ_t − Φ_k,    ρ_t = ρ₀ − α · (t − t_k)
 
-with s_t the calibrated speed, Φ the integrated calibrated yaw rate (counter-clockwise
-positive, so Φ_t − Φ_k = −∫_t^{t_k} ω dτ: "θ₀ minus the integrated yaw rate since t"), θ the
-yaw counter-clockwise from east, ρ the receiver clock drift (m/s) and α its rate. Vertical
-velocity is taken as zero (land vehicle). θ₀ is the heading at the newest epoch. An antenna at
-(r_x, r_y) off the vehicle origin moves at v_t = R(θ_t)·[s_t − ω_t·r_y, ω_t·r_x] (v + ω × r,
-ω_t the calibrated yaw rate), which is still a·cos θ₀ + b·sin θ₀ (``lever_velocity``).
+with s_t the calibrated (horizontal) speed, Φ the integrated calibrated yaw rate
+(counter-clockwise positive, so Φ_t − Φ_k = −∫_t^{t_k} ω dτ: "θ₀ minus the integrated yaw rate
+since t"), θ the yaw counter-clockwise from east, ρ the receiver clock drift (m/s), α its rate
+and g = tan γ the road grade (rise over run) over the window. [TK18] takes the vertical
+velocity as zero; on a road that climbs, g·s_t (0.19 m/s median on the comma2k19 minute, 1 %)
+shows in every row as −g_up·g·s_t, which a level model puts into θ₀ (0.1–1° with two to four
+satellites). The grade has a Gaussian prior g ~ N(μ, σ_g²) (σ_g = ``grade_sigma``, μ = 0
+unless given): with three or more satellites the data outweigh it, with two on a straight road
+(where θ₀ and g trade off) it keeps the window observable. θ₀ is the heading at the newest
+epoch. An antenna at (r_x, r_y) off the vehicle origin moves at
+v_t = R(θ_t)·[s_t − ω_t·r_y, ω_t·r_x] (v + ω × r, ω_t the calibrated yaw rate), which is still
+a·cos θ₀ + b·sin θ₀ (``lever_velocity``).
 
-Given θ₀ the model is linear in (ρ₀, α), so they are projected out (variable projection): with
-z = [cos θ₀, sin θ₀, 1] the weighted residual sum of squares is zᵀQz for a 3×3 matrix Q per
-window — a trigonometric polynomial of degree 2 in θ₀ with at most two minima. A grid finds
+Given θ₀ the model is linear in (ρ₀, α, g), so they are projected out (variable projection),
+the grade's prior entering as a weighted pseudo-observation 0·θ₀ + g = μ: with
+z = [cos θ₀, sin θ₀, 1] the weighted residual sum of squares (prior term included) is zᵀQz for
+a 3×3 matrix Q per window — a trigonometric polynomial of degree 2 in θ₀ with at most two
+minima. A grid finds
 both, Gauss–Newton refines them, and iteratively re-weighted passes apply Huber weights. Two
 minima that fit equally well (e.g. two satellites on a straight road) make the window
 *ambiguous*: the one nearer the previous heading propagated by the gyro is kept, or the epoch
 is unavailable. Whenever two separated minima and a recent heading exist, that propagated
 heading weighs in as a pseudo-observation (variance σ_prev² + σ²): the root of least fit +
 prior cost is kept, so that one noisy window cannot switch a two-satellite solution to its
-mirror root. The θ₀ variance is s²/(J_θᵀ P J_θ) (the marginal of the full covariance),
-s² the a-posteriori variance factor, or more where the profiled cost is not a parabola (a flat
+mirror root. The θ₀ variance is s²/(J_θᵀ P J_θ) (the marginal of the full covariance, the
+grade's included), s² the a-posteriori variance factor — with the grade prior's share
+restored to its own σ_g where s² < 1, since s² measures the Doppler rows, not the road — or
+more where the profiled cost is not a parabola (a flat
 side, a near second minimum: the Δcost = n²·s² intervals, n = 1 … 3, are read off the cost),
 plus the errors that white Doppler noise does not cover:
 the uncertainty of the speed scale and gyro bias calibration and the random walk of the clock
@@ -110,6 +120,11 @@ class TightHeadingConfig:
     profile_max_rad: float = np.radians(30.0)
     clock_drift_walk_mps: float = 0.01
     """Random walk of the receiver clock drift (m/s per √s) that the linear model leaves out."""
+    grade_sigma: float = 0.05
+    """Standard deviation of the zero-mean Gaussian prior on the road grade g = tan γ (rise over
+    run) of a window (0: level road, no grade unknown). Road design keeps grades within ±6 %
+    on main roads and ±10–12 % on streets; σ 5 % covers both at 2σ while pulling a window whose
+    geometry cannot see the vertical (two low satellites) towards level."""
     outlier_passes: int = 4
     """Rejection rounds of data snooping per window, each removing one satellite, a pair, or a
     satellite's significant rows (0: no NLOS rejection)."""
@@ -170,6 +185,7 @@ class _WindowSolution:
     variance_factor: np.ndarray
     rho0: np.ndarray
     alpha: np.ndarray
+    grade: np.ndarray
     n_obs: np.ndarray
     n_rejected: np.ndarray
     inconsistent: np.ndarray
@@ -180,20 +196,22 @@ class _WindowSolution:
     scale_gain: np.ndarray
     bias_gain: np.ndarray
     clock_walk_gain: np.ndarray
+    prior_variance: np.ndarray
 
 
-def _fit(X, T, w, config):
-    """Huber-weighted fit of padded windows (observation matrix ``X``, clock design ``T``,
-    a-priori weights ``w``): the robust weights, both minima of the final profiled cost and the
-    clock parameters at the best one."""
+def _fit(X, T, prior, w, config):
+    """Huber-weighted fit of padded windows (observation matrix ``X``, design ``T`` of the
+    linear parameters and the precision ``prior`` of their prior, a-priori weights ``w``): the
+    robust weights, both minima of the final profiled cost and the linear parameters at the
+    best one."""
     weights = np.array(w)
     for _ in range(config.robust_passes):
-        Q, _, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, weights)
+        Q, _, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, weights, prior)
         theta = gauss_newton(Q, grid_minima(Q, config.grid_size)[0], config.gauss_newton_iterations)
         normalised = np.abs(_residual(X, T, XtWT, TtWT_pinv, theta)) * np.sqrt(w)
         ratio = normalised / _robust_scale(normalised, w, config)[:, None]
         weights = w * np.minimum(1.0, config.huber_k / np.maximum(ratio, 1e-300))
-    Q, XtWX, XtWT, TtWT_pinv, rank_t = projected_normal_matrix(X, T, weights)
+    Q, XtWX, XtWT, TtWT_pinv, rank_t = projected_normal_matrix(X, T, weights, prior)
     first, second = grid_minima(Q, config.grid_size)
     theta = gauss_newton(Q, first, config.gauss_newton_iterations)
     has_second = np.isfinite(second)
@@ -215,8 +233,26 @@ def _fit(X, T, w, config):
     }
 
 
+def linear_design(tau, grade_coefficient, grade_prior):
+    """Design T (K, R, p) of the linear parameters and their prior as pseudo-observations
+    (:func:`vo_doppler.heading.profile.projected_normal_matrix`): T = [1, −τ, c] for (ρ₀, α, g)
+    with g ~ N(μ, σ²) per window (``grade_prior`` = (μ, σ), each (K,)), the clock drift and its
+    rate free; or T = [1, −τ] and no prior for a level road (no ``grade_coefficient`` c)."""
+    columns = [np.ones_like(tau), -tau]
+    if grade_coefficient is None:
+        return np.stack(columns, axis=-1), None
+    mean, sigma = (np.broadcast_to(np.asarray(v, dtype=float), tau.shape[:1]) for v in grade_prior)
+    zeros, ones = np.zeros_like(mean), np.ones_like(mean)
+    prior = (
+        np.stack([zeros, zeros, mean], axis=-1)[:, None, :],
+        np.stack([zeros, zeros, ones], axis=-1)[:, None, :],
+        sigma[:, None] ** -2.0,
+    )
+    return np.stack([*columns, grade_coefficient], axis=-1), prior
+
+
 def _residual(X, T, XtWT, TtWT_pinv, theta):
-    """Observation − model per row at θ₀, with (ρ₀, α) at their conditional optimum."""
+    """Observation − model per row at θ₀, with (ρ₀, α, g) at their conditional optimum."""
     z = z_of(theta)
     params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
     return (X @ z[:, :, None])[:, :, 0] - np.einsum("krj,kj->kr", T, params)
@@ -233,10 +269,18 @@ def solve_windows(
     scale_sigma=0.0,
     bias_sigma=0.0,
     noise: ReceiverNoise | None = None,
+    grade_coefficient=None,
+    grade_prior=(0.0, None),
 ):
     """Solve padded windows at once: arrays (K, R) of reduced observations ``y``, coefficients
-    ``a``, ``b`` (model a·cos θ₀ + b·sin θ₀ + ρ₀ − α·τ), row times ``tau`` relative to the
-    window end and weights ``w`` (0 on padding). Returns a :class:`_WindowSolution`.
+    ``a``, ``b`` (model a·cos θ₀ + b·sin θ₀ + ρ₀ − α·τ + c·g), row times ``tau`` relative to
+    the window end and weights ``w`` (0 on padding). Returns a :class:`_WindowSolution`.
+
+    ``grade_coefficient`` (K, R): c = −g_up·s_t, how the window's road grade g moves each row
+    (the vertical velocity g·s_t seen along the line of sight); g is a linear unknown with the
+    Gaussian prior ``grade_prior`` = (μ, σ) per window or scalars (σ None:
+    ``config.grade_sigma``; :func:`linear_design`). None, or ``config.grade_sigma`` 0: a level
+    road.
 
     ``group`` (K, R) numbers the satellite of each row (default: every row its own), the unit
     of NLOS rejection: data snooping on the least-squares fit (:mod:`vo_doppler.heading.snooping`)
@@ -255,7 +299,11 @@ def solve_windows(
     """
     K, R = w.shape
     X = np.stack([-a, -b, y], axis=-1)
-    T = np.stack([np.ones_like(tau), -tau], axis=-1)
+    if config.grade_sigma <= 0:
+        grade_coefficient = None
+    grade_mean, grade_sigma = grade_prior
+    grade_sigma = config.grade_sigma if grade_sigma is None else grade_sigma
+    T, prior = linear_design(tau, grade_coefficient, (grade_mean, grade_sigma))
     if group is None:
         group = np.broadcast_to(np.arange(R), (K, R))
     n_groups = int(np.max(group, initial=0)) + 1
@@ -305,7 +353,7 @@ def solve_windows(
         todo = todo[repair]
         accepted[todo] &= ~tests.reject[repair]
         reflection[todo] |= np.count_nonzero(tests.reject[repair], axis=1) > 1
-    fit = _fit(X, T, w * accepted, config)
+    fit = _fit(X, T, prior, w * accepted, config)
     weights, theta, cost = fit["weights"], fit["theta"], fit["cost"]
     z, dz = z_of(theta), dz_of(theta)
     params = (fit["TtWT_pinv"] @ (fit["XtWT"].transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
@@ -317,7 +365,8 @@ def solve_windows(
     lost &= n_used < n_obs
     inconsistent |= lost
     fallback = inconsistent & blunder & ~lost
-    dof = n_used - (1 + fit["rank_t"])
+    # the prior is one pseudo-observation of the parameter it adds
+    dof = n_used + (prior is not None) - (1 + fit["rank_t"])
     used_w = np.where(accepted, w, 0.0)
     mean_w = np.sum(used_w, axis=1) / np.maximum(n_used, 1)
     floor = config.sigma_floor_mps**2 * mean_w
@@ -325,7 +374,9 @@ def solve_windows(
     # Fallback: the Huber weights hide the fault that could not be named, so the scatter is
     # judged with the a-priori weights (the least-squares variance factor at the robust θ₀).
     robust = np.flatnonzero(fallback & (dof > 0))
-    Q_prior = projected_normal_matrix(X[robust], T[robust], used_w[robust])[0]
+    Q_prior = projected_normal_matrix(
+        X[robust], T[robust], used_w[robust], None if prior is None else [v[robust] for v in prior]
+    )[0]
     unweighted = quadratic(Q_prior, z[robust], z[robust]) / dof[robust]
     posterior[robust] = np.maximum(posterior[robust], unweighted)
     variance_factor = np.maximum(posterior, floor)
@@ -341,6 +392,7 @@ def solve_windows(
         profile_sigma=_profile_sigma(Q, theta, cost, variance_factor, config),
         rho0=params[:, 0],
         alpha=params[:, 1],
+        grade=params[:, 2] if prior is not None else np.zeros(K),
         n_obs=n_obs,
         n_rejected=n_obs - n_used,
         inconsistent=inconsistent,
@@ -351,7 +403,7 @@ def solve_windows(
             _fallback_variance(suspects, theta, bias_variance),
             np.where(reflection, bias_variance, 0.0),
         ),
-        **_error_gains(a, b, tau, weights, theta),
+        **_error_gains(a, b, T, prior, weights, theta),
     )
 
 
@@ -396,21 +448,34 @@ def _profile_sigma(Q, theta, cost, variance_factor, config):
     return width
 
 
-def _error_gains(a, b, tau, weights, theta):
+def _error_gains(a, b, T, prior, weights, theta):
     """How errors the noise model leaves out move θ₀, per window (linearised at θ₀).
 
-    The weighted least-squares gain g = e₀ᵀ(JᵀWJ)⁺JᵀW of θ₀ (J = ∂model/∂(θ₀, ρ₀, α)) maps
-    a model error δm to δθ₀ = g·δm. A relative speed-scale error ε gives δm = ε·(a cos θ₀ +
+    The weighted least-squares gain g = e₀ᵀ(JᵀWJ + P)⁺JᵀW of θ₀ (J = ∂model/∂(θ₀, ρ₀, α[, g]),
+    i.e. [J_θ, T], P the prior's precision on the linear parameters) maps a model error δm to
+    δθ₀ = g·δm. A relative speed-scale error ε gives δm = ε·(a cos θ₀ +
     b sin θ₀); a yaw-rate bias error δb rotates row t by −δb·τ, δm = −δb·τ·J_θ; a clock drift
     that random-walks with unit intensity adds ∫ (Σ_{t_i ≥ s} g_i)² ds to var θ₀ (Brownian
     covariance min(s, t) − t_start, with the constant and linear parts absorbed by ρ₀ and α).
+    The prior's pseudo-observations (T_p, w_p) carry their own gain: an error of the prior mean
+    of σ = 1/√w_p moves θ₀ by (N⁻¹T_pᵀ)_θ·√w_p, so ``prior_variance`` = Σ_p (N⁻¹T_pᵀ)_θ²·w_p
+    is the part of var θ₀ that the prior's σ, not the Doppler noise, sets.
     """
     # Windows without a solution (no rows, or no yaw at their end) are unavailable anyway.
     theta, a, b, weights = (np.nan_to_num(x) for x in (theta, a, b, weights))
     cos_t, sin_t = np.cos(theta)[:, None], np.sin(theta)[:, None]
     j_theta = -a * sin_t + b * cos_t
-    J = np.stack([j_theta, np.ones_like(tau), -tau], axis=-1)
-    normal_inv = np.linalg.pinv(weighted_gram(J, weights, J), hermitian=True)
+    tau = -T[..., 1]
+    J = np.concatenate([j_theta[..., None], T], axis=-1)
+    normal = weighted_gram(J, weights, J)
+    prior_variance = np.zeros(len(theta))
+    if prior is not None:
+        _, Tp, wp = prior
+        normal[:, 1:, 1:] += weighted_gram(Tp, wp, Tp)
+    normal_inv = np.linalg.pinv(normal, hermitian=True)
+    if prior is not None:
+        prior_gain = np.einsum("kj,kpj->kp", normal_inv[:, 0, 1:], Tp)
+        prior_variance = np.sum(prior_gain**2 * wp, axis=1)
     g = np.einsum("kj,krj,kr->kr", normal_inv[:, 0, :], J, weights)
     tail = np.cumsum(g[:, ::-1], axis=1)[:, ::-1]
     step = np.diff(tau, axis=1, prepend=tau[:, :1])
@@ -418,6 +483,7 @@ def _error_gains(a, b, tau, weights, theta):
         "scale_gain": np.sum(g * (a * cos_t + b * sin_t), axis=1),
         "bias_gain": -np.sum(g * tau * j_theta, axis=1),
         "clock_walk_gain": np.sum(np.maximum(step, 0.0) * tail**2, axis=1),
+        "prior_variance": prior_variance,
     }
 
 
@@ -450,6 +516,7 @@ def tight_heading_series(
     speed_scale_sigma: np.ndarray | float = 0.0,
     gyro_bias_sigma: np.ndarray | float = 0.0,
     lever_velocity: np.ndarray | float = 0.0,
+    grade_prior: tuple = (0.0, None),
 ) -> TightHeadingResult:
     """Heading at every epoch from the window of Doppler rows ending there ([TK18] sec. 3.5).
 
@@ -463,6 +530,9 @@ def tight_heading_series(
     origin in the vehicle frame (along, across) = ω × r = (−ω·r_y, ω·r_x) for an antenna at
     (r_x, r_y) turning at ω (:func:`antenna_offset_velocity`); the Doppler rows then see
     v_t = R(θ_t)·[s_t + along_t, across_t] instead of s_t·[cos θ_t, sin θ_t].
+
+    ``grade_prior`` = (μ, σ), per epoch or scalars: the Gaussian prior of the road grade of the
+    window ending at each epoch (σ None: ``config.grade_sigma``; a level road when that is 0).
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     speed = np.asarray(speed, dtype=float)
@@ -471,6 +541,11 @@ def tight_heading_series(
     scale_sigma = np.broadcast_to(np.asarray(speed_scale_sigma, dtype=float), (m,))
     bias_sigma = np.broadcast_to(np.asarray(gyro_bias_sigma, dtype=float), (m,))
     lever = np.broadcast_to(np.asarray(lever_velocity, dtype=float), (m, 2))
+    grade_mean = np.broadcast_to(np.asarray(grade_prior[0], dtype=float), (m,))
+    grade_sigma = np.broadcast_to(
+        np.asarray(config.grade_sigma if grade_prior[1] is None else grade_prior[1], dtype=float),
+        (m,),
+    )
     if np.any(np.diff(t_epoch) <= 0):
         raise ValueError("epoch times must be strictly increasing")
     if m == 0:
@@ -509,7 +584,7 @@ def tight_heading_series(
     if len(chunks) > 1 and config.outlier_passes:
         samples = []
         for k in chunks:
-            y, a, b, tau, w, group = padded(k)
+            y, a, b, tau, w, group, _ = padded(k)
             samples.append(
                 noise_statistics(
                     a,
@@ -528,9 +603,22 @@ def tight_heading_series(
         noise = receiver_noise(samples)
     solutions = []
     for k in chunks:
-        y, a, b, tau, w, group = padded(k)
+        y, a, b, tau, w, group, grade_coefficient = padded(k)
         solutions.append(
-            solve_windows(y, a, b, tau, w, config, group, scale_sigma[k], bias_sigma[k], noise)
+            solve_windows(
+                y,
+                a,
+                b,
+                tau,
+                w,
+                config,
+                group,
+                scale_sigma[k],
+                bias_sigma[k],
+                noise,
+                grade_coefficient,
+                (grade_mean[k], grade_sigma[k]),
+            )
         )
     solution = _concatenate(solutions)
     model_variance = (
@@ -538,6 +626,9 @@ def tight_heading_series(
         + (solution.bias_gain * bias_sigma) ** 2
         + solution.clock_walk_gain * config.clock_drift_walk_mps**2
         + solution.repair_variance
+        # s²/info scales the whole var θ₀ by the Doppler rows' variance factor s², but the
+        # grade prior's part is set by its own σ: where s² < 1 it is restored to full size
+        + np.clip(1.0 - solution.variance_factor, 0.0, None) * solution.prior_variance
     )
     return _decide(solution, model_variance, t_epoch, speed, yaw_angle, n_sat_epoch, config)
 
@@ -555,11 +646,13 @@ def windows_per_chunk(width: int, n_groups: int, config: TightHeadingConfig) -> 
 def _padded_rows(rows, per_row, index, row_epoch, k, bounds, per_epoch, width):
     """The rows of windows ``k`` padded to ``width`` (the widest window of the series, so that
     a window's arrays, and so its solution, do not depend on the chunk it is solved in):
-    y, a, b, τ, w and the satellite group of :func:`solve_windows`."""
+    y, a, b, τ, w, the satellite group and the grade coefficient c = −g_up·s_t of
+    :func:`solve_windows`."""
     (y_all, row_group), (lo, hi) = per_row, bounds
     t_epoch, speed, yaw_angle, lever = per_epoch
     slot = lo[k][:, None] + np.arange(width)[None, :]
-    inside = slot < hi[k][:, None]
+    # a window whose end has no yaw angle has no θ₀ to solve for: no rows
+    inside = (slot < hi[k][:, None]) & np.isfinite(yaw_angle[k])[:, None]
     slot = np.where(inside, slot, 0)
     row = index[slot]
     epoch = row_epoch[slot]
@@ -576,7 +669,8 @@ def _padded_rows(rows, per_row, index, row_epoch, k, bounds, per_epoch, width):
     y = np.where(w > 0, y_all[row], 0.0)
     a, b, tau = np.where(w > 0, a, 0.0), np.where(w > 0, b, 0.0), np.where(w > 0, tau, 0.0)
     group = np.where(w > 0, row_group[row], 0)
-    return y, a, b, tau, w, group
+    grade_coefficient = np.where(w > 0, -rows.los[row, 2] * speed[epoch], 0.0)
+    return y, a, b, tau, w, group, grade_coefficient
 
 
 def antenna_offset_velocity(yaw_rate: np.ndarray, lever_arm_m) -> np.ndarray:
