@@ -214,6 +214,7 @@ def sequence_heading(
         sequence.enu,
         config,
         sequence.antenna_lever_arm_m,
+        sequence.forward_acceleration,
     )
 
 

@@ -84,10 +84,13 @@ def heading_from_gnss(
     enu: EnuFrame,
     config: HeadingPipelineConfig,
     antenna_lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0),
+    forward_acceleration: SensorSeries | None = None,
 ) -> HeadingTable:
     """The heading stage ([TK18] sec. 3.3–3.5) from the GNSS stage's Doppler rows and
     conventional velocities: what ``run``, ``heading`` and the benchmarks all call. The table
-    carries the conventional solution's speed σ and HDOP on its valid epochs."""
+    carries the conventional solution's speed σ and HDOP on its valid epochs.
+    ``forward_acceleration``: the road grade prior's accelerometer, if the recording has one
+    (:func:`~vo_doppler.heading.pipeline.heading_pipeline`)."""
     table = heading_pipeline(
         epoch_time,
         rows.in_enu(),
@@ -99,6 +102,7 @@ def heading_from_gnss(
         conventional_sigma_mps=velocity.sigma_mps,
         conventional_yaw_sigma=conventional_heading_sigma(velocity, enu),
         antenna_lever_arm_m=antenna_lever_arm_m,
+        forward_acceleration=forward_acceleration,
     )
     table.speed_sigma_conv = np.where(table.conv_valid, velocity.speed_sigma_mps, np.nan)
     table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)

@@ -30,6 +30,7 @@ from vo_doppler.heading.calibration import (
     WheelScaleKalman,
 )
 from vo_doppler.heading.conventional import heading_from_velocity, vehicle_heading_from_antenna
+from vo_doppler.heading.grade import GradePriorConfig, accelerometer_grade, grade_prior
 from vo_doppler.heading.tight_heading import (
     TightHeadingConfig,
     antenna_offset_velocity,
@@ -50,6 +51,8 @@ class HeadingPipelineConfig:
     calibration: str = "ls"
     gate: GateConfig = field(default_factory=GateConfig)
     tight: TightHeadingConfig = field(default_factory=TightHeadingConfig)
+    grade: GradePriorConfig = field(default_factory=GradePriorConfig)
+    """The road grade prior from a forward accelerometer, where the recording has one."""
     conventional_min_speed_mps: float = 0.5
     calibration_max_velocity_sigma_mps: float = 2.0
     """Conventional velocities with a larger standard deviation (√trace of the 3-D velocity
@@ -65,6 +68,18 @@ class HeadingPipelineConfig:
     """Spread of an uncalibrated wheel scale about one."""
     fixed_gyro_bias: float | None = None
     fixed_wheel_scale: float | None = None
+
+
+def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, config):
+    """(μ, σ) of the tight heading's grade per epoch: the accelerometer's where calibrated,
+    else N(0, ``config.tight.grade_sigma``)."""
+    level = (0.0, config.tight.grade_sigma)
+    if forward_acceleration is None or not len(forward_acceleration.t):
+        return level
+    raw = accelerometer_grade(t_epoch, config.tight.window_s, forward_acceleration, speed)
+    mean, sigma = grade_prior(raw, velocity, valid, config.grade)
+    known = np.isfinite(mean) & np.isfinite(sigma)
+    return np.where(known, mean, level[0]), np.where(known, sigma, level[1])
 
 
 def _calibrators(config: HeadingPipelineConfig):
@@ -149,6 +164,7 @@ def heading_pipeline(
     conventional_sigma_mps: np.ndarray | None = None,
     conventional_yaw_sigma: np.ndarray | None = None,
     antenna_lever_arm_m: Sequence[float] = (0.0, 0.0),
+    forward_acceleration: SensorSeries | None = None,
 ) -> HeadingTable:
     """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise).
 
@@ -164,6 +180,11 @@ def heading_pipeline(
     rate at each epoch) and the conventional heading and speed are turned into the vehicle's
     (:func:`~vo_doppler.heading.conventional.vehicle_heading_from_antenna`), with the raw yaw
     rate for the calibration (the bias is not known yet) and the calibrated one in the table.
+
+    ``forward_acceleration`` (m/s², specific force along the vehicle's forward axis): the road
+    grade prior of the tight heading comes from it and the wheel speed, its offset calibrated
+    on the conventional velocities (:mod:`vo_doppler.heading.grade`); without it, and before
+    that calibration, the prior is N(0, ``config.tight.grade_sigma``).
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     velocity = np.asarray(conventional_velocity_enu, dtype=float).reshape(-1, 3)
@@ -201,6 +222,7 @@ def heading_pipeline(
         conv_yaw, _ = vehicle_heading_from_antenna(
             antenna_yaw, antenna_speed, cal.scale * wheel, offset
         )
+    grade = _grade_prior(t_epoch, velocity, conventional_valid, speed, forward_acceleration, config)
     result = tight_heading_series(
         rows,
         t_epoch,
@@ -210,6 +232,7 @@ def heading_pipeline(
         speed_scale_sigma=cal.scale_sigma / cal.scale,
         gyro_bias_sigma=cal.bias_sigma,
         lever_velocity=np.nan_to_num(offset),
+        grade_prior=grade,
     )
     return HeadingTable(
         t=t_epoch,

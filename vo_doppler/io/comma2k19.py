@@ -41,6 +41,14 @@ def read_gyro_yaw_rate(base: str | Path, signal: str = "gyro") -> tuple[np.ndarr
     return t, -value[:, 2]
 
 
+def read_forward_acceleration(base: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """(t, specific force m/s² along the device's forward axis) from
+    ``processed_log/IMU/accelerometer`` (axes forward, right, down, as the gyro's)."""
+    t = load_array(base, "processed_log", "IMU", "accelerometer", "t")
+    value = load_array(base, "processed_log", "IMU", "accelerometer", "value")
+    return t, value[:, 0]
+
+
 @dataclass(frozen=True)
 class GroundTruth:
     """``global_pose`` on the monotonic clock: yaw (rad, CCW, unwrapped) of the velocity and

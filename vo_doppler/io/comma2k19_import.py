@@ -34,6 +34,7 @@ from vo_doppler.io.comma2k19 import (
     gps_minus_log,
     gps_minus_mono,
     load_array,
+    read_forward_acceleration,
     read_gyro_yaw_rate,
     read_raw_gnss,
     read_vehicle_poses,
@@ -41,7 +42,11 @@ from vo_doppler.io.comma2k19 import (
 from vo_doppler.io.comma2k19_video import CALIB, IMAGES, TIMES, VIDEO, decode_video
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.rinex_write import ObsEpochs, write_obs
-from vo_doppler.io.sensor_csv import YAW_RATE_COLUMN, write_sensor_csv
+from vo_doppler.io.sensor_csv import (
+    FORWARD_ACCELERATION_COLUMN,
+    YAW_RATE_COLUMN,
+    write_sensor_csv,
+)
 from vo_doppler.io.sequence import FORMAT, MANIFEST
 from vo_doppler.io.sp3 import read_sp3
 from vo_doppler.io.trajectory import write_tum
@@ -108,6 +113,12 @@ def import_comma2k19(
     write_sensor_csv(
         output / "imu" / "yaw_rate.csv", SensorSeries(t_gyro, yaw_rate), YAW_RATE_COLUMN
     )
+    t_acc, forward = read_forward_acceleration(segment)
+    write_sensor_csv(
+        output / "imu" / "forward_acceleration.csv",
+        SensorSeries(t_acc, forward),
+        FORWARD_ACCELERATION_COLUMN,
+    )
     rotation = ecef_to_enu_rotation(lat, lon)
     truth = Trajectory(
         t_pose + offset,
@@ -139,7 +150,11 @@ def import_comma2k19(
             "wheel_speed": WHEEL_SIGNALS,
             "time_offset_s": offset,
         },
-        "imu": {"yaw_rate": "imu/yaw_rate.csv", "time_offset_s": offset},
+        "imu": {
+            "yaw_rate": "imu/yaw_rate.csv",
+            "forward_acceleration": "imu/forward_acceleration.csv",
+            "time_offset_s": offset,
+        },
         "ground_truth": {
             "trajectory": "ground_truth.tum",
             "device_mount_yaw_deg": float(np.degrees(mount)),

@@ -110,13 +110,16 @@ def read_numeric_csv(
 def read_sensor_csv(path: str | Path, column: str, time_offset_s: float = 0.0) -> SensorSeries:
     """The ``t,<column>`` signal of a headed CSV, ``time_offset_s`` added to its times."""
     columns, report = read_numeric_csv(path, ("t", column))
-    unit = "rad/s" if column == YAW_RATE_COLUMN else "m/s" if column == SPEED_COLUMN else ""
+    unit = {YAW_RATE_COLUMN: "rad/s", SPEED_COLUMN: "m/s", FORWARD_ACCELERATION_COLUMN: "m/s²"}
+    unit = unit.get(column, "")
     skipped = report.n_malformed + report.n_non_finite
     return SensorSeries(columns["t"] + time_offset_s, columns[column], column, unit, skipped)
 
 
 YAW_RATE_COLUMN = "yaw_rate_rad_s"
 SPEED_COLUMN = "speed_mps"
+FORWARD_ACCELERATION_COLUMN = "forward_acceleration_mps2"
+"""Specific force along the vehicle's forward axis (an accelerometer's reading), m/s²."""
 
 
 def read_yaw_rate_csv(path: str | Path, time_offset_s: float = 0.0) -> SensorSeries:

@@ -26,6 +26,7 @@ from vo_doppler.io.doppler_sigma import read_doppler_sigma
 from vo_doppler.io.images import list_images, read_times
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.satellite_states import read_satellite_states
+from vo_doppler.io.sensor_csv import FORWARD_ACCELERATION_COLUMN, read_sensor_csv
 from vo_doppler.io.textfile import regular_file
 from vo_doppler.io.time_order import TimeOrderReport
 from vo_doppler.io.trajectory import read_tum
@@ -242,6 +243,14 @@ def read_sequence_with_report(
         truth_path = m.resolve("ground_truth.trajectory", truth_cfg["trajectory"])
         if truth_path.exists():
             truth = read_tum(m.file("ground_truth", "trajectory"))
+    forward_acceleration = None
+    imu = m.data.get("imu")
+    if isinstance(imu, dict) and "forward_acceleration" in imu:
+        forward_acceleration = read_sensor_csv(
+            m.file("imu", "forward_acceleration"),
+            FORWARD_ACCELERATION_COLUMN,
+            m.number("imu", "time_offset_s", 0.0),
+        )
     name = m.data.get("name", m.root.name)
     if not isinstance(name, str | int | float) or isinstance(name, bool):
         raise m.error("name", f"{name!r} is not a name")
@@ -253,6 +262,7 @@ def read_sequence_with_report(
         observations=obs,
         navigation=nav,
         doppler_sigma=sigma,
+        forward_acceleration=forward_acceleration,
         yaw_rate=motion.yaw_rate,
         wheel_speed=motion.speed,
         enu=enu,

@@ -46,6 +46,9 @@ class Sequence:
     """GPS time − sensor time per sensor ('camera', 'can', …) as the manifest gave it."""
     doppler_sigma: ReportedSigma | None = None
     """The receiver's σ of each Doppler range rate, when it reported one."""
+    forward_acceleration: SensorSeries | None = None
+    """Specific force along the vehicle's forward axis (m/s², an accelerometer's), if recorded:
+    the tight heading's road grade prior."""
 
     @property
     def has_camera(self) -> bool:

@@ -1,0 +1,97 @@
+"""Road grade prior of the tight heading from a forward accelerometer and the wheel speed,
+its offset calibrated by the conventional Doppler velocity (this project's addition to [TK18]).
+
+A forward accelerometer on a vehicle climbing at angle γ measures the specific force
+
+    f = dv/dt + g₀·sin γ + f₀
+
+(v the speed along the road, g₀ standard gravity, f₀ the accelerometer's bias plus g₀·sin of the
+mounting pitch: constant over a drive). Averaged over the heading window (t_k − W, t_k], as the
+tight heading's grade unknown is (:mod:`vo_doppler.heading.tight_heading`):
+
+    sin γ̄ = [(1/W)·∫ f dt − (v(t_k) − v(t_k − W))/W − f₀] / g₀,      g = tan γ̄
+
+with the raw wheel speed for v (a scale error of 1 % moves the speed term by 1 %, 0.01 m/s² in
+a 1 m/s² acceleration: 0.1 % of grade). f₀/g₀ is the median of the differences between that
+grade (with f₀ = 0) and the conventional Doppler grade v_up/|v_h| over the valid epochs so
+far (causal, like the wheel-scale and gyro-bias calibration), and the prior's σ is the robust
+scatter of those differences (1.4826·MAD, which the Doppler's own vertical noise inflates:
+conservative) plus the median's own σ (1.25·scatter/√n), at least ``min_sigma``. Before
+``min_samples`` differences exist there is no prior (NaN).
+
+On the comma2k19 minute (device pitched about 4° down: f₀/g₀ = −7 %) the grade so found,
+offset fitted over the first 20 s, is within 0.4 % (median) / 1.3 % (p95) of the ground
+truth's, whose own spread is 3.3 %.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.timeseries import integral_at, sample
+
+STANDARD_GRAVITY = 9.80665
+"""g₀ (m/s²)."""
+
+
+@dataclass(frozen=True)
+class GradePriorConfig:
+    """Calibration of the accelerometer grade (module docstring)."""
+
+    min_speed_mps: float = 5.0
+    """Conventional velocities slower than this do not calibrate: v_up/|v_h| is too noisy."""
+    min_samples: int = 20
+    min_sigma: float = 0.005
+
+
+def accelerometer_grade(
+    t_epoch: np.ndarray,
+    window_s: float,
+    forward_acceleration: SensorSeries,
+    wheel_speed: SensorSeries,
+) -> np.ndarray:
+    """Mean grade tan γ̄ over each window (t_k − W, t_k] with the offset f₀ taken as zero
+    (module docstring); NaN where either signal does not cover the window."""
+    t_epoch = np.asarray(t_epoch, dtype=float)
+    start = t_epoch - window_s
+    acc = forward_acceleration
+    mean_force = (
+        integral_at(acc.t, acc.value, t_epoch) - integral_at(acc.t, acc.value, start)
+    ) / window_s
+    speed_change = sample(wheel_speed.t, wheel_speed.value, t_epoch) - sample(
+        wheel_speed.t, wheel_speed.value, start
+    )
+    sine = (mean_force - speed_change / window_s) / STANDARD_GRAVITY
+    return np.tan(np.arcsin(np.clip(sine, -1.0, 1.0)))
+
+
+def grade_prior(
+    raw_grade: np.ndarray,
+    velocity_enu: np.ndarray,
+    valid: np.ndarray,
+    config: GradePriorConfig = GradePriorConfig(),
+) -> tuple[np.ndarray, np.ndarray]:
+    """(μ, σ) of the grade at each epoch: ``raw_grade`` (:func:`accelerometer_grade`) less the
+    offset calibrated on the conventional velocities (``velocity_enu``, flagged ``valid``) of
+    this epoch and the earlier ones (module docstring); NaN before ``config.min_samples``."""
+    velocity = np.asarray(velocity_enu, dtype=float).reshape(-1, 3)
+    horizontal = np.hypot(velocity[:, 0], velocity[:, 1])
+    calibrating = np.asarray(valid, dtype=bool) & (horizontal >= config.min_speed_mps)
+    calibrating &= np.isfinite(raw_grade) & np.isfinite(velocity[:, 2])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        difference = raw_grade - velocity[:, 2] / horizontal
+    m = len(raw_grade)
+    offset, sigma = np.full(m, np.nan), np.full(m, np.nan)
+    samples: list[float] = []
+    for k in range(m):
+        if calibrating[k]:
+            samples.append(float(difference[k]))
+        if len(samples) >= config.min_samples:
+            d = np.asarray(samples)
+            offset[k] = np.median(d)
+            scatter = 1.4826 * np.median(np.abs(d - offset[k]))
+            sigma[k] = max(scatter * (1.0 + 1.25 / np.sqrt(len(d))), config.min_sigma)
+    return raw_grade - offset, sigma
