@@ -55,7 +55,10 @@ window (:func:`vo_doppler.heading.snooping.receiver_noise`).
 
 Reliability ([TK18] sec. 3.5): the heading at epoch k is compared with the headings of the previous
 epochs of the last ``reliability_epochs`` propagated by the gyro; it is reliable when enough of
-them exist and all agree within the gate.
+them exist and all agree within the gate, and when it also agrees with the heading of a window
+that shares no row with its own (:func:`_independent_agreement`): overlapping windows agree
+with each other whatever a fault that outlasts them, such as reflected satellites that
+snooping took for the consistent majority.
 """
 
 from __future__ import annotations
@@ -630,7 +633,9 @@ def tight_heading_series(
         # grade prior's part is set by its own σ: where s² < 1 it is restored to full size
         + np.clip(1.0 - solution.variance_factor, 0.0, None) * solution.prior_variance
     )
-    return _decide(solution, model_variance, t_epoch, speed, yaw_angle, n_sat_epoch, config)
+    return _decide(
+        solution, model_variance, t_epoch, speed, (yaw_angle, bias_sigma), n_sat_epoch, config
+    )
 
 
 def windows_per_chunk(width: int, n_groups: int, config: TightHeadingConfig) -> int:
@@ -713,11 +718,11 @@ def _concatenate(solutions):
     )
 
 
-def _decide(
-    sol, model_variance, t_epoch, speed, yaw_angle, n_sat_epoch, config
-) -> TightHeadingResult:
+def _decide(sol, model_variance, t_epoch, speed, gyro, n_sat_epoch, config) -> TightHeadingResult:
     """Availability, ambiguity resolution and reliability; σ from the noise (s²/info) plus
-    ``model_variance``, the calibration and clock errors the model leaves out."""
+    ``model_variance``, the calibration and clock errors the model leaves out. ``gyro``: the
+    integrated calibrated yaw rate Φ and the gyro-bias σ (rad/s) per epoch."""
+    yaw_angle, bias_sigma = gyro
     m = len(t_epoch)
     with np.errstate(divide="ignore", invalid="ignore"):
         noise_variance = np.maximum(sol.variance_factor / sol.info, sol.profile_sigma**2)
@@ -751,7 +756,15 @@ def _decide(
             available[k] = True
         if available[k]:
             last = k
-    reliable = _reliability(yaw, sigma, available, yaw_angle, config)
+    reliable = _independent_agreement(
+        _reliability(yaw, sigma, available, yaw_angle, config),
+        yaw,
+        sigma,
+        available,
+        t_epoch,
+        (yaw_angle, bias_sigma),
+        config,
+    )
     return TightHeadingResult(
         t=t_epoch,
         yaw=np.where(available, wrap_angle(yaw), np.nan),
@@ -795,3 +808,43 @@ def _reliability(yaw, sigma, available, yaw_angle, config):
         count[lag:] += both
         worst[lag:] = np.maximum(worst[lag:], np.where(both, error / allowed, 0.0))
     return available & (count >= config.reliability_min_epochs) & (worst <= 1.0)
+
+
+def _independent_agreement(consistent, yaw, sigma, available, t_epoch, gyro, config):
+    """Reliability: the epochs of ``consistent`` (the consecutive-epoch rule,
+    :func:`_reliability`) whose heading also agrees with a heading from a window that shares no
+    row with theirs.
+
+    Headings of consecutive epochs come from windows that overlap by all but one epoch, so
+    their agreement ([TK18] sec. 3.5) cannot reveal a fault that lasts as long as the window,
+    such as reflected satellites that snooping mistook for the consistent majority (they stay
+    biased for seconds). The reference j is the last reliable heading at least one window
+    earlier (t_j ≤ t_k − W), or, when that is older than ``prior_max_age_s`` (or there is none),
+    the last available one (so that a wrong reliable heading cannot lock the right ones out).
+    Propagated by the gyro it must agree with θ_k within max(gate, n_sigma·√(σ_k² + σ_j² +
+    (σ_b·(t_k − t_j))²)), σ_b the calibrated gyro bias's standard deviation, which the
+    propagation inherits. Epochs with no available heading a window earlier (the first
+    window of a drive) keep the consecutive-epoch rule alone.
+    """
+    yaw_angle, bias_sigma = gyro
+    reliable = np.zeros(len(yaw), dtype=bool)
+    last_reliable = last_available = -1
+    p = 0
+    for k in np.flatnonzero(consistent):
+        while p < k and t_epoch[p] <= t_epoch[k] - config.window_s:
+            last_available = p if available[p] else last_available
+            last_reliable = p if reliable[p] else last_reliable
+            p += 1
+        fresh = last_reliable >= 0 and t_epoch[k] - t_epoch[last_reliable] <= config.prior_max_age_s
+        j = last_reliable if fresh else last_available
+        if j < 0:
+            reliable[k] = True
+            continue
+        predicted = yaw[j] + yaw_angle[k] - yaw_angle[j]
+        drift = bias_sigma[k] * (t_epoch[k] - t_epoch[j])
+        allowed = max(
+            config.reliability_gate_rad,
+            config.reliability_n_sigma * np.sqrt(sigma[k] ** 2 + sigma[j] ** 2 + drift**2),
+        )
+        reliable[k] = abs(wrap_angle(yaw[k] - predicted)) <= allowed
+    return reliable
