@@ -21,6 +21,7 @@ from vo_doppler.fusion.heading_blend import (
     blend_heading,
     fit_process_noise,
     forward_filter,
+    robust_start,
     rts_smooth,
 )
 from vo_doppler.fusion.heading_correction import correct_heading
@@ -281,6 +282,62 @@ def test_robust_update_follows_a_lasting_change_and_ignores_a_burst():
     )
     assert np.degrees(np.abs(robust.correction).max()) < 0.5
     assert np.degrees(np.abs(plain.correction).max()) > 2.5
+
+
+def test_robust_weight_judges_one_measurements_error_not_the_inflated_variance():
+    # κ = 40 correlated measurements: r = 40·r₁ enters the gain, r₁ the robust weight.
+    r, r_single, q = np.array([1e-4, 4e-3]), np.array([1e-4, 1e-4]), np.array([0.0, 1e-4])
+    P_pred, S, S_single = 2e-4, 2e-4 + 4e-3, 2e-4 + 1e-4
+    outlier = 0.18  # 10.4 σ of one measurement, but only 2.8 σ of the inflated S
+    robust = forward_filter(np.array([0.0, outlier]), r, q, 3.0, r_single)
+    # δ moves by k·√S₁·P⁻/S, whatever the outlier; judged against S it would move P⁻/S·0.18.
+    assert robust.x[1] == pytest.approx(3.0 * np.sqrt(S_single) * P_pred / S)
+    u = outlier / np.sqrt(S_single)
+    assert robust.P[1] == pytest.approx((1.0 - P_pred / (S * u / 3.0)) * P_pred)
+    assert robust.log_likelihood == pytest.approx(
+        -0.5 * np.log(2 * np.pi * S_single) - (3.0 * u - 4.5)
+    )
+    blind = forward_filter(np.array([0.0, outlier]), r, q, 3.0)
+    assert blind.x[1] == pytest.approx(P_pred / S * outlier)
+    assert blind.x[1] > 3.0 * robust.x[1]
+
+
+def test_robust_start_takes_the_median_only_when_the_first_is_an_outlier():
+    first = np.arange(3)
+    r, still = np.full(3, 1e-4), np.zeros(3)
+    start = robust_start(np.array([0.5, 0.0, 0.001]), r, still, first, 3.0)
+    assert start == pytest.approx(0.001)  # the median of 0.5, 0, 0.001
+    # Within k·√(r₀ + r_m + Q_m − Q₀) of the median, the first measurement starts.
+    # Still: 3·√2e-4 = 0.042; with 1e-4 of process variance up to the median: 3·√3e-4 = 0.052.
+    drifting = np.array([0.0, 0.0, 1e-4])
+    assert robust_start(np.array([0.05, 0.0, 0.001]), r, still, first, 3.0) == pytest.approx(0.001)
+    assert robust_start(np.array([0.05, 0.0, 0.001]), r, drifting, first, 3.0) == pytest.approx(
+        0.05
+    )
+    assert robust_start(np.array([0.055, 0.0, 0.001]), r, drifting, first, 3.0) == pytest.approx(
+        0.001
+    )
+    across = robust_start(np.array([-np.pi + 0.3, np.pi - 0.01, np.pi - 0.02]), r, still, first, 3)
+    assert across == pytest.approx(np.pi - 0.01)
+
+
+def test_a_wrong_first_heading_does_not_start_the_blend():
+    n = 400
+    gt = _straight(n)
+    yaw = np.zeros(n)
+    yaw[0] = np.radians(30.0)  # the first heading is wrong
+    config = BlendConfig(sigma_distance=1e-4, sigma_turn=1e-4, measurement_scale=1.0, smooth=False)
+    common = {"config": config, "reference": "orientation"}
+    robust = blend_heading(gt, gt.t, yaw, np.radians(0.5), **common)
+    first = blend_heading(
+        gt,
+        gt.t,
+        yaw,
+        np.radians(0.5),
+        **{**common, "config": replace(config, start_measurements=1)},
+    )
+    assert np.degrees(np.abs(robust.correction).max()) < 0.1
+    assert np.degrees(np.abs(first.correction).max()) > 10.0
 
 
 def test_pipeline_dispatches_on_the_method():

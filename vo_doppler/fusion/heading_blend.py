@@ -29,20 +29,32 @@ State: the offset δ = (true course − VO course), a scalar in rad, held unwrap
   window), so the κ measurements of one window carry about one measurement's information.
 
 * Forward filter, wrapping the innovation ν_j = wrap(z_j − δ⁻_j) and starting diffuse (the
-  first measurement sets δ = z, P = r)::
+  start sets δ = z₀, P = r₀)::
 
       P⁻_j = P_{j−1} + q_j,  S_j = P⁻_j + r_j,  K_j = P⁻_j/S_j,
       δ_j = δ⁻_j + K_j·ν_j,  P_j = (1 − K_j)·P⁻_j                                      (B3)
 
 * Robust update (B3′): an absolute heading can be biased for seconds (a conventional Doppler
   velocity from reflected signals in a street canyon: p95 course errors of 20° on a real
-  u-blox drive), far beyond its σ. Each update therefore uses Huber's weight on the
-  normalised innovation u_j = ν_j/√S_j: with w_j = min(1, k/|u_j|) the innovation variance is
-  taken as S_j/w_j (r_j inflated to S_j/w_j − P⁻_j), so an innovation beyond k standard
-  deviations moves δ by at most k·√S_j·K_j, and the log-likelihood uses Huber's ρ
-  (½u² inside, k|u| − ½k² beyond), the density whose maximum-likelihood estimate that is
-  (Huber, "Robust estimation of a location parameter", Ann. Math. Statist. 1964). k = ∞
-  gives (B3).
+  u-blox drive; a tight heading from a window whose reflected satellites looked like the
+  consistent majority), far beyond its σ. Each update therefore uses Huber's weight on the
+  normalised innovation u_j = ν_j/√S'_j, S'_j = P⁻_j + (s·σ_j)² the variance of the
+  innovation of one measurement: κ_j of (B2) accounts for the information that correlated
+  measurements share, not for the error of each, which is (s·σ_j)² whatever its neighbours
+  (judged against S_j, a 20σ error of a tight heading with κ = 40 would pass as a 3σ one).
+  With w_j = min(1, k/|u_j|) the innovation variance is taken as S_j/w_j (r_j inflated to
+  S_j/w_j − P⁻_j), so an innovation beyond k standard deviations moves δ by at most
+  k·√S'_j·K_j, and the log-likelihood uses Huber's ρ (½u² inside, k|u| − ½k² beyond) with
+  ln S'_j, the density whose maximum-likelihood estimate that is (Huber, "Robust estimation
+  of a location parameter", Ann. Math. Statist. 1964). k = ∞ gives (B3).
+
+* Robust start: z₀ is the first measurement unless it lies beyond k standard deviations
+  (√(r₀ + r_m + the process variance accumulated between them), r = (s·σ)²) from the
+  circular median z_m of the first ``start_measurements`` measurements at least their
+  correlation time apart (:func:`decimate`); then z_m. One wrong heading (or one wrong window
+  of correlated ones) cannot set δ, which the bounded update (B3′) would then leave only
+  slowly. The start looks ahead by those correlation times (4 s for the tight heading's
+  2-s window), the only look-ahead of the forward filter.
 
 * RTS smoother (offline use), and between measurement nodes a < b, at a time k::
 
@@ -122,6 +134,9 @@ class BlendConfig:
     of the three noise parameters; below it the defaults hold."""
     huber_k: float = 3.0
     """k of the robust update (B3′), in standard deviations of the innovation (inf: (B3))."""
+    start_measurements: int = 3
+    """Measurements, at least a correlation time apart, whose median starts the filter (1:
+    the first measurement)."""
 
 
 @dataclass
@@ -209,36 +224,65 @@ def inflation(measurements: OffsetMeasurements) -> np.ndarray:
 
 
 def forward_filter(
-    z: np.ndarray, r: np.ndarray, q: np.ndarray, huber_k: float = np.inf
+    z: np.ndarray,
+    r: np.ndarray,
+    q: np.ndarray,
+    huber_k: float = np.inf,
+    r_single: np.ndarray | None = None,
+    start: np.ndarray | float | None = None,
 ) -> FilterOutput:
     """(B3), robust as (B3′) with ``huber_k``, over measurements ``z`` (M,) with variances
-    ``r`` and process variances ``q`` since the previous measurement (q[0] unused); ``r`` and
-    ``q`` may carry a trailing axis of G parameter sets, filtered side by side."""
+    ``r`` (inflated by κ) and process variances ``q`` since the previous measurement (q[0]
+    unused); ``r_single`` the variance of each measurement's own error, (s·σ_j)², which the
+    robust weight judges (default ``r``); ``start`` the initial δ (default z[0]). ``r``,
+    ``r_single`` and ``q`` may carry a trailing axis of G parameter sets, filtered side by
+    side."""
     r = np.asarray(r, dtype=float)
+    r_single = r if r_single is None else np.asarray(r_single, dtype=float)
     q = np.asarray(q, dtype=float)
-    shape = (len(z), *np.broadcast_shapes(r.shape[1:], q.shape[1:]))
-    r = np.broadcast_to(r.reshape(r.shape + (1,) * (len(shape) - r.ndim)), shape)
-    q = np.broadcast_to(q.reshape(q.shape + (1,) * (len(shape) - q.ndim)), shape)
+    shape = (len(z), *np.broadcast_shapes(r.shape[1:], r_single.shape[1:], q.shape[1:]))
+
+    def spread(a):
+        return np.broadcast_to(a.reshape(a.shape + (1,) * (len(shape) - a.ndim)), shape)
+
+    r, r_single, q = spread(r), spread(r_single), spread(q)
     x = np.empty(shape)
     P = np.empty(shape)
     P_pred = np.full(shape, np.inf)
     log_likelihood = np.zeros(shape[1:])
     if len(z) == 0:
         return FilterOutput(x, P, P_pred, log_likelihood)
-    x[0], P[0] = z[0], r[0]
+    x[0], P[0] = z[0] if start is None else start, r[0]
     for j in range(1, len(z)):
         P_pred[j] = P[j - 1] + q[j]
         S = P_pred[j] + r[j]
+        S_single = P_pred[j] + r_single[j]
         innovation = wrap_angle(z[j] - x[j - 1])
-        size = np.abs(innovation) / np.sqrt(S)
+        size = np.abs(innovation) / np.sqrt(S_single)
         beyond = size > huber_k
         gain = P_pred[j] / np.where(beyond, S * size / huber_k, S)
         x[j] = x[j - 1] + gain * innovation
         P[j] = (1.0 - gain) * P_pred[j]
         inside = np.minimum(size, huber_k)
         rho = 0.5 * inside**2 + (huber_k * (size - inside) if np.isfinite(huber_k) else 0.0)
-        log_likelihood -= 0.5 * np.log(2.0 * np.pi * S) + rho
+        log_likelihood -= 0.5 * np.log(2.0 * np.pi * S_single) + rho
     return FilterOutput(x, P, P_pred, log_likelihood)
+
+
+def robust_start(
+    z: np.ndarray, r_single: np.ndarray, accumulated: np.ndarray, first: np.ndarray, huber_k: float
+):
+    """The filter's start (module docstring): z[0], unless it lies more than ``huber_k``
+    standard deviations from the circular median z_m of the measurements ``first`` (the first
+    few at least a correlation time apart, z[0] the first of them); then z_m. The deviation
+    of z[0] − z_m is √(r₀ + r_m + Q_m − Q₀), ``r_single`` the measurements' variances (s·σ)²
+    and ``accumulated`` Q the process variance of (B1) accumulated at them (both (M,) or
+    (M, G) for G parameter sets, giving G starts)."""
+    differences = wrap_angle(z[first] - z[0])
+    median = float(np.median(differences))
+    middle = first[np.argmin(np.abs(differences - median))]
+    spread = np.sqrt(r_single[0] + r_single[middle] + accumulated[middle] - accumulated[0])
+    return np.where(np.abs(median) > huber_k * spread, wrap_angle(z[0] + median), z[0])
 
 
 def rts_smooth(forward: FilterOutput) -> tuple[np.ndarray, np.ndarray]:
@@ -311,7 +355,10 @@ def fit_process_noise(
     accumulated = clock.variance(measurements.t[keep], grid_d, grid_psi)
     q = np.diff(accumulated, axis=0, prepend=accumulated[:1])
     r = np.multiply.outer(measurements.sigma[keep] ** 2, grid_s**2)
-    log_likelihood = forward_filter(measurements.z[keep], r, q, config.huber_k).log_likelihood
+    z = measurements.z[keep]
+    first = np.arange(min(config.start_measurements, len(keep)))
+    start = robust_start(z, r, accumulated, first, config.huber_k)
+    log_likelihood = forward_filter(z, r, q, config.huber_k, start=start).log_likelihood
     best = int(np.argmax(log_likelihood))
     return NoiseModel(float(grid_d[best]), float(grid_psi[best]), float(grid_s[best]), True)
 
@@ -398,9 +445,15 @@ def blend_heading(
     clock = DriftClock.from_poses(t, positions, rotations)
     noise = fit_process_noise(measurements, clock, config)
     clock_node = clock.variance(measurements.t, noise.sigma_distance, noise.sigma_turn)
-    r = np.maximum((noise.scale * measurements.sigma) ** 2 * inflation(measurements), 1e-18)
+    r_single = np.maximum((noise.scale * measurements.sigma) ** 2, 1e-18)
     q = np.diff(clock_node, prepend=clock_node[:1])
-    forward = forward_filter(measurements.z, r, q, config.huber_k)
+    start = None
+    if len(measurements):
+        first = decimate(measurements.t, measurements.correlation_s)[: config.start_measurements]
+        start = robust_start(measurements.z, r_single, clock_node, first, config.huber_k)
+    forward = forward_filter(
+        measurements.z, r_single * inflation(measurements), q, config.huber_k, r_single, start
+    )
     smoothed = rts_smooth(forward) if config.smooth else None
     middle = np.concatenate([t[:1], 0.5 * (t[1:] + t[:-1])])
     delta_step, _ = offset_at(
