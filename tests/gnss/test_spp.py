@@ -2,15 +2,20 @@
 
 from __future__ import annotations
 
+import tracemalloc
+
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from tests.conftest import require_shared
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
 from vo_doppler.gnss.atmosphere import klobuchar_delay, troposphere_delay
-from vo_doppler.gnss.spp import solve_spp
+from vo_doppler.gnss.spp import nearest_time, receiver_positions, solve_spp
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.model.gnss_solutions import SppSolution
 
 KLOBUCHAR = np.array([1.8626e-08, 2.2352e-08, -1.1921e-07, -5.9605e-08])
 KLOBUCHAR = np.concatenate([KLOBUCHAR, [1.2902e05, 1.6384e05, -1.9661e05, -2.6214e05]])
@@ -70,3 +75,40 @@ def test_spp_without_redundancy_is_solved_but_not_valid():
     everything = solve_spp(obs, nav, "G")
     np.testing.assert_array_equal(everything.valid, everything.verified)
     assert everything.valid.all()
+
+
+# Times on a coarse grid (ties and repeated epochs are common) and a validity mask.
+epochs = st.lists(st.tuples(st.integers(0, 40), st.booleans()), min_size=1, max_size=60)
+
+
+@given(epochs)
+def test_nearest_valid_fix_is_the_pairwise_argmin(rows):
+    """The nearest valid epoch by binary search is the one the full (epochs × valid) table's
+    argmin picks, ties to the earlier and to the first of equal times included."""
+    t = np.sort(np.array([step for step, _ in rows], dtype=float) * 0.05)
+    valid = np.array([flag for _, flag in rows])
+    position = np.column_stack([np.arange(t.size, dtype=float), t, -t])
+    position[~valid] = np.nan
+    solution = SppSolution(t, position, {}, np.zeros(t.size), t, t, valid, 0)
+    out = receiver_positions(solution, None)
+    if not valid.any():
+        assert np.isnan(out).all()
+        return
+    good = np.flatnonzero(valid)
+    expected = good[np.abs(t[:, None] - t[good][None, :]).argmin(axis=1)]
+    assert np.array_equal(out, position[np.where(valid, np.arange(t.size), expected)])
+    assert np.array_equal(nearest_time(t[good], t), np.searchsorted(good, expected))
+
+
+def test_nearest_time_on_a_long_record_keeps_memory_linear():
+    """A day at 20 Hz with every other epoch valid: the pairwise table would take 12 TB; the
+    search holds a few arrays of the record's length. Odd epochs lie halfway: the earlier."""
+    t = np.arange(1_728_000, dtype=float)
+    tracemalloc.start()
+    try:
+        index = nearest_time(t[::2], t)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert np.array_equal(index, np.arange(t.size) // 2)
+    assert peak < 10 * t.nbytes

@@ -255,8 +255,21 @@ def receiver_positions(solution: SppSolution, fallback: np.ndarray | None) -> np
     valid = solution.valid
     if valid.any():
         good = np.flatnonzero(valid)
-        nearest = good[np.abs(solution.t[:, None] - solution.t[good][None, :]).argmin(axis=1)]
-        out[~valid] = solution.position_ecef[nearest[~valid]]
+        missing = ~valid
+        nearest = good[nearest_time(solution.t[good], solution.t[missing])]
+        out[missing] = solution.position_ecef[nearest]
     elif fallback is not None and np.linalg.norm(fallback) > EARTH_SURFACE_M:
         out[:] = fallback
     return out
+
+
+def nearest_time(sorted_t: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Index into ascending times ``sorted_t`` (non-empty) of the nearest to each of ``t``: on a
+    tie the earlier, among equal times the first, as ``argmin`` over all pairs would choose,
+    in O((n + m) log n) time and O(m) memory instead of an (m × n) table."""
+    last = sorted_t.size - 1
+    after = np.searchsorted(sorted_t, t)
+    before = np.searchsorted(sorted_t, sorted_t[np.maximum(after - 1, 0)])
+    after = np.searchsorted(sorted_t, sorted_t[np.minimum(after, last)])
+    use_before = np.abs(t - sorted_t[before]) <= np.abs(t - sorted_t[after])
+    return np.where(use_before, before, after)
