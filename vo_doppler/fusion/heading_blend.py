@@ -137,6 +137,10 @@ class BlendConfig:
     start_measurements: int = 3
     """Measurements, at least a correlation time apart, whose median starts the filter (1:
     the first measurement)."""
+    fit_chunk_bytes: int = 32 * 2**20
+    """Memory (bytes) for the grid points of the noise fit filtered side by side: the grid is
+    filtered in chunks of as many points as fit (:func:`grid_log_likelihood`); the fit does
+    not depend on it."""
 
 
 @dataclass
@@ -352,15 +356,43 @@ def fit_process_noise(
     )
     axes = [np.array([f]) if f is not None else g for f, g in zip(fixed, grids, strict=True)]
     grid_d, grid_psi, grid_s = (g.ravel() for g in np.meshgrid(*axes, indexing="ij"))
-    accumulated = clock.variance(measurements.t[keep], grid_d, grid_psi)
-    q = np.diff(accumulated, axis=0, prepend=accumulated[:1])
-    r = np.multiply.outer(measurements.sigma[keep] ** 2, grid_s**2)
-    z = measurements.z[keep]
-    first = np.arange(min(config.start_measurements, len(keep)))
-    start = robust_start(z, r, accumulated, first, config.huber_k)
-    log_likelihood = forward_filter(z, r, q, config.huber_k, start=start).log_likelihood
+    log_likelihood = grid_log_likelihood(
+        measurements, keep, clock, (grid_d, grid_psi, grid_s), config
+    )
     best = int(np.argmax(log_likelihood))
     return NoiseModel(float(grid_d[best]), float(grid_psi[best]), float(grid_s[best]), True)
+
+
+FIT_FLOATS_PER_MEASUREMENT = 8
+"""Floats per measurement and grid point alive at once in :func:`grid_log_likelihood`: the
+accumulated variance and its two terms, q, r, and the filter's δ, P and P⁻ (B3)."""
+
+
+def grid_log_likelihood(
+    measurements: OffsetMeasurements,
+    keep: np.ndarray,
+    clock: DriftClock,
+    grid: tuple[np.ndarray, np.ndarray, np.ndarray],
+    config: BlendConfig,
+) -> np.ndarray:
+    """Innovation log-likelihood of (B3′), from the robust start, over the measurements ``keep``
+    for every grid point (σ_d, σ_ψ, s), the points filtered side by side in chunks of at most
+    ``config.fit_chunk_bytes`` (at least one point; each point's filter is elementwise in the
+    points, so its value does not depend on the chunk it is in)."""
+    grid_d, grid_psi, grid_s = grid
+    t, z, variance = measurements.t[keep], measurements.z[keep], measurements.sigma[keep] ** 2
+    per_point = 8 * FIT_FLOATS_PER_MEASUREMENT * max(len(keep), 1)
+    size = max(1, config.fit_chunk_bytes // per_point)
+    first = np.arange(min(config.start_measurements, len(keep)))
+    out = np.empty(grid_d.size)
+    for begin in range(0, grid_d.size, size):
+        part = slice(begin, begin + size)
+        accumulated = clock.variance(t, grid_d[part], grid_psi[part])
+        q = np.diff(accumulated, axis=0, prepend=accumulated[:1])
+        r = np.multiply.outer(variance, grid_s[part] ** 2)
+        start = robust_start(z, r, accumulated, first, config.huber_k)
+        out[part] = forward_filter(z, r, q, config.huber_k, start=start).log_likelihood
+    return out
 
 
 def offset_at(
