@@ -116,7 +116,7 @@ class TightHeadingConfig:
     reliability_gate_rad: float = np.radians(3.0)
     reliability_n_sigma: float = 3.0
     epoch_match_s: float = 1e-3
-    chunk_bytes: int = 32 * 2**20
+    chunk_bytes: int = 16 * 2**20
     """Memory (bytes) for the windows solved at once: the windows are solved in chunks of as
     many as fit (:func:`windows_per_chunk`); the headings do not depend on it."""
     profile_step_rad: float = np.radians(0.25)
