@@ -16,7 +16,10 @@ fitted σ(C/N0, elevation) models are printed). Figures:
 * conventional velocity (epochs flagged valid): |speed error| and |course error| against the
   ground truth's velocity (differences of its positions, central, at the GNSS epochs; on
   comma2k19 they differ from global_pose's own velocities by 0.002 m/s median), median and p95,
-  how many valid epochs fall beyond 1.5° and beyond 3σ of their own speed or course σ;
+  how many valid epochs fall beyond 1.5° and beyond 3σ of their own speed or course σ; twice:
+  as the GNSS stage flags them with its σ (vel.csv of ``vo-doppler gnss``), and as ``run`` and
+  ``heading`` flag them in heading.csv after the gyro and wheel test, with that table's σ
+  (``heading.integrity``, docs/design.md (I1));
 * calibration: the heading stage's final wheel scale and gyro bias against the values that fit
   the ground truth with the same models (scale = Σ w·v / Σ w², bias = slope of ∫ω − ψ_truth);
 * tight heading: availability and |error| against the truth yaw, open sky and with an
@@ -35,6 +38,7 @@ from rich.table import Table
 from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
+from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import integral_at, sample
 from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
@@ -80,18 +84,25 @@ def _stats(values: np.ndarray) -> dict:
     }
 
 
-def conventional_figures(sequence: Sequence, velocity) -> dict:
+def conventional_figures(sequence: Sequence, velocity, table: HeadingTable | None = None) -> dict:
+    """Figures of the conventional velocity's valid epochs against the truth: as the GNSS
+    stage flags them with its σ (``vo-doppler gnss``, vel.csv), or, given the heading stage's
+    ``table``, as ``run`` and ``heading`` flag them after the gyro and wheel test with the
+    table's σ (heading.csv)."""
     truth = truth_velocity(sequence, velocity.t)
     moving = np.linalg.norm(truth[:, :2], axis=1) > MOVING_MPS
     valid = velocity.valid & moving
+    speed_sigma, course_sigma = velocity.speed_sigma_mps, velocity.course_sigma_rad
+    if table is not None:
+        valid &= table.conv_valid
+        speed_sigma, course_sigma = table.speed_sigma_conv, table.sigma_conv
     speed_error = np.abs(
         np.linalg.norm(velocity.velocity_enu[:, :2], axis=1) - np.linalg.norm(truth[:, :2], axis=1)
     )
     course = np.arctan2(velocity.velocity_enu[:, 1], velocity.velocity_enu[:, 0])
     course_error = np.degrees(np.abs(wrap_angle(course - np.arctan2(truth[:, 1], truth[:, 0]))))
     beyond = valid & (
-        (speed_error > 3.0 * velocity.speed_sigma_mps)
-        | (course_error > 3.0 * np.degrees(velocity.course_sigma_rad))
+        (speed_error > 3.0 * speed_sigma) | (course_error > 3.0 * np.degrees(course_sigma))
     )
     return {
         "moving_epochs": int(moving.sum()),
@@ -148,7 +159,8 @@ def evaluate(folder: Path, fit_noise: bool) -> dict:
     after = obs.epoch_time >= obs.epoch_time[0] + CANYON_AFTER_S
     figures = {
         "epochs": int(obs.epoch_time.size),
-        "conventional": conventional_figures(sequence, gnss.velocity),
+        "conventional_gnss": conventional_figures(sequence, gnss.velocity),
+        "conventional": conventional_figures(sequence, gnss.velocity, open_sky),
         "truth_wheel_scale": scale_truth,
         "truth_gyro_bias_dps": float(np.degrees(bias_truth)),
         "open_sky": tight_figures(sequence, open_sky, np.ones(after.size, dtype=bool)),
@@ -168,9 +180,9 @@ def print_sequence(console: Console, name: str, variants: dict) -> None:
 
 
 def print_variant(console: Console, name: str, figures: dict) -> None:
-    c = figures["conventional"]
     table = Table(title=f"{name}: conventional Doppler velocity ({figures['epochs']} epochs)")
     for column in (
+        "flags, σ",
         "valid",
         "verified",
         "speed med",
@@ -181,16 +193,19 @@ def print_variant(console: Console, name: str, figures: dict) -> None:
         "> 3σ",
     ):
         table.add_column(column, justify="right")
-    table.add_row(
-        f"{c['valid']:.1%}",
-        f"{c['verified']:.1%}",
-        _fmt(c["speed_error_mps"]["median"], ".3f"),
-        _fmt(c["speed_error_mps"]["p95"], ".3f"),
-        _fmt(c["course_error_deg"]["median"], ".2f"),
-        _fmt(c["course_error_deg"]["p95"], ".2f"),
-        str(c["valid_course_beyond_bound"]),
-        str(c["valid_beyond_3_sigma"]),
-    )
+    for label, key in (("GNSS stage", "conventional_gnss"), ("+ gyro/wheel", "conventional")):
+        c = figures[key]
+        table.add_row(
+            label,
+            f"{c['valid']:.1%}",
+            f"{c['verified']:.1%}",
+            _fmt(c["speed_error_mps"]["median"], ".3f"),
+            _fmt(c["speed_error_mps"]["p95"], ".3f"),
+            _fmt(c["course_error_deg"]["median"], ".2f"),
+            _fmt(c["course_error_deg"]["p95"], ".2f"),
+            str(c["valid_course_beyond_bound"]),
+            str(c["valid_beyond_3_sigma"]),
+        )
     console.print(table)
     heading = Table(title=f"{name}: tight heading and calibration")
     for column in (

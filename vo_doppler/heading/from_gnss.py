@@ -88,7 +88,8 @@ def heading_from_gnss(
 ) -> HeadingTable:
     """The heading stage ([TK18] sec. 3.3–3.5) from the GNSS stage's Doppler rows and
     conventional velocities: what ``run``, ``heading`` and the benchmarks all call. The table
-    carries the conventional solution's speed σ and HDOP on its valid epochs.
+    carries the conventional solution's speed σ (scaled as the heading's, design (I1)) and
+    HDOP on its valid epochs.
     ``forward_acceleration``: the road grade prior's accelerometer, if the recording has one
     (:func:`~vo_doppler.heading.pipeline.heading_pipeline`)."""
     table = heading_pipeline(
@@ -103,7 +104,7 @@ def heading_from_gnss(
         conventional_yaw_sigma=conventional_heading_sigma(velocity, enu),
         antenna_lever_arm_m=antenna_lever_arm_m,
         forward_acceleration=forward_acceleration,
+        conventional_speed_sigma_mps=velocity.speed_sigma_mps,
     )
-    table.speed_sigma_conv = np.where(table.conv_valid, velocity.speed_sigma_mps, np.nan)
     table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)
     return table

@@ -31,6 +31,7 @@ from vo_doppler.heading.calibration import (
 )
 from vo_doppler.heading.conventional import heading_from_velocity, vehicle_heading_from_antenna
 from vo_doppler.heading.grade import GradePriorConfig, accelerometer_grade, grade_prior
+from vo_doppler.heading.integrity import ConsistencyConfig, conventional_integrity
 from vo_doppler.heading.tight_heading import (
     TightHeadingConfig,
     antenna_offset_velocity,
@@ -53,6 +54,8 @@ class HeadingPipelineConfig:
     tight: TightHeadingConfig = field(default_factory=TightHeadingConfig)
     grade: GradePriorConfig = field(default_factory=GradePriorConfig)
     """The road grade prior from a forward accelerometer, where the recording has one."""
+    integrity: ConsistencyConfig = field(default_factory=ConsistencyConfig)
+    """The conventional velocity's test against the calibrated gyro and wheel speed."""
     conventional_min_speed_mps: float = 0.5
     calibration_max_velocity_sigma_mps: float = 2.0
     """Conventional velocities with a larger standard deviation (√trace of the 3-D velocity
@@ -80,6 +83,14 @@ def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, config):
     mean, sigma = grade_prior(raw, velocity, valid, config.grade)
     known = np.isfinite(mean) & np.isfinite(sigma)
     return np.where(known, mean, level[0]), np.where(known, sigma, level[1])
+
+
+def _scaled_sigma(sigma, test, valid):
+    """σ at the valid epochs times the test's σ factor (NaN elsewhere; None if unknown)."""
+    if sigma is None:
+        return None
+    factor = 1.0 if test is None else test.sigma_factor
+    return np.where(valid, factor * np.asarray(sigma, dtype=float), np.nan)
 
 
 def _calibrators(config: HeadingPipelineConfig):
@@ -165,6 +176,7 @@ def heading_pipeline(
     conventional_yaw_sigma: np.ndarray | None = None,
     antenna_lever_arm_m: Sequence[float] = (0.0, 0.0),
     forward_acceleration: SensorSeries | None = None,
+    conventional_speed_sigma_mps: np.ndarray | None = None,
 ) -> HeadingTable:
     """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise).
 
@@ -172,7 +184,13 @@ def heading_pipeline(
     its covariance); when given, only velocities within ``calibration_max_velocity_sigma_mps``
     calibrate the sensors. ``conventional_yaw_sigma`` (rad): standard deviation of each
     conventional heading (:func:`~vo_doppler.heading.conventional.velocity_heading_sigma`),
-    kept in the table for the heading correction.
+    kept in the table for the heading correction. ``conventional_speed_sigma_mps``: standard
+    deviation of each conventional horizontal speed.
+
+    Where these σ are given, the conventional velocity is tested against the calibrated gyro
+    and wheel speed (:mod:`vo_doppler.heading.integrity`, design (I1)): epochs that fail are
+    not valid in the table, and the table's conventional heading and speed σ are the given
+    ones times the factor by which the test's residuals exceed them.
 
     ``antenna_lever_arm_m``: the GNSS antenna (x forward, y left[, z up], m) from the vehicle
     origin. In turns the antenna moves at ω × r relative to the vehicle, so the Doppler
@@ -222,6 +240,17 @@ def heading_pipeline(
         conv_yaw, _ = vehicle_heading_from_antenna(
             antenna_yaw, antenna_speed, cal.scale * wheel, offset
         )
+    integrity = conventional_integrity(
+        t_epoch,
+        conv_ok,
+        conv_yaw,
+        conventional_yaw_sigma,
+        yaw_angle,
+        conv_speed,
+        conventional_speed_sigma_mps,
+        cal.scale * wheel,
+        config.integrity,
+    )
     grade = _grade_prior(t_epoch, velocity, conventional_valid, speed, forward_acceleration, config)
     result = tight_heading_series(
         rows,
@@ -242,13 +271,14 @@ def heading_pipeline(
         n_obs_window=result.n_obs,
         n_sat_epoch=result.n_sat_epoch,
         yaw_conv=conv_yaw,
-        conv_valid=conv_ok,
+        conv_valid=integrity.valid,
         gyro_bias=cal.bias,
         wheel_scale=cal.scale,
         rejected_rows=result.n_rejected,
         tc_verifiable=result.verifiable,
-        sigma_conv=None
-        if conventional_yaw_sigma is None
-        else np.where(conv_ok, np.asarray(conventional_yaw_sigma, dtype=float), np.nan),
+        sigma_conv=_scaled_sigma(conventional_yaw_sigma, integrity.course, integrity.valid),
+        speed_sigma_conv=_scaled_sigma(
+            conventional_speed_sigma_mps, integrity.speed, integrity.valid
+        ),
         tc_window_s=config.tight.window_s,
     )
