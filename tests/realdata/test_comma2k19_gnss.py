@@ -75,7 +75,7 @@ def test_conventional_velocity_with_fitted_noise(comma):
 
 def test_heading_table_carries_the_conventional_sigma_and_dop(comma):
     """heading.csv's conventional speed σ is the velocity solution's times one factor, the
-    speed test's (measured 1.28: median 0.048 m/s, 0.038 unscaled; design (I1)), and its HDOP
+    speed test's (measured 1.30: median 0.049 m/s, 0.038 unscaled; design (I1)), and its HDOP
     the solution's, on its valid epochs (median 0.72 on this minute)."""
     sequence, gnss = comma
     velocity = gnss.velocity

@@ -1,14 +1,15 @@
 """Integrity of the conventional Doppler velocity against the vehicle's own sensors
-(docs/design.md, "Conventional velocity integrity").
+(docs/design.md, "Conventional velocity integrity against the car's sensors").
 
 Several reflected satellites at once can be fitted by a wrong velocity that the GNSS stage's
 chi-square test cannot see (five or six satellites leave it one or two degrees of freedom).
 A car knows its turning and its speed without GNSS: over a few seconds the conventional course
-minus the integrated calibrated yaw rate is a constant (plus a drift from what is left of the
-gyro bias), and the conventional speed minus the calibrated wheel speed is a constant (plus a
-drift from the wheel scale and the wheel's lag in accelerations). At each epoch k both
-differences of the other epochs within ``half_window_s`` are fitted by a line in time (Huber
-IRLS, scale from the MAD), and the epoch's own difference is compared with the line at t_k:
+minus the integrated calibrated yaw rate is a constant plus a slope, what is left of the gyro
+bias (prior N(0, σ_b²) from the calibration), and the conventional speed minus the calibrated
+wheel speed a constant plus a slope (the wheel scale and the wheel's lag in accelerations). At
+each epoch k both differences of the other epochs within ``half_window_s`` are fitted by such a
+line (Huber IRLS on residuals in units of each epoch's own σ, started from the median), and the
+epoch's own difference is compared with the line at t_k:
 
     z_k = e_k / √(σ_k² + σ_fit,k²)                                              (I1)
 
@@ -37,6 +38,7 @@ HUBER_K = 1.345
 MAD_TO_SIGMA = 1.4826
 IRLS_STEPS = 5
 CHUNK_EPOCHS = 2048
+MIN_SLOPE_SIGMA = 1e-9
 
 
 @dataclass(frozen=True)
@@ -71,29 +73,42 @@ class ConsistencyTest:
 def windowed_line_residuals(
     t: np.ndarray,
     values: np.ndarray,
+    sigma: np.ndarray,
     usable: np.ndarray,
     half_window_s: float,
     min_neighbours: int,
     angular: bool = False,
+    slope_sigma: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Each epoch's value minus a robust line through the other usable epochs within
-    ``half_window_s``, at its own time, and the line's variance there (I1). ``angular``:
-    differences wrapped to (−π, π]. NaN where fewer than ``min_neighbours`` others are usable
-    or the epoch itself is not."""
+    ``half_window_s``, at its own time, and the line's variance there (I1): Huber IRLS on the
+    residuals in units of each value's ``sigma``, from the median (slope zero).
+    ``angular``: differences wrapped to (−π, π]. ``slope_sigma`` (per epoch, units of value per
+    second): a prior N(0, σ²) on the line's slope (none where infinite or not given). NaN
+    where fewer than ``min_neighbours`` others are usable or the epoch itself is not."""
     t = np.asarray(t, dtype=float)
     values = np.asarray(values, dtype=float)
+    sigma = np.asarray(sigma, dtype=float)
     usable = np.asarray(usable, dtype=bool) & np.isfinite(values) & np.isfinite(t)
+    usable &= np.isfinite(sigma) & (sigma > 0)
+    slope_sigma = np.full(t.size, np.inf) if slope_sigma is None else np.asarray(slope_sigma)
+    slope_precision = np.maximum(slope_sigma, MIN_SLOPE_SIGMA) ** -2.0
     residual, variance = np.full(t.size, np.nan), np.full(t.size, np.nan)
     for start in range(0, t.size, CHUNK_EPOCHS):
         epochs = np.arange(start, min(start + CHUNK_EPOCHS, t.size))
-        residual[epochs], variance[epochs] = _line_at_epochs(
-            epochs, t, values, usable, half_window_s, min_neighbours, angular
+        line, line_variance, count = _line_at_epochs(
+            epochs, t, values, sigma, usable, half_window_s, angular, slope_precision[epochs]
         )
+        enough = count >= min_neighbours
+        residual[epochs] = np.where(enough, line, np.nan)
+        variance[epochs] = np.where(enough, line_variance, np.nan)
     return residual, variance
 
 
-def _line_at_epochs(epochs, t, values, usable, half_window_s, min_neighbours, angular):
-    """:func:`windowed_line_residuals` at ``epochs`` (an (epochs × window) block)."""
+def _line_at_epochs(epochs, t, values, sigma, usable, half_window_s, angular, slope_precision):
+    """:func:`windowed_line_residuals` at ``epochs`` (an (epochs × window) block of the other
+    usable epochs in each window): weighted normal equations with the slope prior's precision
+    added to the slope's diagonal; also the number of neighbours."""
     lo = np.searchsorted(t, t[epochs] - half_window_s, "left")
     hi = np.searchsorted(t, t[epochs] + half_window_s, "right")
     index = lo[:, None] + np.arange(int((hi - lo).max()))
@@ -105,23 +120,24 @@ def _line_at_epochs(epochs, t, values, usable, half_window_s, min_neighbours, an
     if angular:
         y = wrap_angle(y)
     y = np.where(mask, y, 0.0)
-    weight = mask.astype(float)
-    for _ in range(IRLS_STEPS):
-        s0, s1, s2 = weight.sum(1), (weight * dt).sum(1), (weight * dt**2).sum(1)
-        y0, y1 = (weight * y).sum(1), (weight * dt * y).sum(1)
-        with np.errstate(divide="ignore", invalid="ignore"):
+    precision = np.where(mask, sigma[index] ** -2.0, 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # rows without neighbours
+        c0 = np.nanmedian(np.where(mask, y, np.nan), axis=1)
+    c1 = np.zeros(epochs.size)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for _ in range(IRLS_STEPS):
+            normalised = np.abs(y - c0[:, None] - c1[:, None] * dt) * np.sqrt(precision)
+            weight = precision * np.minimum(1.0, HUBER_K / normalised)
+            weight = np.where(mask, np.nan_to_num(weight, nan=0.0, posinf=0.0), 0.0)
+            weight = np.where(mask & (normalised == 0), precision, weight)
+            s0, s1 = weight.sum(1), (weight * dt).sum(1)
+            s2 = (weight * dt**2).sum(1) + slope_precision
+            y0, y1 = (weight * y).sum(1), (weight * dt * y).sum(1)
             det = s0 * s2 - s1**2
             c0 = (s2 * y0 - s1 * y1) / det
             c1 = (s0 * y1 - s1 * y0) / det
-            fit = np.abs(y - c0[:, None] - c1[:, None] * dt)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)  # rows without neighbours
-                scale = MAD_TO_SIGMA * np.nanmedian(np.where(mask, fit, np.nan), axis=1)
-            huber = np.minimum(1.0, HUBER_K * scale[:, None] / fit)
-        weight = np.where(mask, np.nan_to_num(huber, nan=1.0), 0.0)
-    enough = mask.sum(1) >= min_neighbours
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(enough, -c0, np.nan), np.where(enough, scale**2 * s2 / det, np.nan)
+        return -c0, s2 / det, mask.sum(1)
 
 
 def consistency_test(
@@ -131,11 +147,20 @@ def consistency_test(
     usable: np.ndarray,
     config: ConsistencyConfig,
     angular: bool = False,
+    slope_sigma: np.ndarray | None = None,
 ) -> ConsistencyTest:
     """Test (I1) of one quantity: ``difference`` is the GNSS value minus the sensor's (course
-    minus integrated yaw rate, or speed minus wheel speed), ``sigma`` the GNSS value's σ."""
+    minus integrated yaw rate, or speed minus wheel speed), ``sigma`` the GNSS value's σ,
+    ``slope_sigma`` the σ of the sensor's drift (:func:`windowed_line_residuals`)."""
     residual, variance = windowed_line_residuals(
-        t, difference, usable, config.half_window_s, config.min_neighbours, angular
+        t,
+        difference,
+        sigma,
+        usable,
+        config.half_window_s,
+        config.min_neighbours,
+        angular,
+        slope_sigma,
     )
     with np.errstate(invalid="ignore"):
         z = residual / np.sqrt(np.asarray(sigma, dtype=float) ** 2 + variance)
@@ -168,11 +193,13 @@ def conventional_integrity(
     speed: np.ndarray,
     speed_sigma: np.ndarray | None,
     wheel_speed: np.ndarray,
+    gyro_bias_sigma: np.ndarray,
     config: ConsistencyConfig = ConsistencyConfig(),
 ) -> ConventionalIntegrity:
     """Test (I1) of the conventional yaw against the integrated calibrated yaw rate
     ``yaw_angle`` and of its horizontal speed against the calibrated ``wheel_speed``, at the
-    epochs ``valid`` so far (rad, m/s; module docstring)."""
+    epochs ``valid`` so far (rad, m/s; module docstring). The course line's slope is what is
+    left of the gyro bias: its prior is N(0, ``gyro_bias_sigma``²) (rad/s, per epoch)."""
     valid = np.asarray(valid, dtype=bool)
     if not config.enabled:
         return ConventionalIntegrity(None, None, valid.copy())
@@ -180,7 +207,13 @@ def conventional_integrity(
     failed = np.zeros(valid.shape, dtype=bool)
     if yaw_sigma is not None:
         course = consistency_test(
-            t, np.asarray(yaw) - np.asarray(yaw_angle), yaw_sigma, valid, config, angular=True
+            t,
+            np.asarray(yaw) - np.asarray(yaw_angle),
+            yaw_sigma,
+            valid,
+            config,
+            angular=True,
+            slope_sigma=gyro_bias_sigma,
         )
         failed |= course.failed
     if speed_sigma is not None:

@@ -249,6 +249,7 @@ def heading_pipeline(
         conv_speed,
         conventional_speed_sigma_mps,
         cal.scale * wheel,
+        cal.bias_sigma,
         config.integrity,
     )
     grade = _grade_prior(t_epoch, velocity, conventional_valid, speed, forward_acceleration, config)
