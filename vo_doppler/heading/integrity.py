@@ -43,6 +43,9 @@ MIN_SLOPE_SIGMA = 1e-9
 
 @dataclass(frozen=True)
 class ConsistencyConfig:
+    """The test (I1): its window (±``half_window_s``), false-alarm rate per test and the
+    neighbours an epoch needs to be tested."""
+
     enabled: bool = True
     half_window_s: float = 2.0
     false_alarm: float = 0.001
@@ -64,10 +67,6 @@ class ConsistencyTest:
     z: np.ndarray
     sigma_factor: float
     failed: np.ndarray
-
-    @property
-    def tested(self) -> np.ndarray:
-        return np.isfinite(self.z)
 
 
 def windowed_line_residuals(
@@ -129,8 +128,6 @@ def _line_at_epochs(epochs, t, values, sigma, usable, half_window_s, angular, sl
         for _ in range(IRLS_STEPS):
             normalised = np.abs(y - c0[:, None] - c1[:, None] * dt) * np.sqrt(precision)
             weight = precision * np.minimum(1.0, HUBER_K / normalised)
-            weight = np.where(mask, np.nan_to_num(weight, nan=0.0, posinf=0.0), 0.0)
-            weight = np.where(mask & (normalised == 0), precision, weight)
             s0, s1 = weight.sum(1), (weight * dt).sum(1)
             s2 = (weight * dt**2).sum(1) + slope_precision
             y0, y1 = (weight * y).sum(1), (weight * dt * y).sum(1)

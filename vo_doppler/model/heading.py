@@ -34,10 +34,11 @@ class HeadingTable:
     """A bias on any satellite the tightly coupled heading used would have shown in the
     residuals (False where it could hide, and where the heading is unavailable)."""
     sigma_conv: np.ndarray | None = None
-    """Standard deviation (rad) of the conventional heading, NaN where unknown or invalid."""
+    """Standard deviation (rad) of the conventional heading, NaN where unknown or invalid (the
+    heading stage's is the velocity's times the factor of its gyro test, design (I1))."""
     speed_sigma_conv: np.ndarray | None = None
     """Standard deviation (m/s) of the conventional horizontal speed, NaN where unknown or
-    invalid."""
+    invalid (scaled as ``sigma_conv``, by the wheel-speed test's factor)."""
     hdop_conv: np.ndarray | None = None
     """Horizontal DOP of the conventional velocity's geometry, NaN where unknown or invalid."""
     tc_window_s: float = DEFAULT_TC_WINDOW_S
