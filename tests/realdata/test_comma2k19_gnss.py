@@ -65,7 +65,7 @@ def test_conventional_velocity_with_fitted_noise(comma):
     course median 0.12° (p95 0.53°); one valid epoch beyond 1.5° (1.80°, at t + 1.2 s: several
     satellites reflected at once, 0.2–1.1 m/s against the truth, and fitted by a wrong
     velocity, so that no residual shows it) in the GNSS stage; after the gyro and wheel test
-    (heading.csv, design (I1)) valid 96.3 %, none beyond 1.5° and 6 of 600 beyond 3σ of the
+    (heading.csv, design (I1)) valid 96.2 %, none beyond 1.5° and 4 of 600 beyond 3σ of the
     scaled σ (35 before)."""
     sequence, gnss = comma[:2]
     figures = checked_conventional_figures(sequence, gnss)[0]

@@ -47,7 +47,7 @@ class ConsistencyConfig:
     neighbours an epoch needs to be tested."""
 
     enabled: bool = True
-    half_window_s: float = 2.0
+    half_window_s: float = 5.0
     false_alarm: float = 0.001
     """Probability that one test (course or speed) fails an epoch without a fault."""
     min_neighbours: int = 5
