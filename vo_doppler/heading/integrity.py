@@ -37,7 +37,7 @@ from vo_doppler.geo import wrap_angle
 HUBER_K = 1.345
 MAD_TO_SIGMA = 1.4826
 IRLS_STEPS = 5
-CHUNK_EPOCHS = 2048
+CHUNK_EPOCHS = 512
 MIN_SLOPE_SIGMA = 1e-9
 
 
