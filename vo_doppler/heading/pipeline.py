@@ -82,6 +82,11 @@ def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, config):
     return np.where(known, mean, level[0]), np.where(known, sigma, level[1])
 
 
+def _sigma_where(sigma: np.ndarray | None, valid: np.ndarray) -> np.ndarray | None:
+    """σ at the ``valid`` epochs, NaN elsewhere (None where no σ is known)."""
+    return None if sigma is None else np.where(valid, np.asarray(sigma, dtype=float), np.nan)
+
+
 def _calibrators(config: HeadingPipelineConfig):
     if config.calibration == "ls":
         return GyroBiasCalibrator(config.gate), WheelScaleCalibrator(config.gate)
@@ -247,8 +252,8 @@ def heading_pipeline(
         wheel_scale=cal.scale,
         rejected_rows=result.n_rejected,
         tc_verifiable=result.verifiable,
-        sigma_conv=None
-        if conventional_yaw_sigma is None
-        else np.where(conv_ok, np.asarray(conventional_yaw_sigma, dtype=float), np.nan),
+        sigma_conv=_sigma_where(conventional_yaw_sigma, conv_ok),
         tc_window_s=config.tight.window_s,
+        conv_gnss_valid=conv_ok,
+        sigma_conv_gnss=_sigma_where(conventional_yaw_sigma, conv_ok),
     )
