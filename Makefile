@@ -4,7 +4,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 
-.PHONY: demo test lint bench fuzz clean
+.PHONY: demo test lint bench fuzz clean browser
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -21,7 +21,18 @@ $(TEST_STAMP): $(BIN)/python pyproject.toml
 demo: $(STAMP)
 	$(BIN)/vo-doppler run sample_sequences/urban_canyon_small -o out/demo
 
-test: $(TEST_STAMP)
+# The report's browser test needs a headless Chromium: Debian's package, installed when missing
+# and this machine can (root with apt-get); otherwise the browser tests skip and say why.
+browser:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 \
+	  || command -v google-chrome >/dev/null 2>&1 \
+	  || { if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	         echo "installing Debian's chromium for the browser tests"; \
+	         apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null \
+	           || echo "chromium could not be installed: the browser tests will skip"; \
+	       else echo "no chromium and no root apt-get: the browser tests will skip"; fi; }
+
+test: $(TEST_STAMP) browser
 	$(BIN)/python -m pytest -q
 
 lint: $(TEST_STAMP)

@@ -160,6 +160,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--repeats must be at least 1")
     runs: dict[str, list[dict]] = {name: [] for name in PIPELINES}
     results = {}
+    first_poses: dict[str, np.ndarray] = {}
     with tempfile.TemporaryDirectory() as tmp:
         speed_csv = Path(tmp) / "speed.csv"
         write_speed_csv(truth, speed_csv)
@@ -169,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
                 out = Path(tmp) / f"{len(name)}_{repeat}"
                 runs[name].append(timed_process(name, args, speed_csv, out))
                 poses = np.load(out.with_suffix(".npy"))
-                if name in results and not np.array_equal(poses, results[name][0].matrices):
+                if not np.array_equal(poses, first_poses.setdefault(name, poses)):
                     print(f"warning: {name} gave different poses in repeat {repeat}")
                 results[name] = (Trajectory.from_matrices(times, poses), runs[name][-1]["stats"])
     rows = {}

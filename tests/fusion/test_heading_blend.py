@@ -427,7 +427,7 @@ def test_correct_cli_kalman_weighs_conventional_headings_by_their_sigma(tmp_path
         path = tmp_path / f"heading_{name}.csv"
         write_heading_csv(path, table)
         if not keep_sigma:
-            lines = [line.rsplit(",", 1)[0] for line in path.read_text().splitlines()]
+            lines = [line.rsplit(",", 3)[0] for line in path.read_text().splitlines()]
             path.write_text("\n".join(lines) + "\n")
             assert np.isnan(read_heading_csv(path).sigma_conv).all()
         else:

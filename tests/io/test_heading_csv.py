@@ -50,3 +50,34 @@ def test_files_without_the_columns_read_as_nan(tmp_path):
     back = read_heading_csv(path)
     assert np.isnan(back.speed_sigma_conv).all() and np.isnan(back.hdop_conv).all()
     assert np.isfinite(back.sigma_conv[0])
+
+
+def test_gnss_only_validity_and_sigma_round_trip_apart_from_the_checked_ones(tmp_path):
+    table = _table()
+    table.conv_gnss_valid = table.conv_valid
+    table.conv_valid = np.array([True, False, False, True])
+    table.sigma_conv = np.where(table.conv_valid, 0.006, np.nan)
+    table.sigma_conv_gnss = np.where(table.conv_gnss_valid, 0.002, np.nan)
+    path = tmp_path / "heading.csv"
+    write_heading_csv(path, table)
+    back = read_heading_csv(path)
+    np.testing.assert_array_equal(back.conv_valid, [True, False, False, True])
+    np.testing.assert_array_equal(back.conv_gnss_valid, [True, False, True, True])
+    np.testing.assert_allclose(np.degrees(back.sigma_conv_gnss[[0, 2, 3]]), 0.1146, atol=1e-4)
+    np.testing.assert_allclose(np.degrees(back.sigma_conv[[0, 3]]), 0.3438, atol=1e-4)
+
+
+def test_files_without_the_gnss_only_columns_take_the_checked_ones(tmp_path):
+    path = tmp_path / "heading.csv"
+    table = _table()
+    table.conv_gnss_valid = np.ones(4, dtype=bool)
+    write_heading_csv(path, table)
+    rows = [line.split(",") for line in path.read_text().splitlines()]
+    new = ("conv_gnss_valid", "heading_conv_gnss_sigma_deg")
+    keep = [i for i, name in enumerate(rows[0]) if name not in new]
+    path.write_text("\n".join(",".join(row[i] for i in keep) for row in rows) + "\n")
+    back = read_heading_csv(path)
+    assert back.conv_gnss_valid is None and back.sigma_conv_gnss is None
+    valid, sigma = back.published_conventional
+    np.testing.assert_array_equal(valid, back.conv_valid)
+    np.testing.assert_array_equal(sigma, back.sigma_conv)

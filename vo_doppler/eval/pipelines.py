@@ -107,7 +107,7 @@ def heading_availability(table: HeadingTable, tc_usable: np.ndarray) -> dict[str
     tc = float(np.mean(tc_usable))
     return {
         "vo": 0.0,
-        "vo_gps_conv": float(np.mean(table.conv_valid)),
+        "vo_gps_conv": float(np.mean(table.published_conventional[0])),
         "vo_gps_tc": tc,
         "dr_gps_tc": tc,
     }

@@ -74,8 +74,11 @@ def tight_absolute_heading(table: HeadingTable, config: CorrectionConfig) -> Abs
 
 
 def conventional_absolute_heading(table: HeadingTable) -> AbsoluteHeading:
-    """The valid conventional (single-epoch Doppler velocity) headings."""
-    return AbsoluteHeading(table.t, table.yaw_conv, table.conv_valid, table.sigma_conv)
+    """The conventional (single-epoch Doppler velocity) headings as the published method has
+    them: valid by the GNSS tests alone, with the velocity solution's σ — the baseline the
+    tightly coupled heading is compared with."""
+    valid, sigma = table.published_conventional
+    return AbsoluteHeading(table.t, table.yaw_conv, valid, sigma)
 
 
 def absolute_heading(table: HeadingTable, source: str, config: CorrectionConfig) -> AbsoluteHeading:

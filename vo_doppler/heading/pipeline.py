@@ -85,12 +85,15 @@ def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, config):
     return np.where(known, mean, level[0]), np.where(known, sigma, level[1])
 
 
+def _sigma_where(sigma: np.ndarray | None, valid: np.ndarray) -> np.ndarray | None:
+    """σ at the ``valid`` epochs, NaN elsewhere (None where no σ is known)."""
+    return None if sigma is None else np.where(valid, np.asarray(sigma, dtype=float), np.nan)
+
+
 def _scaled_sigma(sigma, test, valid):
-    """σ at the valid epochs times the test's σ factor (NaN elsewhere; None if unknown)."""
-    if sigma is None:
-        return None
-    factor = 1.0 if test is None else test.sigma_factor
-    return np.where(valid, factor * np.asarray(sigma, dtype=float), np.nan)
+    """:func:`_sigma_where` times the integrity test's σ factor (design (I1))."""
+    shown = _sigma_where(sigma, valid)
+    return shown if shown is None or test is None else test.sigma_factor * shown
 
 
 def _calibrators(config: HeadingPipelineConfig):
@@ -282,4 +285,6 @@ def heading_pipeline(
             conventional_speed_sigma_mps, integrity.speed, integrity.valid
         ),
         tc_window_s=config.tight.window_s,
+        conv_gnss_valid=conv_ok,
+        sigma_conv_gnss=_sigma_where(conventional_yaw_sigma, conv_ok),
     )

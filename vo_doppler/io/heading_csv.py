@@ -5,10 +5,13 @@ n_sat_epoch, heading_conv_deg, conv_valid, gyro_bias_dps, wheel_scale, then reje
 of the window rejected as biased, NLOS) and tc_verifiable (a bias on any satellite used would
 have shown), tc_window_s (the tight heading's window, the same on every row),
 conv_speed_sigma_mps and conv_hdop (the conventional velocity's speed standard deviation and
-horizontal DOP) and heading_conv_sigma_deg (the conventional heading's standard deviation).
-Unavailable headings are written as ``nan``; flags as 0/1. Reading converts back to yaw (rad,
-counter-clockwise from east); the last six columns are optional (files written before they
-existed read as zero, or NaN for the standard deviations and the DOP).
+horizontal DOP) and heading_conv_sigma_deg (the conventional heading's standard deviation),
+conv_gnss_valid and heading_conv_gnss_sigma_deg (the conventional heading's validity by the GNSS
+tests alone and its σ from the velocity solution: the published method, the comparison
+pipeline's input; ``conv_valid`` adds every integrity test). Unavailable headings are written as
+``nan``; flags as 0/1. Reading converts back to yaw (rad, counter-clockwise from east); the last
+eight columns are optional (files written before they existed read as zero, or NaN for the
+standard deviations and the DOP; without conv_gnss_valid the GNSS validity is conv_valid's).
 """
 
 from __future__ import annotations
@@ -42,6 +45,8 @@ OPTIONAL_COLUMNS = (
     "conv_speed_sigma_mps",
     "conv_hdop",
     "heading_conv_sigma_deg",
+    "conv_gnss_valid",
+    "heading_conv_gnss_sigma_deg",
 )
 
 
@@ -63,6 +68,8 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         table.speed_sigma_conv,
         table.hdop_conv,
         np.degrees(table.sigma_conv),
+        table.published_conventional[0].astype(int),
+        np.degrees(table.published_conventional[1]),
     ]
     formats = (
         "{:.3f}",
@@ -80,6 +87,8 @@ def write_heading_csv(path: str | Path, table: HeadingTable) -> None:
         "{:g}",
         "{:.4f}",
         "{:.3f}",
+        "{:.4f}",
+        "{:d}",
         "{:.4f}",
     )
     with Path(path).open("w", newline="") as handle:
@@ -120,6 +129,9 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
         for i, c in enumerate(c for c in OPTIONAL_COLUMNS if c in header)
     }
     tc_deg, conv_deg = data[:, 1], data[:, 6]
+    gnss_valid, gnss_sigma_deg = (
+        optional.get(c) for c in ("conv_gnss_valid", "heading_conv_gnss_sigma_deg")
+    )
     return HeadingTable(
         t=data[:, 0],
         yaw_tc=np.where(np.isfinite(tc_deg), course_to_yaw(np.radians(tc_deg)), np.nan),
@@ -137,6 +149,8 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
         speed_sigma_conv=optional.get("conv_speed_sigma_mps", np.full(len(data), np.nan)),
         hdop_conv=optional.get("conv_hdop", np.full(len(data), np.nan)),
         tc_window_s=_window_s(optional.get("tc_window_s"), path),
+        conv_gnss_valid=None if gnss_valid is None else (gnss_valid > 0.5) & np.isfinite(conv_deg),
+        sigma_conv_gnss=None if gnss_sigma_deg is None else np.radians(gnss_sigma_deg),
     )
 
 

@@ -43,6 +43,13 @@ class HeadingTable:
     """Horizontal DOP of the conventional velocity's geometry, NaN where unknown or invalid."""
     tc_window_s: float = DEFAULT_TC_WINDOW_S
     """The tightly coupled solver's window (s): its headings' errors are correlated over it."""
+    conv_gnss_valid: np.ndarray | None = None
+    """The conventional heading as the published method has it: valid by the GNSS tests alone
+    (redundancy and χ², no gyro or wheel speed), the comparison pipeline's input (read through
+    :attr:`published_conventional`)."""
+    sigma_conv_gnss: np.ndarray | None = None
+    """Standard deviation (rad) of the conventional heading from the velocity solution alone,
+    NaN where unknown or not ``conv_gnss_valid``."""
 
     def __post_init__(self) -> None:
         n = len(self.t)
@@ -58,6 +65,14 @@ class HeadingTable:
         return len(self.t)
 
     @property
+    def published_conventional(self) -> tuple[np.ndarray, np.ndarray]:
+        """Validity and σ (rad) of the conventional heading by the GNSS tests alone (the
+        published method), falling back on ``conv_valid`` and ``sigma_conv`` where not given."""
+        valid = self.conv_valid if self.conv_gnss_valid is None else self.conv_gnss_valid
+        sigma = self.sigma_conv if self.sigma_conv_gnss is None else self.sigma_conv_gnss
+        return valid, sigma
+
+    @property
     def tc_available(self) -> np.ndarray:
         return np.isfinite(self.yaw_tc)
 
@@ -68,7 +83,10 @@ class HeadingTable:
 
     @property
     def course_conv(self) -> np.ndarray:
-        return np.where(self.conv_valid, yaw_to_course(np.nan_to_num(self.yaw_conv)), np.nan)
+        """Conventional heading as course (rad) where it passed the GNSS tests or every test
+        (``conv_valid`` and :attr:`published_conventional` say which), NaN elsewhere."""
+        shown = self.conv_valid | self.published_conventional[0]
+        return np.where(shown, yaw_to_course(np.nan_to_num(self.yaw_conv)), np.nan)
 
     def calibrated_speed(self, wheel: SensorSeries) -> SensorSeries:
         """Wheel speed × the wheel scale current at each sample (held between epochs and

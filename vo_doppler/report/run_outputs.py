@@ -54,7 +54,11 @@ log = logging.getLogger(__name__)
 
 FACT_FORMATS = {
     "gnss_epochs": ("GNSS epochs", "{:d}"),
-    "conventional_heading_availability": ("conventional heading available", "{:.1%}"),
+    "conventional_heading_availability": (
+        "conventional heading available (GNSS tests; the comparison pipeline's input)",
+        "{:.1%}",
+    ),
+    "conventional_heading_valid": ("conventional heading valid (every integrity test)", "{:.1%}"),
     "tight_heading_availability": ("tightly coupled heading available", "{:.1%}"),
     "tight_heading_reliable": ("tightly coupled heading reliable (gyro-consistent)", "{:.1%}"),
     "tight_heading_used": ("tightly coupled heading used by the correction", "{:.1%}"),
@@ -81,7 +85,8 @@ def summarise(result: RunResult) -> dict:
     table = result.heading
     summary = {
         "gnss_epochs": len(table),
-        "conventional_heading_availability": float(np.mean(table.conv_valid)),
+        "conventional_heading_availability": float(np.mean(table.published_conventional[0])),
+        "conventional_heading_valid": float(np.mean(table.conv_valid)),
         "tight_heading_availability": float(np.mean(table.tc_available)),
         "tight_heading_reliable": float(np.mean(table.tc_reliable)),
         "tight_heading_used": float(np.mean(result.tc_usable)),
