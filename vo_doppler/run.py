@@ -24,6 +24,7 @@ import logging
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from enum import StrEnum
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -39,7 +40,6 @@ from vo_doppler.geo import EnuFrame, yaw_of
 from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
-from vo_doppler.io.images import prefetch_images
 from vo_doppler.lowcost.dead_reckoning import wheel_gyro_track
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.gnss_solutions import VelocitySolution
@@ -48,9 +48,11 @@ from vo_doppler.model.observations import Observations
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
-from vo_doppler.vo.batch import VoOutput, run_visual_odometry
 from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.frames import vehicle_trajectory
+
+if TYPE_CHECKING:
+    from vo_doppler.vo.batch import VoOutput
 
 log = logging.getLogger(__name__)
 
@@ -218,6 +220,26 @@ def sequence_heading(
     )
 
 
+def sequence_vo(
+    sequence: Sequence,
+    config: VoConfig,
+    speed: SensorSeries,
+    on_frame: Callable[[int], None] | None = None,
+    images: Iterable[np.ndarray] | None = None,
+) -> VoOutput:
+    """The VO stage on a recording with a camera, scaled by the calibrated wheel speed; images
+    are read from ``sequence.image_paths`` unless given."""
+    # OpenCV and pycolmap (about 70 MiB resident) load here, not with the module: a recording
+    # without a camera never needs them, and the stages before the VO run without them.
+    from vo_doppler.io.images import prefetch_images
+    from vo_doppler.vo.batch import run_visual_odometry
+
+    frames = images if images is not None else prefetch_images(sequence.image_paths)
+    return run_visual_odometry(
+        frames, sequence.image_times, sequence.camera, config, (speed.t, speed.value), on_frame
+    )
+
+
 def run_sequence(
     sequence: Sequence,
     config: RunConfig | None = None,
@@ -234,15 +256,7 @@ def run_sequence(
     vo = None
     vo_vehicle = None
     if sequence.has_camera:
-        frames = images if images is not None else prefetch_images(sequence.image_paths)
-        vo = run_visual_odometry(
-            frames,
-            sequence.image_times,
-            sequence.camera,
-            config.vo,
-            (speed.t, speed.value),
-            on_frame,
-        )
+        vo = sequence_vo(sequence, config.vo, speed, on_frame, images)
         vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
     else:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
