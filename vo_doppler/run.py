@@ -20,6 +20,8 @@ time. A recording without a camera runs every pipeline that needs none.
 
 from __future__ import annotations
 
+import ctypes
+import functools
 import logging
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -240,6 +242,21 @@ def sequence_vo(
     )
 
 
+@functools.cache
+def _malloc_trim() -> Callable[[int], int] | None:
+    return getattr(ctypes.CDLL(None), "malloc_trim", None)
+
+
+def release_free_heap() -> None:
+    """Give the C heap's free memory back to the system (glibc's ``malloc_trim``; nothing
+    elsewhere). After a stage frees its large NumPy temporaries glibc keeps much of them
+    resident: its mmap threshold rises to the largest block freed, so later large arrays come
+    from the heap, whose free pages are returned only from its top."""
+    trim = _malloc_trim()
+    if trim is not None:
+        trim(0)
+
+
 def run_sequence(
     sequence: Sequence,
     config: RunConfig | None = None,
@@ -251,16 +268,20 @@ def run_sequence(
     config = config or RunConfig()
     obs = sequence.observations
     gnss = sequence_gnss(sequence, config)
+    release_free_heap()
     table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
+    release_free_heap()
     speed = table.calibrated_speed(sequence.wheel_speed)
     vo = None
     vo_vehicle = None
     if sequence.has_camera:
         vo = sequence_vo(sequence, config.vo, speed, on_frame, images)
         vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
+        release_free_heap()
     else:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
     start = start_position(gnss, obs, sequence.enu)
     trajectories = correct_all(sequence, table, vo_vehicle, speed, start, config)
+    release_free_heap()
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
     return RunResult(gnss, table, vo, speed, trajectories, start, usable)
