@@ -22,7 +22,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-STAGES = ("sequence_gnss", "sequence_heading", "run_visual_odometry", "correct_all")
+STAGES = ("sequence_gnss", "sequence_heading", "sequence_vo", "correct_all")
 
 
 def _status_kib(field: str) -> int:

@@ -20,10 +20,13 @@ time. A recording without a camera runs every pipeline that needs none.
 
 from __future__ import annotations
 
+import ctypes
+import functools
 import logging
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from enum import StrEnum
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -39,7 +42,6 @@ from vo_doppler.geo import EnuFrame, yaw_of
 from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
-from vo_doppler.io.images import prefetch_images
 from vo_doppler.lowcost.dead_reckoning import wheel_gyro_track
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.gnss_solutions import VelocitySolution
@@ -48,9 +50,11 @@ from vo_doppler.model.observations import Observations
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
-from vo_doppler.vo.batch import VoOutput, run_visual_odometry
 from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.frames import vehicle_trajectory
+
+if TYPE_CHECKING:
+    from vo_doppler.vo.batch import VoOutput
 
 log = logging.getLogger(__name__)
 
@@ -218,6 +222,41 @@ def sequence_heading(
     )
 
 
+def sequence_vo(
+    sequence: Sequence,
+    config: VoConfig,
+    speed: SensorSeries,
+    on_frame: Callable[[int], None] | None = None,
+    images: Iterable[np.ndarray] | None = None,
+) -> VoOutput:
+    """The VO stage on a recording with a camera, scaled by the calibrated wheel speed; images
+    are read from ``sequence.image_paths`` unless given."""
+    # OpenCV and pycolmap (about 70 MiB resident) load here, not with the module: a recording
+    # without a camera never needs them, and the stages before the VO run without them.
+    from vo_doppler.io.images import prefetch_images
+    from vo_doppler.vo.batch import run_visual_odometry
+
+    frames = images if images is not None else prefetch_images(sequence.image_paths)
+    return run_visual_odometry(
+        frames, sequence.image_times, sequence.camera, config, (speed.t, speed.value), on_frame
+    )
+
+
+@functools.cache
+def _malloc_trim() -> Callable[[int], int] | None:
+    return getattr(ctypes.CDLL(None), "malloc_trim", None)
+
+
+def release_free_heap() -> None:
+    """Give the C heap's free memory back to the system (glibc's ``malloc_trim``; nothing
+    elsewhere). After a stage frees its large NumPy temporaries glibc keeps much of them
+    resident: its mmap threshold rises to the largest block freed, so later large arrays come
+    from the heap, whose free pages are returned only from its top."""
+    trim = _malloc_trim()
+    if trim is not None:
+        trim(0)
+
+
 def run_sequence(
     sequence: Sequence,
     config: RunConfig | None = None,
@@ -229,24 +268,20 @@ def run_sequence(
     config = config or RunConfig()
     obs = sequence.observations
     gnss = sequence_gnss(sequence, config)
+    release_free_heap()
     table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
+    release_free_heap()
     speed = table.calibrated_speed(sequence.wheel_speed)
     vo = None
     vo_vehicle = None
     if sequence.has_camera:
-        frames = images if images is not None else prefetch_images(sequence.image_paths)
-        vo = run_visual_odometry(
-            frames,
-            sequence.image_times,
-            sequence.camera,
-            config.vo,
-            (speed.t, speed.value),
-            on_frame,
-        )
+        vo = sequence_vo(sequence, config.vo, speed, on_frame, images)
         vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
+        release_free_heap()
     else:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
     start = start_position(gnss, obs, sequence.enu)
     trajectories = correct_all(sequence, table, vo_vehicle, speed, start, config)
+    release_free_heap()
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
     return RunResult(gnss, table, vo, speed, trajectories, start, usable)

@@ -14,3 +14,11 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected an integer ≥ 1, got {text!r}")
     return value
+
+
+def window_size(text: str) -> int:
+    """argparse type: a sliding-window length of at least 3 frames."""
+    value = int(text)
+    if value < 3:
+        raise argparse.ArgumentTypeError(f"must be at least 3 frames, got {value}")
+    return value

@@ -13,8 +13,8 @@ from rich.markup import escape
 from rich.progress import Progress
 from rich.table import Table
 
+from vo_doppler.commands.arg_types import window_size
 from vo_doppler.commands.time_hints import overlap_error, overlaps
-from vo_doppler.commands.vo_command import window_size
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig

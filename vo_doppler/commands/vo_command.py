@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from rich.progress import Progress
 
+from vo_doppler.commands.arg_types import window_size
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import associate, evaluate
 from vo_doppler.io.calibration import read_camera
@@ -57,14 +58,6 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--gt", type=Path, help="ground truth (KITTI poses or TUM) to evaluate")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     parser.set_defaults(func=run)
-
-
-def window_size(text: str) -> int:
-    """argparse type: a sliding-window length of at least 3 frames."""
-    value = int(text)
-    if value < 3:
-        raise argparse.ArgumentTypeError(f"must be at least 3 frames, got {value}")
-    return value
 
 
 def run(args: argparse.Namespace) -> int:

@@ -11,7 +11,6 @@ from collections.abc import Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from vo_doppler.errors import InputError
@@ -37,6 +36,8 @@ def list_images(folder: str | Path) -> list[Path]:
 
 def read_image(path: Path) -> np.ndarray | None:
     """Grey uint8 image, or ``None`` (with a warning) when the file cannot be decoded."""
+    import cv2  # OpenCV (16 MiB resident) is loaded by the first image read, not with the package
+
     image = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if image is None:
         log.warning("%s: cannot decode image; the frame is flagged and bridged", path)

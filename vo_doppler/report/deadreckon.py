@@ -8,12 +8,12 @@ import json
 from pathlib import Path
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from vo_doppler.geo import EnuFrame, ecef_to_geodetic
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.lowcost.drift import DriftRow
 from vo_doppler.lowcost.pipeline import DeadReckonResult
+from vo_doppler.report.figure import new_figure
 
 DRIFT_COLUMNS = (
     "variant",
@@ -98,7 +98,7 @@ def summary(result: DeadReckonResult) -> dict:
 
 def write_map_figure(path: Path, result: DeadReckonResult) -> None:
     prepared = result.prepared
-    fig = Figure(figsize=(7, 7))
+    fig = new_figure(figsize=(7, 7))
     ax = fig.subplots()
     ax.plot(*prepared.raw_enu.T, ".", ms=2, color="0.6", label="GPS fixes")
     ax.plot(*prepared.track_enu.T, "--", lw=1, color="0.2", label="reconstructed GPS")
@@ -117,7 +117,7 @@ def write_map_figure(path: Path, result: DeadReckonResult) -> None:
 
 
 def write_allan_figure(path: Path, result: DeadReckonResult) -> None:
-    fig = Figure(figsize=(7, 5))
+    fig = new_figure(figsize=(7, 5))
     ax = fig.subplots()
     for name, allan in result.model.allan.items():
         ax.loglog(allan.taus, np.degrees(allan.adev), label=name)

@@ -5,17 +5,16 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.figure import Figure
-from matplotlib.ticker import MaxNLocator
 
 from vo_doppler.geo import EnuFrame
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
+from vo_doppler.report.figure import integer_ticks, new_figure
 
 
 def velocity_figure(path: str | Path, solution: VelocitySolution, title: str = "") -> None:
     """Speed, course and satellite count over time (PNG)."""
     t = solution.t - solution.t[0] if solution.t.size else solution.t
-    fig = Figure(figsize=(9, 7))
+    fig = new_figure(figsize=(9, 7))
     axes = fig.subplots(3, 1, sharex=True)
     axes[0].plot(t, solution.speed_mps, ".-", ms=3)
     axes[0].set_ylabel("speed (m/s)")
@@ -29,7 +28,7 @@ def velocity_figure(path: str | Path, solution: VelocitySolution, title: str = "
         axes[2].plot(t[missing], solution.n_sat[missing], "rx", label="unavailable")
         axes[2].legend(loc="best")
     axes[2].set_ylabel("satellites")
-    axes[2].yaxis.set_major_locator(MaxNLocator(integer=True))
+    integer_ticks(axes[2].yaxis)
     axes[2].set_xlabel("time since first epoch (s)")
     fig.suptitle(title or "GNSS Doppler velocity")
     _save(fig, path)
@@ -38,7 +37,7 @@ def velocity_figure(path: str | Path, solution: VelocitySolution, title: str = "
 def spp_figure(path: str | Path, solution: SppSolution, title: str = "") -> None:
     """East/north/up about the median fix and satellite count over time (PNG)."""
     t = solution.t - solution.t[0] if solution.t.size else solution.t
-    fig = Figure(figsize=(9, 6))
+    fig = new_figure(figsize=(9, 6))
     axes = fig.subplots(2, 1, sharex=True)
     if solution.valid.any():
         frame = EnuFrame.from_ecef(np.median(solution.position_ecef[solution.valid], axis=0))
@@ -49,7 +48,7 @@ def spp_figure(path: str | Path, solution: SppSolution, title: str = "") -> None
     axes[0].set_ylabel("position about median (m)")
     axes[1].step(t, solution.n_sat, where="mid")
     axes[1].set_ylabel("satellites")
-    axes[1].yaxis.set_major_locator(MaxNLocator(integer=True))
+    integer_ticks(axes[1].yaxis)
     axes[1].set_xlabel("time since first epoch (s)")
     fig.suptitle(title or "GNSS single-point positions")
     _save(fig, path)

@@ -6,12 +6,16 @@ with the same band when ground truth is given."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from vo_doppler.geo import wrap_angle, yaw_to_course
 from vo_doppler.model.heading import HeadingTable
+from vo_doppler.report.figure import new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 CONVENTIONAL, TIGHT = "tab:blue", "tab:red"
 BAND_SIGMAS = 2.0
@@ -60,7 +64,7 @@ def build_heading_figure(
     step per epoch centred on it."""
     t = table.t - (table.t[0] if len(table) else 0.0)
     panels = 4 if truth_yaw is not None else 3
-    fig = Figure(figsize=(10, 1.6 + 2.3 * panels))
+    fig = new_figure(figsize=(10, 1.6 + 2.3 * panels))
     axes = fig.subplots(
         panels, 1, sharex=True, height_ratios=[1.0, 0.7, 1.6] + [1.6] * (panels - 3)
     )

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from matplotlib.figure import Figure
-
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.report.figure import new_figure
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
@@ -20,7 +19,7 @@ def plot_top_view(
 ) -> None:
     """Plot each trajectory's positions on ``plane`` (horizontal, vertical axis names)."""
     h, v = AXIS_INDEX[plane[0]], AXIS_INDEX[plane[1]]
-    fig = Figure(figsize=(7, 6), dpi=110)
+    fig = new_figure(figsize=(7, 6), dpi=110)
     ax = fig.subplots()
     for label, trajectory in trajectories.items():
         if not len(trajectory):

@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import gc
 import json
 import logging
 from pathlib import Path
@@ -45,7 +46,7 @@ from vo_doppler.report.run_report import (
     write_run_report,
 )
 from vo_doppler.report.trajectory_map import TRUTH, write_geojson
-from vo_doppler.run import Pipeline, RunConfig, RunResult
+from vo_doppler.run import Pipeline, RunConfig, RunResult, release_free_heap
 
 SUMMARY_FILE = "summary.json"
 MAX_PROBLEMS_PER_FILE = 20
@@ -178,6 +179,14 @@ def driven_m(result: RunResult) -> float:
     return float(travelled_distance(speed.t, np.abs(speed.value), speed.t[-1:])[0])
 
 
+def release_figures() -> None:
+    """Free the figures already written: a matplotlib figure is a web of reference cycles that
+    only the cycle collector frees, and its freed buffers go back to the system only on request
+    (:func:`vo_doppler.run.release_free_heap`)."""
+    gc.collect()
+    release_free_heap()
+
+
 def write_run_outputs(
     sequence: Sequence,
     result: RunResult,
@@ -234,21 +243,25 @@ def write_run_outputs(
         report.error_figure = png_data_uri(
             build_error_per_100m_figure(per_100m, sequence.name), out / "error_per_100m.png"
         )
+        release_figures()
         report.heading_error_figure = png_data_uri(
             build_heading_error_figure(shown, truth, heading_t0, sequence.name),
             out / "heading_error.png",
         )
+        release_figures()
         report.worst = worst_reliable_tight_errors(table, result.tc_usable, truth_yaw)
         lengths = segment_lengths_that_fit(truth.path_length)
         report.segment_note = (
             "KITTI translation error: " + segment_lengths_note(lengths, truth.path_length) + "."
         )
     trajectories_figure(out / "trajectories.png", shown, truth, sequence.name)
+    release_figures()
     write_geojson(out / "trajectories.geojson", report.tracks, TRACK_LABELS, sequence.enu)
     report.heading_figure = png_data_uri(
         build_heading_figure(table, truth_yaw, sequence.name, result.tc_usable),
         out / "heading.png",
     )
+    release_figures()
     report.headline = headline(report.errors, summary["tight_heading_used"])
     report.facts = readable_facts(summary)
     (out / SUMMARY_FILE).write_text(json.dumps(summary, indent=2))

@@ -14,17 +14,21 @@ import html
 import io
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from vo_doppler.eval.per_distance import ErrorPerDistance
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, PipelineErrors
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.report.figure import new_figure
 from vo_doppler.report.provenance import DataDescription
 from vo_doppler.report.trajectory_map import COLOURS, TRUTH, map_html
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NO_ABSOLUTE_HEADING = {"vo"}
 """Pipelines that use no absolute heading: their heading-use column reads "—", not 0 %."""
@@ -133,7 +137,7 @@ def trajectories_figure(
     path: Path, trajectories: dict[str, Trajectory], truth: Trajectory | None, title: str
 ) -> None:
     """Top view (east, north in metres) of every pipeline's trajectory and the ground truth."""
-    fig = Figure(figsize=(8, 7))
+    fig = new_figure(figsize=(8, 7))
     ax = fig.subplots()
     if truth is not None:
         ax.plot(*truth.positions[:, :2].T, "k-", lw=2.5, alpha=0.35, label="ground truth")
@@ -154,7 +158,7 @@ def trajectories_figure(
 
 def build_error_per_100m_figure(per_100m: dict[str, ErrorPerDistance], title: str) -> Figure:
     """Per pipeline, the error of each 100 m stretch against where the stretch starts."""
-    fig = Figure(figsize=(9, 3.8))
+    fig = new_figure(figsize=(9, 3.8))
     ax = fig.subplots()
     for name, result in per_100m.items():
         ax.plot(
@@ -193,7 +197,7 @@ def build_heading_error_figure(
     """Per pipeline, the vehicle heading error (deg) over time; when one pipeline's errors
     reach more than ten times another's, the axis is linear within ±1° and logarithmic
     beyond, so that the small errors stay readable beside the large ones."""
-    fig = Figure(figsize=(9, 3.8))
+    fig = new_figure(figsize=(9, 3.8))
     ax = fig.subplots()
     spread = []
     for name, trajectory in trajectories.items():

@@ -1,0 +1,45 @@
+"""Heavy libraries load when they are used, not on import: the main job's modules load neither
+OpenCV nor pycolmap (about 70 MiB resident, needed only by the VO stage on a recording with a
+camera) nor matplotlib (about 28 MiB, needed only when a figure is drawn). Checked in a fresh
+interpreter, since this one has them all loaded by other tests."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from vo_doppler.report.figure import new_figure
+
+HEAVY = ("cv2", "pycolmap", "matplotlib")
+MAIN_JOB = (
+    "vo_doppler.commands.run_command",
+    "vo_doppler.run",
+    "vo_doppler.report.run_outputs",
+    "vo_doppler.batch",
+)
+
+
+def loaded_after_import(modules: tuple[str, ...]) -> list[str]:
+    """The ``HEAVY`` libraries in ``sys.modules`` after importing ``modules`` in a new process."""
+    code = (
+        f"import sys\nfor name in {modules!r}:\n    __import__(name)\n"
+        f"print(' '.join(m for m in {HEAVY!r} if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return done.stdout.split()
+
+
+def test_the_main_job_imports_no_opencv_pycolmap_or_matplotlib():
+    assert loaded_after_import(MAIN_JOB) == []
+
+
+def test_the_check_sees_a_heavy_import():
+    assert loaded_after_import(("vo_doppler.vo.batch",)) == ["cv2", "pycolmap"]
+
+
+def test_new_figure_draws_with_matplotlib():
+    from matplotlib.figure import Figure
+
+    figure = new_figure(figsize=(2.0, 1.5))
+    assert isinstance(figure, Figure)
+    assert tuple(figure.get_size_inches()) == (2.0, 1.5)
