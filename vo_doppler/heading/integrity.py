@@ -33,9 +33,9 @@ import numpy as np
 from scipy.stats import norm
 
 from vo_doppler.geo import wrap_angle
+from vo_doppler.heading.calibration import MAD_TO_SIGMA
 
 HUBER_K = 1.345
-MAD_TO_SIGMA = 1.4826
 IRLS_STEPS = 5
 CHUNK_EPOCHS = 512
 MIN_SLOPE_SIGMA = 1e-9
