@@ -69,16 +69,17 @@ def test_device_orientation_convention():
 
 
 def test_conventional_velocity_against_global_pose(comma):
-    """Measured: the GNSS stage's valid 100 %, speed error median 0.043 m/s (p95 0.18), course
-    error median 0.18° (p95 0.73°), 2 of 600 beyond 1.5° and 36 beyond 3σ; after the gyro and
-    wheel test (heading.csv) valid 95.5 %, 0.042 m/s, 0.18° (p95 0.70°), none beyond 1.5° and 8
-    beyond 3σ of the scaled σ. 0.084 m/s while the truth sat on global_pose's
-    frame_gps_times, 0.126 s late against the receiver's time tags
-    (``comma2k19.gps_minus_log``)."""
+    """Measured: the GNSS stage's valid 98.7 % (100 % before the continuity test (2b)), speed
+    error median 0.043 m/s (p95 0.18), course error median 0.18° (p95 0.70°), none of 600
+    beyond 1.5° (2 before (2b)) and 29 beyond 3σ (36); after the gyro and wheel test
+    (heading.csv) valid 95.2 %, 0.041 m/s, 0.18° (p95 0.70°), none beyond 1.5° and 8 beyond
+    3σ of the scaled σ. 0.084 m/s while the truth sat on global_pose's frame_gps_times,
+    0.126 s late against the receiver's time tags (``comma2k19.gps_minus_log``)."""
     sequence, gnss = comma[:2]
     figures = checked_conventional_figures(sequence, gnss)[0]
-    assert figures["valid"] >= 0.99
-    assert figures["valid_course_beyond_bound"] <= 3
+    assert figures["valid"] >= 0.97
+    assert figures["valid_course_beyond_bound"] == 0
+    assert figures["valid_beyond_3_sigma"] <= 33
 
 
 def test_calibration_through_the_raw_doppler_path(comma):

@@ -15,8 +15,9 @@ exclusion: chi-square test, iterated (``lsq.lsq_with_exclusion``). Fewer than fo
 (after mask and exclusion) → the epoch is unavailable (NaN), never guessed. ``valid`` only where
 the solution could be tested and passed: at least five satellites left after the exclusion
 (redundancy), the chi-square test accepting them, and a vertical velocity that a land vehicle
-can have (:func:`vertical_velocity_plausible`); a four-satellite solution is given, with its σ,
-but not valid.
+can have (:func:`vertical_velocity_plausible`) — these make it ``verified`` — and a course and
+speed continuous with the neighbouring epochs' (:mod:`vo_doppler.gnss.continuity`); a
+four-satellite solution is given, with its σ, but not valid.
 
 The vertical test adds the one fact about a car that the GNSS-only solution leaves out: it
 climbs no steeper than its road. Reflected (NLOS) Doppler from several satellites at once can
@@ -33,6 +34,7 @@ from dataclasses import replace
 import numpy as np
 
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.gnss.continuity import continuity_checked
 from vo_doppler.gnss.doppler_noise import fitted_sigma
 from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion
 from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models, modelled_sigma
@@ -243,7 +245,7 @@ def solve_velocity(
             and vertical_velocity_plausible(velocity_enu[k], covariance_enu)
         )
         valid[k] = verified[k]
-    return VelocitySolution(
+    solution = VelocitySolution(
         t=epoch_time,
         velocity_ecef=velocity,
         velocity_enu=velocity_enu,
@@ -260,6 +262,7 @@ def solve_velocity(
         speed_sigma_mps=horizontal_sigma[:, 0],
         course_sigma_rad=horizontal_sigma[:, 1],
     )
+    return continuity_checked(solution)
 
 
 def vertical_velocity_plausible(velocity_enu: np.ndarray, covariance_enu: np.ndarray) -> bool:

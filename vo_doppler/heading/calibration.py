@@ -37,6 +37,7 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 from vo_doppler.geo import wrap_angle
+from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 
 PRIOR_WHEEL_SCALE = 1.0
 PRIOR_WHEEL_SCALE_SIGMA = 0.03
@@ -105,7 +106,6 @@ def variation_gate(
     return keep
 
 
-MAD_TO_SIGMA = 1.4826
 MIN_ROBUST_SAMPLES = 30
 """Fewer samples are fitted by least squares: the MAD of n residuals has a relative standard
 error of about 1.17/√n (over 20 % below 30 samples), too loose for weights and σ; the prior

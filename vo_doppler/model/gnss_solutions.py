@@ -34,10 +34,11 @@ class VelocitySolution:
 
     ``covariance`` 4×4 of (v_x, v_y, v_z, b) in ECEF; ``dop`` columns (GDOP, PDOP, HDOP, VDOP,
     TDOP) of the velocity geometry (unweighted). Integrity: ``verified`` epochs have redundancy
-    (≥ 5 satellites after exclusion) and pass the chi-square test, and only they are ``valid``
-    (the two flags agree; a solved four-satellite epoch, whose fault cannot be detected, and an
-    epoch whose residuals still fail the test after the allowed exclusions keep their values
-    for inspection but are not valid). Unsolved epochs: NaN.
+    (≥ 5 satellites after exclusion), pass the chi-square test and have a plausible vertical
+    velocity; ``valid`` epochs are the verified ones whose course and speed are also continuous
+    with their neighbours' (a solved four-satellite epoch, whose fault cannot be detected, an
+    epoch whose residuals still fail the test after the allowed exclusions and one that jumps off
+    its neighbours keep their values for inspection but are not valid). Unsolved epochs: NaN.
     """
 
     t: np.ndarray
