@@ -45,7 +45,7 @@ def evaluate_sequence(folder: Path, figures: Path, console: Console) -> dict:
     error_per_100m_figure(figures / f"{inputs.name}_error_per_100m.png", per_100m, inputs.name)
     return {
         "gnss_epochs": len(table),
-        "conventional_availability": float(np.mean(table.conv_valid)),
+        "conventional_availability": float(np.mean(table.published_conventional[0])),
         "tight_availability": float(np.mean(table.tc_available)),
         "tight_used": float(np.mean(result.tc_usable)),
         "path_length_m": truth.path_length,
@@ -58,7 +58,7 @@ def evaluate_sequence(folder: Path, figures: Path, console: Console) -> dict:
 
 def print_sequence(console: Console, name: str, figures: dict) -> None:
     table = Table(
-        title=f"{name}: {figures['path_length_m']:.0f} m, conventional heading on "
+        title=f"{name}: {figures['path_length_m']:.0f} m, conventional heading (GNSS tests) on "
         f"{figures['conventional_availability']:.0%} of epochs, tightly coupled on "
         f"{figures['tight_availability']:.0%} (used {figures['tight_used']:.0%})"
     )
