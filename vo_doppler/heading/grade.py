@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
 
@@ -92,6 +93,6 @@ def grade_prior(
         if len(samples) >= config.min_samples:
             d = np.asarray(samples)
             offset[k] = np.median(d)
-            scatter = 1.4826 * np.median(np.abs(d - offset[k]))
+            scatter = MAD_TO_SIGMA * np.median(np.abs(d - offset[k]))
             sigma[k] = max(scatter * (1.0 + 1.25 / np.sqrt(len(d))), config.min_sigma)
     return raw_grade - offset, sigma

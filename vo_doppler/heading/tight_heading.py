@@ -69,6 +69,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.geo import wrap_angle, yaw_to_course
+from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.heading.profile import (
     dz_of,
     gauss_newton,
@@ -495,7 +496,7 @@ def _robust_scale(normalised, w, config):
     masked = np.where(w > 0, normalised, np.nan)
     with warnings.catch_warnings():  # windows without rows give NaN, replaced below
         warnings.simplefilter("ignore", RuntimeWarning)
-        mad = 1.4826 * np.nanmedian(masked, axis=1)
+        mad = MAD_TO_SIGMA * np.nanmedian(masked, axis=1)
         mean_w = np.nanmean(np.where(w > 0, w, np.nan), axis=1)
     floor = config.sigma_floor_mps * np.sqrt(np.nan_to_num(mean_w, nan=1.0))
     return np.maximum(np.nan_to_num(mad, nan=1.0), np.maximum(floor, 1e-300))
