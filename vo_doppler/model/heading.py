@@ -45,8 +45,8 @@ class HeadingTable:
     """The tightly coupled solver's window (s): its headings' errors are correlated over it."""
     conv_gnss_valid: np.ndarray | None = None
     """The conventional heading as the published method has it: valid by the GNSS tests alone
-    (redundancy and χ², no gyro or wheel speed), the comparison pipeline's input (read through
-    :attr:`published_conventional`)."""
+    (redundancy, χ², vertical velocity, course continuity; no gyro or wheel speed), the
+    comparison pipeline's input (read through :attr:`published_conventional`)."""
     sigma_conv_gnss: np.ndarray | None = None
     """Standard deviation (rad) of the conventional heading from the velocity solution alone,
     NaN where unknown or not ``conv_gnss_valid``."""
