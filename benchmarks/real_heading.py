@@ -58,7 +58,9 @@ def truth_velocity(sequence: Sequence, t: np.ndarray) -> np.ndarray:
 
 
 def calibration_truth(sequence: Sequence) -> tuple[float, float]:
-    """(wheel scale, gyro bias rad/s) fitted to the ground truth with the calibration's models."""
+    """(wheel scale, gyro bias rad/s) fitted to the ground truth with the calibration's models:
+    the bias is the slope of the integrated yaw rate minus the truth's yaw (its orientation,
+    unwrapped over the whole drive: a course from the velocity turns at random while stopped)."""
     truth = sequence.truth
     t = truth.t
     velocity = truth_velocity(sequence, t)
@@ -67,7 +69,7 @@ def calibration_truth(sequence: Sequence) -> tuple[float, float]:
     ok = np.isfinite(wheel) & (speed > MOVING_MPS)
     scale = float(np.sum(wheel[ok] * speed[ok]) / np.sum(wheel[ok] ** 2))
     phi = integral_at(sequence.yaw_rate.t, sequence.yaw_rate.value, t)
-    yaw = np.unwrap(np.arctan2(velocity[:, 1], velocity[:, 0]))
+    yaw = np.unwrap(truth.yaw())
     ok &= np.isfinite(phi)
     design = np.column_stack([np.ones(ok.sum()), t[ok] - t[ok].mean()])
     bias = float(np.linalg.lstsq(design, phi[ok] - yaw[ok], rcond=None)[0][1])
