@@ -145,3 +145,11 @@ def test_reflections_that_pass_the_chi_square_fail_the_gyro_test():
     unchecked = heading_from_gnss(t, rows, velocity, wheel, gyro, FRAME, off)
     assert unchecked.conv_valid[FAULT].all()
     np.testing.assert_array_equal(unchecked.yaw_tc, table.yaw_tc)  # tight heading untouched
+
+
+def test_threshold_is_the_normal_two_sided_quantile():
+    from scipy.stats import norm
+
+    for false_alarm in (0.001, 0.01, 0.05):
+        config = ConsistencyConfig(false_alarm=false_alarm)
+        assert config.threshold == norm.isf(false_alarm / 2.0)

@@ -30,7 +30,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import norm
+from scipy.special import ndtri
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.calibration import MAD_TO_SIGMA
@@ -56,7 +56,7 @@ class ConsistencyConfig:
 
     @property
     def threshold(self) -> float:
-        return float(norm.isf(self.false_alarm / 2.0))
+        return float(-ndtri(self.false_alarm / 2.0))
 
 
 @dataclass(frozen=True)
