@@ -60,7 +60,12 @@ def add_run_options(parser: argparse.ArgumentParser) -> None:
         "--systems", default="GREJC", help="GNSS systems to use (RINEX letters: G, R, E, J, C)"
     )
     parser.add_argument("--elev-mask", type=float, default=10.0, help="elevation mask (deg)")
-    parser.add_argument("--window", type=window_size, default=30, help="VO window (frames, >= 3)")
+    parser.add_argument(
+        "--window",
+        type=window_size,
+        default=VoConfig().window_size,
+        help="VO window (frames, >= 3)",
+    )
     parser.add_argument(
         "--reference",
         choices=("course", "orientation"),
