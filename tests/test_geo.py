@@ -57,3 +57,18 @@ def test_yaw_course_convention():
     assert np.isclose(yaw_to_course(0.0), np.pi / 2)  # facing east = course 90°
     assert np.isclose(yaw_to_course(np.pi / 2), 0.0)  # facing north = course 0°
     assert np.isclose(course_to_yaw(np.pi), -np.pi / 2)  # course 180° = facing south
+
+
+def test_ecef_to_geodetic_gives_pymap3ds_bits():
+    import pymap3d
+
+    rng = np.random.default_rng(1)
+    directions = rng.normal(size=(500, 3))
+    points = directions / np.linalg.norm(directions, axis=1)[:, None]
+    points *= rng.uniform(6.3e6, 6.5e6, size=(500, 1))
+    edges = np.array([[0.0, 0.0, 6356752.3], [0.0, 0.0, -6356752.3], [0.0, 0.0, 0.0], [1e3, 20, 5]])
+    for ecef in (points, points[0], points[:1], np.vstack([points[:5], edges]), *edges):
+        expected = pymap3d.ecef2geodetic(ecef[..., 0], ecef[..., 1], ecef[..., 2], deg=False)
+        for got, want in zip(ecef_to_geodetic(ecef), expected, strict=True):
+            assert np.shape(got) == np.shape(want)
+            assert np.array_equal(got, want)

@@ -1,7 +1,8 @@
 """Heavy libraries load when they are used, not on import: the main job's modules load neither
 OpenCV nor pycolmap (about 70 MiB resident, needed only by the VO stage on a recording with a
-camera) nor matplotlib (about 28 MiB, needed only when a figure is drawn). Checked in a fresh
-interpreter, since this one has them all loaded by other tests."""
+camera) nor matplotlib (about 28 MiB, needed only when a figure is drawn), nor scipy.stats and
+filterpy (about 0.4 s of CPU per process; filterpy only serves the Kalman calibration, which is not
+the default). Checked in a fresh interpreter, since this one has them all loaded by other tests."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import sys
 
 from vo_doppler.report.figure import new_figure
 
-HEAVY = ("cv2", "pycolmap", "matplotlib")
+HEAVY = ("cv2", "pycolmap", "matplotlib", "scipy.stats", "filterpy")
 MAIN_JOB = (
     "vo_doppler.commands.run_command",
     "vo_doppler.run",
@@ -29,12 +30,13 @@ def loaded_after_import(modules: tuple[str, ...]) -> list[str]:
     return done.stdout.split()
 
 
-def test_the_main_job_imports_no_opencv_pycolmap_or_matplotlib():
+def test_the_main_job_imports_no_opencv_pycolmap_matplotlib_or_scipy_stats():
     assert loaded_after_import(MAIN_JOB) == []
 
 
 def test_the_check_sees_a_heavy_import():
     assert loaded_after_import(("vo_doppler.vo.batch",)) == ["cv2", "pycolmap"]
+    assert loaded_after_import(("scipy.stats",)) == ["scipy.stats"]
 
 
 def test_new_figure_draws_with_matplotlib():

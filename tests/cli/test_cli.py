@@ -47,3 +47,17 @@ def test_a_subcommands_help_lists_its_own_options(capsys):
         main(["correct", "--help"])
     assert exit_info.value.code == 0
     assert "--heading" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["run", "seq", "-o", "out"],
+        ["batch", "a", "-o", "out"],
+        ["vo", "img", "--calib", "c", "-o", "o"],
+    ],
+)
+def test_the_vo_window_defaults_to_the_vo_configs(argv):
+    from vo_doppler.vo.config import VoConfig
+
+    assert build_parser(argv[0]).parse_args(argv).window == VoConfig().window_size

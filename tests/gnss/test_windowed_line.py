@@ -59,3 +59,11 @@ def test_consistency_test_threshold_and_sigma_factor():
     assert ConsistencyConfig().threshold == pytest.approx(3.2905, abs=1e-4)
     honest = consistency_test(t, values, 2 * sigma, np.ones(t.size, bool), ConsistencyConfig())
     assert honest.sigma_factor == pytest.approx(1.0, abs=0.1)
+
+
+def test_threshold_is_the_normal_two_sided_quantile():
+    from scipy.stats import norm
+
+    for false_alarm in (0.001, 0.01, 0.05):
+        config = ConsistencyConfig(false_alarm=false_alarm)
+        assert config.threshold == norm.isf(false_alarm / 2.0)

@@ -285,3 +285,13 @@ def test_blunders_beyond_the_rejection_passes_fall_back_to_the_robust_fit():
     assert result.sigma[end] > 2.0 * clean.sigma[end]
     assert _error(scenario, result)[end] < 3.0 * result.sigma[end]
     assert not clean.fallback.any()
+
+
+def test_chi2_isf_1_is_scipy_stats_chi2_isf():
+    from scipy.stats import chi2
+
+    from vo_doppler.heading.snooping import chi2_isf_1
+
+    q = np.array([1e-6, 0.001 / 14, 0.0005, 0.01, 0.25, 0.9])
+    assert np.array_equal(chi2_isf_1(q), chi2.isf(q, 1))
+    assert chi2_isf_1(0.001) == chi2.isf(0.001, 1)

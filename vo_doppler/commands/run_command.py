@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import logging
 import sys
 from pathlib import Path
@@ -59,7 +60,12 @@ def add_run_options(parser: argparse.ArgumentParser) -> None:
         "--systems", default="GREJC", help="GNSS systems to use (RINEX letters: G, R, E, J, C)"
     )
     parser.add_argument("--elev-mask", type=float, default=10.0, help="elevation mask (deg)")
-    parser.add_argument("--window", type=window_size, default=30, help="VO window (frames, >= 3)")
+    parser.add_argument(
+        "--window",
+        type=window_size,
+        default=VoConfig().window_size,
+        help="VO window (frames, >= 3)",
+    )
     parser.add_argument(
         "--reference",
         choices=("course", "orientation"),
@@ -102,6 +108,8 @@ def run(args: argparse.Namespace) -> int:
     except BaseException:
         log.error("%s", untouched(args.output))
         raise
+    finally:
+        gc.unfreeze()
     require_tight_heading(result, args.sequence, args.output)
     return 0
 
@@ -124,9 +132,14 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
         f"{len(inputs.observations.epoch_time)} GNSS epochs, {len(inputs.wheel_speed)} wheel "
         f"and {len(inputs.yaw_rate)} yaw-rate samples"
     )
+    # What is alive now (the imported modules, the inputs; after the stages, their results)
+    # stays to the end of the command: the cycle collector's full passes (automatic, and after
+    # each figure) skip it until ``run`` unfreezes it.
+    gc.freeze()
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("visual odometry", total=len(inputs.image_paths))
         result = run_sequence(inputs, config, lambda _: progress.advance(task))
+    gc.freeze()
     checks = result_checks(inputs, report, result, warnings)
     with staged_output(args.output) as out:
         summary = write_run_outputs(

@@ -53,7 +53,10 @@ def register(subparsers, summary: str) -> None:
     timing.add_argument("--fps", type=float, help="fixed frame rate (Hz)")
     parser.add_argument("--speed", type=Path, help="CSV t,speed_mps for metric scale")
     parser.add_argument(
-        "--window", type=window_size, default=30, help="bundle-adjustment window (frames, >= 3)"
+        "--window",
+        type=window_size,
+        default=VoConfig().window_size,
+        help="bundle-adjustment window (frames, >= 3)",
     )
     parser.add_argument("--gt", type=Path, help="ground truth (KITTI poses or TUM) to evaluate")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")

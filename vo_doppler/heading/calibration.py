@@ -34,7 +34,6 @@ from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
-from filterpy.kalman import KalmanFilter
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
@@ -352,6 +351,10 @@ class _KalmanFit:
     index = 0
 
     def __init__(self, dim_x: int, config: GateConfig):
+        # filterpy (with scipy.stats, about 0.4 s of imports) loads only for this alternative,
+        # not with the module: the default calibration is the least-squares one.
+        from filterpy.kalman import KalmanFilter
+
         self.filter = KalmanFilter(dim_x=dim_x, dim_z=1)
         self.config = config
         self._t: float | None = None

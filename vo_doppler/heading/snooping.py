@@ -73,7 +73,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
-from scipy.stats import chi2
+from scipy.special import chdtri, gammaincinv
 
 from vo_doppler.heading.profile import (
     minimum_cost,
@@ -91,6 +91,12 @@ three quarters of the (window, satellite) statistics are raised by a bias (a ref
 its own satellite and, through the fit, smears into every other satellite of its windows)."""
 MAX_PAIR_SATELLITES = 12
 """Two-satellite hypotheses are formed among this many satellites of largest statistic."""
+
+
+def chi2_isf_1(q):
+    """χ²(1)'s inverse survival function (``scipy.stats.chi2.isf(q, 1)`` for 0 < q < 1, the
+    same special function) without importing scipy.stats (about 0.4 s per process)."""
+    return chdtri(1, q)
 
 
 @dataclass
@@ -247,8 +253,8 @@ def snoop_satellites(
     best_sat, best_row = np.argmax(sat_stat, axis=1), np.argmax(row_stat, axis=1)
     k = np.arange(K)
     sat_max, row_max = sat_stat[k, best_sat], row_stat[k, best_row]
-    row_critical = chi2.isf(alpha / (2 * np.maximum(n_row, 1)), 1)
-    sat_critical = chi2.isf(alpha / (2 * np.maximum(n_sat, 1)), 1)
+    row_critical = chi2_isf_1(alpha / (2 * np.maximum(n_row, 1)))
+    sat_critical = chi2_isf_1(alpha / (2 * np.maximum(n_sat, 1)))
     detected = (sat_max > sat_critical) | (row_max > row_critical)
     by_row = row_max > sat_max
     suspect = np.where(by_row, group[k, best_row], best_sat)
@@ -458,7 +464,7 @@ def receiver_noise(samples: list[NoiseSample]) -> ReceiverNoise:
         for f in ("squared_sum", "seen", "correlated", "model")
     }
     white = scale**2 * parts["seen"] + parts["model"]
-    target = chi2.ppf(CORRELATED_QUANTILE, 1)
+    target = 2.0 * gammaincinv(0.5, CORRELATED_QUANTILE)
 
     def excess(kappa2: float) -> float:
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -502,5 +508,5 @@ def _pairs(windows, sums, normal, cost_bound, solver, alpha, margin):
     largest = gain[rows, best]
     gain[rows, best] = -np.inf
     identified = largest - np.max(gain, axis=1) >= margin
-    wins = largest > chi2.isf(alpha / np.maximum(n_tests - 1, 1), 1)
+    wins = largest > chi2_isf_1(alpha / np.maximum(n_tests - 1, 1))
     return np.stack([g1[rows, best], g2[rows, best]], axis=1), identified, wins

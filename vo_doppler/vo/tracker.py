@@ -51,8 +51,8 @@ class FeatureTracker:
         height, width = image.shape
         per_cell = max(1, cfg.max_features // (cfg.grid_rows * cfg.grid_cols))
         mask = np.full((height, width), 255, np.uint8)
-        for x, y in existing.points.astype(int):
-            cv2.circle(mask, (int(x), int(y)), cfg.min_corner_distance_px, 0, -1)
+        for x, y in existing.points.astype(int).tolist():
+            cv2.circle(mask, (x, y), cfg.min_corner_distance_px, 0, -1)
         cell_rows = np.linspace(0, height, cfg.grid_rows + 1).astype(int)
         cell_cols = np.linspace(0, width, cfg.grid_cols + 1).astype(int)
         counts = np.zeros((cfg.grid_rows, cfg.grid_cols), int)

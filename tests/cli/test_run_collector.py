@@ -1,0 +1,28 @@
+"""``vo-doppler run`` freezes what is alive before its stages (the cycle collector's full passes
+then skip the imported modules) and unfreezes it when it ends, also when it fails: a process
+that goes on after the command (these tests, a notebook) keeps collecting its garbage."""
+
+from __future__ import annotations
+
+import gc
+
+from vo_doppler.cli import main
+from vo_doppler.commands import run_command
+from vo_doppler.errors import EXIT_INTERNAL
+from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+
+
+def test_the_collector_is_frozen_during_the_stages_and_unfrozen_after(tmp_path, monkeypatch):
+    drive = tmp_path / "drive"
+    simulate_urban_canyon(drive, UrbanCanyonConfig(duration_s=10.0, seed=4, image_size=(320, 180)))
+    frozen_during = []
+
+    def failing_stages(*args, **kwargs):
+        frozen_during.append(gc.get_freeze_count())
+        raise RuntimeError("stage failed")
+
+    monkeypatch.setattr(run_command, "run_sequence", failing_stages)
+    assert gc.get_freeze_count() == 0
+    assert main(["run", str(drive), "-o", str(tmp_path / "out")]) == EXIT_INTERNAL
+    assert frozen_during and frozen_during[0] > 0
+    assert gc.get_freeze_count() == 0
