@@ -62,6 +62,9 @@ class _Frame:
     """Pose comes from image geometry (not from a motion prediction)."""
     keyframe: bool = False
     flags: list[str] = field(default_factory=list)
+    still_of: _Frame | None = None
+    """The frame this one stood still at (a standstill or a duplicate image): its final pose is
+    that frame's, whatever the window adjustment made of its own copy."""
 
 
 @dataclass
@@ -175,6 +178,8 @@ class VisualOdometry:
         for f in frames:
             if not f.measured and not f.flags:
                 f.flags.append("no-geometry")
+            if f.still_of is not None:
+                f.T_cw = f.still_of.T_cw.copy()
         stats.flagged_frames = [
             {"index": f.index, "t": f.t, "reasons": f.flags} for f in frames if f.flags
         ]
@@ -221,6 +226,7 @@ class VisualOdometry:
             frame.flags.append("duplicate")
         if result.median_flow_px < self.config.standstill_flow_px:
             frame.T_cw = ref.T_cw.copy()
+            frame.still_of = ref.still_of or ref
             frame.measured = ref.measured
             if "duplicate" not in frame.flags:
                 frame.flags.append("standstill")
