@@ -22,7 +22,9 @@ class VoConfig:
     seed 0 1.54/1.30/1.04/0.89; 30/20 on seeds 1 and 2: 1.81/1.54 and 0.74/0.68 (VO + TC
     0.299/0.299, 0.185/0.183, 0.227/0.220, 0.141/0.139 on the sample and seeds 0-2; at 15 the
     sample's VO + TC was 0.313). KITTI 06 clip final error 0.484/0.485/0.483/0.489 m (ratio to
-    the baseline 0.546/0.547/0.545/0.552, over the issue's 0.55 at 15)."""
+    the baseline 0.546/0.547/0.545/0.552, over the issue's 0.55 at 15). 17 frames: VO alone
+    0.58/1.03/1.50/0.63 on the sample and seeds 0–2, but VO + TC 0.308/0.186/0.218/0.140, worse on
+    the sample and seed 0 (KITTI 0.483 m, ratio 0.545): not taken."""
     max_features: int = 600
     """Corners kept tracked; 500 took the sample's VO alone (30-frame window) from 0.76 to 2.23 m
     per 100 m."""
