@@ -35,6 +35,9 @@ class VoConfig:
     replenish_below: float = 0.8
     """Detect new corners when fewer than this fraction of ``max_features`` are tracked."""
     klt_window_px: int = 15
+    """KLT window (px); the KLT's cost goes with its area. 13 with the 20-frame window: VO alone
+    0.72/0.92/1.28/1.49 against 0.63/1.04/1.54/0.68 m per 100 m on the sample and seeds 0–2, VO + TC
+    0.320/0.206/0.214/0.161 against 0.299/0.183/0.220/0.139, KITTI final-error ratio 0.58."""
     klt_levels: int = 3
     klt_epsilon: float = 0.01
     """KLT stop (px); 0.03 took the sample's VO alone from 0.76 to 0.96 m per 100 m."""
