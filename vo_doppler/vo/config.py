@@ -22,7 +22,9 @@ class VoConfig:
     seed 0 1.54/1.30/1.04/0.89; 30/20 on seeds 1 and 2: 1.81/1.54 and 0.74/0.68 (VO + TC
     0.299/0.299, 0.185/0.183, 0.227/0.220, 0.141/0.139 on the sample and seeds 0-2; at 15 the
     sample's VO + TC was 0.313). KITTI 06 clip final error 0.484/0.485/0.483/0.489 m (ratio to
-    the baseline 0.546/0.547/0.545/0.552, over the issue's 0.55 at 15)."""
+    the baseline 0.546/0.547/0.545/0.552, over the issue's 0.55 at 15). 17 frames: VO alone
+    0.58/1.03/1.50/0.63 on the sample and seeds 0–2, but VO + TC 0.308/0.186/0.218/0.140, worse on
+    the sample and seed 0 (KITTI 0.483 m, ratio 0.545): not taken."""
     max_features: int = 600
     """Corners kept tracked; 500 took the sample's VO alone (30-frame window) from 0.76 to 2.23 m
     per 100 m."""
@@ -33,6 +35,9 @@ class VoConfig:
     replenish_below: float = 0.8
     """Detect new corners when fewer than this fraction of ``max_features`` are tracked."""
     klt_window_px: int = 15
+    """KLT window (px); the KLT's cost goes with its area. 13 with the 20-frame window: VO alone
+    0.72/0.92/1.28/1.49 against 0.63/1.04/1.54/0.68 m per 100 m on the sample and seeds 0–2, VO + TC
+    0.320/0.206/0.214/0.161 against 0.299/0.183/0.220/0.139, KITTI final-error ratio 0.58."""
     klt_levels: int = 3
     klt_epsilon: float = 0.01
     """KLT stop (px); 0.03 took the sample's VO alone from 0.76 to 0.96 m per 100 m."""
@@ -66,6 +71,8 @@ class VoConfig:
     window 20, sample/seeds 0–2 0.69/1.09/1.76/0.68 against 0.63/1.04/1.54/0.68 (VO + TC
     0.314/0.186/0.223/0.149 against 0.299/0.183/0.220/0.139): kept at 2."""
     ba_max_iterations: int = 4
+    """Levenberg–Marquardt iterations per window solve. 3 with the 20-frame window: VO alone
+    0.67/1.07/1.76/0.79 against 0.63/1.04/1.54/0.68 m per 100 m on the sample and seeds 0–2."""
     ba_function_tolerance: float = 1e-5
     ba_threads: int = 1
     ba_loss_scale_px: float = 1.5
