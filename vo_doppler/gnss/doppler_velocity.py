@@ -15,9 +15,9 @@ exclusion: chi-square test, iterated (``lsq.lsq_with_exclusion``). Fewer than fo
 (after mask and exclusion) → the epoch is unavailable (NaN), never guessed. ``valid`` only where
 the solution could be tested and passed: at least five satellites left after the exclusion
 (redundancy), the chi-square test accepting them, and a vertical velocity that a land vehicle
-can have (:func:`vertical_velocity_plausible`) — these make it ``verified`` — and a course and
-speed continuous with the neighbouring epochs' (:mod:`vo_doppler.gnss.continuity`); a
-four-satellite solution is given, with its σ, but not valid.
+can have (:func:`vertical_velocity_plausible`) — these make it ``verified`` — and a course
+continuous with the neighbouring epochs' (:mod:`vo_doppler.gnss.continuity`); a four-satellite
+solution is given, with its σ, but not valid.
 
 The vertical test adds the one fact about a car that the GNSS-only solution leaves out: it
 climbs no steeper than its road. Reflected (NLOS) Doppler from several satellites at once can

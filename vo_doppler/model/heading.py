@@ -83,9 +83,10 @@ class HeadingTable:
 
     @property
     def course_conv(self) -> np.ndarray:
-        """Conventional heading as course (rad) where it passed the GNSS tests or every test
-        (``conv_valid`` and :attr:`published_conventional` say which), NaN elsewhere."""
-        shown = self.conv_valid | self.published_conventional[0]
+        """Conventional heading as course (rad) where it passed the GNSS tests
+        (:attr:`published_conventional`; ``conv_valid``, every test, is a subset), NaN
+        elsewhere."""
+        shown = self.published_conventional[0]
         return np.where(shown, yaw_to_course(np.nan_to_num(self.yaw_conv)), np.nan)
 
     def calibrated_speed(self, wheel: SensorSeries) -> SensorSeries:
