@@ -15,13 +15,21 @@ from pathlib import Path
 
 import pytest
 
-from tests.helpers.batch import BLOCK_DIR_ENV, die_or_fail, tiny_drive, wait_while_blocked
+from tests.helpers.batch import (
+    BLOCK_DIR_ENV,
+    die_or_fail,
+    opencv_thread_count,
+    tiny_drive,
+    wait_while_blocked,
+)
 from vo_doppler.batch import (
     MARKER,
     Failure,
     Status,
+    _pool,
     fingerprint,
     finished,
+    opencv_threads,
     output_names,
     plan,
     read_list,
@@ -214,3 +222,17 @@ def test_ray_executor_gives_the_local_aggregate(tmp_path_factory, tmp_path):
         {k: v for k, v in row.items() if k not in drop} for row in local.rows
     ]
     assert remote.rows[0]["vo_gps_tc_error_per_100m_m"] > 0
+
+
+@pytest.mark.parametrize(
+    ("cores", "workers", "threads"), [(8, 2, 4), (8, 3, 2), (2, 4, 1), (1, 1, 1)]
+)
+def test_opencv_threads_share_out_the_cores(monkeypatch, cores, workers, threads):
+    monkeypatch.setattr(os, "cpu_count", lambda: cores)
+    assert opencv_threads(workers) == threads
+
+
+def test_pool_workers_run_opencv_with_their_share_of_threads():
+    with _pool(2) as pool:
+        counts = set(pool.map(opencv_thread_count, range(4)))
+    assert counts == {opencv_threads(2)}

@@ -21,7 +21,8 @@ turned into a sequence folder under ``work_dir`` = ``OUT/<name>/prepared``). Wit
 source is a sequence folder.
 
 Executors: ``local`` (default), a ``concurrent.futures`` process pool started with ``spawn``
-(no state inherited from the parent; each worker imports the package afresh); ``ray``, the
+(no state inherited from the parent; each worker imports the package afresh and gives OpenCV
+its share of the cores); ``ray``, the
 same function as a Ray task on a local Ray instance or on the cluster at ``ray_address``
 (or ``RAY_ADDRESS``). A worker that dies (killed, out of memory, a crash in native code)
 fails only its recording: the local pool's other victims run again, each alone.
@@ -274,9 +275,19 @@ def default_workers(recordings: int) -> int:
     return max(1, min(os.cpu_count() or 1, recordings))
 
 
-def _exit_with_parent(parent: int) -> None:
-    """Pool initializer: a thread that ends the worker once its parent is gone (a batch killed
-    by any signal leaves no worker computing on)."""
+def opencv_threads(workers: int) -> int:
+    """OpenCV threads per worker: the machine's cores shared out, at least 1 (a run's OpenCV
+    threads would otherwise compete with the other workers for the same cores)."""
+    return max(1, (os.cpu_count() or 1) // max(1, workers))
+
+
+def _start_worker(parent: int, threads: int) -> None:
+    """Pool initializer: OpenCV limited to ``threads`` threads, and a thread that ends the
+    worker once its parent is gone (a batch killed by any signal leaves no worker computing
+    on)."""
+    import cv2
+
+    cv2.setNumThreads(threads)
 
     def watch() -> None:
         while os.getppid() == parent:
@@ -290,8 +301,8 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     return ProcessPoolExecutor(
         max_workers=workers,
         mp_context=multiprocessing.get_context("spawn"),
-        initializer=_exit_with_parent,
-        initargs=(os.getpid(),),
+        initializer=_start_worker,
+        initargs=(os.getpid(), opencv_threads(workers)),
     )
 
 

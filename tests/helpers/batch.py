@@ -40,3 +40,10 @@ def die_or_fail(source: Path, work_dir: Path) -> Path:
     if source.name.startswith("bug"):
         raise RuntimeError(f"bug in the importer of {source.name}")
     return source
+
+
+def opencv_thread_count(_: int) -> int:
+    """A pool worker's OpenCV thread count (a module-level function, so spawn can pickle it)."""
+    import cv2
+
+    return cv2.getNumThreads()
