@@ -31,9 +31,7 @@ from rich.table import Table
 from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
-from vo_doppler.gnss.pipeline import gnss_velocity
-from vo_doppler.heading.pipeline import heading_pipeline
-from vo_doppler.run import RunConfig
+from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -51,41 +49,30 @@ def _errors(error_deg: np.ndarray, mask: np.ndarray) -> dict:
 
 
 def sequence_with_truth(folder: Path):
-    """The sequence's inputs, its GNSS velocity result with the run's settings and the
+    """The sequence's inputs, its GNSS stage result with the run's settings and the
     ground-truth yaw (unwrapped) at its GNSS epochs."""
     inputs = read_with_truth(folder)
-    config = RunConfig()
-    obs = inputs.observations
-    gnss = gnss_velocity(obs, inputs.navigation, config.systems, config.elevation_mask)
-    truth = inputs.truth
-    truth_yaw = truth.yaw_at(obs.epoch_time)
+    gnss = sequence_gnss(inputs, RunConfig())
+    truth_yaw = inputs.truth.yaw_at(inputs.observations.epoch_time)
     return inputs, gnss, truth_yaw
 
 
 def evaluate(folder: Path) -> dict:
     inputs, gnss, truth_yaw = sequence_with_truth(folder)
     config = RunConfig()
-    obs = inputs.observations
-    rows = gnss.rows.in_enu()
     variants = {
         "off": dataclasses.replace(config.heading.tight, outlier_passes=0),
         "on": config.heading.tight,
     }
-    figures = {"epochs": len(obs.epoch_time), "rows": len(rows), "variants": {}}
+    figures = {
+        "epochs": len(inputs.observations.epoch_time),
+        "rows": len(gnss.rows),
+        "variants": {},
+    }
     for name, tight in variants.items():
         heading = dataclasses.replace(config.heading, tight=tight)
         start = time.perf_counter()
-        table = heading_pipeline(
-            obs.epoch_time,
-            rows,
-            gnss.velocity.velocity_enu,
-            gnss.velocity.valid,
-            inputs.wheel_speed,
-            inputs.yaw_rate,
-            heading,
-            conventional_sigma_mps=gnss.velocity.sigma_mps,
-            antenna_lever_arm_m=inputs.antenna_lever_arm_m,
-        )
+        table = sequence_heading(inputs, gnss.rows, gnss.velocity, heading)
         seconds = time.perf_counter() - start
         error = np.degrees(np.abs(wrap_angle(table.yaw_tc - truth_yaw)))
         used = usable_tight_heading(table, config.correction.tc_max_sigma)

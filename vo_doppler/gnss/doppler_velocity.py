@@ -17,7 +17,8 @@ the solution could be tested and passed: at least five satellites left after the
 (redundancy), the chi-square test accepting them, and a vertical velocity that a land vehicle
 can have (:func:`vertical_velocity_plausible`) — these make it ``verified`` — and a course
 continuous with the neighbouring epochs' (:mod:`vo_doppler.gnss.continuity`); a four-satellite
-solution is given, with its σ, but not valid.
+solution is given, with its σ, but not valid (``untestable``: the heading stage's calibration
+tests it against the wheels and the gyro instead).
 
 The vertical test adds the one fact about a car that the GNSS-only solution leaves out: it
 climbs no steeper than its road. Reflected (NLOS) Doppler from several satellites at once can
@@ -211,6 +212,7 @@ def solve_velocity(
     rms = np.full(n, np.nan)
     valid = np.zeros(n, dtype=bool)
     verified = np.zeros(n, dtype=bool)
+    untestable = np.zeros(n, dtype=bool)
     horizontal_sigma = np.full((n, 2), np.nan)
     order = np.argsort(rows.epoch, kind="stable")
     bounds = np.searchsorted(rows.epoch[order], np.arange(n + 1))
@@ -239,10 +241,10 @@ def solve_velocity(
         covariance_enu = rotation @ result.covariance[:3, :3] @ rotation.T
         dop[k] = _dop(H[result.used], rotation)
         horizontal_sigma[k] = speed_course_sigma(velocity_enu[k], covariance_enu)
-        verified[k] = (
-            result.passed
-            and n_sat[k] > MIN_SATELLITES
-            and vertical_velocity_plausible(velocity_enu[k], covariance_enu)
+        plausible = vertical_velocity_plausible(velocity_enu[k], covariance_enu)
+        verified[k] = result.passed and n_sat[k] > MIN_SATELLITES and plausible
+        untestable[k] = (
+            n_sat[k] == MIN_SATELLITES and (result.dof == 0 or result.passed) and plausible
         )
         valid[k] = verified[k]
     solution = VelocitySolution(
@@ -259,6 +261,7 @@ def solve_velocity(
         valid=valid,
         n_no_ephemeris=rows.n_no_ephemeris,
         verified=verified,
+        untestable=untestable,
         speed_sigma_mps=horizontal_sigma[:, 0],
         course_sigma_rad=horizontal_sigma[:, 1],
     )

@@ -15,6 +15,7 @@ from vo_doppler.gnss.doppler_velocity import (
 )
 from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
+from vo_doppler.gnss.receiver_track import smoothed_track
 from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.model.doppler_sigma import ReportedSigma
@@ -51,8 +52,10 @@ def gnss_velocity(
     reported_sigma: ReportedSigma | None = None,
     fit_noise: bool = False,
 ) -> GnssVelocityResult:
-    """Per-epoch Doppler velocity. Line-of-sight vectors use the SPP fix of each epoch (or the
-    nearest one, or ``receiver_ecef`` / the RINEX approximate position when SPP fails);
+    """Per-epoch Doppler velocity. Line-of-sight vectors use ``receiver_ecef`` where given, else
+    the SPP fixes smoothed along the Doppler velocities (``receiver_track``: the velocities
+    of a first solution with the nearest valid fix, or the RINEX approximate position when SPP
+    fails, then the rows and velocities again from the smoothed track);
     ``range_rate`` 'phase' replaces the Doppler by the carrier-phase rate (``phase_rate``);
     ``reported_sigma`` the receiver's σ of the range rates (weights where present);
     ``fit_noise`` re-solves with σ fitted to the residuals (``solve_with_fitted_noise``);
@@ -67,15 +70,33 @@ def gnss_velocity(
         else receiver_positions(spp, fallback)
     )
     measured = carrier_phase_doppler(obs) if range_rate == "phase" else obs
-    rows = doppler_rows(
-        measured,
-        source,
-        position,
-        systems=systems,
-        bands=bands,
-        elevation_mask_rad=elevation_mask_rad,
-        reported_sigma=reported_sigma,
-    )
+
+    def rows_at(position):
+        return doppler_rows(
+            measured,
+            source,
+            position,
+            systems=systems,
+            bands=bands,
+            elevation_mask_rad=elevation_mask_rad,
+            reported_sigma=reported_sigma,
+        )
+
+    rows = rows_at(position)
+    if receiver_ecef is None:
+        first = solve_velocity(rows, obs.epoch_time)
+        known = first.valid | first.untestable
+        track = smoothed_track(
+            obs.epoch_time,
+            spp.position_ecef,
+            spp.horizontal_sigma_m,
+            first.velocity_ecef,
+            first.covariance,
+            known,
+        )
+        if track is not None:
+            position = track
+            rows = rows_at(position)
     if fit_noise:
         velocity, rows, models = solve_with_fitted_noise(rows, obs.epoch_time)
     else:

@@ -105,6 +105,7 @@ def heading_from_gnss(
         antenna_lever_arm_m=antenna_lever_arm_m,
         forward_acceleration=forward_acceleration,
         conventional_speed_sigma_mps=velocity.speed_sigma_mps,
+        conventional_untestable=velocity.untestable,
     )
     table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)
     return table

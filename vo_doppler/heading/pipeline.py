@@ -180,6 +180,7 @@ def heading_pipeline(
     antenna_lever_arm_m: Sequence[float] = (0.0, 0.0),
     forward_acceleration: SensorSeries | None = None,
     conventional_speed_sigma_mps: np.ndarray | None = None,
+    conventional_untestable: np.ndarray | None = None,
 ) -> HeadingTable:
     """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise).
 
@@ -195,6 +196,14 @@ def heading_pipeline(
     not valid in the table, and the table's conventional heading and speed σ are the given
     ones times the factor by which the test's residuals exceed them.
 
+    ``conventional_untestable``: epochs solved without redundancy (four satellites), whose
+    fault the GNSS stage cannot detect (``VelocitySolution.untestable``). They are not valid,
+    but they calibrate the sensors under the same gates as the valid ones: the calibration's
+    robust fit over many epochs is their test, as in [TK18] sec. 3.3, whose conventional
+    headings need only four satellites. In a street canyon they are most of the solved epochs
+    (a simulated 120-s canyon drive: 190 valid, 414 more untestable), and a calibration from the
+    few valid ones converges late.
+
     ``antenna_lever_arm_m``: the GNSS antenna (x forward, y left[, z up], m) from the vehicle
     origin. In turns the antenna moves at ω × r relative to the vehicle, so the Doppler
     velocity is not the vehicle's: the tightly coupled model adds ω × r (ω the calibrated yaw
@@ -209,12 +218,17 @@ def heading_pipeline(
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     velocity = np.asarray(conventional_velocity_enu, dtype=float).reshape(-1, 3)
-    conv_yaw, conv_ok = heading_from_velocity(
-        velocity, conventional_valid, config.conventional_min_speed_mps
+    valid = np.asarray(conventional_valid, dtype=bool)
+    candidates = valid.copy()
+    if conventional_untestable is not None:
+        candidates |= np.asarray(conventional_untestable, dtype=bool)
+    conv_yaw, conv_seen = heading_from_velocity(
+        velocity, candidates, config.conventional_min_speed_mps
     )
+    conv_ok = conv_seen & valid
     # Horizontal speed: the tightly coupled model's velocity is horizontal, and the vertical
     # component of a canyon fix is noisy (large VDOP), which would bias |v| and the scale up.
-    conv_speed = np.where(conventional_valid, np.hypot(velocity[:, 0], velocity[:, 1]), np.nan)
+    conv_speed = np.where(candidates, np.hypot(velocity[:, 0], velocity[:, 1]), np.nan)
     wheel = sample(speed.t, speed.value, t_epoch)
     raw_rate = sample(yaw_rate.t, yaw_rate.value, t_epoch)
     lever = any(float(v) != 0.0 for v in tuple(antenna_lever_arm_m)[:2])
@@ -224,7 +238,7 @@ def heading_pipeline(
         conv_yaw, conv_speed = vehicle_heading_from_antenna(
             antenna_yaw, antenna_speed, wheel, offset
         )
-    calibrating = np.asarray(conventional_valid, bool).copy()
+    calibrating = candidates.copy()
     if conventional_sigma_mps is not None:
         sigma = np.nan_to_num(np.asarray(conventional_sigma_mps, dtype=float), nan=np.inf)
         calibrating &= sigma <= config.calibration_max_velocity_sigma_mps
@@ -249,7 +263,7 @@ def heading_pipeline(
         conv_yaw,
         conventional_yaw_sigma,
         yaw_angle,
-        conv_speed,
+        np.where(valid, conv_speed, np.nan),
         conventional_speed_sigma_mps,
         cal.scale * wheel,
         cal.bias_sigma,
@@ -274,7 +288,7 @@ def heading_pipeline(
         tc_reliable=result.reliable,
         n_obs_window=result.n_obs,
         n_sat_epoch=result.n_sat_epoch,
-        yaw_conv=conv_yaw,
+        yaw_conv=np.where(conv_ok, conv_yaw, np.nan),
         conv_valid=integrity.valid,
         gyro_bias=cal.bias,
         wheel_scale=cal.scale,

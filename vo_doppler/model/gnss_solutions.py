@@ -58,6 +58,11 @@ class VelocitySolution:
     """σ of the horizontal speed from the covariance (m/s)."""
     course_sigma_rad: np.ndarray | None = None
     """σ of the course from the covariance (rad; large when slow)."""
+    untestable: np.ndarray | None = None
+    """Solved from exactly four satellites (no redundancy, so a fault cannot be detected in the
+    epoch) with a plausible vertical velocity: not valid, but a candidate wherever redundancy
+    from elsewhere tests it (the heading stage's robust calibration against the wheels and the
+    gyro); None: no such epoch flagged."""
 
     @property
     def speed_mps(self) -> np.ndarray:
