@@ -98,3 +98,20 @@ def test_invalid_and_slow_epochs_do_not_calibrate_and_the_prior_is_causal():
     np.testing.assert_array_equal(half_sigma, sigma[:60])
     # 1 % white noise on the accelerometer grade: σ is about 1 %
     assert np.nanmedian(sigma[-10:]) == pytest.approx(0.01, rel=0.5)
+
+
+def test_the_doppler_share_of_the_scatter_is_taken_out_of_the_prior_sigma():
+    rng = np.random.default_rng(4)
+    n = 4000
+    grade = rng.uniform(-0.05, 0.05, n)
+    speed = 10.0
+    vertical_sigma = np.full(n, 0.4)  # 4 % of grade at 10 m/s: a canyon's VDOP
+    velocity = _doppler(np.zeros(n), grade, speed)
+    velocity[:, 2] += rng.normal(0.0, 1.0, n) * vertical_sigma
+    raw = grade + OFFSET + rng.normal(0.0, 0.006, n)  # the accelerometer's own error: 0.6 %
+    valid = np.ones(n, dtype=bool)
+    _, blind = grade_prior(raw, velocity, valid)
+    mean, sigma = grade_prior(raw, velocity, valid, vertical_sigma_mps=vertical_sigma)
+    assert blind[-1] == pytest.approx(np.hypot(0.04, 0.006), rel=0.1)
+    assert sigma[-1] == pytest.approx(0.006, abs=0.003)
+    assert np.median(np.abs(mean - grade)[100:]) < 0.006

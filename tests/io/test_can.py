@@ -37,6 +37,9 @@ BO_ 170 WHEELS: 8 XXX
  SG_ WR : 23|16@0+ (0.01,0) [0|600] "km/h" XXX
 BO_ 171 REAR: 4 XXX
  SG_ W3 : 7|16@0+ (0.01,0) [0|600] "km/h" XXX
+BO_ 40 ACC: 4 XXX
+ SG_ AX : 7|16@0- (0.001,0) [-30|30] "m/s^2" XXX
+ SG_ AG : 23|16@0- (0.0001,0) [-3|3] "g" XXX
 BO_ 200 MUXED: 8 XXX
  SG_ SEL M : 0|8@1+ (1,0) [0|255] "" XXX
  SG_ V m1 : 8|16@1+ (1,0) [0|65535] "km/h" XXX
@@ -298,3 +301,37 @@ def test_comma_raw_can_truncated_payloads():
     assert report.n_padded > 0 and report.n_undecodable == 0
     for k, ref in enumerate(parse_signal_list(FOUR_WHEELS)):
         assert np.max(np.abs(decoded[ref].value - expected[:, k])) <= 0.01
+
+
+def _acceleration_messages(db, n=10):
+    acc = db.get_message_by_name("ACC")
+    return [
+        can.Message(
+            timestamp=T0 + 0.01 * i,
+            arbitration_id=40,
+            data=acc.encode({"AX": 0.5 * i, "AG": 0.05}),
+            is_extended_id=False,
+            channel=0,
+        )
+        for i in range(n)
+    ]
+
+
+def test_longitudinal_acceleration_in_m_s2_or_g_decodes_to_si(tmp_path, dbc_path):
+    path = tmp_path / "bus.log"
+    with can.Logger(str(path)) as writer:
+        for message in _acceleration_messages(load_dbc(dbc_path)):
+            writer.on_message_received(message)
+    ax = read_can_motion(path, dbc_path, forward_acceleration="ACC.AX", yaw_rate_offset_s=1.5)
+    np.testing.assert_allclose(ax.forward_acceleration.value, 0.5 * np.arange(10), atol=1e-9)
+    np.testing.assert_allclose(ax.forward_acceleration.t, T0 + 1.5 + 0.01 * np.arange(10))
+    ag = read_can_motion(path, dbc_path, forward_acceleration="ACC.AG")
+    np.testing.assert_allclose(ag.forward_acceleration.value, 0.05 * 9.80665, atol=1e-9)
+    assert read_can_motion(path, dbc_path).forward_acceleration is None
+
+
+def test_an_acceleration_signal_that_is_not_one_is_named(tmp_path, dbc_path):
+    path = tmp_path / "bus.log"
+    path.write_text("(1600000000.000000) can0 028#00C8000000\n")
+    with pytest.raises(InputError, match=r"WHEELS\.WL is in m/s, not m/s²"):
+        read_can_motion(path, dbc_path, forward_acceleration="WHEELS.WL")

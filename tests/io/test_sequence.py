@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import yaml
 
@@ -61,3 +62,37 @@ def test_antenna_lever_arm_is_read_and_defaults_to_zero(tmp_path):
         write_manifest(tmp_path, manifest)
         with pytest.raises(InputError, match=r"gnss\.antenna_lever_arm_m .* not three numbers"):
             read_sequence(tmp_path)
+
+
+def test_forward_acceleration_from_the_can_bus_or_a_csv_but_not_both(tmp_path):
+    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
+    sequence = read_sequence(tmp_path)
+    acceleration = sequence.forward_acceleration
+    assert acceleration.unit == "m/s^2" and len(acceleration) > 100
+    inside = (acceleration.t > acceleration.t[0] + 0.5) & (
+        acceleration.t < acceleration.t[-1] - 0.5
+    )
+    t0, t1 = acceleration.t[inside][[0, -1]]
+    wheel = sequence.wheel_speed
+
+    def speed(t):  # the generating speed: the rear wheels' mean over ±50 ms, less their +2 %
+        return np.mean(wheel.value[np.abs(wheel.t - t) < 0.05]) / 1.02
+
+    gained = (speed(t1) - speed(t0)) / (t1 - t0)
+    # the mean reading is the mean dv/dt plus the simulator's bias (0.1 m/s²)
+    assert float(acceleration.value[inside].mean()) - gained == pytest.approx(0.1, abs=0.02)
+    manifest = yaml.safe_load((tmp_path / "sequence.yaml").read_text())
+    del manifest["can"]["forward_acceleration"]
+    write_manifest(tmp_path, manifest)
+    assert read_sequence(tmp_path).forward_acceleration is None
+    (tmp_path / "acc.csv").write_text("t,forward_acceleration_mps2\n0.0,0.1\n1.0,0.2\n")
+    manifest["imu"] = {"forward_acceleration": "acc.csv"}
+    manifest["can"]["forward_acceleration"] = "VEHICLE_DYNAMICS.LONG_ACCEL"
+    write_manifest(tmp_path, manifest)
+    with pytest.raises(InputError, match=r"can\.forward_acceleration.*given twice"):
+        read_sequence(tmp_path)
+    manifest["can"]["forward_acceleration"] = "VEHICLE_DYNAMICS.YAW_RATE"
+    del manifest["imu"]
+    write_manifest(tmp_path, manifest)
+    with pytest.raises(InputError, match="not m/s²"):
+        read_sequence(tmp_path)

@@ -9,6 +9,7 @@ import pytest
 from vo_doppler.io.can import read_can_log, read_can_motion
 from vo_doppler.sim.can_bus import (
     DBC_PATH,
+    FORWARD_ACCELERATION_SIGNAL,
     WHEEL_SPEED_SIGNALS,
     YAW_RATE_SIGNAL,
     CanSimConfig,
@@ -89,3 +90,33 @@ def test_sensor_errors_are_the_configured_ones(can_log):
     left, right = simulation.wheel_kmh[:, 2], simulation.wheel_kmh[:, 3]
     track = (right - left).mean() / 3.6 / (1 + config.wheel_scale_error) / YAW_RATE
     assert track == pytest.approx(config.track_m, abs=0.01)  # wheel noise: σ ≈ 0.002 m
+
+
+def test_longitudinal_accelerometer_reads_the_speed_change_plus_its_bias_and_noise(can_log):
+    path, _, config = can_log
+    offset = -gps_to_unix_offset(18)
+    motion = read_can_motion(
+        path,
+        DBC_PATH,
+        YAW_RATE_SIGNAL,
+        WHEEL_SPEED_SIGNALS,
+        1.0,
+        offset,
+        offset,
+        forward_acceleration=FORWARD_ACCELERATION_SIGNAL,
+    )
+    acceleration = motion.forward_acceleration
+    assert acceleration.unit == "m/s^2" and len(acceleration) == 2500
+    # constant speed: what is read is the bias and the noise (σ 0.03: the mean within 0.002)
+    assert np.mean(acceleration.value) == pytest.approx(config.long_accel_bias_mps2, abs=0.002)
+    assert np.std(acceleration.value) == pytest.approx(config.long_accel_noise_mps2, rel=0.05)
+
+
+def test_the_accelerometer_noise_leaves_the_other_signals_as_they_were():
+    quiet = CanSimConfig(long_accel_noise_mps2=0.0)
+    noisy = CanSimConfig(long_accel_noise_mps2=0.5)
+    a = simulate_can(circling, T0, T0 + 5.0, quiet, np.random.default_rng(3))
+    b = simulate_can(circling, T0, T0 + 5.0, noisy, np.random.default_rng(3))
+    np.testing.assert_array_equal(a.wheel_kmh, b.wheel_kmh)
+    np.testing.assert_array_equal(a.yaw_rate_dps, b.yaw_rate_dps)
+    assert a.lines != b.lines

@@ -214,6 +214,7 @@ def solve_velocity(
     verified = np.zeros(n, dtype=bool)
     untestable = np.zeros(n, dtype=bool)
     horizontal_sigma = np.full((n, 2), np.nan)
+    vertical_sigma = np.full(n, np.nan)
     order = np.argsort(rows.epoch, kind="stable")
     bounds = np.searchsorted(rows.epoch[order], np.arange(n + 1))
     y_all = rows.reduced()
@@ -241,6 +242,7 @@ def solve_velocity(
         covariance_enu = rotation @ result.covariance[:3, :3] @ rotation.T
         dop[k] = _dop(H[result.used], rotation)
         horizontal_sigma[k] = speed_course_sigma(velocity_enu[k], covariance_enu)
+        vertical_sigma[k] = np.sqrt(covariance_enu[2, 2])
         plausible = vertical_velocity_plausible(velocity_enu[k], covariance_enu)
         verified[k] = result.passed and n_sat[k] > MIN_SATELLITES and plausible
         untestable[k] = (
@@ -264,6 +266,7 @@ def solve_velocity(
         untestable=untestable,
         speed_sigma_mps=horizontal_sigma[:, 0],
         course_sigma_rad=horizontal_sigma[:, 1],
+        vertical_sigma_mps=vertical_sigma,
     )
     return continuity_checked(solution)
 

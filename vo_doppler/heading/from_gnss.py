@@ -106,6 +106,7 @@ def heading_from_gnss(
         forward_acceleration=forward_acceleration,
         conventional_speed_sigma_mps=velocity.speed_sigma_mps,
         conventional_untestable=velocity.untestable,
+        conventional_vertical_sigma_mps=velocity.vertical_sigma_mps,
     )
     table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)
     return table

@@ -73,14 +73,14 @@ class HeadingPipelineConfig:
     fixed_wheel_scale: float | None = None
 
 
-def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, config):
+def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, vertical_sigma, config):
     """(μ, σ) of the tight heading's grade per epoch: the accelerometer's where calibrated,
     else N(0, ``config.tight.grade_sigma``)."""
     level = (0.0, config.tight.grade_sigma)
     if forward_acceleration is None or not len(forward_acceleration.t):
         return level
     raw = accelerometer_grade(t_epoch, config.tight.window_s, forward_acceleration, speed)
-    mean, sigma = grade_prior(raw, velocity, valid, config.grade)
+    mean, sigma = grade_prior(raw, velocity, valid, config.grade, vertical_sigma)
     known = np.isfinite(mean) & np.isfinite(sigma)
     return np.where(known, mean, level[0]), np.where(known, sigma, level[1])
 
@@ -181,6 +181,7 @@ def heading_pipeline(
     forward_acceleration: SensorSeries | None = None,
     conventional_speed_sigma_mps: np.ndarray | None = None,
     conventional_untestable: np.ndarray | None = None,
+    conventional_vertical_sigma_mps: np.ndarray | None = None,
 ) -> HeadingTable:
     """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise).
 
@@ -215,6 +216,8 @@ def heading_pipeline(
     grade prior of the tight heading comes from it and the wheel speed, its offset calibrated
     on the conventional velocities (:mod:`vo_doppler.heading.grade`); without it, and before
     that calibration, the prior is N(0, ``config.tight.grade_sigma``).
+    ``conventional_vertical_sigma_mps``: σ of each conventional up velocity, whose share the
+    grade prior's σ leaves out (:func:`~vo_doppler.heading.grade.grade_prior`).
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     velocity = np.asarray(conventional_velocity_enu, dtype=float).reshape(-1, 3)
@@ -269,7 +272,15 @@ def heading_pipeline(
         cal.bias_sigma,
         config.integrity,
     )
-    grade = _grade_prior(t_epoch, velocity, conventional_valid, speed, forward_acceleration, config)
+    grade = _grade_prior(
+        t_epoch,
+        velocity,
+        conventional_valid,
+        speed,
+        forward_acceleration,
+        conventional_vertical_sigma_mps,
+        config,
+    )
     result = tight_heading_series(
         rows,
         t_epoch,

@@ -59,6 +59,10 @@ UNIT_TO_SI: dict[str, tuple[float, str]] = {
     "dps": (np.pi / 180.0, "rad/s"),
     "degree/s": (np.pi / 180.0, "rad/s"),
     "rad/s": (1.0, "rad/s"),
+    "m/s^2": (1.0, "m/s^2"),
+    "m/s2": (1.0, "m/s^2"),
+    "m/s²": (1.0, "m/s^2"),
+    "g": (9.80665, "m/s^2"),
 }
 
 _LINE_FORMATS = {".log": can.CanutilsLogReader, ".csv": can.CSVReader}
@@ -108,11 +112,13 @@ class CanDecodeReport:
 
 @dataclass
 class CanMotion:
-    """Yaw rate (rad/s, counter-clockwise positive) and speed (m/s) decoded from a CAN log."""
+    """Yaw rate (rad/s, counter-clockwise positive) and speed (m/s) decoded from a CAN log,
+    and the longitudinal acceleration (m/s², forward positive) where one was asked for."""
 
     yaw_rate: SensorSeries | None
     speed: SensorSeries | None
     report: CanDecodeReport
+    forward_acceleration: SensorSeries | None = None
 
 
 class SignalError(InputError):
@@ -146,6 +152,8 @@ MAX_YAW_RATE = 10.0
 """rad/s: no car turns faster (a decoded rate beyond it is a wrong factor or unit)."""
 MAX_WHEEL_SPEED = 200.0
 """m/s (720 km/h): no road vehicle's wheel speed beyond it."""
+MAX_ACCELERATION = 50.0
+"""m/s² (5 g): no car's longitudinal acceleration beyond it, crashes aside."""
 MAX_UNREADABLE_LOGGED = 10
 """Unreadable lines logged one by one; the rest are only counted."""
 MAX_ARBITRATION_ID = 0x1FFFFFFF
@@ -538,8 +546,11 @@ def _motion(
     yaw_rate_sign: float,
     yaw_rate_offset_s: float,
     speed_offset_s: float,
+    acceleration: SignalRef | None = None,
 ) -> CanMotion:
-    """Yaw rate (signed, shifted) and mean wheel speed (shifted) from decoded series."""
+    """Yaw rate (signed, shifted), mean wheel speed (shifted) and the longitudinal acceleration
+    (shifted as the yaw rate: both come from the same inertial sensor cluster) from decoded
+    series."""
     yaw_series = None
     if yaw_rate is not None:
         raw = decoded[yaw_rate]
@@ -555,9 +566,18 @@ def _motion(
         if bad:
             raise SignalError(f"wheel-speed signals {bad} are not speeds")
         speed_series = mean_of_series(parts, "speed_mps").shifted(speed_offset_s)
+    acceleration_series = None
+    if acceleration is not None:
+        raw = decoded[acceleration]
+        if raw.unit != "m/s^2":
+            raise SignalError(f"acceleration signal {acceleration} is in {raw.unit}, not m/s²")
+        acceleration_series = SensorSeries(
+            raw.t + yaw_rate_offset_s, raw.value, "forward_acceleration_mps2", "m/s^2"
+        )
     for series, ref, limit in (
         (yaw_series, yaw_rate, MAX_YAW_RATE),
         (speed_series, ",".join(map(str, wheels)), MAX_WHEEL_SPEED),
+        (acceleration_series, acceleration, MAX_ACCELERATION),
     ):
         if series is not None and len(series) and np.abs(series.value).max() > limit:
             worst = float(np.abs(series.value).max())
@@ -565,7 +585,7 @@ def _motion(
                 f"{ref} decodes to {worst:.4g} {series.unit}, beyond any car's {limit:g} "
                 f"{series.unit}: check the DBC factor and unit"
             )
-    return CanMotion(yaw_series, speed_series, report)
+    return CanMotion(yaw_series, speed_series, report, acceleration_series)
 
 
 def read_can_motion(
@@ -578,18 +598,24 @@ def read_can_motion(
     speed_offset_s: float = 0.0,
     channel: str | None = None,
     short_frames: str = "skip",
+    forward_acceleration: str | None = None,
 ) -> CanMotion:
-    """Read a CAN log and decode yaw rate (``MSG.SIG``) and mean wheel speed (``MSG.A,MSG.B``),
-    frame by frame (no frame is held beyond its decoding)."""
+    """Read a CAN log and decode yaw rate (``MSG.SIG``), mean wheel speed (``MSG.A,MSG.B``) and,
+    if named, the longitudinal acceleration (``MSG.SIG``, forward positive, as an accelerometer
+    measures it: gravity's share on a slope included), frame by frame (no frame is held beyond
+    its decoding)."""
     _check_sign(yaw_rate_sign)
     db = load_dbc(dbc_path)
     report = CanDecodeReport()
     try:
         yaw_ref = SignalRef.parse(yaw_rate) if yaw_rate else None
         wheels = parse_signal_list(wheel_speed) if wheel_speed else []
+        acceleration_ref = SignalRef.parse(forward_acceleration) if forward_acceleration else None
         decoder = _StreamDecoder(
             db,
-            ([yaw_ref] if yaw_ref else []) + wheels,
+            ([yaw_ref] if yaw_ref else [])
+            + wheels
+            + ([acceleration_ref] if acceleration_ref else []),
             channel,
             report,
             short_frames,
@@ -602,7 +628,14 @@ def read_can_motion(
     decoded = decoder.finish(log_path)
     try:
         motion = _motion(
-            decoded, report, yaw_ref, wheels, yaw_rate_sign, yaw_rate_offset_s, speed_offset_s
+            decoded,
+            report,
+            yaw_ref,
+            wheels,
+            yaw_rate_sign,
+            yaw_rate_offset_s,
+            speed_offset_s,
+            acceleration_ref,
         )
     except SignalError as exc:
         raise SignalError(str(exc), dbc_path) from exc

@@ -212,6 +212,17 @@ def read_sequence_with_report(
     log_path = m.file("can", "log")
     dbc_path = m.file("can", "dbc")
     yaw_name = m.string("can", "yaw_rate")
+    can_acceleration = (
+        m.string("can", "forward_acceleration")
+        if "forward_acceleration" in m.section("can")
+        else None
+    )
+    imu = m.data.get("imu")
+    if can_acceleration and isinstance(imu, dict) and "forward_acceleration" in imu:
+        raise m.error(
+            "can.forward_acceleration",
+            "the forward acceleration is given twice (can. and imu.): keep one",
+        )
     try:
         motion = read_can_motion(
             log_path,
@@ -222,9 +233,12 @@ def read_sequence_with_report(
             can_offset,
             can_offset,
             short_frames=short_frames,
+            forward_acceleration=can_acceleration,
         )
     except SignalError as exc:
-        raise m.error("can.yaw_rate / can.wheel_speed", str(exc)) from exc
+        raise m.error(
+            "can.yaw_rate / can.wheel_speed / can.forward_acceleration", str(exc)
+        ) from exc
     if motion.yaw_rate is None or motion.speed is None or not len(motion.speed):
         raise InputError("CAN log gave no yaw rate or wheel speed", log_path)
     report.can = motion.report
@@ -243,8 +257,7 @@ def read_sequence_with_report(
         truth_path = m.resolve("ground_truth.trajectory", truth_cfg["trajectory"])
         if truth_path.exists():
             truth = read_tum(m.file("ground_truth", "trajectory"))
-    forward_acceleration = None
-    imu = m.data.get("imu")
+    forward_acceleration = motion.forward_acceleration
     if isinstance(imu, dict) and "forward_acceleration" in imu:
         forward_acceleration = read_sensor_csv(
             m.file("imu", "forward_acceleration"),

@@ -58,6 +58,8 @@ class VelocitySolution:
     """σ of the horizontal speed from the covariance (m/s)."""
     course_sigma_rad: np.ndarray | None = None
     """σ of the course from the covariance (rad; large when slow)."""
+    vertical_sigma_mps: np.ndarray | None = None
+    """σ of the up velocity from the covariance (m/s)."""
     untestable: np.ndarray | None = None
     """Solved from exactly four satellites (no redundancy, so a fault cannot be detected in the
     epoch) with a plausible vertical velocity: not valid, but a candidate wherever redundancy

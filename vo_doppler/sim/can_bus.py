@@ -7,8 +7,11 @@ Signals (the DBC is the reference for ids, bit layout and scaling):
   wheels √((v ∓ ω·track/2)² + (ω·wheelbase)²). All multiplied by (1 + wheel scale error)
   (tyre radius error; default +2 %), plus white noise.
 - ``VEHICLE_DYNAMICS`` (0x130): yaw rate in deg/s (counter-clockwise positive, factor 0.01)
-  = ω + bias (default 0.3 deg/s) + bias random walk + white noise; lateral acceleration v·ω and
-  longitudinal acceleration dv/dt; a 4-bit rolling counter.
+  = ω + bias (default 0.3 deg/s) + bias random walk + white noise; lateral acceleration v·ω;
+  longitudinal acceleration as an accelerometer on the city's level roads measures it, dv/dt +
+  bias (default 0.1 m/s², sensor offset and mounting pitch) + white noise (its noise drawn from
+  a generator spawned off ``rng``, so the other signals are those of a bus without it); a 4-bit
+  rolling counter.
 Raw values are rounded to the DBC step (quantisation) and saturated at the signal range.
 Both messages are sent every 12 ms (second one half a period later) with a little jitter.
 Log times are Unix seconds (UTC, as candump writes them): t_unix = t_gps + 315 964 800 − leap.
@@ -31,6 +34,7 @@ WHEEL_MESSAGE = "WHEEL_SPEEDS"
 DYNAMICS_MESSAGE = "VEHICLE_DYNAMICS"
 WHEELS = ("FL", "FR", "RL", "RR")
 YAW_RATE_SIGNAL = f"{DYNAMICS_MESSAGE}.YAW_RATE"
+FORWARD_ACCELERATION_SIGNAL = f"{DYNAMICS_MESSAGE}.LONG_ACCEL"
 WHEEL_SPEED_SIGNALS = f"{WHEEL_MESSAGE}.WHEEL_SPEED_RL,{WHEEL_MESSAGE}.WHEEL_SPEED_RR"
 
 
@@ -50,6 +54,8 @@ class CanSimConfig:
     yaw_rate_bias_dps: float = 0.3
     yaw_bias_walk_dps: float = 0.003
     yaw_rate_noise_dps: float = 0.05
+    long_accel_bias_mps2: float = 0.1
+    long_accel_noise_mps2: float = 0.03
     track_m: float = 1.55
     wheelbase_m: float = 2.7
     channel: str = "can0"
@@ -125,6 +131,8 @@ def simulate_can(
     bias = config.yaw_rate_bias_dps + np.concatenate([[0.0], np.cumsum(walk[1:])])
     yaw_dps = np.degrees(motion.yaw_rate) + bias + rng.normal(0.0, config.yaw_rate_noise_dps, n)
     long_accel = np.gradient(motion.speed, t_dyn) if n > 1 else np.zeros(n)
+    long_accel += config.long_accel_bias_mps2
+    long_accel += rng.spawn(1)[0].normal(0.0, config.long_accel_noise_mps2, n)
     dyn_raw = _raw(
         dyn_msg,
         {

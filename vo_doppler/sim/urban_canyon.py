@@ -32,8 +32,9 @@ Sequence folder (``simulate_urban_canyon(out_dir, config)``)::
     camera: {images, image_format, times, calib, fps, width, height, time_offset_s}
     gnss: {obs, nav: [..], rate_hz, systems, time_offset_s, antenna_lever_arm_m (x, y, z m),
            doppler_sign: "range_rate = -wavelength * doppler", visibility}
-    can: {log, dbc, period_s, time_offset_s, yaw_rate, yaw_rate_sign, wheel_speed}
-         yaw_rate / wheel_speed are MESSAGE.SIGNAL names as ``vo-doppler heading`` takes them
+    can: {log, dbc, period_s, time_offset_s, yaw_rate, yaw_rate_sign, wheel_speed,
+          forward_acceleration}
+         yaw_rate / wheel_speed / forward_acceleration are MESSAGE.SIGNAL names
     ground_truth: {trajectory, frame, rate_hz}
     truth: generating sensor errors (wheel_scale_error, yaw_rate_bias_dps, …) — evaluation only
     city: {blocks, block_size_m, street_width_m, height_range_m, corner_streets}
@@ -71,6 +72,7 @@ from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.camera_effects import CameraEffects, EffectsCamera
 from vo_doppler.sim.can_bus import (
     DBC_PATH,
+    FORWARD_ACCELERATION_SIGNAL,
     WHEEL_SPEED_SIGNALS,
     YAW_RATE_SIGNAL,
     CanSimConfig,
@@ -502,6 +504,7 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
             "yaw_rate": YAW_RATE_SIGNAL,
             "yaw_rate_sign": 1,
             "wheel_speed": WHEEL_SPEED_SIGNALS,
+            "forward_acceleration": FORWARD_ACCELERATION_SIGNAL,
         },
         "ground_truth": {
             "trajectory": files["ground_truth"],
@@ -531,6 +534,8 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
             "yaw_rate_bias_dps": config.can.yaw_rate_bias_dps,
             "yaw_bias_walk_dps_per_sqrt_s": config.can.yaw_bias_walk_dps,
             "yaw_rate_noise_dps": config.can.yaw_rate_noise_dps,
+            "long_accel_bias_mps2": config.can.long_accel_bias_mps2,
+            "long_accel_noise_mps2": config.can.long_accel_noise_mps2,
             "gnss": _plain(asdict(config.gnss)),
         },
         "city": {
