@@ -42,6 +42,20 @@ def can_log(tmp_path_factory):
     return path, simulation, config
 
 
+def read_on_gps_time(path, **options):
+    """The log's yaw rate and rear wheel speed (and ``options``' signals) on GPS time."""
+    offset = -gps_to_unix_offset(18)
+    return read_can_motion(
+        path,
+        DBC_PATH,
+        YAW_RATE_SIGNAL,
+        WHEEL_SPEED_SIGNALS,
+        yaw_rate_offset_s=offset,
+        speed_offset_s=offset,
+        **options,
+    )
+
+
 def test_log_is_candump_format_at_12_ms(can_log):
     path, _, _ = can_log
     first = path.read_text().splitlines()[0]
@@ -56,15 +70,7 @@ def test_log_is_candump_format_at_12_ms(can_log):
 
 def test_decoded_signals_equal_generating_values_within_quantisation(can_log):
     path, simulation, _ = can_log
-    offset = -gps_to_unix_offset(18)
-    motion = read_can_motion(
-        path,
-        DBC_PATH,
-        YAW_RATE_SIGNAL,
-        WHEEL_SPEED_SIGNALS,
-        yaw_rate_offset_s=offset,
-        speed_offset_s=offset,
-    )
+    motion = read_on_gps_time(path)
     assert motion.report.n_undecodable == 0 and motion.report.n_padded == 0
     yaw = motion.yaw_rate
     np.testing.assert_allclose(yaw.t, simulation.t_dynamics, atol=1e-6)
@@ -94,17 +100,7 @@ def test_sensor_errors_are_the_configured_ones(can_log):
 
 def test_longitudinal_accelerometer_reads_the_speed_change_plus_its_bias_and_noise(can_log):
     path, _, config = can_log
-    offset = -gps_to_unix_offset(18)
-    motion = read_can_motion(
-        path,
-        DBC_PATH,
-        YAW_RATE_SIGNAL,
-        WHEEL_SPEED_SIGNALS,
-        1.0,
-        offset,
-        offset,
-        forward_acceleration=FORWARD_ACCELERATION_SIGNAL,
-    )
+    motion = read_on_gps_time(path, forward_acceleration=FORWARD_ACCELERATION_SIGNAL)
     acceleration = motion.forward_acceleration
     assert acceleration.unit == "m/s^2" and len(acceleration) == 2500
     # constant speed: what is read is the bias and the noise (σ 0.03: the mean within 0.002)

@@ -154,6 +154,8 @@ MAX_WHEEL_SPEED = 200.0
 """m/s (720 km/h): no road vehicle's wheel speed beyond it."""
 MAX_ACCELERATION = 50.0
 """m/s² (5 g): no car's longitudinal acceleration beyond it, crashes aside."""
+UNIT_NAMES = {"rad/s": "an angular rate", "m/s^2": "m/s²"}
+"""How an error names the SI unit a signal should have had."""
 MAX_UNREADABLE_LOGGED = 10
 """Unreadable lines logged one by one; the rest are only counted."""
 MAX_ARBITRATION_ID = 0x1FFFFFFF
@@ -538,6 +540,16 @@ def _check_sign(yaw_rate_sign: float) -> None:
         raise InputError(f"yaw_rate_sign must be +1 or -1, not {yaw_rate_sign!r}")
 
 
+def _single(decoded, ref, unit, kind, offset_s, sign, name) -> SensorSeries | None:
+    """The decoded signal ``ref`` (None if not asked for) in ``unit``, times sign, shifted."""
+    if ref is None:
+        return None
+    raw = decoded[ref]
+    if raw.unit != unit:
+        raise SignalError(f"{kind} signal {ref} is in {raw.unit}, not {UNIT_NAMES[unit]}")
+    return SensorSeries(raw.t + offset_s, sign * raw.value, name, unit)
+
+
 def _motion(
     decoded: dict[SignalRef, SensorSeries],
     report: CanDecodeReport,
@@ -551,14 +563,9 @@ def _motion(
     """Yaw rate (signed, shifted), mean wheel speed (shifted) and the longitudinal acceleration
     (shifted as the yaw rate: both come from the same inertial sensor cluster) from decoded
     series."""
-    yaw_series = None
-    if yaw_rate is not None:
-        raw = decoded[yaw_rate]
-        if raw.unit != "rad/s":
-            raise SignalError(f"yaw-rate signal {yaw_rate} is in {raw.unit}, not an angular rate")
-        yaw_series = SensorSeries(
-            raw.t + yaw_rate_offset_s, yaw_rate_sign * raw.value, "yaw_rate_rad_s", "rad/s"
-        )
+    yaw_series = _single(
+        decoded, yaw_rate, "rad/s", "yaw-rate", yaw_rate_offset_s, yaw_rate_sign, "yaw_rate_rad_s"
+    )
     speed_series = None
     if wheels:
         parts = [decoded[ref] for ref in wheels]
@@ -566,14 +573,15 @@ def _motion(
         if bad:
             raise SignalError(f"wheel-speed signals {bad} are not speeds")
         speed_series = mean_of_series(parts, "speed_mps").shifted(speed_offset_s)
-    acceleration_series = None
-    if acceleration is not None:
-        raw = decoded[acceleration]
-        if raw.unit != "m/s^2":
-            raise SignalError(f"acceleration signal {acceleration} is in {raw.unit}, not m/s²")
-        acceleration_series = SensorSeries(
-            raw.t + yaw_rate_offset_s, raw.value, "forward_acceleration_mps2", "m/s^2"
-        )
+    acceleration_series = _single(
+        decoded,
+        acceleration,
+        "m/s^2",
+        "acceleration",
+        yaw_rate_offset_s,
+        1.0,
+        "forward_acceleration_mps2",
+    )
     for series, ref, limit in (
         (yaw_series, yaw_rate, MAX_YAW_RATE),
         (speed_series, ",".join(map(str, wheels)), MAX_WHEEL_SPEED),
