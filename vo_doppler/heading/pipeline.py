@@ -254,7 +254,8 @@ def heading_pipeline(
     cal = causal_calibration(t_epoch, conv_speed, conv_yaw, calibrating, wheel, raw_angle, config)
     # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
     steps = cal.bias[:-1] * np.diff(t_epoch)
-    yaw_angle = raw_angle - np.concatenate([[0.0], np.cumsum(steps)])[: len(t_epoch)]
+    bias_integral = np.concatenate([[0.0], np.cumsum(steps)])[: len(t_epoch)]
+    yaw_angle = raw_angle - bias_integral
     offset = antenna_offset_velocity(raw_rate - cal.bias, antenna_lever_arm_m)
     if lever:
         conv_yaw, _ = vehicle_heading_from_antenna(
@@ -291,6 +292,7 @@ def heading_pipeline(
         gyro_bias_sigma=cal.bias_sigma,
         lever_velocity=np.nan_to_num(offset),
         grade_prior=grade,
+        calibration=(cal.scale, cal.bias, bias_integral),
     )
     return HeadingTable(
         t=t_epoch,

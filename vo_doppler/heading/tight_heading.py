@@ -521,6 +521,7 @@ def tight_heading_series(
     gyro_bias_sigma: np.ndarray | float = 0.0,
     lever_velocity: np.ndarray | float = 0.0,
     grade_prior: tuple = (0.0, None),
+    calibration: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> TightHeadingResult:
     """Heading at every epoch from the window of Doppler rows ending there ([TK18] sec. 3.5).
 
@@ -537,6 +538,14 @@ def tight_heading_series(
 
     ``grade_prior`` = (μ, σ), per epoch or scalars: the Gaussian prior of the road grade of the
     window ending at each epoch (σ None: ``config.grade_sigma``; a level road when that is 0).
+
+    ``calibration`` = (k, b, B) per epoch: the wheel scale and gyro bias current at each epoch
+    and B(t) = ∫ b̂ dt, the bias integral already taken out of ``yaw_angle`` (a causal
+    calibration changes as data arrive). Each window then uses the calibration of its newest
+    epoch for all its rows, s_t·k_k/k_t and Φ_t − Φ_k + B_t − B_k − b_k·(t − t_k), which is what
+    ``speed_scale_sigma`` and ``gyro_bias_sigma`` of that epoch describe: without it, the rows of
+    a window at the start of a drive carry the prior's scale and bias while its σ is already
+    the first estimate's (measured: 1.8° off at σ 0.39° on a simulated drive's fifth second).
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     speed = np.asarray(speed, dtype=float)
@@ -577,7 +586,9 @@ def tight_heading_series(
     n_groups = int(np.max(row_group, initial=0)) + 1
     size = windows_per_chunk(width, n_groups, config)
     chunks = [np.arange(start, min(start + size, m)) for start in range(0, m, size)]
-    per_epoch = (t_epoch, speed, yaw_angle, lever)
+    if calibration is None:
+        calibration = (np.ones(m), np.zeros(m), np.zeros(m))
+    per_epoch = (t_epoch, speed, yaw_angle, lever, *(np.asarray(c, float) for c in calibration))
 
     def padded(k):
         return _padded_rows(
@@ -655,16 +666,18 @@ def _padded_rows(rows, per_row, index, row_epoch, k, bounds, per_epoch, width):
     y, a, b, τ, w, the satellite group and the grade coefficient c = −g_up·s_t of
     :func:`solve_windows`."""
     (y_all, row_group), (lo, hi) = per_row, bounds
-    t_epoch, speed, yaw_angle, lever = per_epoch
+    t_epoch, speed, yaw_angle, lever, scale, bias, bias_integral = per_epoch
     slot = lo[k][:, None] + np.arange(width)[None, :]
     # a window whose end has no yaw angle has no θ₀ to solve for: no rows
     inside = (slot < hi[k][:, None]) & np.isfinite(yaw_angle[k])[:, None]
     slot = np.where(inside, slot, 0)
     row = index[slot]
     epoch = row_epoch[slot]
-    delta = yaw_angle[epoch] - yaw_angle[k][:, None]
     tau = t_epoch[epoch] - t_epoch[k][:, None]
-    along, across = speed[epoch] + lever[epoch, 0], lever[epoch, 1]
+    delta = yaw_angle[epoch] - yaw_angle[k][:, None]
+    delta += bias_integral[epoch] - bias_integral[k][:, None] - bias[k][:, None] * tau
+    window_speed = speed[epoch] * scale[k][:, None] / scale[epoch]
+    along, across = window_speed + lever[epoch, 0], lever[epoch, 1]
     ge, gn = rows.los[row, 0], rows.los[row, 1]
     cos_d, sin_d = np.cos(delta), np.sin(delta)
     # The LOS turned by −δ, so that −G·R(θ₀ + δ)·[along, across] = a·cos θ₀ + b·sin θ₀.
@@ -675,7 +688,7 @@ def _padded_rows(rows, per_row, index, row_epoch, k, bounds, per_epoch, width):
     y = np.where(w > 0, y_all[row], 0.0)
     a, b, tau = np.where(w > 0, a, 0.0), np.where(w > 0, b, 0.0), np.where(w > 0, tau, 0.0)
     group = np.where(w > 0, row_group[row], 0)
-    grade_coefficient = np.where(w > 0, -rows.los[row, 2] * speed[epoch], 0.0)
+    grade_coefficient = np.where(w > 0, -rows.los[row, 2] * window_speed, 0.0)
     return y, a, b, tau, w, group, grade_coefficient
 
 
