@@ -57,6 +57,10 @@ def test_run_recovers_calibration_and_heading(sequence, run_output):
     assert summary["tight_heading_availability"] > 0.5
     assert summary["final_gyro_bias_dps"] == pytest.approx(0.3, abs=0.1)
     assert summary["final_wheel_scale"] == pytest.approx(1 / 1.02, abs=0.01)
+    # the simulated CAN bus carries a longitudinal accelerometer, whose offset is calibrated
+    # after the drive's first valid conventional velocities: the grade prior is then its own
+    assert 0.0 < summary["grade_prior_from_accelerometer"] < 1.0
+    assert summary["grade_prior_sigma_median"] <= 0.05
     table = read_heading_csv(run_output / "heading.csv")
     assert np.all(np.diff(table.t) > 0)
     assert summary["tight_heading_rejected_rows"] == int(table.rejected_rows.sum())

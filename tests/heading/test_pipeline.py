@@ -122,3 +122,28 @@ def test_conventional_speeds_far_from_the_wheel_speed_do_not_calibrate():
             assert error < 0.003
         else:  # least squares without the gate does not
             assert error > worse_than
+
+
+def test_the_table_records_where_the_grade_prior_came_from():
+    t, scenario, velocity = _drive(noise=0.0)
+    wheel = SensorSeries(t, scenario.speed)
+    gyro = SensorSeries(t, np.gradient(np.unwrap(scenario.yaw), t))
+    config = HeadingPipelineConfig()
+    plain = heading_pipeline(t, scenario.rows, velocity, np.ones(len(t), bool), wheel, gyro)
+    assert not plain.grade_from_accelerometer.any()
+    np.testing.assert_array_equal(plain.grade_prior_sigma, config.tight.grade_sigma)
+    # a level road: the accelerometer reads dv/dt plus an offset of 0.2 m/s²
+    acceleration = SensorSeries(t, np.gradient(scenario.speed, t) + 0.2)
+    table = heading_pipeline(
+        t,
+        scenario.rows,
+        velocity,
+        np.ones(len(t), bool),
+        wheel,
+        gyro,
+        forward_acceleration=acceleration,
+    )
+    fitted = table.grade_from_accelerometer
+    assert fitted[-100:].all() and not fitted[:10].any()
+    np.testing.assert_array_equal(table.grade_prior_sigma[fitted], config.grade.min_sigma)
+    np.testing.assert_array_equal(table.grade_prior_sigma[~fitted], config.tight.grade_sigma)

@@ -75,14 +75,15 @@ class HeadingPipelineConfig:
 
 def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, vertical_sigma, config):
     """(μ, σ) of the tight heading's grade per epoch: the accelerometer's where calibrated,
-    else N(0, ``config.tight.grade_sigma``)."""
-    level = (0.0, config.tight.grade_sigma)
+    else N(0, ``config.tight.grade_sigma``); and where it is the accelerometer's."""
+    m = len(t_epoch)
+    level = np.zeros(m), np.full(m, config.tight.grade_sigma)
     if forward_acceleration is None or not len(forward_acceleration.t):
-        return level
+        return level, np.zeros(m, dtype=bool)
     raw = accelerometer_grade(t_epoch, config.tight.window_s, forward_acceleration, speed)
     mean, sigma = grade_prior(raw, velocity, valid, config.grade, vertical_sigma)
     known = np.isfinite(mean) & np.isfinite(sigma)
-    return np.where(known, mean, level[0]), np.where(known, sigma, level[1])
+    return (np.where(known, mean, level[0]), np.where(known, sigma, level[1])), known
 
 
 def _sigma_where(sigma: np.ndarray | None, valid: np.ndarray) -> np.ndarray | None:
@@ -273,7 +274,7 @@ def heading_pipeline(
         cal.bias_sigma,
         config.integrity,
     )
-    grade = _grade_prior(
+    grade, grade_from_accelerometer = _grade_prior(
         t_epoch,
         velocity,
         conventional_valid,
@@ -314,4 +315,6 @@ def heading_pipeline(
         tc_window_s=config.tight.window_s,
         conv_gnss_valid=conv_ok,
         sigma_conv_gnss=_sigma_where(conventional_yaw_sigma, conv_ok),
+        grade_prior_sigma=grade[1],
+        grade_from_accelerometer=grade_from_accelerometer,
     )

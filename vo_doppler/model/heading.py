@@ -50,6 +50,11 @@ class HeadingTable:
     sigma_conv_gnss: np.ndarray | None = None
     """Standard deviation (rad) of the conventional heading from the velocity solution alone,
     NaN where unknown or not ``conv_gnss_valid``."""
+    grade_prior_sigma: np.ndarray | None = None
+    """σ of the road-grade prior of the tight window ending at each epoch (rise over run)."""
+    grade_from_accelerometer: np.ndarray | None = None
+    """Whether that prior came from a calibrated forward accelerometer (else the zero-mean
+    default)."""
 
     def __post_init__(self) -> None:
         n = len(self.t)
@@ -57,7 +62,9 @@ class HeadingTable:
             self.rejected_rows = np.zeros(n, dtype=int)
         if self.tc_verifiable is None:
             self.tc_verifiable = np.zeros(n, dtype=bool)
-        for name in ("sigma_conv", "speed_sigma_conv", "hdop_conv"):
+        if self.grade_from_accelerometer is None:
+            self.grade_from_accelerometer = np.zeros(n, dtype=bool)
+        for name in ("sigma_conv", "speed_sigma_conv", "hdop_conv", "grade_prior_sigma"):
             if getattr(self, name) is None:
                 setattr(self, name, np.full(n, np.nan))
 

@@ -65,6 +65,10 @@ FACT_FORMATS = {
     "tight_heading_used": ("tightly coupled heading used by the correction", "{:.1%}"),
     "tight_heading_rejected_rows": ("Doppler rows rejected by the NLOS tests", "{:d}"),
     "tight_heading_epochs_with_rejection": ("epochs with a rejection", "{:d}"),
+    "grade_prior_from_accelerometer": (
+        "road-grade prior from the forward accelerometer",
+        "{:.1%}",
+    ),
     "final_wheel_scale": ("wheel scale at the end", "{:.4f}"),
     "final_gyro_bias_dps": ("gyro bias at the end", "{:+.3f} deg/s"),
     "vo_frames": ("VO frames", "{:d}"),
@@ -93,6 +97,8 @@ def summarise(result: RunResult) -> dict:
         "tight_heading_used": float(np.mean(result.tc_usable)),
         "tight_heading_rejected_rows": int(table.rejected_rows.sum()),
         "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
+        "grade_prior_from_accelerometer": float(np.mean(table.grade_from_accelerometer)),
+        "grade_prior_sigma_median": _finite_median(table.grade_prior_sigma),
         "final_wheel_scale": float(table.wheel_scale[-1]),
         "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
         "doppler_noise": doppler_noise_summary(result),
@@ -104,6 +110,11 @@ def summarise(result: RunResult) -> dict:
     else:
         summary["camera"] = "none: non-visual pipelines only"
     return summary
+
+
+def _finite_median(values: np.ndarray) -> float | None:
+    finite = values[np.isfinite(values)]
+    return float(np.median(finite)) if finite.size else None
 
 
 def doppler_noise_summary(result: RunResult) -> dict:
