@@ -1,5 +1,5 @@
-"""Which precise orbits a comma2k19 segment takes from a folder of SP3 files, and the picklable
-import step of a batch over raw segments."""
+"""Which precise orbits a comma2k19 segment takes from a folder of SP3 files, the picklable
+import step of a batch over raw segments, and segments without a DBC."""
 
 from __future__ import annotations
 
@@ -11,11 +11,14 @@ import pytest
 from tests.conftest import require_shared
 from tests.helpers.precise_text import sp3_text
 from vo_doppler.errors import InputError
+from vo_doppler.io.comma2k19 import read_gyro_yaw_rate, read_wheel_speed
 from vo_doppler.io.comma2k19_import import (
     Comma2k19Import,
+    import_comma2k19,
     orbits_for_segment,
     segment_gps_span,
 )
+from vo_doppler.io.sequence import read_sequence
 
 COMMA = "comma2k19_example1"
 SP3 = "Sta20124_1400_1845.sp3"
@@ -56,3 +59,47 @@ def test_the_import_step_pickles_and_names_its_orbits(tmp_path):
     step = Comma2k19Import(tmp_path / "orbits")
     assert pickle.loads(pickle.dumps(step)) == step
     assert "orbits" in repr(step)
+
+
+def segment_without_dbc(tmp_path):
+    """The example segment's folders linked into ``tmp_path``, without its DBC and CAN log: a
+    comma2k19 segment as the dataset ships it."""
+    source = require_shared(COMMA)
+    segment = tmp_path / "segment"
+    segment.mkdir()
+    for entry in ("global_pose", "processed_log"):
+        (segment / entry).symlink_to(source / entry)
+    return segment
+
+
+@pytest.mark.shared_data
+def test_a_segment_without_a_dbc_takes_the_decoded_wheel_speeds_and_the_gyro(tmp_path):
+    segment = segment_without_dbc(tmp_path)
+    sp3 = require_shared(f"{COMMA}/{SP3}")
+    with_can = import_comma2k19(require_shared(COMMA), tmp_path / "can", sp3)
+    without = import_comma2k19(segment, tmp_path / "vehicle", sp3)
+    assert (with_can.vehicle_signals, without.vehicle_signals) == ("can", "vehicle")
+    can, csv = read_sequence(with_can.folder), read_sequence(without.folder)
+    # the same four wheels: comma's decoded m/s against the DBC's km/h from the raw frames
+    at = csv.wheel_speed.t[10:-10]
+    difference = np.interp(at, can.wheel_speed.t, can.wheel_speed.value) - np.interp(
+        at, csv.wheel_speed.t, csv.wheel_speed.value
+    )
+    assert np.median(np.abs(difference)) < 0.01
+    t_gyro, yaw_rate = read_gyro_yaw_rate(segment)
+    np.testing.assert_array_equal(csv.yaw_rate.value, yaw_rate)
+    np.testing.assert_allclose(csv.yaw_rate.t, t_gyro + without.gps_minus_log_s, atol=1e-6)
+    assert csv.observations.epoch_time.size == can.observations.epoch_time.size
+    with pytest.raises(InputError, match="DBC for the CAN log is not a file"):
+        import_comma2k19(segment, tmp_path / "x", sp3, dbc=tmp_path / "missing.dbc")
+
+
+def test_a_signal_of_the_wrong_shape_is_named(tmp_path):
+    folder = tmp_path / "processed_log" / "CAN" / "wheel_speed"
+    folder.mkdir(parents=True)
+    with (folder / "t").open("wb") as stream:
+        np.save(stream, np.arange(5.0))
+    with (folder / "value").open("wb") as stream:
+        np.save(stream, np.ones((5, 3)))
+    with pytest.raises(InputError, match=r"wheel_speed: .*value \(5, 3\); expected .*\(N, 4\)"):
+        read_wheel_speed(tmp_path)

@@ -7,7 +7,9 @@ import pytest
 import yaml
 
 from vo_doppler.errors import InputError
-from vo_doppler.io.sequence import read_manifest, read_sequence
+from vo_doppler.io.sensor_csv import SPEED_COLUMN, YAW_RATE_COLUMN, write_sensor_csv
+from vo_doppler.io.sequence import read_manifest, read_sequence, read_sequence_with_report
+from vo_doppler.model.series import SensorSeries
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
 
@@ -95,4 +97,52 @@ def test_forward_acceleration_from_the_can_bus_or_a_csv_but_not_both(tmp_path):
     del manifest["imu"]
     write_manifest(tmp_path, manifest)
     with pytest.raises(InputError, match="not m/s²"):
+        read_sequence(tmp_path)
+
+
+def test_vehicle_signals_from_sensor_csvs_instead_of_a_can_log(tmp_path):
+    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
+    from_can = read_sequence(tmp_path)
+    offset = 1.0e9
+    (tmp_path / "vehicle").mkdir()
+    write_sensor_csv(
+        tmp_path / "vehicle" / "yaw.csv",
+        SensorSeries(from_can.yaw_rate.t - offset, from_can.yaw_rate.value),
+        YAW_RATE_COLUMN,
+    )
+    write_sensor_csv(
+        tmp_path / "vehicle" / "speed.csv",
+        SensorSeries(from_can.wheel_speed.t - offset, from_can.wheel_speed.value),
+        SPEED_COLUMN,
+    )
+    manifest = yaml.safe_load((tmp_path / "sequence.yaml").read_text())
+    can = manifest.pop("can")
+    manifest["vehicle"] = {
+        "yaw_rate": "vehicle/yaw.csv",
+        "wheel_speed": "vehicle/speed.csv",
+        "time_offset_s": offset,
+    }
+    write_manifest(tmp_path, manifest)
+    sequence, report = read_sequence_with_report(tmp_path)
+    for name in ("yaw_rate", "wheel_speed"):
+        np.testing.assert_allclose(getattr(sequence, name).t, getattr(from_can, name).t, atol=1e-6)
+        np.testing.assert_array_equal(getattr(sequence, name).value, getattr(from_can, name).value)
+    assert report.vehicle_source == "vehicle" and report.can is None
+    assert sequence.clock_offsets_s["vehicle"] == offset
+    assert sequence.forward_acceleration is None
+    manifest["can"] = can
+    write_manifest(tmp_path, manifest)
+    with pytest.raises(InputError, match="given twice"):
+        read_sequence(tmp_path)
+    del manifest["can"], manifest["vehicle"]
+    write_manifest(tmp_path, manifest)
+    with pytest.raises(InputError, match="neither a 'can' nor a 'vehicle' section"):
+        read_sequence(tmp_path)
+    manifest["vehicle"] = {"yaw_rate": "vehicle/yaw.csv", "wheel_speed": "vehicle/yaw.csv"}
+    write_manifest(tmp_path, manifest)
+    with pytest.raises(InputError, match=r"yaw\.csv.*lacks column\(s\) speed_mps"):
+        read_sequence(tmp_path)
+    del manifest["vehicle"]["wheel_speed"]
+    write_manifest(tmp_path, manifest)
+    with pytest.raises(InputError, match="section 'vehicle' lacks 'wheel_speed'"):
         read_sequence(tmp_path)

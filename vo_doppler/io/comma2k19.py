@@ -34,19 +34,38 @@ def load_array(base: str | Path, *parts: str) -> np.ndarray:
         raise InputError(f"cannot load comma2k19 array: {exc}", path) from exc
 
 
+def read_signal(base: str | Path, *parts: str, columns: int) -> tuple[np.ndarray, np.ndarray]:
+    """(t, value) of one signal folder, e.g. ``("processed_log", "IMU", "gyro")``: ``t`` (N,)
+    and ``value`` (N, ``columns``), checked for those shapes."""
+    t = load_array(base, *parts, "t")
+    value = load_array(base, *parts, "value")
+    if t.ndim != 1 or value.ndim != 2 or value.shape != (t.size, columns):
+        raise InputError(
+            f"comma2k19 signal of shape t {t.shape}, value {value.shape}; expected t (N,) and "
+            f"value (N, {columns})",
+            Path(base).joinpath(*parts),
+        )
+    return t.astype(float), value.astype(float)
+
+
 def read_gyro_yaw_rate(base: str | Path, signal: str = "gyro") -> tuple[np.ndarray, np.ndarray]:
     """(t, yaw rate rad/s CCW) from ``processed_log/IMU/<signal>`` (−gyro_z)."""
-    t = load_array(base, "processed_log", "IMU", signal, "t")
-    value = load_array(base, "processed_log", "IMU", signal, "value")
+    t, value = read_signal(base, "processed_log", "IMU", signal, columns=3)
     return t, -value[:, 2]
 
 
 def read_forward_acceleration(base: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """(t, specific force m/s² along the device's forward axis) from
     ``processed_log/IMU/accelerometer`` (axes forward, right, down, as the gyro's)."""
-    t = load_array(base, "processed_log", "IMU", "accelerometer", "t")
-    value = load_array(base, "processed_log", "IMU", "accelerometer", "value")
+    t, value = read_signal(base, "processed_log", "IMU", "accelerometer", columns=3)
     return t, value[:, 0]
+
+
+def read_wheel_speed(base: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """(t, mean of the four wheel speeds, m/s) from ``processed_log/CAN/wheel_speed``, the
+    car's wheel speeds as comma decoded them from its bus (every car of the dataset)."""
+    t, value = read_signal(base, "processed_log", "CAN", "wheel_speed", columns=4)
+    return t, value.mean(axis=1)
 
 
 @dataclass(frozen=True)

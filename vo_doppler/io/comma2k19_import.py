@@ -3,17 +3,20 @@
 
 Written: ``gnss/raw_gnss_ublox.obs`` (RINEX 3.04, GPS + GLONASS: C1C L1C D1C S1C; the Doppler
 D = −ṙ/λ from the pseudorange rate ṙ, RINEX 3.05 sec. 5.2.10), ``gnss/doppler_sigma.csv`` (the
-receiver's σ of each pseudorange rate, ``gnss.doppler_sigma``), the precise orbits (and
-clocks) copied beside them, ``can/`` (the segment's ``can_motion.log``, or one written from
-``raw_can`` in candump format, with the DBC), ``imu/yaw_rate.csv`` (gyro yaw rate on the log
-clock, a record for ``heading --yaw-rate-csv``), ``ground_truth.tum`` (``global_pose`` as
-vehicle poses in the ENU frame of the first pose) and the clock offsets. Every log-clock
-time (CAN, IMU, the poses' and the video's ``frame_times``) goes to GPS time through one
-offset, the GNSS receiver's time tags against their log times (``comma2k19.gps_minus_log``;
-``global_pose``'s own ``frame_gps_times``, 0.126 s later on the example segment, are recorded
-but not used). A segment's ``video.hevc`` is decoded into the camera
-(``vo_doppler.io.comma2k19_video``); without one the camera section is left out, and ``run``
-then runs the non-visual pipelines.
+receiver's σ of each pseudorange rate, ``gnss.doppler_sigma``), the precise orbits (and clocks)
+copied beside them, ``can/`` (the segment's ``can_motion.log``, or one written from ``raw_can``
+in candump format, with the DBC; the CAN yaw rate and the four wheel speeds), or, for a segment
+without a DBC (comma2k19 ships none; the example segment of ../shared has its Toyota's),
+``vehicle/wheel_speed.csv`` from the wheel speeds comma decoded
+(``processed_log/CAN/wheel_speed``, every car of the dataset) with the IMU gyro as the yaw
+rate; ``imu/yaw_rate.csv`` (gyro yaw rate on the log clock), ``ground_truth.tum``
+(``global_pose`` as vehicle poses in the ENU frame of the first pose) and the clock offsets.
+Every log-clock time (CAN, IMU, the poses' and the video's ``frame_times``) goes to GPS time
+through one offset, the GNSS receiver's time tags against their log times
+(``comma2k19.gps_minus_log``; ``global_pose``'s own ``frame_gps_times``, 0.126 s later on the
+example segment, are recorded but not used). A segment's ``video.hevc`` is decoded into the
+camera (``vo_doppler.io.comma2k19_video``); without one the camera section is left out, and
+``run`` then runs the non-visual pipelines.
 """
 
 from __future__ import annotations
@@ -38,12 +41,14 @@ from vo_doppler.io.comma2k19 import (
     read_gyro_yaw_rate,
     read_raw_gnss,
     read_vehicle_poses,
+    read_wheel_speed,
 )
 from vo_doppler.io.comma2k19_video import CALIB, IMAGES, TIMES, VIDEO, decode_video
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.rinex_write import ObsEpochs, write_obs
 from vo_doppler.io.sensor_csv import (
     FORWARD_ACCELERATION_COLUMN,
+    SPEED_COLUMN,
     YAW_RATE_COLUMN,
     write_sensor_csv,
 )
@@ -76,6 +81,9 @@ class ImportSummary:
     gps_minus_log_s: float
     ground_truth_poses: int
     has_video: bool
+    vehicle_signals: str
+    """``can`` (the CAN log decoded by its DBC) or ``vehicle`` (without a DBC: the wheel speeds
+    comma decoded, ``processed_log/CAN/wheel_speed``, and the IMU gyro's yaw rate)."""
 
 
 def import_comma2k19(
@@ -87,10 +95,18 @@ def import_comma2k19(
 ) -> ImportSummary:
     """Write the sequence folder ``output`` from the segment folder ``segment``."""
     segment, output = Path(segment), Path(output)
+    if dbc is not None and not Path(dbc).is_file():
+        raise InputError("the DBC for the CAN log is not a file", dbc)
     dbc = Path(dbc) if dbc is not None else segment / DBC
     if not dbc.is_file():
-        raise InputError("no DBC for the CAN log (give --dbc)", dbc)
-    for folder in ("gnss", "can", "imu"):
+        log.info(
+            "%s: no DBC (%s); the wheel speed comes from processed_log/CAN/wheel_speed and the "
+            "yaw rate from the IMU gyro",
+            segment,
+            DBC,
+        )
+        dbc = None
+    for folder in ("gnss", "imu", "can" if dbc else "vehicle"):
         (output / folder).mkdir(parents=True, exist_ok=True)
     offset = gps_minus_log(segment)
     pose_offset = gps_minus_mono(segment)
@@ -107,12 +123,36 @@ def import_comma2k19(
     if clocks is not None:
         gnss["clocks"] = f"gnss/{Path(clocks).name}"
         shutil.copyfile(clocks, output / gnss["clocks"])
-    _write_can(segment, output / "can" / CAN_LOG)
-    shutil.copyfile(dbc, output / "can" / dbc.name)
     t_gyro, yaw_rate = read_gyro_yaw_rate(segment)
     write_sensor_csv(
         output / "imu" / "yaw_rate.csv", SensorSeries(t_gyro, yaw_rate), YAW_RATE_COLUMN
     )
+    if dbc is not None:
+        _write_can(segment, output / "can" / CAN_LOG)
+        shutil.copyfile(dbc, output / "can" / dbc.name)
+        vehicle = {
+            "can": {
+                "log": f"can/{CAN_LOG}",
+                "dbc": f"can/{dbc.name}",
+                "yaw_rate": YAW_RATE_SIGNAL,
+                "wheel_speed": WHEEL_SIGNALS,
+                "time_offset_s": offset,
+            }
+        }
+    else:
+        t_wheel, wheel_speed = read_wheel_speed(segment)
+        write_sensor_csv(
+            output / "vehicle" / "wheel_speed.csv",
+            SensorSeries(t_wheel, wheel_speed),
+            SPEED_COLUMN,
+        )
+        vehicle = {
+            "vehicle": {
+                "yaw_rate": "imu/yaw_rate.csv",
+                "wheel_speed": "vehicle/wheel_speed.csv",
+                "time_offset_s": offset,
+            }
+        }
     t_acc, forward = read_forward_acceleration(segment)
     write_sensor_csv(
         output / "imu" / "forward_acceleration.csv",
@@ -143,13 +183,7 @@ def import_comma2k19(
         },
         **({"camera": camera} if camera else {}),
         "gnss": gnss,
-        "can": {
-            "log": f"can/{CAN_LOG}",
-            "dbc": f"can/{dbc.name}",
-            "yaw_rate": YAW_RATE_SIGNAL,
-            "wheel_speed": WHEEL_SIGNALS,
-            "time_offset_s": offset,
-        },
+        **vehicle,
         "imu": {
             "yaw_rate": "imu/yaw_rate.csv",
             "forward_acceleration": "imu/forward_acceleration.csv",
@@ -166,7 +200,16 @@ def import_comma2k19(
         },
     }
     (output / MANIFEST).write_text(yaml.safe_dump(manifest, sort_keys=False))
-    return ImportSummary(output, epochs, obs_rows, raw.n_dropped, offset, len(truth), has_video)
+    return ImportSummary(
+        output,
+        epochs,
+        obs_rows,
+        raw.n_dropped,
+        offset,
+        len(truth),
+        has_video,
+        "can" if dbc is not None else "vehicle",
+    )
 
 
 def _write_gnss(folder: Path, raw, approx_position: np.ndarray) -> tuple[int, int]:

@@ -26,12 +26,18 @@ from vo_doppler.io.doppler_sigma import read_doppler_sigma
 from vo_doppler.io.images import list_images, read_times
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.satellite_states import read_satellite_states
-from vo_doppler.io.sensor_csv import FORWARD_ACCELERATION_COLUMN, read_sensor_csv
+from vo_doppler.io.sensor_csv import (
+    FORWARD_ACCELERATION_COLUMN,
+    read_sensor_csv,
+    read_speed_csv,
+    read_yaw_rate_csv,
+)
 from vo_doppler.io.textfile import regular_file
 from vo_doppler.io.time_order import TimeOrderReport
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.io.yaml_file import load_yaml
 from vo_doppler.model.sequence import Sequence
+from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
 
@@ -50,6 +56,10 @@ class InputReport:
     can: CanDecodeReport | None = None
     yaw_rate_dbc_unit: str = ""
     can_time_offset_s: float = 0.0
+    """The clock offset of the vehicle signals, from ``can`` or ``vehicle``."""
+    vehicle_source: str = "can"
+    """Where the yaw rate and wheel speed came from: ``can`` (a CAN log and its DBC) or
+    ``vehicle`` (sensor CSV files)."""
 
     def warnings(self) -> list[str]:
         return [text for report in self.time_order for text in report.problems()]
@@ -182,7 +192,7 @@ def read_sequence_with_report(
 ) -> tuple[Sequence, InputReport]:
     """:func:`read_sequence` and what reading found (time order per sensor, CAN decoding)."""
     m = Manifest(read_manifest(folder), allow_outside)
-    for name in ("gnss", "can", "origin"):
+    for name in ("gnss", "origin"):
         m.section(name)
     report = InputReport()
     images, times, camera, camera_offset = [], np.zeros(0), None, 0.0
@@ -202,6 +212,85 @@ def read_sequence_with_report(
         sigma = read_doppler_sigma(m.file("gnss", "doppler_sigma"))
     if m.number("gnss", "time_offset_s", 0.0) != 0.0:
         raise m.error("gnss.time_offset_s", "GNSS observations must be on GPS time (0)")
+    motion = _vehicle_motion(m, report)
+    enu = EnuFrame(
+        np.radians(m.number("origin", "lat_deg", low=-90.0, high=90.0)),
+        np.radians(m.number("origin", "lon_deg", low=-180.0, high=180.0)),
+        m.number("origin", "height_m", 0.0, low=-1.0e3, high=1.0e4),
+    )
+    lever_arm = _lever_arm(m.value("gnss", "antenna_lever_arm_m", (0.0, 0.0, 0.0)), m.path)
+    truth = None
+    truth_cfg = m.data.get("ground_truth")
+    if isinstance(truth_cfg, dict) and "trajectory" in truth_cfg:
+        truth_path = m.resolve("ground_truth.trajectory", truth_cfg["trajectory"])
+        if truth_path.exists():
+            truth = read_tum(m.file("ground_truth", "trajectory"))
+    forward_acceleration = motion.forward_acceleration
+    imu = m.data.get("imu")
+    if isinstance(imu, dict) and "forward_acceleration" in imu:
+        forward_acceleration = read_sensor_csv(
+            m.file("imu", "forward_acceleration"),
+            FORWARD_ACCELERATION_COLUMN,
+            m.number("imu", "time_offset_s", 0.0),
+        )
+    name = m.data.get("name", m.root.name)
+    if not isinstance(name, str | int | float) or isinstance(name, bool):
+        raise m.error("name", f"{name!r} is not a name")
+    sequence = Sequence(
+        name=str(name),
+        image_paths=images,
+        image_times=times + camera_offset,
+        camera=camera,
+        observations=obs,
+        navigation=nav,
+        doppler_sigma=sigma,
+        forward_acceleration=forward_acceleration,
+        yaw_rate=motion.yaw_rate,
+        wheel_speed=motion.speed,
+        enu=enu,
+        truth=truth,
+        antenna_lever_arm_m=lever_arm,
+        clock_offsets_s={"camera": camera_offset, motion.source: motion.offset_s, "gnss": 0.0},
+    )
+    return sequence, report
+
+
+@dataclass(frozen=True)
+class _VehicleMotion:
+    yaw_rate: SensorSeries
+    speed: SensorSeries
+    forward_acceleration: SensorSeries | None
+    source: str
+    offset_s: float
+
+
+def _vehicle_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
+    """The yaw rate and wheel speed (and a forward acceleration on the bus) from the ``can``
+    section, or from the sensor CSVs of the ``vehicle`` section: exactly one of the two."""
+    has = {name: isinstance(m.data.get(name), dict) for name in ("can", "vehicle")}
+    if has["can"] and has["vehicle"]:
+        raise m.error(
+            "can / vehicle",
+            "the yaw rate and wheel speed are given twice (can and vehicle): keep one",
+        )
+    if not has["can"] and not has["vehicle"]:
+        raise InputError(
+            "manifest has neither a 'can' nor a 'vehicle' section (the yaw rate and wheel speed)",
+            m.path,
+        )
+    if has["can"]:
+        return _can_motion(m, report)
+    offset = m.number("vehicle", "time_offset_s", 0.0)
+    yaw_rate = read_yaw_rate_csv(m.file("vehicle", "yaw_rate"), offset)
+    speed = read_speed_csv(m.file("vehicle", "wheel_speed"), offset)
+    report.vehicle_source = "vehicle"
+    report.yaw_rate_dbc_unit = "rad/s"
+    report.can_time_offset_s = offset
+    return _VehicleMotion(yaw_rate, speed, None, "vehicle", offset)
+
+
+def _can_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
+    """The ``can`` section: the log decoded with its DBC."""
     can_offset = m.number("can", "time_offset_s", 0.0)
     short_frames = m.string("can", "short_frames", "skip")
     if short_frames not in ("skip", "pad"):
@@ -245,45 +334,9 @@ def read_sequence_with_report(
     report.time_order.extend(motion.report.time_order.values())
     report.yaw_rate_dbc_unit = motion.report.dbc_units.get(yaw_name.strip(), "")
     report.can_time_offset_s = can_offset
-    enu = EnuFrame(
-        np.radians(m.number("origin", "lat_deg", low=-90.0, high=90.0)),
-        np.radians(m.number("origin", "lon_deg", low=-180.0, high=180.0)),
-        m.number("origin", "height_m", 0.0, low=-1.0e3, high=1.0e4),
+    return _VehicleMotion(
+        motion.yaw_rate, motion.speed, motion.forward_acceleration, "can", can_offset
     )
-    lever_arm = _lever_arm(m.value("gnss", "antenna_lever_arm_m", (0.0, 0.0, 0.0)), m.path)
-    truth = None
-    truth_cfg = m.data.get("ground_truth")
-    if isinstance(truth_cfg, dict) and "trajectory" in truth_cfg:
-        truth_path = m.resolve("ground_truth.trajectory", truth_cfg["trajectory"])
-        if truth_path.exists():
-            truth = read_tum(m.file("ground_truth", "trajectory"))
-    forward_acceleration = motion.forward_acceleration
-    if isinstance(imu, dict) and "forward_acceleration" in imu:
-        forward_acceleration = read_sensor_csv(
-            m.file("imu", "forward_acceleration"),
-            FORWARD_ACCELERATION_COLUMN,
-            m.number("imu", "time_offset_s", 0.0),
-        )
-    name = m.data.get("name", m.root.name)
-    if not isinstance(name, str | int | float) or isinstance(name, bool):
-        raise m.error("name", f"{name!r} is not a name")
-    sequence = Sequence(
-        name=str(name),
-        image_paths=images,
-        image_times=times + camera_offset,
-        camera=camera,
-        observations=obs,
-        navigation=nav,
-        doppler_sigma=sigma,
-        forward_acceleration=forward_acceleration,
-        yaw_rate=motion.yaw_rate,
-        wheel_speed=motion.speed,
-        enu=enu,
-        truth=truth,
-        antenna_lever_arm_m=lever_arm,
-        clock_offsets_s={"camera": camera_offset, "can": can_offset, "gnss": 0.0},
-    )
-    return sequence, report
 
 
 def _lever_arm(value, path: Path) -> tuple[float, float, float]:
