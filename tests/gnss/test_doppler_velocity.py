@@ -208,3 +208,21 @@ def test_yamatogawa_walk_speeds():
     assert np.percentile(walking, 90) <= 2.0
     # raw u-blox Doppler noise (≈0.2 m/s per satellite) keeps the standstill median near 0.12 m/s
     assert np.median(speed[t < 55]) <= 0.15
+
+
+def test_the_horizontal_protection_grows_as_satellites_are_lost(nav):
+    """Fifteen satellites all over the sky control each other: one undetected bias (on all three
+    signals of a satellite) moves the velocity by decimetres per second; with five the same
+    test protects far less, with four not at all."""
+    protection = {}
+    for name, satellites in {
+        "fifteen": SATELLITES,
+        "five": {"G": (5, 6, 7, 11, 13)},
+        "four": {"G": (5, 6, 7, 11)},
+    }.items():
+        obs = _synthetic_obs(nav, n_epochs=1, satellites=satellites)
+        solution, _ = doppler_velocity(obs, nav, RECEIVER, systems="GREC", elevation_mask_rad=-1.0)
+        protection[name] = solution.horizontal_protection_mps[0]
+    assert 0.0 < protection["fifteen"] < 0.5
+    assert protection["five"] > 10.0 * protection["fifteen"]
+    assert np.isinf(protection["four"])

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.special import chdtri, chndtr, chndtrinc
 from scipy.stats import chi2
 
-from vo_doppler.gnss.lsq import lsq_with_exclusion, weighted_lsq
+from vo_doppler.gnss.lsq import lsq_with_exclusion, minimal_detectable_shift, weighted_lsq
 
 X_TRUE = np.array([1.5, -2.0, 0.25, 3.0])
 
@@ -65,3 +66,41 @@ def test_too_few_satellites_or_a_singular_geometry_is_unavailable():
     flat[:, 2] = 0.0  # no vertical component: the up velocity is unobservable
     singular = lsq_with_exclusion(flat, y, np.full(6, 0.1), np.arange(6), min_groups=4)
     assert not singular.valid and np.isnan(singular.covariance).all()
+
+
+@pytest.mark.parametrize("rows_per_satellite", [1, 2])
+def test_the_minimal_detectable_bias_is_detected_at_the_stated_power_and_moves_x_as_stated(
+    rows_per_satellite,
+):
+    H = _geometry(7 * rows_per_satellite, seed=5)
+    sigma = np.linspace(0.03, 0.12, len(H))
+    groups = np.repeat(np.arange(7), rows_per_satellite)
+    _, covariance, _ = weighted_lsq(H, H @ X_TRUE, sigma)
+    dof = len(H) - 4
+    shift = minimal_detectable_shift(H, sigma, groups, covariance, dof)
+    assert shift.shape == (7, 4)
+    noncentrality = chndtrinc(chdtri(dof, 1e-3), dof, 0.2)
+    assert 1.0 - chndtr(chdtri(dof, 1e-3), dof, noncentrality) == pytest.approx(0.8, abs=1e-9)
+    for g in range(7):
+        rows = groups == g
+        # the bias that gives this shift: solve Δx = C Hᵀ W c ∇ for ∇ along the shift
+        unit = covariance @ H.T @ (rows / sigma**2)
+        bias = float(shift[g] @ unit / (unit @ unit))
+        y = H @ X_TRUE + bias * rows
+        x, _, residuals = weighted_lsq(H, y, sigma)
+        np.testing.assert_allclose(x - X_TRUE, shift[g], rtol=1e-9, atol=1e-12)
+        # noise-free rows: Ω is the non-centrality the test needs for power 0.8
+        assert np.sum((residuals / sigma) ** 2) == pytest.approx(noncentrality, rel=1e-9)
+
+
+def test_without_redundancy_no_bias_is_detectable():
+    H = _geometry(4)
+    sigma = np.full(4, 0.1)
+    _, covariance, _ = weighted_lsq(H, H @ X_TRUE, sigma)
+    assert np.isinf(minimal_detectable_shift(H, sigma, np.arange(4), covariance, 0)).all()
+    flat = _geometry(5, seed=2)
+    flat[:4, 2] = 0.0  # only the fifth satellite sees the vertical: nothing can check it
+    sigma5 = np.full(5, 0.1)
+    _, covariance5, _ = weighted_lsq(flat, flat @ X_TRUE, sigma5)
+    shift = minimal_detectable_shift(flat, sigma5, np.arange(5), covariance5, 1)
+    assert np.isinf(shift[4]).all() and np.isfinite(shift[:4]).all()

@@ -37,7 +37,7 @@ import numpy as np
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.continuity import continuity_checked
 from vo_doppler.gnss.doppler_noise import fitted_sigma
-from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion
+from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion, minimal_detectable_shift
 from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models, modelled_sigma
 from vo_doppler.gnss.satellite_source import StateSource, satellite_source, transmit_states
 from vo_doppler.gnss.signals import strength_code, wavelengths
@@ -215,6 +215,7 @@ def solve_velocity(
     untestable = np.zeros(n, dtype=bool)
     horizontal_sigma = np.full((n, 2), np.nan)
     vertical_sigma = np.full(n, np.nan)
+    protection = np.full(n, np.nan)
     order = np.argsort(rows.epoch, kind="stable")
     bounds = np.searchsorted(rows.epoch[order], np.arange(n + 1))
     y_all = rows.reduced()
@@ -243,6 +244,11 @@ def solve_velocity(
         dop[k] = _dop(H[result.used], rotation)
         horizontal_sigma[k] = speed_course_sigma(velocity_enu[k], covariance_enu)
         vertical_sigma[k] = np.sqrt(covariance_enu[2, 2])
+        kept = result.used
+        shift = minimal_detectable_shift(
+            H[kept], sigma_all[r][kept], satellite[r][kept], result.covariance, result.dof, alpha
+        )
+        protection[k] = _horizontal_protection(shift[:, :3], rotation)
         plausible = vertical_velocity_plausible(velocity_enu[k], covariance_enu)
         verified[k] = result.passed and n_sat[k] > MIN_SATELLITES and plausible
         untestable[k] = (
@@ -267,8 +273,18 @@ def solve_velocity(
         speed_sigma_mps=horizontal_sigma[:, 0],
         course_sigma_rad=horizontal_sigma[:, 1],
         vertical_sigma_mps=vertical_sigma,
+        horizontal_protection_mps=protection,
     )
     return continuity_checked(solution)
+
+
+def _horizontal_protection(shift_ecef: np.ndarray, rotation: np.ndarray) -> float:
+    """The largest horizontal (ENU) norm of the velocity shifts, one per satellite (inf if a
+    satellite's bias cannot be detected at all)."""
+    if not np.all(np.isfinite(shift_ecef)):
+        return float("inf")
+    horizontal = (shift_ecef @ rotation.T)[:, :2]
+    return float(np.max(np.hypot(horizontal[:, 0], horizontal[:, 1])))
 
 
 def vertical_velocity_plausible(velocity_enu: np.ndarray, covariance_enu: np.ndarray) -> bool:

@@ -4,16 +4,23 @@ Global test: the weighted sum of squared residuals Ω = rᵀWr of a correct mode
 u unknowns follows χ²(n − u); when Ω exceeds the (1 − α) quantile, the row with the largest
 normalised residual |r_i| / √(Q_vv,ii), Q_vv = W⁻¹ − H (HᵀWH)⁻¹ Hᵀ (Baarda's w-test), is
 excluded and the solution repeated, while enough distinct satellites remain.
+
+What the test cannot see (external reliability, :func:`minimal_detectable_shift`): the shift of
+the solution that the smallest bias on one satellite the test still detects with probability
+``DETECTION_POWER`` would cause.
 """
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import chdtri
+from scipy.special import chdtri, chndtrinc
 
 DEFAULT_ALPHA = 1e-3
+DETECTION_POWER = 0.8
+"""β₀ of the minimal detectable bias: the test detects a bias of that size four times in five."""
 
 
 @dataclass(frozen=True)
@@ -83,3 +90,48 @@ def lsq_with_exclusion(
         normalised = np.abs(residuals[used]) / np.sqrt(np.maximum(q_vv, 1e-30))
         worst = np.flatnonzero(used)[int(np.argmax(normalised))]
         used[worst] = False
+
+
+@functools.lru_cache(maxsize=256)
+def detectable_noncentrality(dof: int, alpha: float, power: float) -> float:
+    """λ₀: the non-centrality of χ²(dof) that the test at ``alpha`` detects with ``power``."""
+    return float(chndtrinc(chdtri(dof, alpha), dof, 1.0 - power))
+
+
+def minimal_detectable_shift(
+    H: np.ndarray,
+    sigma: np.ndarray,
+    groups: np.ndarray,
+    covariance: np.ndarray,
+    dof: int,
+    alpha: float = DEFAULT_ALPHA,
+    power: float = DETECTION_POWER,
+) -> np.ndarray:
+    """Baarda's external reliability of the solution of the rows ``H`` (kept rows only, their
+    ``sigma`` and ``groups``, ``covariance`` = (HᵀWH)⁻¹): for each group g (a satellite, in
+    the order of ``np.unique(groups)``) the shift of the solution by the minimal detectable
+    bias ∇_g, one bias on every row of g that the global test of ``dof`` degrees of freedom at
+    ``alpha`` detects with probability ``power``::
+
+        ∇_g = √(λ₀ / (c_gᵀ W Q_vv W c_g)),    Δx_g = (HᵀWH)⁻¹ Hᵀ W c_g · ∇_g
+
+    with W = diag(σ⁻²), Q_vv = W⁻¹ − H (HᵀWH)⁻¹ Hᵀ, c_g the indicator of g's rows and λ₀ the
+    non-centrality of χ²(dof) at which the test's power is ``power`` (W. Baarda, "A testing
+    procedure for use in geodetic networks", 1968; P. J. G. Teunissen, "Testing theory", 2000,
+    ch. 4). A smaller bias goes undetected more often. Rows of infinities where a bias on g
+    cannot show in the residuals (no redundancy, or g controlled by no other row)."""
+    names, group = np.unique(groups, return_inverse=True)
+    indicator = np.zeros((len(groups), len(names)))
+    indicator[np.arange(len(groups)), group.reshape(-1)] = 1.0
+    if dof < 1:
+        return np.full((len(names), H.shape[1]), np.inf)
+    weight = sigma**-2.0
+    weighted = indicator * weight[:, None]
+    q_vv = np.diag(sigma**2) - H @ covariance @ H.T
+    controlled = np.einsum("ig,ij,jg->g", weighted, q_vv, weighted)
+    own = np.einsum("ig,ig->g", indicator, weighted)
+    noncentrality = detectable_noncentrality(dof, alpha, power)
+    with np.errstate(divide="ignore"):
+        bias = np.sqrt(noncentrality / np.where(controlled > 1e-12 * own, controlled, 0.0))
+    shift = (covariance @ H.T @ weighted).T * bias[:, None]
+    return np.where(np.isfinite(bias)[:, None], shift, np.inf)

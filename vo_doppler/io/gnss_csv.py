@@ -26,6 +26,7 @@ VELOCITY_COLUMNS = (
     "course_sigma_deg",
     "pdop",
     "hdop",
+    "hpl_mps",
 )
 SPP_COLUMNS = (
     "gps_time_s",
@@ -61,6 +62,10 @@ def _write(path: Path, columns: tuple[str, ...], table: list[np.ndarray], format
             )
 
 
+def _or_nan(values: np.ndarray | None, n: int) -> np.ndarray:
+    return np.full(n, np.nan) if values is None else values
+
+
 def write_velocity_csv(path: str | Path, solution: VelocitySolution) -> None:
     """One row per epoch; unavailable epochs have empty numbers and valid = 0."""
     v = solution.velocity_enu
@@ -83,11 +88,12 @@ def write_velocity_csv(path: str | Path, solution: VelocitySolution) -> None:
             np.degrees(solution.course_sigma_rad),
             solution.dop[:, 1],
             solution.dop[:, 2],
+            _or_nan(solution.horizontal_protection_mps, len(solution.t)),
         ],
         ["{:.3f}"]
         + ["{:.4f}"] * 4
         + ["{:.2f}", "{:.4f}", "{:d}", "{:.4f}", "{:d}", "{:d}"]
-        + ["{:.4f}", "{:.3f}", "{:.2f}", "{:.2f}"],
+        + ["{:.4f}", "{:.3f}", "{:.2f}", "{:.2f}", "{:.3f}"],
     )
 
 

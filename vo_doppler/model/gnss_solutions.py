@@ -60,6 +60,13 @@ class VelocitySolution:
     """σ of the course from the covariance (rad; large when slow)."""
     vertical_sigma_mps: np.ndarray | None = None
     """σ of the up velocity from the covariance (m/s)."""
+    horizontal_protection_mps: np.ndarray | None = None
+    """The largest horizontal velocity error (m/s) that a bias on one satellite's Doppler could
+    cause while the chi-square test would catch it less than four times in five (the effect of
+    Baarda's minimal detectable bias, :func:`vo_doppler.gnss.lsq.minimal_detectable_shift`):
+    what the σ does not cover when one satellite is reflected. Infinite without redundancy,
+    NaN where unsolved; a street canyon's five or six satellites along the street leave it at
+    metres per second even where the σ is centimetres."""
     untestable: np.ndarray | None = None
     """Solved from exactly four satellites (no redundancy, so a fault cannot be detected in the
     epoch) with a plausible vertical velocity: not valid, but a candidate wherever redundancy
