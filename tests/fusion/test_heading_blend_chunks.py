@@ -11,6 +11,7 @@ import pytest
 
 from vo_doppler.fusion.heading_blend import (
     FIT_FLOATS_PER_MEASUREMENT,
+    OUTLIER_GRID,
     SCALE_GRID,
     SIGMA_GRID,
     BlendConfig,
@@ -27,7 +28,7 @@ N = 2000
 @pytest.fixture(scope="module")
 def walk():
     """A random walk in distance and turning seen through noisy headings (N measurements, all
-    kept: no correlation time), on the fit's full 2,560-point grid."""
+    kept: no correlation time), on the fit's 2,560-point grid of σ_d, σ_ψ and s (one ε)."""
     rng = np.random.default_rng(11)
     distance = np.arange(N, dtype=float)
     turn = np.cumsum(np.abs(rng.normal(0.0, 0.01, N)))
@@ -37,7 +38,8 @@ def walk():
         t, offset + 0.02 * rng.standard_normal(N), np.full(N, 0.02), np.zeros(N)
     )
     clock = DriftClock(t, distance, turn)
-    grid = tuple(g.ravel() for g in np.meshgrid(SIGMA_GRID, SIGMA_GRID, SCALE_GRID, indexing="ij"))
+    axes = (SIGMA_GRID, SIGMA_GRID, SCALE_GRID, OUTLIER_GRID[1:2])
+    grid = tuple(g.ravel() for g in np.meshgrid(*axes, indexing="ij"))
     return measurements, clock, grid
 
 
@@ -61,7 +63,7 @@ def test_the_fit_is_the_same_and_its_memory_follows_the_budget(walk):
     """2,000 measurements × 2,560 points side by side hold about 235 MiB; in chunks of 8 MiB
     the fit's traced peak stays near the budget, and the chosen noise is the same."""
     measurements, clock, _ = walk
-    config = BlendConfig(fit_chunk_bytes=8 * MIB)
+    config = BlendConfig(fit_chunk_bytes=8 * MIB, outlier_fraction=float(OUTLIER_GRID[1]))
     tracemalloc.start()
     try:
         chunked = fit_process_noise(measurements, clock, config)

@@ -162,6 +162,8 @@ def run(args: argparse.Namespace) -> int:
         )
         summary["sigma_turn"] = result.noise.sigma_turn
         summary["heading_sigma_scale"] = result.noise.scale
+        summary["outlier_fraction"] = result.noise.outlier_fraction
+        summary["correlation_floor_s"] = result.noise.correlation_floor_s
     log.info("correct: %s", json.dumps(summary))
     print(json.dumps(summary))
     return 0
