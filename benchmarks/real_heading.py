@@ -118,12 +118,13 @@ def conventional_figures(sequence: Sequence, velocity, table: HeadingTable | Non
 
 
 def tight_figures(sequence: Sequence, table, epochs: np.ndarray) -> dict:
-    """Heading figures over the moving epochs among ``epochs`` (mask)."""
+    """Heading figures over the moving epochs among ``epochs`` (mask); the tight heading is
+    available where it is finite and reliable (issue 11's definition)."""
     truth = truth_velocity(sequence, table.t)
     moving = (np.linalg.norm(truth[:, :2], axis=1) > MOVING_MPS) & epochs
     truth_yaw = sequence.truth.yaw_at(table.t)
     error = np.degrees(np.abs(wrap_angle(table.yaw_tc - truth_yaw)))
-    available = table.tc_available & moving
+    available = table.tc_available & table.tc_reliable & moving
     conventional = table.conv_valid & moving
     conv_error = np.degrees(np.abs(wrap_angle(table.yaw_conv - truth_yaw)))
     return {
