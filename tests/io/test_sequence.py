@@ -127,7 +127,7 @@ def test_vehicle_signals_from_sensor_csvs_instead_of_a_can_log(tmp_path):
     for name in ("yaw_rate", "wheel_speed"):
         np.testing.assert_allclose(getattr(sequence, name).t, getattr(from_can, name).t, atol=1e-6)
         np.testing.assert_array_equal(getattr(sequence, name).value, getattr(from_can, name).value)
-    assert report.vehicle_source == "vehicle" and report.can is None
+    assert report.can is None and report.vehicle_time_offset_s == offset
     assert sequence.clock_offsets_s["vehicle"] == offset
     assert sequence.forward_acceleration is None
     manifest["can"] = can

@@ -50,16 +50,15 @@ _REQUIRED = object()
 @dataclass
 class InputReport:
     """What reading a sequence found besides the data: per-sensor time order, the CAN decoding,
-    the DBC unit of the yaw-rate signal and the manifest's CAN clock offset."""
+    the DBC unit of the yaw-rate signal and the manifest's clock offset of the vehicle
+    signals."""
 
     time_order: list[TimeOrderReport] = field(default_factory=list)
     can: CanDecodeReport | None = None
     yaw_rate_dbc_unit: str = ""
-    can_time_offset_s: float = 0.0
-    """The clock offset of the vehicle signals, from ``can`` or ``vehicle``."""
-    vehicle_source: str = "can"
-    """Where the yaw rate and wheel speed came from: ``can`` (a CAN log and its DBC) or
-    ``vehicle`` (sensor CSV files)."""
+    vehicle_time_offset_s: float = 0.0
+    """The clock offset of the yaw rate and wheel speed, from ``can`` or ``vehicle`` (``can``
+    None: they came from the ``vehicle`` section's CSVs)."""
 
     def warnings(self) -> list[str]:
         return [text for report in self.time_order for text in report.problems()]
@@ -283,9 +282,8 @@ def _vehicle_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
     offset = m.number("vehicle", "time_offset_s", 0.0)
     yaw_rate = read_yaw_rate_csv(m.file("vehicle", "yaw_rate"), offset)
     speed = read_speed_csv(m.file("vehicle", "wheel_speed"), offset)
-    report.vehicle_source = "vehicle"
     report.yaw_rate_dbc_unit = "rad/s"
-    report.can_time_offset_s = offset
+    report.vehicle_time_offset_s = offset
     return _VehicleMotion(yaw_rate, speed, None, "vehicle", offset)
 
 
@@ -333,7 +331,7 @@ def _can_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
     report.can = motion.report
     report.time_order.extend(motion.report.time_order.values())
     report.yaw_rate_dbc_unit = motion.report.dbc_units.get(yaw_name.strip(), "")
-    report.can_time_offset_s = can_offset
+    report.vehicle_time_offset_s = can_offset
     return _VehicleMotion(
         motion.yaw_rate, motion.speed, motion.forward_acceleration, "can", can_offset
     )

@@ -158,8 +158,8 @@ def result_checks(
         velocity.valid, np.linalg.norm(velocity.velocity_enu[:, :2], axis=1), np.nan
     )
     estimate = estimate_clock_offset(inputs.wheel_speed, velocity.t, horizontal)
-    sensor = "CAN" if report.vehicle_source == "can" else "vehicle signals"
-    warning = clock_warning(sensor, estimate, report.can_time_offset_s)
+    sensor = "CAN" if report.can is not None else "vehicle signals"
+    warning = clock_warning(sensor, estimate, report.vehicle_time_offset_s)
     if warning:
         log.warning("%s", warning)
     return {
