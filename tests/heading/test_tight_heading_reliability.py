@@ -29,7 +29,9 @@ def test_the_threshold_combines_both_sigmas_and_the_propagated_gyro_bias():
     for offset, expected in ((0.999 * allowed, True), (1.001 * allowed, False)):
         yaw = np.array([1.0, 1.0, 1.3 + offset, 1.3])
         every = np.ones(4, bool)
-        agree = _independent_agreement(every, yaw, sigma, every, t, (yaw_angle, bias_sigma), config)
+        agree = _independent_agreement(
+            every, every, yaw, sigma, every, t, (yaw_angle, bias_sigma), config
+        )
         # Epochs 0 and 1 have no window before theirs; epoch 3 refers to epoch 1 as well.
         np.testing.assert_array_equal(agree, [True, True, expected, True])
 
@@ -41,11 +43,11 @@ def test_unavailable_epochs_are_never_the_reference():
     gyro = (np.zeros(6), np.zeros(6))
     sigma = np.full(6, 0.01)
     available = np.array([True, False, True, True, True, True])
-    agree = _independent_agreement(available, yaw, sigma, available, t, gyro, config)
+    agree = _independent_agreement(available, available, yaw, sigma, available, t, gyro, config)
     np.testing.assert_array_equal(agree, available)
     every = np.ones(6, bool)
     # Epoch 1 has no window before it; epoch 3 refers to it and disagrees.
-    agree = _independent_agreement(every, yaw, sigma, every, t, gyro, config)
+    agree = _independent_agreement(every, every, yaw, sigma, every, t, gyro, config)
     np.testing.assert_array_equal(agree, [True, True, True, False, True, True])
 
 
@@ -55,11 +57,46 @@ def test_a_wrong_reliable_heading_cannot_lock_the_right_ones_out():
     yaw = np.where(t < 2.0, 1.0, 0.0)  # the first window's headings are wrong
     every = np.ones(20, bool)
     agree = _independent_agreement(
-        every, yaw, np.full(20, 0.01), every, t, (np.zeros(20), np.zeros(20)), config
+        every, every, yaw, np.full(20, 0.01), every, t, (np.zeros(20), np.zeros(20)), config
     )
     # Until the wrong reference at t = 1 is older than 10 s (epoch 12), the right headings
     # disagree with it; then the last available heading a window earlier (right) serves.
     np.testing.assert_array_equal(agree, (t < 2.0) | (t >= 12.0))
+
+
+def test_a_vague_reference_confirms_nothing_and_the_window_must_verify_itself():
+    config = TightHeadingConfig(
+        window_s=2.0, reliability_gate_rad=0.05, reference_max_sigma_rad=0.2, prior_max_age_s=10.0
+    )
+    t = np.array([0.0, 3.0])
+    yaw = np.array([0.0, 1.5])  # 86° apart, within 3σ of the vague reference
+    gyro = (np.zeros(2), np.zeros(2))
+    every = np.ones(2, bool)
+    for sigma_reference, verifiable, expected in (
+        (0.5, np.array([False, False]), False),
+        (0.5, np.array([False, True]), True),
+        (0.19, np.array([False, True]), False),  # informative: it disagrees
+    ):
+        sigma = np.array([sigma_reference, 0.01])
+        agree = _independent_agreement(every, verifiable, yaw, sigma, every, t, gyro, config)
+        # Epoch 0 is the first window of the drive: the consecutive-epoch rule alone.
+        np.testing.assert_array_equal(agree, [True, expected])
+
+
+def test_the_gyro_drift_since_the_reference_counts_towards_its_vagueness():
+    config = TightHeadingConfig(
+        window_s=2.0, reliability_gate_rad=0.05, reference_max_sigma_rad=0.1
+    )
+    t = np.array([0.0, 5.0])
+    sigma = np.array([0.06, 0.01])
+    yaw = np.array([0.0, 0.0])
+    every = np.ones(2, bool)
+    never = np.zeros(2, bool)
+    # √(0.06² + (b·5)²) against 0.1: b = 0.0159 gives 0.0999, b = 0.0161 gives 0.1006.
+    for bias_sigma, expected in ((0.0159, True), (0.0161, False)):
+        gyro = (np.zeros(2), np.full(2, bias_sigma))
+        agree = _independent_agreement(every, never, yaw, sigma, every, t, gyro, config)
+        np.testing.assert_array_equal(agree, [True, expected])
 
 
 def test_a_fault_longer_than_the_window_is_not_reliable():

@@ -116,6 +116,14 @@ class TightHeadingConfig:
     reliability_min_epochs: int = 5
     reliability_gate_rad: float = np.radians(3.0)
     reliability_n_sigma: float = 3.0
+    reference_max_sigma_rad: float = np.radians(10.0)
+    """An earlier window's heading confirms a later one only when its σ, with the gyro
+    bias's drift since, is at most this. The independent check is for gross faults that
+    outlast a window (a mirror root, a reflected satellite the heading absorbs), tens of
+    degrees: a reference within 10° (gate ≈ 30°) reveals them, a vaguer one agrees with almost
+    any heading (a one-satellite window at σ 16° "confirmed" a two-satellite heading 88° off,
+    one satellite reflected). A heading with only a vaguer reference is reliable only when its
+    own window is verifiable."""
     epoch_match_s: float = 1e-3
     chunk_bytes: int = 16 * 2**20
     """Memory (bytes) for the windows solved at once: the windows are solved in chunks of as
@@ -770,8 +778,10 @@ def _decide(sol, model_variance, t_epoch, speed, gyro, n_sat_epoch, config) -> T
             available[k] = True
         if available[k]:
             last = k
+    verifiable = available & (sol.min_redundancy >= config.testable_redundancy) & ~sol.inconsistent
     reliable = _independent_agreement(
         _reliability(yaw, sigma, available, yaw_angle, config),
+        verifiable,
         yaw,
         sigma,
         available,
@@ -791,9 +801,7 @@ def _decide(sol, model_variance, t_epoch, speed, gyro, n_sat_epoch, config) -> T
         clock_drift=np.where(available, sol.rho0, np.nan),
         clock_drift_rate=np.where(available, sol.alpha, np.nan),
         n_rejected=sol.n_rejected.astype(int),
-        verifiable=available
-        & (sol.min_redundancy >= config.testable_redundancy)
-        & ~sol.inconsistent,
+        verifiable=verifiable,
         inconsistent=sol.inconsistent & (sol.n_obs >= config.min_obs),
         fallback=available & sol.fallback,
     )
@@ -824,10 +832,10 @@ def _reliability(yaw, sigma, available, yaw_angle, config):
     return available & (count >= config.reliability_min_epochs) & (worst <= 1.0)
 
 
-def _independent_agreement(consistent, yaw, sigma, available, t_epoch, gyro, config):
+def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoch, gyro, config):
     """Reliability: the epochs of ``consistent`` (the consecutive-epoch rule,
     :func:`_reliability`) whose heading also agrees with a heading from a window that shares no
-    row with theirs.
+    row with theirs, or, without an informative one, whose own window is ``verifiable``.
 
     Headings of consecutive epochs come from windows that overlap by all but one epoch, so
     their agreement ([TK18] sec. 3.5) cannot reveal a fault that lasts as long as the window,
@@ -837,8 +845,12 @@ def _independent_agreement(consistent, yaw, sigma, available, t_epoch, gyro, con
     the last available one (so that a wrong reliable heading cannot lock the right ones out).
     Propagated by the gyro it must agree with θ_k within max(gate, n_sigma·√(σ_k² + σ_j² +
     (σ_b·(t_k − t_j))²)), σ_b the calibrated gyro bias's standard deviation, which the
-    propagation inherits. Epochs with no available heading a window earlier (the first
-    window of a drive) keep the consecutive-epoch rule alone.
+    propagation inherits. Epochs with no available heading a window earlier (the first window
+    of a drive) keep the consecutive-epoch rule alone. A reference is informative when
+    √(σ_j² + (σ_b·(t_k − t_j))²) ≤ ``reference_max_sigma_rad``; where the reference is vaguer
+    (e.g. a one-satellite window's) the epoch is reliable only when its own window is
+    verifiable: a two-satellite window with one reflected satellite fits it exactly, and
+    nothing else would reveal it.
     """
     yaw_angle, bias_sigma = gyro
     reliable = np.zeros(len(yaw), dtype=bool)
@@ -854,11 +866,14 @@ def _independent_agreement(consistent, yaw, sigma, available, t_epoch, gyro, con
         if j < 0:
             reliable[k] = True
             continue
+        reference_variance = sigma[j] ** 2 + (bias_sigma[k] * (t_epoch[k] - t_epoch[j])) ** 2
+        if reference_variance > config.reference_max_sigma_rad**2:
+            reliable[k] = verifiable[k]
+            continue
         predicted = yaw[j] + yaw_angle[k] - yaw_angle[j]
-        drift = bias_sigma[k] * (t_epoch[k] - t_epoch[j])
         allowed = max(
             config.reliability_gate_rad,
-            config.reliability_n_sigma * np.sqrt(sigma[k] ** 2 + sigma[j] ** 2 + drift**2),
+            config.reliability_n_sigma * np.sqrt(sigma[k] ** 2 + reference_variance),
         )
         reliable[k] = abs(wrap_angle(yaw[k] - predicted)) <= allowed
     return reliable
