@@ -22,7 +22,7 @@ from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.fusion.correction import CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.model.sequence import Sequence
-from vo_doppler.run import RunConfig, RunResult, correct_all
+from vo_doppler.run import Pipeline, RunConfig, RunResult, correct_all
 from vo_doppler.vo.frames import vehicle_trajectory
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,7 +33,7 @@ METHODS = {
         correction=CorrectionConfig(method="kalman", blend=BlendConfig(smooth=False))
     ),
 }
-PIPELINES = ("vo", "vo_gps_conv", "vo_gps_tc", "dr_gps_tc")
+PIPELINES = tuple(Pipeline)
 MAX_RATIO = 0.5
 """Issue 13: VO + GPS (tightly coupled) at most half the VO alone's and the conventional's error."""
 

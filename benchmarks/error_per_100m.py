@@ -1,6 +1,6 @@
-"""Trajectory error per 100 m, side by side, for the four pipelines on each sequence:
-VO alone (initial heading from ground truth), VO + GPS (conventional Doppler heading),
-VO + GPS (tightly coupled heading), wheel + gyro dead reckoning + GPS (tightly coupled).
+"""Trajectory error per 100 m, side by side, for the six pipelines on each sequence: VO and
+wheel + gyro dead reckoning, each alone (initial heading from ground truth), + GPS
+(conventional Doppler heading) and + GPS (tightly coupled heading).
 
     python benchmarks/error_per_100m.py SEQUENCE_DIR [SEQUENCE_DIR ...] [--json FILE]
 

@@ -34,6 +34,8 @@ def test_run_writes_every_output(run_output):
         "trajectory_vo.tum",
         "trajectory_corrected.tum",
         "trajectory_vo_gps_conv.tum",
+        "trajectory_dr.tum",
+        "trajectory_dr_gps_conv.tum",
         "trajectory_dr_gps_tc.tum",
         "heading.csv",
         "trajectories.png",

@@ -65,6 +65,8 @@ class Pipeline(StrEnum):
     VO = "vo"
     VO_GPS_CONV = "vo_gps_conv"
     VO_GPS_TC = "vo_gps_tc"
+    DR = "dr"
+    DR_GPS_CONV = "dr_gps_conv"
     DR_GPS_TC = "dr_gps_tc"
 
 
@@ -155,8 +157,8 @@ def correct_all(
     start: np.ndarray,
     config: RunConfig,
 ) -> dict[Pipeline, Trajectory]:
-    """The VO alone, the VO corrected by the conventional and by the tightly coupled heading,
-    and dead reckoning corrected by the tightly coupled heading (vehicle poses, ENU).
+    """The VO and the wheel + gyro dead reckoning, each alone and corrected by the conventional
+    and by the tightly coupled heading (vehicle poses, ENU).
 
     Every trajectory starts at ``start`` with the first absolute heading (tightly coupled, else
     conventional), matched at its own time. Only usable tightly coupled headings correct.
@@ -182,6 +184,10 @@ def correct_all(
         trajectories[Pipeline.VO_GPS_TC] = correct(vo_level, tight, config.correction).vehicle
     if dr is not None:
         dr_level = level_with_yaw(dr, yaw0 - yaw_at(dr, t0), start)
+        trajectories[Pipeline.DR] = dr_level
+        trajectories[Pipeline.DR_GPS_CONV] = correct(
+            dr_level, conventional, config.correction
+        ).vehicle
         trajectories[Pipeline.DR_GPS_TC] = correct(dr_level, tight, config.correction).vehicle
     return trajectories
 

@@ -95,5 +95,10 @@ def test_run_without_camera(imported, tmp_path, capsys):
     assert "no camera: only the non-visual pipelines ran" in capsys.readouterr().out
     summary = json.loads((out / "summary.json").read_text())
     assert summary["camera"] == "none: non-visual pipelines only"
-    assert (out / "trajectory_dr_gps_tc.tum").is_file()
+    for pipeline in ("dr", "dr_gps_conv", "dr_gps_tc"):
+        assert (out / f"trajectory_{pipeline}.tum").is_file()
     assert not (out / "trajectory_vo.tum").exists()
+    evaluation = summary["evaluation"]
+    # one minute of highway: the DR's own heading drifts, each GNSS heading corrects it
+    assert evaluation["dr_gps_tc"]["error_per_100m_m"] < evaluation["dr"]["error_per_100m_m"]
+    assert evaluation["dr"]["heading_availability"] == 0.0

@@ -41,12 +41,21 @@ def test_headline_states_the_cut_or_says_plainly_it_did_not_help():
     worse = headline({"vo": _errors(0.2), "vo_gps_tc": _errors(0.23)}, 0.9)
     assert "did not reduce" in worse and "0.20 m per 100 m alone" in worse
     assert "No ground truth" in headline({}, 0.93) and "93%" in headline({}, 0.93)
-    no_camera = headline({"dr_gps_tc": _errors(0.4)}, 0.9)
-    assert no_camera.startswith("No camera") and "(tightly coupled) 0.40" in no_camera
+    no_camera = headline(
+        {"dr": _errors(2.0), "dr_gps_conv": _errors(0.8), "dr_gps_tc": _errors(0.4)}, 0.9
+    )
+    assert no_camera.startswith(
+        "No camera: The tightly coupled Doppler heading cut the wheel + gyro dead reckoning's "
+        "error from 2.00 to 0.40 m per 100 m (5.0× less) (the conventional Doppler heading: "
+        "0.80 m per 100 m)"
+    )
+    partial = headline({"dr_gps_tc": _errors(0.4)}, 0.9)
+    assert partial == "Error per 100 m (m): wheel + gyro DR + GPS (tightly coupled) 0.40."
 
 
 def test_vo_alone_heading_use_is_a_dash_not_zero():
     assert table_cell("vo", "heading_availability", 0.0, "{:.0%}") == "—"
+    assert table_cell("dr", "heading_availability", 0.0, "{:.0%}") == "—"
     assert table_cell("vo_gps_tc", "heading_availability", 0.93, "{:.0%}") == "93%"
     assert table_cell("vo", "heading_rmse_deg", float("nan"), "{:.2f}") == "—"
 

@@ -18,8 +18,12 @@ PIPELINE_LABELS = {
     "vo": "VO alone",
     "vo_gps_conv": "VO + GPS (conventional)",
     "vo_gps_tc": "VO + GPS (tightly coupled)",
+    "dr": "wheel + gyro DR alone",
+    "dr_gps_conv": "wheel + gyro DR + GPS (conventional)",
     "dr_gps_tc": "wheel + gyro DR + GPS (tightly coupled)",
 }
+UNCORRECTED = ("vo", "dr")
+"""Pipelines without an absolute heading: evaluated from the truth's initial heading."""
 
 
 @dataclass
@@ -105,10 +109,13 @@ def with_initial_heading(estimate: Trajectory, truth: Trajectory) -> Trajectory:
 def heading_availability(table: HeadingTable, tc_usable: np.ndarray) -> dict[str, float]:
     """Fraction of GNSS epochs whose absolute heading each pipeline could use."""
     tc = float(np.mean(tc_usable))
+    conventional = float(np.mean(table.published_conventional[0]))
     return {
         "vo": 0.0,
-        "vo_gps_conv": float(np.mean(table.published_conventional[0])),
+        "vo_gps_conv": conventional,
         "vo_gps_tc": tc,
+        "dr": 0.0,
+        "dr_gps_conv": conventional,
         "dr_gps_tc": tc,
     }
 
@@ -120,11 +127,12 @@ def evaluate_pipelines(
     truth: Trajectory,
 ) -> tuple[dict[str, PipelineErrors], dict[str, ErrorPerDistance], dict[str, Trajectory]]:
     """Errors of every pipeline, its per-window errors, and the trajectories as evaluated:
-    translated to the truth's start, the VO alone also turned to the truth's initial heading."""
+    translated to the truth's start, the uncorrected ones also turned to the truth's initial
+    heading."""
     availability = heading_availability(table, tc_usable)
     errors, per_100m, shown = {}, {}, {}
     for name, trajectory in trajectories.items():
-        estimate = with_initial_heading(trajectory, truth) if name == "vo" else trajectory
+        estimate = with_initial_heading(trajectory, truth) if name in UNCORRECTED else trajectory
         shown[name] = align_start_to_truth(estimate, truth)
         errors[name], per_100m[name] = evaluate_trajectory(
             shown[name], truth, availability.get(name, float("nan"))

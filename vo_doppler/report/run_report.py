@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from vo_doppler.eval.per_distance import ErrorPerDistance
-from vo_doppler.eval.pipelines import PIPELINE_LABELS, PipelineErrors
+from vo_doppler.eval.pipelines import PIPELINE_LABELS, UNCORRECTED, PipelineErrors
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
@@ -29,9 +29,6 @@ from vo_doppler.report.trajectory_map import COLOURS, TRUTH, map_html
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
-
-NO_ABSOLUTE_HEADING = {"vo"}
-"""Pipelines that use no absolute heading: their heading-use column reads "—", not 0 %."""
 
 TABLE_COLUMNS = (
     ("error_per_100m_m", "error per 100 m, mean [m]", "{:.2f}"),
@@ -114,9 +111,9 @@ def label(name: str) -> str:
 
 
 def table_cell(name: str, key: str, value: float, fmt: str) -> str:
-    """A table cell: "—" where the quantity does not apply (the VO alone's heading use) or is
-    unknown (NaN), else ``fmt``."""
-    if key == "heading_availability" and name in NO_ABSOLUTE_HEADING:
+    """A table cell: "—" where the quantity does not apply (an uncorrected pipeline's heading
+    use) or is unknown (NaN), else ``fmt``."""
+    if key == "heading_availability" and name in UNCORRECTED:
         return "—"
     if value is None or not np.isfinite(value):
         return "—"
@@ -266,19 +263,23 @@ def worst_reliable_tight_errors(
 
 def headline(errors: dict[str, PipelineErrors], used_fraction: float) -> str:
     """The result in one sentence: how much the tightly coupled heading changed the VO's error
-    per 100 m (or, without ground truth, how often it was used)."""
-    if errors and ("vo" not in errors or "vo_gps_tc" not in errors):
-        shown = "; ".join(f"{label(n)} {e.error_per_100m_m:.2f}" for n, e in errors.items())
-        return f"No camera, so no VO to correct: error per 100 m (m): {shown}."
+    per 100 m, or the wheel + gyro dead reckoning's without a camera (or, without ground truth,
+    how often it was used)."""
     if not errors:
         return (
             "No ground truth: this report shows the trajectories and headings but cannot say "
             f"how accurate they are. The tightly coupled heading was used by the correction at "
             f"{used_fraction:.0%} of the GNSS epochs."
         )
-    alone = errors["vo"].error_per_100m_m
-    tight = errors["vo_gps_tc"].error_per_100m_m
-    conv = errors.get("vo_gps_conv")
+    base = "vo" if "vo" in errors else "dr"
+    if base not in errors or f"{base}_gps_tc" not in errors:
+        shown = "; ".join(f"{label(n)} {e.error_per_100m_m:.2f}" for n, e in errors.items())
+        return f"Error per 100 m (m): {shown}."
+    what = "the VO's" if base == "vo" else "the wheel + gyro dead reckoning's"
+    camera = "" if base == "vo" else "No camera: "
+    alone = errors[base].error_per_100m_m
+    tight = errors[f"{base}_gps_tc"].error_per_100m_m
+    conv = errors.get(f"{base}_gps_conv")
     versus = (
         f" (the conventional Doppler heading: {conv.error_per_100m_m:.2f} m per 100 m)"
         if conv is not None
@@ -286,12 +287,12 @@ def headline(errors: dict[str, PipelineErrors], used_fraction: float) -> str:
     )
     if tight < alone:
         return (
-            f"The tightly coupled Doppler heading cut the VO's error from {alone:.2f} to "
+            f"{camera}The tightly coupled Doppler heading cut {what} error from {alone:.2f} to "
             f"{tight:.2f} m per 100 m ({alone / tight:.1f}× less){versus}."
         )
     return (
-        f"The tightly coupled Doppler heading did not reduce the VO's error on this drive: "
-        f"{alone:.2f} m per 100 m alone, {tight:.2f} m per 100 m corrected{versus}."
+        f"{camera}The tightly coupled Doppler heading did not reduce {what} error on this "
+        f"drive: {alone:.2f} m per 100 m alone, {tight:.2f} m per 100 m corrected{versus}."
     )
 
 

@@ -22,6 +22,8 @@ COLOURS = {
     "vo": "#ff7f0e",
     "vo_gps_conv": "#1f77b4",
     "vo_gps_tc": "#d62728",
+    "dr": "#8c564b",
+    "dr_gps_conv": "#17becf",
     "dr_gps_tc": "#2ca02c",
 }
 """One colour per track, shared by every figure of the report."""
