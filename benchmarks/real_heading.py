@@ -36,18 +36,21 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmarks.sequence_runs import read_with_truth, run_sequences
+from vo_doppler.eval.pipelines import evaluate_pipelines
+from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
+from vo_doppler.run import Pipeline, RunConfig, correct_all, sequence_gnss, sequence_heading
 
 ROOT = Path(__file__).resolve().parents[1]
 CANYON_SATS = 2
 CANYON_AFTER_S = 20.0
 COURSE_BOUND_DEG = 1.5
 MOVING_MPS = 2.0
+DEAD_RECKONING = (Pipeline.DR, Pipeline.DR_GPS_CONV, Pipeline.DR_GPS_TC)
 
 
 def truth_velocity(sequence: Sequence, t: np.ndarray) -> np.ndarray:
@@ -151,6 +154,16 @@ def canyon_inputs(sequence: Sequence, config: RunConfig):
     )
 
 
+def dead_reckoning_figures(sequence: Sequence, table: HeadingTable, config: RunConfig) -> dict:
+    """Error per 100 m (m) of the wheel + gyro dead reckoning alone, corrected by the
+    conventional and by the tightly coupled heading of ``table`` (``run``'s pipelines)."""
+    speed = table.calibrated_speed(sequence.wheel_speed)
+    trajectories = correct_all(sequence, table, None, speed, np.zeros(3), config)
+    usable = usable_tight_heading(table, config.correction.tc_max_sigma)
+    errors, _, _ = evaluate_pipelines(trajectories, table, usable, sequence.truth)
+    return {str(name): errors[name].error_per_100m_m for name in DEAD_RECKONING if name in errors}
+
+
 def evaluate(folder: Path, fit_noise: bool) -> dict:
     sequence = read_with_truth(folder)
     config = RunConfig()
@@ -168,6 +181,10 @@ def evaluate(folder: Path, fit_noise: bool) -> dict:
         "truth_gyro_bias_dps": float(np.degrees(bias_truth)),
         "open_sky": tight_figures(sequence, open_sky, np.ones(after.size, dtype=bool)),
         "canyon": tight_figures(sequence, canyon, after),
+        "dead_reckoning": {
+            "open_sky": dead_reckoning_figures(sequence, open_sky, config),
+            "canyon": dead_reckoning_figures(sequence, canyon, config),
+        },
         "doppler_noise": [model.to_dict() for model in gnss.noise_models.values()],
     }
     return figures
@@ -220,10 +237,12 @@ def print_variant(console: Console, name: str, figures: dict) -> None:
         "conv p95 [°]",
         "wheel scale (truth)",
         "gyro bias °/s (truth)",
+        "DR alone / + conv / + TC [m per 100 m]",
     ):
         heading.add_column(column, justify="right")
     for case in ("open_sky", "canyon"):
         f = figures[case]
+        dr = figures["dead_reckoning"][case]
         heading.add_row(
             case,
             f"{f['tc_available']:.1%}",
@@ -233,6 +252,7 @@ def print_variant(console: Console, name: str, figures: dict) -> None:
             _fmt(f["conv_error_deg"]["p95"], ".2f"),
             f"{f['wheel_scale']:.4f} ({figures['truth_wheel_scale']:.4f})",
             f"{f['gyro_bias_dps']:.3f} ({figures['truth_gyro_bias_dps']:.3f})",
+            " / ".join(_fmt(dr.get(name), ".2f") for name in DEAD_RECKONING),
         )
     console.print(heading)
     noise = Table(title=f"{name}: Doppler σ model fitted from the data (gnss.noise_model)")

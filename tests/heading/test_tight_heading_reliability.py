@@ -73,14 +73,25 @@ def test_a_vague_reference_confirms_nothing_and_the_window_must_verify_itself():
     gyro = (np.zeros(2), np.zeros(2))
     every = np.ones(2, bool)
     for sigma_reference, verifiable, expected in (
-        (0.5, np.array([False, False]), False),
-        (0.5, np.array([False, True]), True),
-        (0.19, np.array([False, True]), False),  # informative: it disagrees
+        (0.5, np.array([True, False]), False),
+        (0.5, np.array([True, True]), True),
+        (0.19, np.array([True, True]), False),  # informative: it disagrees
     ):
         sigma = np.array([sigma_reference, 0.01])
         agree = _independent_agreement(every, verifiable, yaw, sigma, every, t, gyro, config)
-        # Epoch 0 is the first window of the drive: the consecutive-epoch rule alone.
         np.testing.assert_array_equal(agree, [True, expected])
+
+
+def test_the_first_window_of_a_drive_must_verify_itself():
+    config = TightHeadingConfig(window_s=2.0, reliability_gate_rad=0.05)
+    t = np.array([0.0, 1.0, 2.5])
+    yaw, sigma = np.zeros(3), np.full(3, 0.01)
+    gyro = (np.zeros(3), np.zeros(3))
+    every = np.ones(3, bool)
+    verifiable = np.array([False, True, False])
+    agree = _independent_agreement(every, verifiable, yaw, sigma, every, t, gyro, config)
+    # Epochs 0 and 1 have no window before theirs; epoch 2 refers to epoch 0 (t ≤ 0.5).
+    np.testing.assert_array_equal(agree, [False, True, True])
 
 
 def test_the_gyro_drift_since_the_reference_counts_towards_its_vagueness():
@@ -91,11 +102,11 @@ def test_the_gyro_drift_since_the_reference_counts_towards_its_vagueness():
     sigma = np.array([0.06, 0.01])
     yaw = np.array([0.0, 0.0])
     every = np.ones(2, bool)
-    never = np.zeros(2, bool)
-    # √(0.06² + (b·5)²) against 0.1: b = 0.0159 gives 0.0999, b = 0.0161 gives 0.1006.
+    first_only = np.array([True, False])
+    # √(0.06² + (b·5)²) against 0.1: b = 0.0159 gives 0.0996, b = 0.0161 gives 0.1004.
     for bias_sigma, expected in ((0.0159, True), (0.0161, False)):
         gyro = (np.zeros(2), np.full(2, bias_sigma))
-        agree = _independent_agreement(every, never, yaw, sigma, every, t, gyro, config)
+        agree = _independent_agreement(every, first_only, yaw, sigma, every, t, gyro, config)
         np.testing.assert_array_equal(agree, [True, expected])
 
 

@@ -122,8 +122,9 @@ class TightHeadingConfig:
     outlast a window (a mirror root, a reflected satellite the heading absorbs), tens of
     degrees: a reference within 10° (gate ≈ 30°) reveals them, a vaguer one agrees with almost
     any heading (a one-satellite window at σ 16° "confirmed" a two-satellite heading 88° off,
-    one satellite reflected). A heading with only a vaguer reference is reliable only when its
-    own window is verifiable."""
+    one satellite reflected; three satellites 0.5 s into a drive, one reflected, gave a heading
+    64° off at σ 0.2° that nothing could check). A heading without an informative reference is
+    reliable only when its own window is verifiable."""
     epoch_match_s: float = 1e-3
     chunk_bytes: int = 16 * 2**20
     """Memory (bytes) for the windows solved at once: the windows are solved in chunks of as
@@ -845,12 +846,11 @@ def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoc
     the last available one (so that a wrong reliable heading cannot lock the right ones out).
     Propagated by the gyro it must agree with θ_k within max(gate, n_sigma·√(σ_k² + σ_j² +
     (σ_b·(t_k − t_j))²)), σ_b the calibrated gyro bias's standard deviation, which the
-    propagation inherits. Epochs with no available heading a window earlier (the first window
-    of a drive) keep the consecutive-epoch rule alone. A reference is informative when
-    √(σ_j² + (σ_b·(t_k − t_j))²) ≤ ``reference_max_sigma_rad``; where the reference is vaguer
-    (e.g. a one-satellite window's) the epoch is reliable only when its own window is
-    verifiable: a two-satellite window with one reflected satellite fits it exactly, and
-    nothing else would reveal it.
+    propagation inherits. A reference is informative when √(σ_j² + (σ_b·(t_k − t_j))²) ≤
+    ``reference_max_sigma_rad``; where there is none (the first window of a drive) or only a
+    vaguer one (e.g. a one-satellite window's), the epoch is reliable only when its own window
+    is verifiable: a window with one reflected satellite among too few to test it fits that
+    satellite exactly, and nothing else would reveal it.
     """
     yaw_angle, bias_sigma = gyro
     reliable = np.zeros(len(yaw), dtype=bool)
@@ -863,11 +863,10 @@ def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoc
             p += 1
         fresh = last_reliable >= 0 and t_epoch[k] - t_epoch[last_reliable] <= config.prior_max_age_s
         j = last_reliable if fresh else last_available
-        if j < 0:
-            reliable[k] = True
-            continue
-        reference_variance = sigma[j] ** 2 + (bias_sigma[k] * (t_epoch[k] - t_epoch[j])) ** 2
-        if reference_variance > config.reference_max_sigma_rad**2:
+        reference_variance = (
+            sigma[j] ** 2 + (bias_sigma[k] * (t_epoch[k] - t_epoch[j])) ** 2 if j >= 0 else np.inf
+        )
+        if not reference_variance <= config.reference_max_sigma_rad**2:
             reliable[k] = verifiable[k]
             continue
         predicted = yaw[j] + yaw_angle[k] - yaw_angle[j]
