@@ -82,16 +82,23 @@ def test_a_vague_reference_confirms_nothing_and_the_window_must_verify_itself():
         np.testing.assert_array_equal(agree, [True, expected])
 
 
-def test_the_first_window_of_a_drive_must_verify_itself():
-    config = TightHeadingConfig(window_s=2.0, reliability_gate_rad=0.05)
-    t = np.array([0.0, 1.0, 2.5])
-    yaw, sigma = np.zeros(3), np.full(3, 0.01)
+def test_the_first_windows_of_a_drive_verify_themselves_or_a_later_window_confirms_them():
+    config = TightHeadingConfig(window_s=2.0, reliability_gate_rad=0.05, prior_max_age_s=10.0)
     gyro = (np.zeros(3), np.zeros(3))
+    sigma = np.full(3, 0.01)
     every = np.ones(3, bool)
     verifiable = np.array([False, True, False])
-    agree = _independent_agreement(every, verifiable, yaw, sigma, every, t, gyro, config)
-    # Epochs 0 and 1 have no window before theirs; epoch 2 refers to epoch 0 (t ≤ 0.5).
-    np.testing.assert_array_equal(agree, [False, True, True])
+    for t, yaw, expected in (
+        # epoch 0 has no window before it; epoch 2 (t ≥ 2) is the first one after it
+        ([0.0, 1.0, 2.5], [0.0, 0.0, 0.0], [True, True, True]),
+        ([0.0, 1.0, 2.5], [0.0, 0.0, 1.0], [False, True, False]),
+        # nothing within 10 s after epoch 0: only its own window could vouch for it
+        ([0.0, 1.0, 12.5], [0.0, 0.0, 0.0], [False, True, True]),
+    ):
+        agree = _independent_agreement(
+            every, verifiable, np.array(yaw), sigma, every, np.array(t), gyro, config
+        )
+        np.testing.assert_array_equal(agree, expected)
 
 
 def test_the_gyro_drift_since_the_reference_counts_towards_its_vagueness():

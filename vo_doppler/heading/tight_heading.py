@@ -123,8 +123,8 @@ class TightHeadingConfig:
     degrees: a reference within 10° (gate ≈ 30°) reveals them, a vaguer one agrees with almost
     any heading (a one-satellite window at σ 16° "confirmed" a two-satellite heading 88° off,
     one satellite reflected; three satellites 0.5 s into a drive, one reflected, gave a heading
-    64° off at σ 0.2° that nothing could check). A heading without an informative reference is
-    reliable only when its own window is verifiable."""
+    64° off at σ 0.2° that nothing could check). A heading without an informative reference
+    before it needs one after it, or a verifiable window (:func:`_independent_agreement`)."""
     epoch_match_s: float = 1e-3
     chunk_bytes: int = 16 * 2**20
     """Memory (bytes) for the windows solved at once: the windows are solved in chunks of as
@@ -835,8 +835,8 @@ def _reliability(yaw, sigma, available, yaw_angle, config):
 
 def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoch, gyro, config):
     """Reliability: the epochs of ``consistent`` (the consecutive-epoch rule,
-    :func:`_reliability`) whose heading also agrees with a heading from a window that shares no
-    row with theirs, or, without an informative one, whose own window is ``verifiable``.
+    :func:`_reliability`) whose heading also agrees with an informative heading from a window
+    that shares no row with theirs, or whose own window is ``verifiable``.
 
     Headings of consecutive epochs come from windows that overlap by all but one epoch, so
     their agreement ([TK18] sec. 3.5) cannot reveal a fault that lasts as long as the window,
@@ -846,14 +846,16 @@ def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoc
     the last available one (so that a wrong reliable heading cannot lock the right ones out).
     Propagated by the gyro it must agree with θ_k within max(gate, n_sigma·√(σ_k² + σ_j² +
     (σ_b·(t_k − t_j))²)), σ_b the calibrated gyro bias's standard deviation, which the
-    propagation inherits. A reference is informative when √(σ_j² + (σ_b·(t_k − t_j))²) ≤
-    ``reference_max_sigma_rad``; where there is none (the first window of a drive) or only a
-    vaguer one (e.g. a one-satellite window's), the epoch is reliable only when its own window
-    is verifiable: a window with one reflected satellite among too few to test it fits that
-    satellite exactly, and nothing else would reveal it.
+    propagation inherits. A reference is informative when √(σ_j² + (σ_b·|t_k − t_j|)²) ≤
+    ``reference_max_sigma_rad``. Where there is none (the first windows of a drive) or only a
+    vaguer one (e.g. a one-satellite window's), the epoch is reliable when its own window is
+    verifiable or, looking ahead, when it agrees with the first available heading at least one
+    window later (t_j ≥ t_k + W, within ``prior_max_age_s``) and that one is informative: a
+    window with one reflected satellite among too few to test it fits that satellite exactly,
+    and only another window can reveal it.
     """
-    yaw_angle, bias_sigma = gyro
     reliable = np.zeros(len(yaw), dtype=bool)
+    later = _next_available(available, t_epoch, config.window_s)
     last_reliable = last_available = -1
     p = 0
     for k in np.flatnonzero(consistent):
@@ -863,16 +865,37 @@ def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoc
             p += 1
         fresh = last_reliable >= 0 and t_epoch[k] - t_epoch[last_reliable] <= config.prior_max_age_s
         j = last_reliable if fresh else last_available
-        reference_variance = (
-            sigma[j] ** 2 + (bias_sigma[k] * (t_epoch[k] - t_epoch[j])) ** 2 if j >= 0 else np.inf
-        )
-        if not reference_variance <= config.reference_max_sigma_rad**2:
-            reliable[k] = verifiable[k]
-            continue
-        predicted = yaw[j] + yaw_angle[k] - yaw_angle[j]
-        allowed = max(
-            config.reliability_gate_rad,
-            config.reliability_n_sigma * np.sqrt(sigma[k] ** 2 + reference_variance),
-        )
-        reliable[k] = abs(wrap_angle(yaw[k] - predicted)) <= allowed
+        agrees = _agrees(k, j, yaw, sigma, t_epoch, gyro, config)
+        if agrees is None:
+            j = later[k]
+            ahead = j >= 0 and t_epoch[j] - t_epoch[k] <= config.prior_max_age_s
+            agrees = _agrees(k, j, yaw, sigma, t_epoch, gyro, config) if ahead else None
+            agrees = bool(verifiable[k] or agrees)
+        reliable[k] = agrees
     return reliable
+
+
+def _next_available(available, t_epoch, window_s):
+    """Per epoch k, the first available epoch j with t_j ≥ t_k + ``window_s`` (−1 if none)."""
+    m = len(t_epoch)
+    following = np.full(m + 1, -1)
+    for i in range(m - 1, -1, -1):
+        following[i] = i if available[i] else following[i + 1]
+    return following[np.searchsorted(t_epoch, t_epoch + window_s, side="left")]
+
+
+def _agrees(k, j, yaw, sigma, t_epoch, gyro, config):
+    """Whether θ_k agrees with the reference θ_j propagated by the gyro (None when there is no
+    reference or it is not informative; :func:`_independent_agreement`)."""
+    if j < 0:
+        return None
+    yaw_angle, bias_sigma = gyro
+    reference_variance = sigma[j] ** 2 + (bias_sigma[k] * (t_epoch[k] - t_epoch[j])) ** 2
+    if not reference_variance <= config.reference_max_sigma_rad**2:
+        return None
+    predicted = yaw[j] + yaw_angle[k] - yaw_angle[j]
+    allowed = max(
+        config.reliability_gate_rad,
+        config.reliability_n_sigma * np.sqrt(sigma[k] ** 2 + reference_variance),
+    )
+    return bool(abs(wrap_angle(yaw[k] - predicted)) <= allowed)
