@@ -61,9 +61,12 @@ def test_offset_calibrated_on_the_doppler_grade():
     valid = np.ones(T_EPOCH.size, dtype=bool)
     config = GradePriorConfig(min_samples=20)
     mean, sigma = grade_prior(raw, _doppler(T_EPOCH, truth), valid, config)
-    assert np.isnan(mean[:19]).all() and np.isnan(sigma[:19]).all()
-    np.testing.assert_allclose(mean[19:], truth[19:], atol=3e-5)
-    np.testing.assert_array_equal(sigma[19:], config.min_sigma)  # scatter 1e-5: the floor
+    np.testing.assert_allclose(mean, truth, atol=3e-5)
+    np.testing.assert_array_equal(sigma, config.min_sigma)  # scatter 1e-5: the floor
+    # with fewer velocities than min_samples there is no prior at all
+    few = np.arange(T_EPOCH.size) < 19
+    mean, sigma = grade_prior(raw, _doppler(T_EPOCH, truth), few, config)
+    assert np.isnan(mean).all() and np.isnan(sigma).all()
 
 
 def test_exact_offset_when_the_difference_is_constant():
@@ -71,11 +74,11 @@ def test_exact_offset_when_the_difference_is_constant():
     raw = grade + OFFSET
     valid = np.ones(60, dtype=bool)
     mean, sigma = grade_prior(raw, _doppler(np.zeros(60), grade), valid)
-    np.testing.assert_allclose(mean[19:], grade[19:], rtol=0, atol=1e-15)
-    np.testing.assert_array_equal(sigma[19:], GradePriorConfig().min_sigma)
+    np.testing.assert_allclose(mean, grade, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(sigma, GradePriorConfig().min_sigma)
 
 
-def test_invalid_and_slow_epochs_do_not_calibrate_and_the_prior_is_causal():
+def test_invalid_and_slow_epochs_do_not_calibrate_and_one_offset_serves_the_recording():
     rng = np.random.default_rng(1)
     n = 100
     grade = rng.uniform(-0.05, 0.05, n)
@@ -92,12 +95,11 @@ def test_invalid_and_slow_epochs_do_not_calibrate_and_the_prior_is_causal():
     used = valid & (np.arange(n) % 3 != 0)
     np.testing.assert_array_equal(sigma, sigma_wild)
     np.testing.assert_array_equal((raw - mean)[used], (wild - mean_wild)[used])
-    # the prior of epoch k uses epochs ≤ k only
-    half_mean, half_sigma = grade_prior(raw[:60], velocity[:60], valid[:60])
-    np.testing.assert_array_equal(half_mean, mean[:60])
-    np.testing.assert_array_equal(half_sigma, sigma[:60])
+    # f₀ is a constant: the first epochs get the offset that the later ones give
+    np.testing.assert_allclose(raw - mean, np.median((raw - grade)[used]), rtol=0, atol=1e-15)
+    assert np.ptp(sigma) == 0.0
     # 1 % white noise on the accelerometer grade: σ is about 1 %
-    assert np.nanmedian(sigma[-10:]) == pytest.approx(0.01, rel=0.5)
+    assert sigma[0] == pytest.approx(0.01, rel=0.5)
 
 
 def test_the_doppler_share_of_the_scatter_is_taken_out_of_the_prior_sigma():
@@ -112,6 +114,6 @@ def test_the_doppler_share_of_the_scatter_is_taken_out_of_the_prior_sigma():
     valid = np.ones(n, dtype=bool)
     _, blind = grade_prior(raw, velocity, valid)
     mean, sigma = grade_prior(raw, velocity, valid, vertical_sigma_mps=vertical_sigma)
-    assert blind[-1] == pytest.approx(np.hypot(0.04, 0.006), rel=0.1)
-    assert sigma[-1] == pytest.approx(0.006, abs=0.003)
-    assert np.median(np.abs(mean - grade)[100:]) < 0.006
+    assert blind[0] == pytest.approx(np.hypot(0.04, 0.006), rel=0.1)
+    assert sigma[0] == pytest.approx(0.006, abs=0.003)
+    assert np.median(np.abs(mean - grade)) < 0.006
