@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.calibration import GateConfig
+from vo_doppler.heading.grade import grade_prior
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, causal_calibration, heading_pipeline
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.sim.doppler_rows import gyro_from_heading, simulate_doppler
@@ -124,6 +126,14 @@ def test_conventional_speeds_far_from_the_wheel_speed_do_not_calibrate():
             assert error > worse_than
 
 
+def _with_accelerometer(t, scenario, velocity, wheel, gyro, acceleration):
+    """The pipeline with every conventional velocity valid and a forward accelerometer."""
+    valid = np.ones(len(t), bool)
+    return heading_pipeline(
+        t, scenario.rows, velocity, valid, wheel, gyro, forward_acceleration=acceleration
+    )
+
+
 def test_the_table_records_where_the_grade_prior_came_from():
     t, scenario, velocity = _drive(noise=0.0)
     wheel = SensorSeries(t, scenario.speed)
@@ -134,16 +144,40 @@ def test_the_table_records_where_the_grade_prior_came_from():
     np.testing.assert_array_equal(plain.grade_prior_sigma, config.tight.grade_sigma)
     # a level road: the accelerometer reads dv/dt plus an offset of 0.2 m/s²
     acceleration = SensorSeries(t, np.gradient(scenario.speed, t) + 0.2)
-    table = heading_pipeline(
-        t,
-        scenario.rows,
-        velocity,
-        np.ones(len(t), bool),
-        wheel,
-        gyro,
-        forward_acceleration=acceleration,
-    )
+    table = _with_accelerometer(t, scenario, velocity, wheel, gyro, acceleration)
     fitted = table.grade_from_accelerometer
     assert fitted[-100:].all() and not fitted[:10].any()
     np.testing.assert_array_equal(table.grade_prior_sigma[fitted], config.grade.min_sigma)
     np.testing.assert_array_equal(table.grade_prior_sigma[~fitted], config.tight.grade_sigma)
+
+
+def test_the_grade_prior_differentiates_the_calibrated_wheel_speed(monkeypatch):
+    """A level road driven at 10 ± 6 m/s (up to 1.8 m/s² of acceleration) with wheels reading
+    3 % fast: dv/dt of the raw wheel speed would put 0.55 % of grade where there is none."""
+    t = np.arange(0.0, 120.0, 0.1)
+    scenario = simulate_doppler(
+        t,
+        lambda t: 1.0 + 0.2 * np.sin(0.05 * t),
+        lambda t: 10.0 + 6.0 * np.sin(0.3 * t),
+        AZIMUTH,
+        ELEVATION,
+        seed=3,
+    )
+    velocity = scenario.speed[:, None] * np.stack(
+        [np.cos(scenario.yaw), np.sin(scenario.yaw), np.zeros_like(t)], axis=1
+    )
+    t_fine = np.arange(0.0, 120.0, 0.01)
+    wheel = SensorSeries(t_fine, 1.03 * (10.0 + 6.0 * np.sin(0.3 * t_fine)))
+    acceleration = SensorSeries(t_fine, 1.8 * np.cos(0.3 * t_fine) + 0.2)
+    gyro = SensorSeries(t, np.gradient(np.unwrap(scenario.yaw), t))
+    priors = []
+
+    def recording(*args, **kwargs):
+        priors.append(grade_prior(*args, **kwargs))
+        return priors[-1]
+
+    monkeypatch.setattr("vo_doppler.heading.pipeline.grade_prior", recording)
+    table = _with_accelerometer(t, scenario, velocity, wheel, gyro, acceleration)
+    assert table.wheel_scale[-1] == pytest.approx(1 / 1.03, abs=1e-3)
+    mean = priors[0][0]
+    assert np.nanpercentile(np.abs(mean), 95) < 0.001

@@ -75,7 +75,9 @@ class HeadingPipelineConfig:
 
 def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, vertical_sigma, config):
     """(μ, σ) of the tight heading's grade per epoch: the accelerometer's where calibrated,
-    else N(0, ``config.tight.grade_sigma``); and where it is the accelerometer's."""
+    else N(0, ``config.tight.grade_sigma``); and where it is the accelerometer's. ``speed``:
+    the wheel speed times the recording's final wheel scale (dv/dt of a wheel speed 2 % off
+    moved the grade of the simulator's level drives by 0.77 % at p95, 0.24 % calibrated)."""
     m = len(t_epoch)
     level = np.zeros(m), np.full(m, config.tight.grade_sigma)
     if forward_acceleration is None or not len(forward_acceleration.t):
@@ -278,7 +280,7 @@ def heading_pipeline(
         t_epoch,
         velocity,
         conventional_valid,
-        speed,
+        SensorSeries(speed.t, speed.value * cal.scale[-1]),
         forward_acceleration,
         conventional_vertical_sigma_mps,
         config,
