@@ -877,11 +877,12 @@ def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoc
 
 def _next_available(available, t_epoch, window_s):
     """Per epoch k, the first available epoch j with t_j ≥ t_k + ``window_s`` (−1 if none)."""
-    m = len(t_epoch)
-    following = np.full(m + 1, -1)
-    for i in range(m - 1, -1, -1):
-        following[i] = i if available[i] else following[i + 1]
-    return following[np.searchsorted(t_epoch, t_epoch + window_s, side="left")]
+    candidates = np.flatnonzero(available)
+    if not candidates.size:
+        return np.full(len(t_epoch), -1)
+    first = np.searchsorted(t_epoch, t_epoch + window_s, side="left")
+    position = np.minimum(np.searchsorted(candidates, first), candidates.size - 1)
+    return np.where(candidates[position] >= first, candidates[position], -1)
 
 
 def _agrees(k, j, yaw, sigma, t_epoch, gyro, config):
