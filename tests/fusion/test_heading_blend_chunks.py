@@ -28,7 +28,7 @@ N = 2000
 @pytest.fixture(scope="module")
 def walk():
     """A random walk in distance and turning seen through noisy headings (N measurements, all
-    kept: no correlation time), on the fit's 2,560-point grid of σ_d, σ_ψ and s (one ε)."""
+    kept: no correlation time), on the fit's 2,560-point grid of σ_d, σ_ψ and s."""
     rng = np.random.default_rng(11)
     distance = np.arange(N, dtype=float)
     turn = np.cumsum(np.abs(rng.normal(0.0, 0.01, N)))
@@ -38,7 +38,7 @@ def walk():
         t, offset + 0.02 * rng.standard_normal(N), np.full(N, 0.02), np.zeros(N)
     )
     clock = DriftClock(t, distance, turn)
-    axes = (SIGMA_GRID, SIGMA_GRID, SCALE_GRID, OUTLIER_GRID[1:2])
+    axes = (SIGMA_GRID, SIGMA_GRID, SCALE_GRID)
     grid = tuple(g.ravel() for g in np.meshgrid(*axes, indexing="ij"))
     return measurements, clock, grid
 
@@ -49,12 +49,13 @@ def test_the_likelihood_of_every_grid_point_does_not_depend_on_the_chunks(walk):
     measurements, clock, grid = walk
     for keep, budgets in ((np.arange(100), (1,)), (np.arange(N), (8 * MIB, 32 * MIB))):
         whole = grid_log_likelihood(
-            measurements, keep, clock, grid, BlendConfig(fit_chunk_bytes=1 << 40)
+            measurements, keep, clock, grid, OUTLIER_GRID, BlendConfig(fit_chunk_bytes=1 << 40)
         )
+        assert whole.shape == (grid[0].size, OUTLIER_GRID.size)
         assert np.isfinite(whole).all() and np.ptp(whole) > 0
         for budget in budgets:
             chunked = grid_log_likelihood(
-                measurements, keep, clock, grid, BlendConfig(fit_chunk_bytes=budget)
+                measurements, keep, clock, grid, OUTLIER_GRID, BlendConfig(fit_chunk_bytes=budget)
             )
             assert np.array_equal(chunked, whole), budget
 
@@ -74,3 +75,15 @@ def test_the_fit_is_the_same_and_its_memory_follows_the_budget(walk):
     assert chunked == whole
     assert chunked.fitted
     assert peak < 8 * MIB + 8 * FIT_FLOATS_PER_MEASUREMENT * N + MIB
+
+
+def test_one_filter_per_point_gives_the_likelihood_of_every_outlier_fraction(walk):
+    """Each column (one ε) is, bit for bit, the grid filtered with that ε alone."""
+    measurements, clock, grid = walk
+    keep = np.arange(150)
+    config = BlendConfig()
+    every = grid_log_likelihood(measurements, keep, clock, grid, OUTLIER_GRID, config)
+    for column, epsilon in enumerate(OUTLIER_GRID):
+        alone = grid_log_likelihood(measurements, keep, clock, grid, np.array([epsilon]), config)
+        assert np.array_equal(every[:, column], alone[:, 0])
+    assert not np.array_equal(every[:, 0], every[:, 2])

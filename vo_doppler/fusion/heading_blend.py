@@ -275,14 +275,16 @@ def forward_filter(
     ``r`` (inflated by κ) and process variances ``q`` since the previous measurement (q[0]
     unused); ``r_single`` the variance of each measurement's own error, (s·σ_j)², which the
     robust weight judges (default ``r``); ``start`` the initial δ (default z[0]). ``r``,
-    ``r_single`` and ``q`` may carry a trailing axis of G parameter sets, filtered side by
-    side. The log-likelihood is that of the contaminated normal density of (B3″) with
-    ``outlier_fraction`` ε (scalar or one per parameter set; 0: Gaussian)."""
+    ``r_single`` and ``q`` may carry trailing axes of parameter sets, filtered side by side.
+    The log-likelihood is that of the contaminated normal density of (B3″) with
+    ``outlier_fraction`` ε (0: Gaussian), which broadcasts against those trailing axes: ε does
+    not enter (B3)–(B3′), so one filter gives the likelihood of every ε (e.g. parameter sets
+    of shape (G, 1) and ε of shape (E,) give a (G, E) log-likelihood)."""
     r = np.asarray(r, dtype=float)
     r_single = r if r_single is None else np.asarray(r_single, dtype=float)
     q = np.asarray(q, dtype=float)
     epsilon = np.asarray(outlier_fraction, dtype=float)
-    trailing = np.broadcast_shapes(r.shape[1:], r_single.shape[1:], q.shape[1:], epsilon.shape)
+    trailing = np.broadcast_shapes(r.shape[1:], r_single.shape[1:], q.shape[1:])
     shape = (len(z), *trailing)
 
     def spread(a):
@@ -292,7 +294,7 @@ def forward_filter(
     x = np.empty(shape)
     P = np.empty(shape)
     P_pred = np.full(shape, np.inf)
-    log_likelihood = np.zeros(shape[1:])
+    log_likelihood = np.zeros(np.broadcast_shapes(trailing, epsilon.shape))
     if len(z) == 0:
         return FilterOutput(x, P, P_pred, log_likelihood)
     x[0], P[0] = z[0] if start is None else start, r[0]
@@ -464,11 +466,11 @@ def fit_process_noise(
         OUTLIER_GRID,
     )
     axes = [np.array([f]) if f is not None else g for f, g in zip(fixed, grids, strict=True)]
-    grid = tuple(g.ravel() for g in np.meshgrid(*axes, indexing="ij"))
-    log_likelihood = grid_log_likelihood(measurements, keep, clock, grid, config)
-    best = int(np.argmax(log_likelihood))
-    d, psi, scale, epsilon = (float(g[best]) for g in grid)
-    return NoiseModel(d, psi, scale, True, outlier_fraction=epsilon)
+    grid = tuple(g.ravel() for g in np.meshgrid(*axes[:3], indexing="ij"))
+    log_likelihood = grid_log_likelihood(measurements, keep, clock, grid, axes[3], config)
+    point, outlier = np.unravel_index(np.argmax(log_likelihood), log_likelihood.shape)
+    d, psi, scale = (float(g[point]) for g in grid)
+    return NoiseModel(d, psi, scale, True, outlier_fraction=float(axes[3][outlier]))
 
 
 FIT_FLOATS_PER_MEASUREMENT = 8
@@ -480,19 +482,22 @@ def grid_log_likelihood(
     measurements: OffsetMeasurements,
     keep: np.ndarray,
     clock: DriftClock,
-    grid: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    grid: tuple[np.ndarray, np.ndarray, np.ndarray],
+    outlier_fractions: np.ndarray,
     config: BlendConfig,
 ) -> np.ndarray:
     """Innovation log-likelihood (B3″), from the robust start, over the measurements ``keep``
-    for every grid point (σ_d, σ_ψ, s, ε), the points filtered side by side in chunks of at most
-    ``config.fit_chunk_bytes`` (at least one point; each point's filter is elementwise in the
-    points, so its value does not depend on the chunk it is in)."""
-    grid_d, grid_psi, grid_s, grid_epsilon = grid
+    for every grid point (σ_d, σ_ψ, s) (rows) and every ε of ``outlier_fractions`` (columns):
+    one filter per point gives every ε's likelihood (ε enters only the density). The points
+    are filtered side by side in chunks of at most ``config.fit_chunk_bytes`` (at least one
+    point; each point's filter is elementwise in the points, so its value does not depend on
+    the chunk it is in)."""
+    grid_d, grid_psi, grid_s = grid
     t, z, variance = measurements.t[keep], measurements.z[keep], measurements.sigma[keep] ** 2
     per_point = 8 * FIT_FLOATS_PER_MEASUREMENT * max(len(keep), 1)
     size = max(1, config.fit_chunk_bytes // per_point)
     first = start_indices(t, measurements.correlation_s[keep], config)
-    out = np.empty(grid_d.size)
+    out = np.empty((grid_d.size, len(outlier_fractions)))
     for begin in range(0, grid_d.size, size):
         part = slice(begin, begin + size)
         accumulated = clock.variance(t, grid_d[part], grid_psi[part])
@@ -500,7 +505,12 @@ def grid_log_likelihood(
         r = np.multiply.outer(variance, grid_s[part] ** 2)
         start = robust_start(z, r, accumulated, first, config.huber_k)
         out[part] = forward_filter(
-            z, r, q, config.huber_k, start=start, outlier_fraction=grid_epsilon[part]
+            z,
+            r[..., None],
+            q[..., None],
+            config.huber_k,
+            start=start[:, None],
+            outlier_fraction=outlier_fractions,
         ).log_likelihood
     return out
 
