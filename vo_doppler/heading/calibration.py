@@ -120,14 +120,34 @@ class RobustLine:
     weights: np.ndarray
 
 
-def _centred(values: np.ndarray, weights: np.ndarray, groups: np.ndarray | None) -> np.ndarray:
-    if groups is None:
+def _centred(
+    values: np.ndarray, weights: np.ndarray, members: list[np.ndarray] | None
+) -> np.ndarray:
+    """``values`` less their weighted mean within each group (``members``: the indices of
+    each; None: no intercept)."""
+    if members is None:
         return values
     out = values.copy()
-    for g in np.unique(groups):
-        members = groups == g
-        out[members] -= weights[members] @ values[members] / weights[members].sum()
+    for index in members:
+        out[index] -= weights[index] @ values[index] / weights[index].sum()
     return out
+
+
+def median_of_finite(values: np.ndarray) -> float:
+    """``np.median`` of a 1-D array of finite values, to the bit: the middle order statistic,
+    or half the sum of the two middle ones (as ``np.median`` takes their mean), found by one
+    partition without ``np.median``'s generic axis and NaN handling (the IRLS of
+    :func:`huber_line` takes two medians per iteration and epoch)."""
+    half = values.size // 2
+    if values.size % 2:
+        return float(np.partition(values, half)[half])
+    middle = np.partition(values, (half - 1, half))
+    return float((middle[half - 1] + middle[half]) / 2.0)
+
+
+def _robust_scale(residual: np.ndarray) -> float:
+    """1.4826·MAD of the residuals (their standard deviation if Gaussian)."""
+    return MAD_TO_SIGMA * median_of_finite(np.abs(residual - median_of_finite(residual)))
 
 
 def huber_line(
@@ -149,29 +169,30 @@ def huber_line(
     if x.size < MIN_ROBUST_SAMPLES:
         k = np.inf
     weights = np.ones_like(x)
-    params = 1 + (0 if groups is None else len(np.unique(groups)))
+    members = None if groups is None else [np.flatnonzero(groups == g) for g in np.unique(groups)]
+    params = 1 + (0 if members is None else len(members))
     for _ in range(iterations):
-        xc, yc = _centred(x, weights, groups), _centred(y, weights, groups)
+        xc, yc = _centred(x, weights, members), _centred(y, weights, members)
         sxx = float((weights * xc) @ xc)
         if sxx <= 0:
             return RobustLine(np.nan, np.nan, weights)
         slope = float((weights * xc) @ yc) / sxx
         residual = yc - slope * xc
-        scale = MAD_TO_SIGMA * float(np.median(np.abs(residual - np.median(residual))))
+        scale = _robust_scale(residual)
         if scale <= 0:
             break
         updated = np.minimum(1.0, k * scale / np.maximum(np.abs(residual), 1e-300))
-        settled = np.allclose(updated, weights, rtol=0.0, atol=1e-6)
+        settled = bool(np.all(np.abs(updated - weights) <= 1e-6))
         weights = updated
         if settled:
             break
-    xc, yc = _centred(x, weights, groups), _centred(y, weights, groups)
+    xc, yc = _centred(x, weights, members), _centred(y, weights, members)
     slope = float((weights * xc) @ yc) / float((weights * xc) @ xc)
     residual = yc - slope * xc
     n = x.size
     if n <= params:
         return RobustLine(slope, np.nan, weights)
-    scale = MAD_TO_SIGMA * float(np.median(np.abs(residual - np.median(residual))))
+    scale = _robust_scale(residual)
     if not np.isfinite(k) or scale <= 0:
         sigma = np.sqrt(float(residual @ residual) / (n - params) / float(xc @ xc))
         return RobustLine(slope, float(sigma), weights)
