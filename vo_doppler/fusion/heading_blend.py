@@ -290,6 +290,7 @@ def forward_filter(
     def spread(a):
         return np.broadcast_to(a.reshape(a.shape + (1,) * (len(shape) - a.ndim)), shape)
 
+    single_is_inflated = r_single is r
     r, r_single, q = spread(r), spread(r_single), spread(q)
     x = np.empty(shape)
     P = np.empty(shape)
@@ -297,29 +298,45 @@ def forward_filter(
     log_likelihood = np.zeros(np.broadcast_shapes(trailing, epsilon.shape))
     if len(z) == 0:
         return FilterOutput(x, P, P_pred, log_likelihood)
+    density = ContaminatedDensity.of(epsilon)
     x[0], P[0] = z[0] if start is None else start, r[0]
     for j in range(1, len(z)):
         P_pred[j] = P[j - 1] + q[j]
         S = P_pred[j] + r[j]
-        S_single = P_pred[j] + r_single[j]
+        S_single = S if single_is_inflated else P_pred[j] + r_single[j]
         innovation = wrap_angle(z[j] - x[j - 1])
         size = np.abs(innovation) / np.sqrt(S_single)
         beyond = size > huber_k
         gain = P_pred[j] / np.where(beyond, S * size / huber_k, S)
         x[j] = x[j - 1] + gain * innovation
         P[j] = (1.0 - gain) * P_pred[j]
-        log_likelihood += contaminated_log_density(size, S_single, epsilon)
+        log_likelihood += density(size, S_single)
     return FilterOutput(x, P, P_pred, log_likelihood)
 
 
-def contaminated_log_density(size, variance, outlier_fraction):
-    """ln[(1 − ε)·N(ν; 0, S) + ε/(2π)] of (B3″) for an innovation of ``size`` |ν|/√S, S
-    ``variance`` (ε = 0: the normal density)."""
-    normal = -0.5 * size**2 - 0.5 * np.log(2.0 * np.pi * variance)
-    epsilon = np.asarray(outlier_fraction, dtype=float)
-    if not np.any(epsilon > 0):
-        return normal
-    return np.logaddexp(np.log1p(-epsilon) + normal, np.log(epsilon) - np.log(2.0 * np.pi))
+@dataclass(frozen=True)
+class ContaminatedDensity:
+    """ln[(1 − ε)·N(ν; 0, S) + ε/(2π)] of (B3″), its terms in ε taken once for every
+    innovation of a filter."""
+
+    log_inlier: np.ndarray | None
+    """ln(1 − ε); None when ε = 0 everywhere (the normal density)."""
+    log_outlier: np.ndarray
+    """ln(ε) − ln(2π)."""
+
+    @classmethod
+    def of(cls, outlier_fraction: np.ndarray | float) -> ContaminatedDensity:
+        epsilon = np.asarray(outlier_fraction, dtype=float)
+        if not np.any(epsilon > 0):
+            return cls(None, epsilon)
+        return cls(np.log1p(-epsilon), np.log(epsilon) - np.log(2.0 * np.pi))
+
+    def __call__(self, size: np.ndarray, variance: np.ndarray) -> np.ndarray:
+        """The log-density of an innovation of ``size`` |ν|/√S, S ``variance``."""
+        normal = -0.5 * size**2 - 0.5 * np.log(2.0 * np.pi * variance)
+        if self.log_inlier is None:
+            return normal
+        return np.logaddexp(self.log_inlier + normal, self.log_outlier)
 
 
 def robust_start(
