@@ -6,11 +6,15 @@ import json
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from vo_doppler.cli import main
+from vo_doppler.geo import wrap_angle
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.trajectory import read_tum
-from vo_doppler.run import _malloc_trim, release_free_heap
+from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.run import _malloc_trim, initial_yaw_offset, release_free_heap
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
 
@@ -107,3 +111,67 @@ def test_release_free_heap_returns_freed_memory_the_heap_kept():
     release_free_heap()
     assert before - resident_mib() > 16.0, "32 MiB freed between kept blocks stayed resident"
     assert len(kept) == 1024
+
+
+def _heading_table(t, yaw_tc, tc_usable, yaw_conv=None, conv_valid=None) -> HeadingTable:
+    n = len(t)
+    return HeadingTable(
+        t=np.asarray(t, dtype=float),
+        yaw_tc=np.asarray(yaw_tc, dtype=float),
+        sigma_tc=np.full(n, np.radians(0.5)),
+        tc_reliable=np.asarray(tc_usable, dtype=bool),
+        n_obs_window=np.full(n, 8),
+        n_sat_epoch=np.full(n, 6),
+        yaw_conv=np.full(n, np.nan) if yaw_conv is None else np.asarray(yaw_conv, dtype=float),
+        conv_valid=np.zeros(n, dtype=bool) if conv_valid is None else np.asarray(conv_valid),
+        gyro_bias=np.zeros(n),
+        wheel_scale=np.ones(n),
+    )
+
+
+def _turning_trajectory(t: np.ndarray, yaw0: float, rate: float) -> Trajectory:
+    yaw = yaw0 + rate * (t - t[0])
+    return Trajectory(t, np.zeros((len(t), 3)), Rotation.from_euler("z", yaw[:, None]))
+
+
+def test_the_initial_heading_is_the_median_of_the_first_seconds_not_the_first_heading():
+    t = np.arange(0.0, 20.0, 0.5)
+    trajectory = _turning_trajectory(t, yaw0=0.3, rate=0.02)
+    truth_offset = np.radians(100.0)
+    yaw_tc = 0.3 + 0.02 * t + truth_offset
+    yaw_tc[2] += np.radians(40.0)  # the first usable heading is off (a reflected satellite)
+    usable = t >= 1.0
+    yaw_tc[~usable] = np.nan
+    offset = initial_yaw_offset(_heading_table(t, yaw_tc, usable), usable, trajectory)
+    assert offset == pytest.approx(truth_offset, abs=1e-12)
+
+
+def test_the_initial_heading_median_is_circular():
+    t = np.arange(5.0)
+    trajectory = _turning_trajectory(t, yaw0=0.0, rate=0.0)
+    yaw_tc = np.radians([-179.5, 179.0, 179.0, -178.0, 179.0])  # π + (0.5, -1, -1, 2, -1)°
+    usable = np.ones(len(t), dtype=bool)
+    offset = initial_yaw_offset(_heading_table(t, yaw_tc, usable), usable, trajectory)
+    assert np.degrees(wrap_angle(offset - np.pi)) == pytest.approx(-1.0, abs=1e-9)
+
+
+def test_the_initial_heading_takes_the_first_span_inside_the_trajectory():
+    t = np.arange(0.0, 30.0, 1.0)
+    trajectory = _turning_trajectory(t[10:], yaw0=0.5, rate=0.0)
+    yaw_tc = np.where(t < 10.0, 2.0, 1.5)
+    yaw_tc[t >= 16.0] = 2.5  # beyond 5 s from the first heading inside: not used
+    usable = np.ones(len(t), dtype=bool)
+    offset = initial_yaw_offset(_heading_table(t, yaw_tc, usable), usable, trajectory)
+    assert offset == pytest.approx(1.0, abs=1e-12)
+
+
+def test_without_tight_headings_the_conventional_ones_start_the_trajectory(caplog):
+    t = np.arange(0.0, 10.0, 1.0)
+    trajectory = _turning_trajectory(t, yaw0=0.25, rate=0.0)
+    none = np.zeros(len(t), dtype=bool)
+    table = _heading_table(t, np.full(len(t), np.nan), none, np.full(len(t), 1.25), ~none)
+    assert initial_yaw_offset(table, none, trajectory) == pytest.approx(1.0, abs=1e-12)
+    table = _heading_table(t, np.full(len(t), np.nan), none, np.full(len(t), np.nan), none)
+    with caplog.at_level("WARNING"):
+        assert initial_yaw_offset(table, none, trajectory) == pytest.approx(-0.25, abs=1e-12)
+    assert "starts facing east" in caplog.text

@@ -38,7 +38,7 @@ from vo_doppler.fusion.correction import (
     tight_absolute_heading,
     usable_tight_heading,
 )
-from vo_doppler.geo import EnuFrame, yaw_of
+from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
@@ -57,6 +57,9 @@ if TYPE_CHECKING:
     from vo_doppler.vo.batch import VoOutput
 
 log = logging.getLogger(__name__)
+
+INITIAL_HEADING_SPAN_S = 5.0
+"""Seconds of absolute headings, from the first, whose median starts every trajectory."""
 
 
 class Pipeline(StrEnum):
@@ -123,30 +126,37 @@ def level_with_yaw(trajectory: Trajectory, yaw0: float, start: np.ndarray) -> Tr
     return Trajectory.from_matrices(trajectory.t, out)
 
 
-def yaw_at(trajectory: Trajectory, t0: float) -> float:
-    """Yaw of the pose at the first time ≥ ``t0`` (the last pose after the end)."""
-    k = int(np.clip(np.searchsorted(trajectory.t, t0), 0, len(trajectory) - 1))
-    return float(yaw_of(trajectory.matrices[k : k + 1, :3, :3])[0])
+def yaw_offset(trajectory: Trajectory, t: np.ndarray, yaw: np.ndarray) -> float:
+    """Circular median of the absolute headings ``yaw`` minus the trajectory's yaw at ``t``:
+    the rotation about z that best turns the trajectory into the absolute headings."""
+    differences = wrap_angle(yaw - trajectory.yaw_at(t))
+    return float(differences[0] + np.median(wrap_angle(differences - differences[0])))
 
 
-def first_heading(t: np.ndarray, yaw: np.ndarray, valid: np.ndarray) -> tuple[float, float]:
-    """Time and yaw of the first valid absolute heading (NaNs when there is none)."""
-    usable = np.flatnonzero(valid & np.isfinite(yaw))
-    if usable.size == 0:
-        return float("nan"), float("nan")
-    return float(t[usable[0]]), float(yaw[usable[0]])
+def initial_yaw_offset(
+    table: HeadingTable,
+    tc_usable: np.ndarray,
+    trajectory: Trajectory,
+    span_s: float = INITIAL_HEADING_SPAN_S,
+) -> float:
+    """Rotation about z that starts a trajectory with the absolute heading.
 
-
-def initial_heading(table: HeadingTable, tc_usable: np.ndarray, t_fallback: float):
-    """Time and yaw that start every trajectory: the first usable tightly coupled heading,
-    else the first conventional one, else east at ``t_fallback`` (with a warning)."""
-    t0, yaw0 = first_heading(table.t, table.yaw_tc, tc_usable)
-    if not np.isfinite(yaw0):
-        t0, yaw0 = first_heading(table.t, table.yaw_conv, table.conv_valid)
-    if not np.isfinite(yaw0):
-        log.warning("no absolute heading at any epoch: the trajectories start facing east")
-        t0, yaw0 = t_fallback, 0.0
-    return t0, yaw0
+    The circular median of (absolute heading − trajectory yaw) over the usable tightly coupled
+    headings of the ``span_s`` seconds from the first one inside the trajectory's time span, so
+    that one heading that is off cannot turn the whole trajectory; without any, the conventional
+    headings the same way; without those, the trajectory starts facing east (with a warning).
+    """
+    inside = (table.t >= trajectory.t[0]) & (table.t <= trajectory.t[-1])
+    for yaw, valid in ((table.yaw_tc, tc_usable), (table.yaw_conv, table.conv_valid)):
+        rows = np.flatnonzero(valid & inside & np.isfinite(yaw))
+        if rows.size:
+            rows = rows[table.t[rows] <= table.t[rows[0]] + span_s]
+            return yaw_offset(trajectory, table.t[rows], yaw[rows])
+    log.warning(
+        "no absolute heading during the %.0f s of a trajectory: it starts facing east",
+        trajectory.t[-1] - trajectory.t[0],
+    )
+    return float(-trajectory.yaw()[0])
 
 
 def correct_all(
@@ -160,8 +170,8 @@ def correct_all(
     """The VO and the wheel + gyro dead reckoning, each alone and corrected by the conventional
     and by the tightly coupled heading (vehicle poses, ENU).
 
-    Every trajectory starts at ``start`` with the first absolute heading (tightly coupled, else
-    conventional), matched at its own time. Only usable tightly coupled headings correct.
+    Every trajectory starts at ``start``, turned to the absolute headings of its first seconds
+    (:func:`initial_yaw_offset`). Only usable tightly coupled headings correct.
     """
     yaw_rate = table.calibrated_yaw_rate(sequence.yaw_rate)
     begin, end = max(speed.t[0], yaw_rate.t[0]), min(speed.t[-1], yaw_rate.t[-1])
@@ -170,20 +180,18 @@ def correct_all(
     t_dr = np.arange(begin, end, 1.0 / config.dead_reckoning_rate_hz)
     dr = wheel_gyro_track(speed, yaw_rate, t_dr) if len(t_dr) > 1 else None
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
-    t_fallback = vo_vehicle.t[0] if vo_vehicle is not None else table.t[0]
-    t0, yaw0 = initial_heading(table, usable, t_fallback)
     tight = tight_absolute_heading(table, config.correction)
     conventional = conventional_absolute_heading(table)
     trajectories: dict[Pipeline, Trajectory] = {}
     if vo_vehicle is not None:
-        vo_level = level_with_yaw(vo_vehicle, yaw0 - yaw_at(vo_vehicle, t0), start)
+        vo_level = level_with_yaw(vo_vehicle, initial_yaw_offset(table, usable, vo_vehicle), start)
         trajectories[Pipeline.VO] = vo_level
         trajectories[Pipeline.VO_GPS_CONV] = correct(
             vo_level, conventional, config.correction
         ).vehicle
         trajectories[Pipeline.VO_GPS_TC] = correct(vo_level, tight, config.correction).vehicle
     if dr is not None:
-        dr_level = level_with_yaw(dr, yaw0 - yaw_at(dr, t0), start)
+        dr_level = level_with_yaw(dr, initial_yaw_offset(table, usable, dr), start)
         trajectories[Pipeline.DR] = dr_level
         trajectories[Pipeline.DR_GPS_CONV] = correct(
             dr_level, conventional, config.correction

@@ -95,7 +95,7 @@ GLOSSARY = (
     (
         "VO alone / + GPS",
         "VO alone: monocular visual odometry, metric scale from the calibrated wheel speed, "
-        "turned to the first absolute heading and never corrected again. VO + GPS "
+        "turned to the absolute headings of its first seconds and never corrected again. VO + GPS "
         "(conventional): VO heading corrected by the heading of the Doppler velocity. VO + GPS "
         "(tightly coupled): corrected by the [TK18] tightly coupled Doppler heading.",
     ),
