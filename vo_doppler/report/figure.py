@@ -16,6 +16,14 @@ def new_figure(**kwargs: Any) -> Figure:
     return Figure(**kwargs)
 
 
+def tight_layout(fig: Figure) -> None:
+    """``fig.tight_layout()`` without the placeholder layout engine it leaves behind, which
+    makes every ``savefig`` lay out and draw the whole figure once more, unrendered, before
+    drawing it."""
+    fig.tight_layout()
+    fig.set_layout_engine(None)
+
+
 def integer_ticks(axis: Any) -> None:
     """Only whole-number ticks on a matplotlib ``axis`` (counts such as satellites)."""
     from matplotlib.ticker import MaxNLocator

@@ -8,7 +8,7 @@ import numpy as np
 
 from vo_doppler.geo import EnuFrame
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
-from vo_doppler.report.figure import integer_ticks, new_figure
+from vo_doppler.report.figure import integer_ticks, new_figure, tight_layout
 
 
 def velocity_figure(path: str | Path, solution: VelocitySolution, title: str = "") -> None:
@@ -57,5 +57,5 @@ def spp_figure(path: str | Path, solution: SppSolution, title: str = "") -> None
 def _save(fig, path: str | Path) -> None:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
+    tight_layout(fig)
     fig.savefig(path, dpi=120)

@@ -12,7 +12,7 @@ import numpy as np
 
 from vo_doppler.geo import wrap_angle, yaw_to_course
 from vo_doppler.model.heading import HeadingTable
-from vo_doppler.report.figure import new_figure
+from vo_doppler.report.figure import new_figure, tight_layout
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -112,5 +112,5 @@ def build_heading_figure(
         ax.legend(loc="best", fontsize=8)
     axes[-1].set_xlabel("time since first GNSS epoch [s]")
     fig.suptitle(title)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig

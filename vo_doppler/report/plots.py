@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from vo_doppler.model.trajectory import Trajectory
-from vo_doppler.report.figure import new_figure
+from vo_doppler.report.figure import new_figure, tight_layout
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
@@ -34,5 +34,5 @@ def plot_top_view(
     ax.legend()
     if title:
         ax.set_title(title)
-    fig.tight_layout()
+    tight_layout(fig)
     fig.savefig(path)

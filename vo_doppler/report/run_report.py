@@ -23,7 +23,7 @@ from vo_doppler.eval.pipelines import PIPELINE_LABELS, UNCORRECTED, PipelineErro
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
-from vo_doppler.report.figure import new_figure
+from vo_doppler.report.figure import new_figure, tight_layout
 from vo_doppler.report.provenance import DataDescription
 from vo_doppler.report.trajectory_map import COLOURS, TRUTH, map_html
 
@@ -149,7 +149,7 @@ def trajectories_figure(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title)
-    fig.tight_layout()
+    tight_layout(fig)
     fig.savefig(path, dpi=110)
 
 
@@ -172,7 +172,7 @@ def build_error_per_100m_figure(per_100m: dict[str, ErrorPerDistance], title: st
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig
 
 
@@ -213,7 +213,7 @@ def build_heading_error_figure(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig
 
 
