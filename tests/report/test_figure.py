@@ -1,5 +1,6 @@
-"""Figure helpers: the tight layout leaves no layout engine, so saving draws the figure once,
-into the same pixels as matplotlib's own ``tight_layout``."""
+"""Figure helpers: a new figure is on an Agg canvas whose renderer the tight layout and the PNG
+share; the tight layout leaves no layout engine, so saving draws the figure once, into the same
+pixels as matplotlib's own ``tight_layout``."""
 
 from __future__ import annotations
 
@@ -49,3 +50,12 @@ def test_tight_layout_gives_the_layout_and_pixels_of_matplotlibs():
     ]
     assert ours.subplotpars.left > 0.1
     assert _png(ours) == _png(theirs)
+
+
+def test_the_layout_and_the_png_share_the_canvas_renderer():
+    fig, _ = _figure()
+    tight_layout(fig)
+    layout_renderer = fig.canvas.renderer
+    png = _png(fig)
+    assert png.startswith(b"\x89PNG")
+    assert fig.canvas.renderer is layout_renderer

@@ -10,10 +10,15 @@ if TYPE_CHECKING:
 
 
 def new_figure(**kwargs: Any) -> Figure:
-    """``matplotlib.figure.Figure(**kwargs)``: an Agg-rendered figure outside pyplot's state."""
+    """``matplotlib.figure.Figure(**kwargs)`` on an Agg canvas, outside pyplot's state: the
+    tight layout and the PNG then share one renderer (and its text measurements) instead of
+    one each from a canvas made for the occasion."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    return Figure(**kwargs)
+    fig = Figure(**kwargs)
+    FigureCanvasAgg(fig)
+    return fig
 
 
 def tight_layout(fig: Figure) -> None:
