@@ -194,8 +194,14 @@ def driven_m(result: RunResult) -> float:
 def release_figures() -> None:
     """Free the figures already written: a matplotlib figure is a web of reference cycles that
     only the cycle collector frees, and its freed buffers go back to the system only on request
-    (:func:`vo_doppler.run.release_free_heap`)."""
+    (:func:`vo_doppler.run.release_free_heap`).
+
+    When the caller froze what was alive (``vo-doppler run`` does, until it ends), what is
+    alive after the collection is frozen too: mostly matplotlib's modules, imported by the
+    first figure, which each later pass would otherwise walk again."""
     gc.collect()
+    if gc.get_freeze_count():
+        gc.freeze()
     release_free_heap()
 
 
