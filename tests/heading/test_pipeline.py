@@ -6,10 +6,16 @@ import numpy as np
 import pytest
 
 from vo_doppler.geo import wrap_angle
-from vo_doppler.heading.calibration import GateConfig
+from vo_doppler.heading.calibration import GateConfig, estimate_gyro_bias
 from vo_doppler.heading.grade import grade_prior
-from vo_doppler.heading.pipeline import HeadingPipelineConfig, causal_calibration, heading_pipeline
+from vo_doppler.heading.pipeline import (
+    HeadingPipelineConfig,
+    causal_calibration,
+    heading_pipeline,
+    tight_gyro_bias,
+)
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.timeseries import integral_at
 from vo_doppler.sim.doppler_rows import gyro_from_heading, simulate_doppler
 
 AZIMUTH = [30.0, 110.0, 200.0, 280.0, 330.0, 160.0]
@@ -68,6 +74,89 @@ def test_pipeline_calibrates_and_keeps_heading_with_two_satellites():
     )
     plain_error = np.degrees(np.abs(wrap_angle(plain.yaw_tc - scenario.yaw)))
     assert np.nanmedian(plain_error[late]) > 2 * np.nanmedian(error[late])
+
+
+def test_tight_gyro_bias_recovers_a_known_bias_from_tight_headings():
+    t = np.arange(0.0, 120.0, 0.1)
+    bias = np.radians(0.3)
+    yaw = 1.0 + 0.5 * np.sin(0.05 * t)
+    phi = yaw - yaw[0] + bias * t  # Φ = ∫ (ω + b) dt
+    rng = np.random.default_rng(3)
+    tight = yaw + rng.normal(0.0, np.radians(1.0), len(t))
+    tight[::50] += np.radians(30.0)  # faults the Huber fit down-weights
+    sigma = np.full(len(t), np.radians(1.0))
+    reliable = np.ones(len(t), dtype=bool)
+    reliable[200:300] = False
+    tight[200:300] = np.nan
+    speed = np.full(len(t), 10.0)
+    config = HeadingPipelineConfig()
+    value, value_sigma = tight_gyro_bias(t, tight, sigma, reliable, phi, speed, config)
+    assert abs(value - bias) < np.radians(0.002)
+    # σ: the fit's over √(epochs per window), then with the prior (which hardly counts).
+    fit = estimate_gyro_bias(t, tight, phi, speed, reliable, config.gate)
+    expected = fit.sigma * np.sqrt(config.tight.window_s / 0.1)
+    np.testing.assert_allclose(value_sigma, expected, rtol=1e-3)
+    # Vague headings do not calibrate; none left: no estimate.
+    vague = np.full(len(t), 2.0 * config.tight_calibration_max_sigma)
+    assert tight_gyro_bias(t, tight, vague, reliable, phi, speed, config) is None
+
+
+def _biased_drive():
+    """:func:`_drive` with an exact wheel speed and a gyro biased by 0.3 deg/s."""
+    t, scenario, velocity = _drive()
+    bias = np.radians(0.3)
+    t_gyro, rate = gyro_from_heading(
+        t, scenario.yaw, np.ones(len(t), bool), bias, np.radians(0.05), rate_hz=50.0
+    )
+    return t, scenario, velocity, SensorSeries(t, scenario.speed), SensorSeries(t_gyro, rate), bias
+
+
+def test_pipeline_calibrates_the_gyro_from_tight_headings_without_conventional_velocity():
+    t, scenario, velocity, wheel, gyro, bias = _biased_drive()
+    none = np.zeros(len(t), dtype=bool)  # a street canyon from the start
+    table = heading_pipeline(t, scenario.rows, velocity, none, wheel, gyro)
+    assert np.all(np.abs(np.degrees(table.gyro_bias - bias)) < 0.01)
+    single = heading_pipeline(
+        t,
+        scenario.rows,
+        velocity,
+        none,
+        wheel,
+        gyro,
+        HeadingPipelineConfig(tight_calibration=False),
+    )
+    assert np.all(single.gyro_bias == 0.0)
+    error = np.degrees(np.abs(wrap_angle(table.yaw_tc - scenario.yaw)))
+    single_error = np.degrees(np.abs(wrap_angle(single.yaw_tc - scenario.yaw)))
+    used, single_used = table.tc_reliable, single.tc_reliable
+    assert np.percentile(error[used], 95) < 0.5 * np.percentile(single_error[single_used], 95)
+
+
+def test_tight_calibration_leaves_the_conventionally_calibrated_epochs():
+    t, scenario, velocity, wheel, gyro, bias = _biased_drive()
+    conv = velocity + np.random.default_rng(5).normal(0.0, 0.03, velocity.shape)
+    valid = np.ones(len(t), dtype=bool)
+    table = heading_pipeline(t, scenario.rows, conv, valid, wheel, gyro)
+    single = heading_pipeline(
+        t, scenario.rows, conv, valid, wheel, gyro, HeadingPipelineConfig(tight_calibration=False)
+    )
+    raw_angle = integral_at(gyro.t, gyro.value, t)
+    cal = causal_calibration(
+        t,
+        np.linalg.norm(conv, axis=1),
+        np.arctan2(conv[:, 1], conv[:, 0]),
+        valid,
+        scenario.speed,
+        raw_angle,
+    )
+    first = int(np.argmax(cal.bias_estimated))
+    assert 0 < first < 20  # the first seconds have no conventional estimate
+    np.testing.assert_array_equal(table.gyro_bias[first:], single.gyro_bias[first:])
+    assert abs(np.degrees(table.gyro_bias[0] - bias)) < 0.01  # the tight headings' bias there
+    later = t > t[first] + 10.0 + 2.0 * HeadingPipelineConfig().tight.window_s
+    # The same up to rounding: Φ_cal differs there by a constant (the early bias integral).
+    np.testing.assert_allclose(table.yaw_tc[later], single.yaw_tc[later], rtol=0, atol=1e-8)
+    np.testing.assert_array_equal(table.tc_reliable[later], single.tc_reliable[later])
 
 
 def test_causal_calibration_holds_and_overrides():

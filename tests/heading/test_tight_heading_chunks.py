@@ -84,8 +84,8 @@ def series_inputs(heading_inputs):
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(heading_pipeline, "tight_heading_series", spy)
         heading(heading_inputs, 32 * MIB)
-    (call,) = calls
-    return call
+    assert 1 <= len(calls) <= 2  # a second pass where the tight headings calibrate the gyro
+    return calls[-1]
 
 
 def peak_bytes(inputs, chunk_bytes: int) -> int:

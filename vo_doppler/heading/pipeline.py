@@ -11,12 +11,18 @@ uncalibrated sensors), so that a fit over a few samples cannot swing the bias to
 degrees per second; before the first estimate, and while none can be made, the prior (or the
 last estimate) holds. The standard deviations of the calibration go to the tightly coupled
 solver, which propagates them into each heading's standard deviation.
+
+Where the conventional calibration has no gyro bias (a street canyon from the start, or the
+seconds before its first estimate), the tightly coupled headings of a first pass give it
+(:func:`tight_gyro_bias`, non-causal: the whole drive's headings) and the tight heading is
+solved again with it; the wheel scale stays at the prior there (the tight model takes the
+speed as given).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -28,12 +34,18 @@ from vo_doppler.heading.calibration import (
     GyroBiasKalman,
     WheelScaleCalibrator,
     WheelScaleKalman,
+    estimate_gyro_bias,
 )
 from vo_doppler.heading.conventional import heading_from_velocity, vehicle_heading_from_antenna
 from vo_doppler.heading.grade import GradePriorConfig, accelerometer_grade, grade_prior
-from vo_doppler.heading.integrity import ConsistencyConfig, conventional_integrity
+from vo_doppler.heading.integrity import (
+    ConsistencyConfig,
+    ConventionalIntegrity,
+    conventional_integrity,
+)
 from vo_doppler.heading.tight_heading import (
     TightHeadingConfig,
+    TightHeadingResult,
     antenna_offset_velocity,
     tight_heading_series,
 )
@@ -69,6 +81,11 @@ class HeadingPipelineConfig:
     """Spread of an uncalibrated gyro bias about zero (rad/s)."""
     prior_wheel_scale_sigma: float = PRIOR_WHEEL_SCALE_SIGMA
     """Spread of an uncalibrated wheel scale about one."""
+    tight_calibration: bool = True
+    """Where the conventional calibration has no gyro bias estimate, take it from the tightly
+    coupled headings of a first pass and solve them again (:func:`tight_gyro_bias`)."""
+    tight_calibration_max_sigma: float = float(np.radians(2.0))
+    """Tightly coupled headings with a larger σ (rad) do not calibrate."""
     fixed_gyro_bias: float | None = None
     fixed_wheel_scale: float | None = None
 
@@ -120,6 +137,8 @@ class CalibrationSeries:
     scale: np.ndarray
     bias_sigma: np.ndarray
     scale_sigma: np.ndarray
+    bias_estimated: np.ndarray
+    """Epochs whose bias is estimated from data (or fixed), not the prior alone."""
 
 
 def _with_prior(estimate, prior: float, prior_sigma: float) -> tuple[float, float]:
@@ -145,7 +164,9 @@ def causal_calibration(
     """Gyro bias and wheel scale current at each epoch, refreshed epoch by epoch, with their
     standard deviations (least squares: combined with the prior; fixed values: zero)."""
     m = len(t_epoch)
-    out = CalibrationSeries(np.zeros(m), np.ones(m), np.zeros(m), np.zeros(m))
+    out = CalibrationSeries(
+        np.zeros(m), np.ones(m), np.zeros(m), np.zeros(m), np.zeros(m, dtype=bool)
+    )
     bias_cal, scale_cal = _calibrators(config)
     current_bias = (0.0, config.prior_gyro_bias_sigma)
     current_scale = (1.0, config.prior_wheel_scale_sigma)
@@ -155,6 +176,7 @@ def causal_calibration(
                 t_epoch[k], doppler_yaw[k], raw_yaw_angle[k], doppler_speed[k], doppler_valid[k]
             )
             s = scale_cal.add(t_epoch[k], doppler_speed[k], wheel_speed[k], doppler_valid[k])
+            out.bias_estimated[k] = b.valid and b.n_used > 0
             if config.calibration == "ls":
                 current_bias = _with_prior(b, 0.0, config.prior_gyro_bias_sigma)
                 current_scale = _with_prior(s, 1.0, config.prior_wheel_scale_sigma)
@@ -165,9 +187,69 @@ def causal_calibration(
         out.scale[k], out.scale_sigma[k] = current_scale
     if config.fixed_gyro_bias is not None:
         out.bias[:], out.bias_sigma[:] = config.fixed_gyro_bias, 0.0
+        out.bias_estimated[:] = True
     if config.fixed_wheel_scale is not None:
         out.scale[:], out.scale_sigma[:] = config.fixed_wheel_scale, 0.0
     return out
+
+
+def tight_gyro_bias(
+    t_epoch: np.ndarray,
+    tight_yaw: np.ndarray,
+    tight_sigma: np.ndarray,
+    tight_reliable: np.ndarray,
+    raw_yaw_angle: np.ndarray,
+    wheel_speed: np.ndarray,
+    config: HeadingPipelineConfig = HeadingPipelineConfig(),
+) -> tuple[float, float] | None:
+    """Gyro bias (rad/s) and its σ from tightly coupled headings, combined with the prior; None
+    where none can be estimated. This project's addition, for drives without conventional
+    velocities to calibrate (a street canyon from the start).
+
+    [TK18] sec. 3.4's model with the tight heading ψ_TC in place of the Doppler course,
+    ψ_TC(t) − Φ(t) = ψ₀ − b·(t − t_ref)
+    (:func:`~vo_doppler.heading.calibration.estimate_gyro_bias`, its gate and Huber fit, over
+    the whole drive: post-processing, not causal), over the reliable headings with
+    σ ≤ ``config.tight_calibration_max_sigma``. Each window sees the
+    gyro over only ``config.tight.window_s``, so a bias error b_e tilts its heading by a
+    fraction of b_e·window_s while the slope is fitted over the drive's tens of seconds: the
+    bias the first pass used hardly enters. The headings of overlapping windows share their
+    Doppler rows, so the fit's σ (which takes the samples as independent) is multiplied by
+    √(epochs per window)."""
+    t_epoch = np.asarray(t_epoch, dtype=float)
+    sigma = np.nan_to_num(np.asarray(tight_sigma, dtype=float), nan=np.inf)
+    informative = np.asarray(tight_reliable, dtype=bool) & (
+        sigma <= config.tight_calibration_max_sigma
+    )
+    estimate = estimate_gyro_bias(
+        t_epoch, tight_yaw, raw_yaw_angle, wheel_speed, informative, config.gate
+    )
+    if not estimate.valid or len(t_epoch) < 2:
+        return None
+    per_window = max(config.tight.window_s / float(np.median(np.diff(t_epoch))), 1.0)
+    inflated = replace(estimate, sigma=estimate.sigma * float(np.sqrt(per_window)))
+    return _with_prior(inflated, 0.0, config.prior_gyro_bias_sigma)
+
+
+def _tight_calibration_needed(cal: CalibrationSeries, config: HeadingPipelineConfig) -> bool:
+    """A second pass calibrated by :func:`tight_gyro_bias` is needed: the calibration is on
+    and some epochs have no estimated gyro bias."""
+    return (
+        config.tight_calibration
+        and config.calibration != "none"
+        and not bool(np.all(cal.bias_estimated))
+    )
+
+
+@dataclass(frozen=True)
+class _Pass:
+    """One solution of the heading stage under a given calibration."""
+
+    conv_yaw: np.ndarray
+    integrity: ConventionalIntegrity
+    grade: tuple[np.ndarray, np.ndarray]
+    grade_from_accelerometer: np.ndarray
+    result: TightHeadingResult
 
 
 def heading_pipeline(
@@ -255,48 +337,70 @@ def heading_pipeline(
     calibrating &= np.abs(np.nan_to_num(conv_speed - wheel, nan=np.inf)) <= tolerance
     raw_angle = integral_at(yaw_rate.t, yaw_rate.value, t_epoch)
     cal = causal_calibration(t_epoch, conv_speed, conv_yaw, calibrating, wheel, raw_angle, config)
-    # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
-    steps = cal.bias[:-1] * np.diff(t_epoch)
-    bias_integral = np.concatenate([[0.0], np.cumsum(steps)])[: len(t_epoch)]
-    yaw_angle = raw_angle - bias_integral
-    offset = antenna_offset_velocity(raw_rate - cal.bias, antenna_lever_arm_m)
-    if lever:
-        conv_yaw, _ = vehicle_heading_from_antenna(
-            antenna_yaw, antenna_speed, cal.scale * wheel, offset
+
+    def solve(cal: CalibrationSeries) -> _Pass:
+        """The integrity test, grade prior and tight heading under calibration ``cal``."""
+        conv_yaw_cal = conv_yaw
+        # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
+        steps = cal.bias[:-1] * np.diff(t_epoch)
+        bias_integral = np.concatenate([[0.0], np.cumsum(steps)])[: len(t_epoch)]
+        yaw_angle = raw_angle - bias_integral
+        offset = antenna_offset_velocity(raw_rate - cal.bias, antenna_lever_arm_m)
+        if lever:
+            conv_yaw_cal, _ = vehicle_heading_from_antenna(
+                antenna_yaw, antenna_speed, cal.scale * wheel, offset
+            )
+        integrity = conventional_integrity(
+            t_epoch,
+            conv_ok,
+            conv_yaw_cal,
+            conventional_yaw_sigma,
+            yaw_angle,
+            np.where(valid, conv_speed, np.nan),
+            conventional_speed_sigma_mps,
+            cal.scale * wheel,
+            cal.bias_sigma,
+            config.integrity,
         )
-    integrity = conventional_integrity(
-        t_epoch,
-        conv_ok,
-        conv_yaw,
-        conventional_yaw_sigma,
-        yaw_angle,
-        np.where(valid, conv_speed, np.nan),
-        conventional_speed_sigma_mps,
-        cal.scale * wheel,
-        cal.bias_sigma,
-        config.integrity,
-    )
-    grade, grade_from_accelerometer = _grade_prior(
-        t_epoch,
-        velocity,
-        conventional_valid,
-        SensorSeries(speed.t, speed.value * cal.scale[-1]),
-        forward_acceleration,
-        conventional_vertical_sigma_mps,
-        config,
-    )
-    result = tight_heading_series(
-        rows,
-        t_epoch,
-        cal.scale * wheel,
-        yaw_angle,
-        config.tight,
-        speed_scale_sigma=cal.scale_sigma / cal.scale,
-        gyro_bias_sigma=cal.bias_sigma,
-        lever_velocity=np.nan_to_num(offset),
-        grade_prior=grade,
-        calibration=(cal.scale, cal.bias, bias_integral),
-    )
+        grade, grade_from_accelerometer = _grade_prior(
+            t_epoch,
+            velocity,
+            conventional_valid,
+            SensorSeries(speed.t, speed.value * cal.scale[-1]),
+            forward_acceleration,
+            conventional_vertical_sigma_mps,
+            config,
+        )
+        result = tight_heading_series(
+            rows,
+            t_epoch,
+            cal.scale * wheel,
+            yaw_angle,
+            config.tight,
+            speed_scale_sigma=cal.scale_sigma / cal.scale,
+            gyro_bias_sigma=cal.bias_sigma,
+            lever_velocity=np.nan_to_num(offset),
+            grade_prior=grade,
+            calibration=(cal.scale, cal.bias, bias_integral),
+        )
+        return _Pass(conv_yaw_cal, integrity, grade, grade_from_accelerometer, result)
+
+    solved = solve(cal)
+    if _tight_calibration_needed(cal, config):
+        bias = tight_gyro_bias(
+            t_epoch,
+            solved.result.yaw,
+            solved.result.sigma,
+            solved.result.reliable,
+            raw_angle,
+            wheel,
+            config,
+        )
+        if bias is not None:
+            cal.bias_sigma[~cal.bias_estimated] = bias[1]
+            cal.bias[~cal.bias_estimated] = bias[0]
+            solved = solve(cal)
+    result, integrity = solved.result, solved.integrity
     return HeadingTable(
         t=t_epoch,
         yaw_tc=result.yaw,
@@ -304,7 +408,7 @@ def heading_pipeline(
         tc_reliable=result.reliable,
         n_obs_window=result.n_obs,
         n_sat_epoch=result.n_sat_epoch,
-        yaw_conv=np.where(conv_ok, conv_yaw, np.nan),
+        yaw_conv=np.where(conv_ok, solved.conv_yaw, np.nan),
         conv_valid=integrity.valid,
         gyro_bias=cal.bias,
         wheel_scale=cal.scale,
@@ -317,6 +421,6 @@ def heading_pipeline(
         tc_window_s=config.tight.window_s,
         conv_gnss_valid=conv_ok,
         sigma_conv_gnss=_sigma_where(conventional_yaw_sigma, conv_ok),
-        grade_prior_sigma=grade[1],
-        grade_from_accelerometer=grade_from_accelerometer,
+        grade_prior_sigma=solved.grade[1],
+        grade_from_accelerometer=solved.grade_from_accelerometer,
     )
