@@ -9,7 +9,9 @@ from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.calibration import GateConfig, estimate_gyro_bias
 from vo_doppler.heading.grade import grade_prior
 from vo_doppler.heading.pipeline import (
+    CalibrationSeries,
     HeadingPipelineConfig,
+    backfill_start,
     causal_calibration,
     heading_pipeline,
     tight_gyro_bias,
@@ -270,3 +272,30 @@ def test_the_grade_prior_differentiates_the_calibrated_wheel_speed(monkeypatch):
     assert table.wheel_scale[-1] == pytest.approx(1 / 1.03, abs=1e-3)
     mean = priors[0][0]
     assert np.nanpercentile(np.abs(mean), 95) < 0.001
+
+
+def test_the_epochs_before_the_first_estimate_take_the_median_value_with_the_prior_sigma():
+    estimated = np.array([False, False, False, True, True, False, True, False])
+    cal = CalibrationSeries(
+        bias=np.array([0.0, 0.0, 0.0, 0.01, 0.02, 0.0, 0.004, 0.0]),
+        scale=np.array([1.0, 1.0, 1.01, 1.02, 1.03, 1.04, 1.05, 1.06]),
+        bias_sigma=np.array([0.5, 0.5, 0.5, 0.1, 0.05, 0.5, 0.02, 0.5]),
+        scale_sigma=np.full(8, 0.03),
+        bias_estimated=estimated.copy(),
+        scale_estimated=np.array([False, True, True, True, True, True, True, True]),
+    )
+    backfill_start(cal)
+    np.testing.assert_array_equal(cal.bias, [0.01] * 3 + [0.01, 0.02, 0.0, 0.004, 0.0])
+    np.testing.assert_array_equal(cal.bias_sigma, [0.5] * 3 + [0.1, 0.05, 0.5, 0.02, 0.5])
+    np.testing.assert_array_equal(cal.bias_estimated, [True] * 5 + [False, True, False])
+    np.testing.assert_array_equal(cal.scale, [1.03, 1.0, 1.01, 1.02, 1.03, 1.04, 1.05, 1.06])
+    assert cal.scale_estimated.all()
+
+
+def test_a_drive_without_any_estimate_keeps_the_prior_for_the_tight_pass():
+    cal = CalibrationSeries(
+        np.zeros(4), np.ones(4), np.full(4, 0.5), np.full(4, 0.03), *np.zeros((2, 4), dtype=bool)
+    )
+    backfill_start(cal)
+    np.testing.assert_array_equal(cal.bias_sigma, 0.5)
+    assert not cal.bias_estimated.any() and not cal.scale_estimated.any()
