@@ -117,10 +117,11 @@ def start_position(
     return np.zeros(3)
 
 
-def level_with_yaw(trajectory: Trajectory, yaw0: float, start: np.ndarray) -> Trajectory:
-    """Rotate vehicle poses (first-vehicle frame) about z by ``yaw0`` and move them to ``start``."""
+def level_with_yaw(trajectory: Trajectory, turn: float, start: np.ndarray) -> Trajectory:
+    """Rotate vehicle poses (first-vehicle frame) about z by ``turn`` (rad) and move them to
+    ``start``."""
     rotation = np.eye(4)
-    rotation[:3, :3] = Rotation.from_euler("z", yaw0).as_matrix()
+    rotation[:3, :3] = Rotation.from_euler("z", turn).as_matrix()
     out = rotation @ trajectory.matrices
     out[:, :3, 3] += start - out[0, :3, 3]
     return Trajectory.from_matrices(trajectory.t, out)

@@ -237,13 +237,15 @@ def tight_gyro_bias(
     velocities to calibrate (a street canyon from the start).
 
     [TK18] sec. 3.4's model with the tight heading ψ_TC in place of the Doppler course,
-    ψ_TC(t) − Φ(t) = ψ₀ − b·(t − t_ref)
-    (:func:`~vo_doppler.heading.calibration.estimate_gyro_bias`, its gate and Huber fit, over
-    the whole drive: post-processing, not causal), over the reliable headings with
-    σ ≤ ``config.tight_calibration_max_sigma``. Each window sees the
-    gyro over only ``config.tight.window_s``, so a bias error b_e tilts its heading by a
-    fraction of b_e·window_s while the slope is fitted over the drive's tens of seconds: the
-    bias the first pass used hardly enters. The headings of overlapping windows share their
+
+        ψ_TC(t) − Φ(t) = ψ₀ − b·(t − t_ref),
+
+    fitted by :func:`~vo_doppler.heading.calibration.estimate_gyro_bias` (its gate and Huber
+    line) over the whole drive (post-processing, not causal), on the reliable headings with
+    σ ≤ ``config.tight_calibration_max_sigma``. Each window sees the gyro over only
+    ``config.tight.window_s``, so a bias error b_e tilts its heading by a fraction of
+    b_e·window_s while the slope is fitted over the drive's tens of seconds: the bias the first
+    pass used hardly enters. The headings of overlapping windows share their
     Doppler rows, so the fit's σ (which takes the samples as independent) is multiplied by
     √(epochs per window)."""
     t_epoch = np.asarray(t_epoch, dtype=float)
