@@ -24,7 +24,9 @@ fitted σ(C/N0, elevation) models are printed). Figures:
   the ground truth with the same models (scale = Σ w·v / Σ w², bias = slope of ∫ω − ψ_truth);
 * tight heading: availability and |error| against the truth yaw, open sky and with an
   emulated canyon (the ``CANYON_SATS`` highest GPS satellites per epoch after ``CANYON_AFTER_S``
-  of open sky, ``heading.from_gnss.emulated_canyon``).
+  of open sky, ``heading.from_gnss.emulated_canyon``), and with that canyon from the first
+  epoch (no conventional velocity ever calibrates: the gyro bias comes from the tight heading,
+  ``heading.pipeline.tight_gyro_bias``).
 """
 
 from __future__ import annotations
@@ -140,14 +142,15 @@ def tight_figures(sequence: Sequence, table, epochs: np.ndarray) -> dict:
     }
 
 
-def canyon_inputs(sequence: Sequence, config: RunConfig):
-    """Doppler rows and conventional velocities of the emulated canyon (module docstring)."""
+def canyon_inputs(sequence: Sequence, config: RunConfig, after_s: float = CANYON_AFTER_S):
+    """Doppler rows and conventional velocities of the emulated canyon from ``after_s`` into
+    the recording (module docstring)."""
     obs = sequence.observations
     return emulated_canyon(
         obs,
         sequence.navigation,
         CANYON_SATS,
-        obs.epoch_time[0] + CANYON_AFTER_S,
+        obs.epoch_time[0] + after_s,
         "G",
         config.elevation_mask,
         reported_sigma=sequence.doppler_sigma,
@@ -172,18 +175,24 @@ def evaluate(folder: Path, fit_noise: bool) -> dict:
     scale_truth, bias_truth = calibration_truth(sequence)
     open_sky = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
     canyon = sequence_heading(sequence, *canyon_inputs(sequence, config), config.heading)
+    canyon_start = sequence_heading(
+        sequence, *canyon_inputs(sequence, config, after_s=0.0), config.heading
+    )
     after = obs.epoch_time >= obs.epoch_time[0] + CANYON_AFTER_S
+    every = np.ones(after.size, dtype=bool)
     figures = {
         "epochs": int(obs.epoch_time.size),
         "conventional_gnss": conventional_figures(sequence, gnss.velocity),
         "conventional": conventional_figures(sequence, gnss.velocity, open_sky),
         "truth_wheel_scale": scale_truth,
         "truth_gyro_bias_dps": float(np.degrees(bias_truth)),
-        "open_sky": tight_figures(sequence, open_sky, np.ones(after.size, dtype=bool)),
+        "open_sky": tight_figures(sequence, open_sky, every),
         "canyon": tight_figures(sequence, canyon, after),
+        "canyon_start": tight_figures(sequence, canyon_start, every),
         "dead_reckoning": {
             "open_sky": dead_reckoning_figures(sequence, open_sky, config),
             "canyon": dead_reckoning_figures(sequence, canyon, config),
+            "canyon_start": dead_reckoning_figures(sequence, canyon_start, config),
         },
         "doppler_noise": [model.to_dict() for model in gnss.noise_models.values()],
     }
@@ -240,7 +249,7 @@ def print_variant(console: Console, name: str, figures: dict) -> None:
         "DR alone / + conv / + TC [m per 100 m]",
     ):
         heading.add_column(column, justify="right")
-    for case in ("open_sky", "canyon"):
+    for case in ("open_sky", "canyon", "canyon_start"):
         f = figures[case]
         dr = figures["dead_reckoning"][case]
         heading.add_row(

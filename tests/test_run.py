@@ -175,3 +175,17 @@ def test_without_tight_headings_the_conventional_ones_start_the_trajectory(caplo
     with caplog.at_level("WARNING"):
         assert initial_yaw_offset(table, none, trajectory) == pytest.approx(-0.25, abs=1e-12)
     assert "starts facing east" in caplog.text
+
+
+def test_reliable_tight_headings_too_vague_to_correct_still_start_the_trajectory():
+    """A canyon from the start: no conventional heading, tight headings reliable but at σ 3.4°
+    (not usable); before the unreliable ones, after the conventional ones."""
+    t = np.arange(0.0, 10.0, 1.0)
+    trajectory = _turning_trajectory(t, yaw0=0.25, rate=0.0)
+    none = np.zeros(len(t), dtype=bool)
+    yaw_tc = np.where(t < 3.0, 2.0, 0.75)
+    table = _heading_table(t, yaw_tc, t >= 3.0)
+    table.sigma_tc[:] = np.radians(3.4)
+    assert initial_yaw_offset(table, none, trajectory) == pytest.approx(0.5, abs=1e-12)
+    with_conventional = _heading_table(t, yaw_tc, t >= 3.0, np.full(len(t), 1.25), ~none)
+    assert initial_yaw_offset(with_conventional, none, trajectory) == pytest.approx(1.0, abs=1e-12)

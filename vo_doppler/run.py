@@ -145,10 +145,16 @@ def initial_yaw_offset(
     The circular median of (absolute heading − trajectory yaw) over the usable tightly coupled
     headings of the ``span_s`` seconds from the first one inside the trajectory's time span, so
     that one heading that is off cannot turn the whole trajectory; without any, the conventional
-    headings the same way; without those, the trajectory starts facing east (with a warning).
+    headings the same way; without those, the reliable tightly coupled headings too vague to
+    correct (a canyon from the start: two satellites, an uncalibrated wheel scale); without
+    those, the trajectory starts facing east (with a warning).
     """
     inside = (table.t >= trajectory.t[0]) & (table.t <= trajectory.t[-1])
-    for yaw, valid in ((table.yaw_tc, tc_usable), (table.yaw_conv, table.conv_valid)):
+    for yaw, valid in (
+        (table.yaw_tc, tc_usable),
+        (table.yaw_conv, table.conv_valid),
+        (table.yaw_tc, table.tc_available & table.tc_reliable),
+    ):
         rows = np.flatnonzero(valid & inside & np.isfinite(yaw))
         if rows.size:
             rows = rows[table.t[rows] <= table.t[rows[0]] + span_s]
