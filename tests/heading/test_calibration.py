@@ -123,6 +123,29 @@ def test_low_speed_course_is_not_used_and_too_few_samples_is_unavailable():
     assert not estimate_wheel_scale(t, speed, speed, doppler_valid=valid).valid
 
 
+def test_the_gyro_bias_needs_samples_over_the_minimum_span():
+    """Exact courses give the exact bias once they span 3 s, and none before; a half-second
+    reflection episode at the start (courses 1° off) tilts a 1-s fit by 1.4 deg/s but a 3-s one
+    by a fifth of that (least squares: 6·δ·e·(T − e)/T³ for an offset δ over the first e of T
+    seconds)."""
+    t, speed, yaw_rate, yaw = _drive(n=40)
+    bias = np.radians(0.3)
+    phi = integral_at(t, yaw_rate + bias, t)
+
+    def first(span, course=yaw, config=None):
+        n = int(np.sum(t <= span + 1e-9))
+        config = config or GateConfig()
+        return estimate_gyro_bias(t[:n], course[:n], phi[:n], speed[:n], config=config)
+
+    assert not first(2.9).valid
+    assert first(3.0).value == pytest.approx(bias, abs=1e-12)
+    episode = yaw + np.where(t < 0.45, np.radians(1.0), 0.0)
+    short = GateConfig(min_bias_span_s=0.0, huber_k=np.inf)
+    tilted = {span: first(span, episode, short).value - bias for span in (1.0, 3.0)}
+    assert abs(np.degrees(tilted[1.0])) > 1.2
+    assert abs(tilted[3.0]) < 0.25 * abs(tilted[1.0])
+
+
 def test_variation_gate_keeps_neighbours_of_a_spike():
     t = np.arange(6.0)
     d = np.array([0.0, 0.0, 9.0, 0.0, 0.0, 0.0])

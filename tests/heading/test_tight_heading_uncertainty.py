@@ -94,16 +94,17 @@ def test_clock_drift_random_walk_is_inside_sigma():
 
 
 def test_few_imprecise_samples_do_not_swing_the_gyro_bias():
-    """Twelve conventional courses over 0.55 s with 1° noise: least squares alone puts the
-    bias at 5 deg/s (±1.4); combined with the prior of an uncalibrated gyro (0 ± 0.5 deg/s)
-    it stays below 1 deg/s."""
+    """Twelve conventional courses over 0.55 s with 1° noise: least squares alone, without the
+    minimum span, puts the bias at 5 deg/s (±1.4); the estimate needs samples over 3 s, and
+    the prior of an uncalibrated gyro (0 ± 0.5 deg/s) keeps it below 1 deg/s anyway."""
     t = np.arange(12) * 0.05
     rng = np.random.default_rng(8)
     course_noise = rng.normal(0.0, np.radians(1.0), len(t))
     speed = np.full(len(t), 8.0)
-    least_squares = GateConfig(huber_k=np.inf)
+    least_squares = GateConfig(huber_k=np.inf, min_bias_span_s=0.0)
     alone = estimate_gyro_bias(t, course_noise, np.zeros(len(t)), speed, config=least_squares)
     assert abs(np.degrees(alone.value)) > 4.0
+    assert not estimate_gyro_bias(t, course_noise, np.zeros(len(t)), speed).valid
     table = heading_pipeline(
         t,
         simulate_doppler(t, lambda t: 0.0 * t, _speed, AZIMUTH, ELEVATION, 2).rows,
