@@ -60,7 +60,7 @@ class GateConfig:
     min_samples: int = 10
     min_bias_span_s: float = 3.0
     """The gyro bias is a slope, so it needs samples spanning at least this long (s). Reflections
-    come in episodes of about half a second (docs/design.md (2b)); over a span not much longer,
+    come in episodes of about half a second (docs/design.md (I1)); over a span not much longer,
     one episode tilts the whole slope while the residuals' scatter, from a dozen samples, does
     not show it: on a simulated drive (clean1) the first estimate, from 0.75 s of samples, was
     −3.6 ± 1.0 °/s for a true 0.30 °/s and turned the dead reckoning by 5.8° over the 5 s until
