@@ -90,11 +90,11 @@ def series_inputs(heading_inputs):
 
 def peak_bytes(inputs, chunk_bytes: int) -> int:
     """tracemalloc's peak (numpy's arrays included) of the tight heading with a budget."""
-    (rows, t, speed, yaw, config, *rest), kwargs = inputs
-    config = replace(config, chunk_bytes=chunk_bytes)
+    args, kwargs = inputs
+    kwargs = {**kwargs, "config": replace(kwargs["config"], chunk_bytes=chunk_bytes)}
     tracemalloc.start()
     try:
-        tight_heading_series(rows, t, speed, yaw, config, *rest, **kwargs)
+        tight_heading_series(*args, **kwargs)
         return tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()

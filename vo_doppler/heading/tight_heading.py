@@ -572,38 +572,13 @@ def tight_heading_series(
         raise ValueError("epoch times must be strictly increasing")
     if m == 0:
         return _unavailable(t_epoch)
-    epoch_of_row = _match_epochs(rows.t, t_epoch, config.epoch_match_s)
-    y_all = rows.reduced()
-    usable = (
-        (epoch_of_row >= 0)
-        & np.isfinite(y_all)
-        & np.all(np.isfinite(rows.los), axis=1)
-        & (rows.weight > 0)
-    )
-    n_sat_epoch = np.bincount(epoch_of_row[usable], minlength=m)[:m]
-    epoch_safe = np.maximum(epoch_of_row, 0)
-    usable &= np.isfinite(speed[epoch_safe]) & np.isfinite(yaw_angle[epoch_safe])
-    index = np.flatnonzero(usable)
-    if len(index) == 0:
+    windows = _WindowRows.build(rows, t_epoch, speed, yaw_angle, lever, calibration, config)
+    n_sat_epoch = windows.n_sat_epoch
+    if windows.empty:
         return _unavailable(t_epoch, n_sat_epoch)
-    row_group = np.unique(rows.sat_id, return_inverse=True)[1].reshape(-1)
-    row_epoch = epoch_of_row[index]
-    lo = np.searchsorted(t_epoch[row_epoch], t_epoch - config.window_s, side="right")
-    hi = np.searchsorted(t_epoch[row_epoch], t_epoch, side="right")
-
-    width = max(int(np.max(hi - lo)), 1)
-    n_groups = int(np.max(row_group, initial=0)) + 1
+    width, n_groups, padded = windows.width, windows.n_groups, windows.padded
     size = windows_per_chunk(width, n_groups, config)
     chunks = [np.arange(start, min(start + size, m)) for start in range(0, m, size)]
-    if calibration is None:
-        calibration = (np.ones(m), np.zeros(m), np.zeros(m))
-    per_epoch = (t_epoch, speed, yaw_angle, lever, *(np.asarray(c, float) for c in calibration))
-
-    def padded(k):
-        return _padded_rows(
-            rows, (y_all, row_group), index, row_epoch, k, (lo, hi), per_epoch, width
-        )
-
     noise = None
     if len(chunks) > 1 and config.outlier_passes:
         samples = []
@@ -657,6 +632,162 @@ def tight_heading_series(
     return _decide(
         solution, model_variance, t_epoch, speed, (yaw_angle, bias_sigma), n_sat_epoch, config
     )
+
+
+MIN_SCALE_WINDOWS = 10
+"""Fewer disjoint windows with a known heading give no speed scale (:func:`speed_scale_ratio`)."""
+
+
+def speed_scale_ratio(
+    rows: DopplerRows,
+    t_epoch: np.ndarray,
+    speed: np.ndarray,
+    yaw_angle: np.ndarray,
+    yaw: np.ndarray,
+    informative: np.ndarray,
+    config: TightHeadingConfig = TightHeadingConfig(),
+    lever_velocity: np.ndarray | float = 0.0,
+    grade_prior: tuple = (0.0, None),
+    calibration: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+) -> tuple[float, float] | None:
+    """Ratio r of the true horizontal speed to ``speed``, and its σ, from the Doppler rows of
+    windows whose heading ``yaw`` is known (None with fewer than :data:`MIN_SCALE_WINDOWS`).
+
+    This project's addition, for drives whose wheel speed nothing else calibrates (a street
+    canyon from the start). With θ₀ given, the rows of :func:`tight_heading_series`'s window
+    with the speed scaled by r read y = r·(a·cos θ₀ + b·sin θ₀) + ρ₀ − α·τ + c·g, linear in r:
+    the clock terms and the grade (with its prior) are projected out as for θ₀, and
+    r_j = −Q₀₁/Q₀₀ per window, var r_j = s_j²/Q₀₀. A constant speed is not separable from the
+    clock drift, so the information comes from accelerating, braking and turning. Windows are
+    taken among ``informative`` ending at least ``config.window_s`` apart (no shared rows).
+    r is their weighted median (weights 1/var r_j). Its σ has a part that pooling reduces,
+    1.2533·s/√Σ(1/var r_j) with s the robust spread of the normalised (r_j − r)/σ_j (at least 1),
+    and one it does not: the grade prior's mean error is shared by every window (an
+    accelerometer's bias), and a prior σ_g moves r_j by |(N⁻¹)_{r,g}|/σ_g (N the window's
+    normal matrix with the prior), whose weighted mean is added in quadrature. With the two
+    highest satellites, whose lines of sight are mostly vertical, that part dominates: the grade
+    and the speed scale trade off.
+    """
+    t_epoch = np.asarray(t_epoch, dtype=float)
+    m = len(t_epoch)
+    lever = np.broadcast_to(np.asarray(lever_velocity, dtype=float), (m, 2))
+    grade_mean = np.broadcast_to(np.asarray(grade_prior[0], dtype=float), (m,))
+    grade_sigma = np.broadcast_to(
+        np.asarray(config.grade_sigma if grade_prior[1] is None else grade_prior[1], dtype=float),
+        (m,),
+    )
+    speed, yaw_angle = np.asarray(speed, dtype=float), np.asarray(yaw_angle, dtype=float)
+    windows = _WindowRows.build(rows, t_epoch, speed, yaw_angle, lever, calibration, config)
+    candidates = np.flatnonzero(np.asarray(informative, dtype=bool) & np.isfinite(yaw))
+    chosen, last = [], -np.inf
+    for k in candidates:
+        if t_epoch[k] - last >= config.window_s:
+            chosen.append(k)
+            last = t_epoch[k]
+    if windows.empty or len(chosen) < MIN_SCALE_WINDOWS:
+        return None
+    chosen = np.asarray(chosen)
+    y, a, b, tau, w, _, grade_coefficient = windows.padded(chosen)
+    theta = yaw[chosen][:, None]
+    X = np.stack([-(a * np.cos(theta) + b * np.sin(theta)), y], axis=-1)
+    use_grade = config.grade_sigma > 0
+    T, prior = linear_design(
+        tau,
+        grade_coefficient if use_grade else None,
+        (grade_mean[chosen], grade_sigma[chosen]),
+    )
+    if prior is not None:
+        prior = (prior[0][..., 1:], prior[1], prior[2])
+    Q, _, _, _, rank = projected_normal_matrix(X, T, w, prior)
+    info = Q[:, 0, 0]
+    dof = np.sum(w > 0, axis=1) - 1 - rank
+    prior_sigma = np.zeros(len(chosen))
+    if prior is not None:
+        J = np.concatenate([-X[..., :1], T], axis=-1)
+        normal = weighted_gram(J, w, J)
+        normal[:, 1:, 1:] += weighted_gram(prior[1], prior[2], prior[1])
+        gain = np.linalg.pinv(normal, hermitian=True)[:, 0, 1:]
+        prior_sigma = np.abs(np.einsum("kj,kpj,kp->k", gain, prior[1], np.sqrt(prior[2])))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = -Q[:, 0, 1] / info
+        variance = (Q[:, 1, 1] - Q[:, 0, 1] ** 2 / info) / dof / info
+    ok = (info > 0) & (dof > 0) & np.isfinite(ratio) & np.isfinite(variance) & (variance > 0)
+    if ok.sum() < MIN_SCALE_WINDOWS:
+        return None
+    ratio, weight, prior_sigma = ratio[ok], 1.0 / variance[ok], prior_sigma[ok]
+    order = np.argsort(ratio)
+    cumulative = np.cumsum(weight[order])
+    median = float(ratio[order][np.searchsorted(cumulative, 0.5 * cumulative[-1])])
+    spread = max(MAD_TO_SIGMA * float(np.median(np.abs(ratio - median) * np.sqrt(weight))), 1.0)
+    white = 1.2533 * spread / float(np.sqrt(np.sum(weight)))
+    shared = float(np.sum(weight * prior_sigma) / np.sum(weight))
+    return median, float(np.hypot(white, shared))
+
+
+@dataclass(frozen=True)
+class _WindowRows:
+    """The Doppler rows matched to epochs, and each window's rows on demand (:meth:`padded`)."""
+
+    rows: DopplerRows
+    per_row: tuple[np.ndarray, np.ndarray]
+    index: np.ndarray
+    row_epoch: np.ndarray
+    bounds: tuple[np.ndarray, np.ndarray]
+    per_epoch: tuple
+    n_sat_epoch: np.ndarray
+    width: int
+    n_groups: int
+
+    @classmethod
+    def build(cls, rows, t_epoch, speed, yaw_angle, lever, calibration, config) -> _WindowRows:
+        m = len(t_epoch)
+        epoch_of_row = _match_epochs(rows.t, t_epoch, config.epoch_match_s)
+        y_all = rows.reduced()
+        usable = (
+            (epoch_of_row >= 0)
+            & np.isfinite(y_all)
+            & np.all(np.isfinite(rows.los), axis=1)
+            & (rows.weight > 0)
+        )
+        n_sat_epoch = np.bincount(epoch_of_row[usable], minlength=m)[:m]
+        epoch_safe = np.maximum(epoch_of_row, 0)
+        usable &= np.isfinite(speed[epoch_safe]) & np.isfinite(yaw_angle[epoch_safe])
+        index = np.flatnonzero(usable)
+        row_group = np.unique(rows.sat_id, return_inverse=True)[1].reshape(-1)
+        row_epoch = epoch_of_row[index]
+        lo = np.searchsorted(t_epoch[row_epoch], t_epoch - config.window_s, side="right")
+        hi = np.searchsorted(t_epoch[row_epoch], t_epoch, side="right")
+        if calibration is None:
+            calibration = (np.ones(m), np.zeros(m), np.zeros(m))
+        per_epoch = (t_epoch, speed, yaw_angle, lever, *(np.asarray(c, float) for c in calibration))
+        return cls(
+            rows,
+            (y_all, row_group),
+            index,
+            row_epoch,
+            (lo, hi),
+            per_epoch,
+            n_sat_epoch,
+            max(int(np.max(hi - lo, initial=0)), 1),
+            int(np.max(row_group, initial=0)) + 1,
+        )
+
+    @property
+    def empty(self) -> bool:
+        return len(self.index) == 0
+
+    def padded(self, k: np.ndarray):
+        """:func:`_padded_rows` of windows ``k``."""
+        return _padded_rows(
+            self.rows,
+            self.per_row,
+            self.index,
+            self.row_epoch,
+            k,
+            self.bounds,
+            self.per_epoch,
+            self.width,
+        )
 
 
 def windows_per_chunk(width: int, n_groups: int, config: TightHeadingConfig) -> int:
