@@ -99,7 +99,7 @@ class HeadingPipelineConfig:
     do (:func:`tight_wheel_scale`) only when they pin it to this σ (relative), a sixth of the
     prior's 3 %: a scale error δ shifts a two-satellite heading by about δ rad, and that shift
     is shared by every window, which the correction cannot average away. On the simulator's
-    drives in a canyon from the start the rows give σ 0.18–0.20 % (scale within 0.04–0.25 % of
+    drives in a canyon from the start the rows give σ 0.18–0.20 % (scale within 0.04–0.26 % of
     the truth); on the comma2k19 highway minute, at an even speed, 1.45 % (the grade, which the
     two highest satellites see instead of the horizontal speed), and the scale stays at the
     prior."""
