@@ -480,15 +480,7 @@ def _error_gains(a, b, T, prior, weights, theta):
     j_theta = -a * sin_t + b * cos_t
     tau = -T[..., 1]
     J = np.concatenate([j_theta[..., None], T], axis=-1)
-    normal = weighted_gram(J, weights, J)
-    prior_variance = np.zeros(len(theta))
-    if prior is not None:
-        _, Tp, wp = prior
-        normal[:, 1:, 1:] += weighted_gram(Tp, wp, Tp)
-    normal_inv = np.linalg.pinv(normal, hermitian=True)
-    if prior is not None:
-        prior_gain = np.einsum("kj,kpj->kp", normal_inv[:, 0, 1:], Tp)
-        prior_variance = np.sum(prior_gain**2 * wp, axis=1)
+    normal_inv, prior_variance = _normal_inverse(J, weights, prior)
     g = np.einsum("kj,krj,kr->kr", normal_inv[:, 0, :], J, weights)
     tail = np.cumsum(g[:, ::-1], axis=1)[:, ::-1]
     step = np.diff(tau, axis=1, prepend=tau[:, :1])
@@ -498,6 +490,21 @@ def _error_gains(a, b, T, prior, weights, theta):
         "clock_walk_gain": np.sum(np.maximum(step, 0.0) * tail**2, axis=1),
         "prior_variance": prior_variance,
     }
+
+
+def _normal_inverse(J, weights, prior):
+    """(JᵀWJ + P)⁺ per window for the Jacobian J = [∂model/∂x, T] of one parameter x and the
+    linear parameters T, P the precision of ``prior`` (X_p, T_p, w_p) on the latter, and the
+    part of var x that the prior's σ sets: Σ_p (N⁻¹T_pᵀ)_x²·w_p (an error of the prior mean of
+    σ = 1/√w_p moves x by (N⁻¹T_pᵀ)_x·√w_p; zero without a prior)."""
+    normal = weighted_gram(J, weights, J)
+    if prior is None:
+        return np.linalg.pinv(normal, hermitian=True), np.zeros(len(J))
+    _, Tp, wp = prior
+    normal[:, 1:, 1:] += weighted_gram(Tp, wp, Tp)
+    normal_inv = np.linalg.pinv(normal, hermitian=True)
+    prior_gain = np.einsum("kj,kpj->kp", normal_inv[:, 0, 1:], Tp)
+    return normal_inv, np.sum(prior_gain**2 * wp, axis=1)
 
 
 def _robust_scale(normalised, w, config):
@@ -562,17 +569,13 @@ def tight_heading_series(
     m = len(t_epoch)
     scale_sigma = np.broadcast_to(np.asarray(speed_scale_sigma, dtype=float), (m,))
     bias_sigma = np.broadcast_to(np.asarray(gyro_bias_sigma, dtype=float), (m,))
-    lever = np.broadcast_to(np.asarray(lever_velocity, dtype=float), (m, 2))
-    grade_mean = np.broadcast_to(np.asarray(grade_prior[0], dtype=float), (m,))
-    grade_sigma = np.broadcast_to(
-        np.asarray(config.grade_sigma if grade_prior[1] is None else grade_prior[1], dtype=float),
-        (m,),
-    )
     if np.any(np.diff(t_epoch) <= 0):
         raise ValueError("epoch times must be strictly increasing")
     if m == 0:
         return _unavailable(t_epoch)
-    windows = _WindowRows.build(rows, t_epoch, speed, yaw_angle, lever, calibration, config)
+    windows = _WindowRows.build(
+        rows, t_epoch, speed, yaw_angle, lever_velocity, grade_prior, calibration, config
+    )
     n_sat_epoch = windows.n_sat_epoch
     if windows.empty:
         return _unavailable(t_epoch, n_sat_epoch)
@@ -616,7 +619,7 @@ def tight_heading_series(
                 bias_sigma[k],
                 noise,
                 grade_coefficient,
-                (grade_mean[k], grade_sigma[k]),
+                windows.grade_at(k),
             )
         )
     solution = _concatenate(solutions)
@@ -669,15 +672,10 @@ def speed_scale_ratio(
     and the speed scale trade off.
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
-    m = len(t_epoch)
-    lever = np.broadcast_to(np.asarray(lever_velocity, dtype=float), (m, 2))
-    grade_mean = np.broadcast_to(np.asarray(grade_prior[0], dtype=float), (m,))
-    grade_sigma = np.broadcast_to(
-        np.asarray(config.grade_sigma if grade_prior[1] is None else grade_prior[1], dtype=float),
-        (m,),
-    )
     speed, yaw_angle = np.asarray(speed, dtype=float), np.asarray(yaw_angle, dtype=float)
-    windows = _WindowRows.build(rows, t_epoch, speed, yaw_angle, lever, calibration, config)
+    windows = _WindowRows.build(
+        rows, t_epoch, speed, yaw_angle, lever_velocity, grade_prior, calibration, config
+    )
     candidates = np.flatnonzero(np.asarray(informative, dtype=bool) & np.isfinite(yaw))
     chosen, last = [], -np.inf
     for k in candidates:
@@ -692,22 +690,15 @@ def speed_scale_ratio(
     X = np.stack([-(a * np.cos(theta) + b * np.sin(theta)), y], axis=-1)
     use_grade = config.grade_sigma > 0
     T, prior = linear_design(
-        tau,
-        grade_coefficient if use_grade else None,
-        (grade_mean[chosen], grade_sigma[chosen]),
+        tau, grade_coefficient if use_grade else None, windows.grade_at(chosen)
     )
     if prior is not None:
         prior = (prior[0][..., 1:], prior[1], prior[2])
     Q, _, _, _, rank = projected_normal_matrix(X, T, w, prior)
     info = Q[:, 0, 0]
     dof = np.sum(w > 0, axis=1) - 1 - rank
-    prior_sigma = np.zeros(len(chosen))
-    if prior is not None:
-        J = np.concatenate([-X[..., :1], T], axis=-1)
-        normal = weighted_gram(J, w, J)
-        normal[:, 1:, 1:] += weighted_gram(prior[1], prior[2], prior[1])
-        gain = np.linalg.pinv(normal, hermitian=True)[:, 0, 1:]
-        prior_sigma = np.abs(np.einsum("kj,kpj,kp->k", gain, prior[1], np.sqrt(prior[2])))
+    jacobian = np.concatenate([-X[..., :1], T], axis=-1)
+    prior_sigma = np.sqrt(_normal_inverse(jacobian, w, prior)[1])
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = -Q[:, 0, 1] / info
         variance = (Q[:, 1, 1] - Q[:, 0, 1] ** 2 / info) / dof / info
@@ -726,7 +717,8 @@ def speed_scale_ratio(
 
 @dataclass(frozen=True)
 class _WindowRows:
-    """The Doppler rows matched to epochs, and each window's rows on demand (:meth:`padded`)."""
+    """The Doppler rows matched to epochs, each window's rows on demand (:meth:`padded`) and
+    the grade prior per epoch (:meth:`grade_at`); arguments as :func:`tight_heading_series`'s."""
 
     rows: DopplerRows
     per_row: tuple[np.ndarray, np.ndarray]
@@ -734,13 +726,21 @@ class _WindowRows:
     row_epoch: np.ndarray
     bounds: tuple[np.ndarray, np.ndarray]
     per_epoch: tuple
+    grade: tuple[np.ndarray, np.ndarray]
     n_sat_epoch: np.ndarray
     width: int
     n_groups: int
 
     @classmethod
-    def build(cls, rows, t_epoch, speed, yaw_angle, lever, calibration, config) -> _WindowRows:
+    def build(
+        cls, rows, t_epoch, speed, yaw_angle, lever_velocity, grade_prior, calibration, config
+    ) -> _WindowRows:
         m = len(t_epoch)
+        lever = np.broadcast_to(np.asarray(lever_velocity, dtype=float), (m, 2))
+        grade_sigma = config.grade_sigma if grade_prior[1] is None else grade_prior[1]
+        grade = tuple(
+            np.broadcast_to(np.asarray(v, dtype=float), (m,)) for v in (grade_prior[0], grade_sigma)
+        )
         epoch_of_row = _match_epochs(rows.t, t_epoch, config.epoch_match_s)
         y_all = rows.reduced()
         usable = (
@@ -767,6 +767,7 @@ class _WindowRows:
             row_epoch,
             (lo, hi),
             per_epoch,
+            grade,
             n_sat_epoch,
             max(int(np.max(hi - lo, initial=0)), 1),
             int(np.max(row_group, initial=0)) + 1,
@@ -775,6 +776,10 @@ class _WindowRows:
     @property
     def empty(self) -> bool:
         return len(self.index) == 0
+
+    def grade_at(self, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(μ, σ) of the grade prior of windows ``k``."""
+        return self.grade[0][k], self.grade[1][k]
 
     def padded(self, k: np.ndarray):
         """:func:`_padded_rows` of windows ``k``."""
