@@ -2,6 +2,7 @@
 truth, the calibration against truth, and an emulated street canyon.
 
     python benchmarks/real_heading.py SEQUENCE_DIR [SEQUENCE_DIR ...] [--json FILE]
+        [--calibration ls|kalman]
 
 Each folder is a sequence with ground truth, e.g. the comma2k19 minute imported by
 
@@ -31,6 +32,8 @@ fitted σ(C/N0, elevation) models are printed). Figures:
 
 from __future__ import annotations
 
+import argparse
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +45,7 @@ from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
+from vo_doppler.heading.pipeline import CALIBRATION_METHODS
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import integral_at, sample
@@ -167,9 +171,10 @@ def dead_reckoning_figures(sequence: Sequence, table: HeadingTable, config: RunC
     return {str(name): errors[name].error_per_100m_m for name in DEAD_RECKONING if name in errors}
 
 
-def evaluate(folder: Path, fit_noise: bool) -> dict:
+def evaluate(folder: Path, fit_noise: bool, calibration: str = "ls") -> dict:
     sequence = read_with_truth(folder)
     config = RunConfig()
+    config = replace(config, heading=replace(config.heading, calibration=calibration))
     obs = sequence.observations
     gnss = sequence_gnss(sequence, config, fit_noise)
     scale_truth, bias_truth = calibration_truth(sequence)
@@ -278,14 +283,18 @@ def print_variant(console: Console, name: str, figures: dict) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(add_help=False)
+    parser.add_argument("--calibration", choices=CALIBRATION_METHODS, default="ls")
+    chosen, rest = parser.parse_known_args(argv)
     return run_sequences(
         __doc__.splitlines()[0],
         ROOT / "benchmarks" / "results" / "real_heading.json",
         lambda folder, _, console: {
-            noise: evaluate(folder, noise == "fitted") for noise in ("receiver", "fitted")
+            noise: evaluate(folder, noise == "fitted", chosen.calibration)
+            for noise in ("receiver", "fitted")
         },
         print_sequence,
-        argv,
+        rest,
     )
 
 

@@ -232,7 +232,8 @@ def test_kalman_with_the_prior_equals_least_squares_with_the_prior():
 def test_kalman_stays_at_the_prior_without_informative_samples():
     assert HeadingPipelineConfig().prior_gyro_bias_sigma == PRIOR_GYRO_BIAS_SIGMA
     assert HeadingPipelineConfig().prior_wheel_scale_sigma == PRIOR_WHEEL_SCALE_SIGMA
-    kb, kw = GyroBiasKalman(), WheelScaleKalman()
+    kb = GyroBiasKalman(config=GateConfig(min_bias_span_s=0.0))  # the filter alone
+    kw = WheelScaleKalman()
     for estimate, prior, sigma in (
         (kb.estimate, 0.0, PRIOR_GYRO_BIAS_SIGMA),
         (kw.estimate, 1.0, PRIOR_WHEEL_SCALE_SIGMA),
@@ -255,6 +256,36 @@ def test_kalman_stays_at_the_prior_without_informative_samples():
     b = kb.add(1.1, 1.0 + np.radians(1.5), 0.2, 10.0)
     assert b.n_used == 2
     assert abs(np.degrees(b.value)) < 0.1 and 0.99 < b.sigma / PRIOR_GYRO_BIAS_SIGMA < 1.0
+
+
+def test_the_kalman_bias_needs_samples_spanning_the_minimum():
+    """The bias is a slope: the filter's estimate counts only once its accepted samples span
+    ``min_bias_span_s`` (as the least-squares fit's, ``GateConfig``); until then it is NaN and
+    the causal calibration holds the prior."""
+    t = np.arange(0.0, 4.0, 0.25)
+    phi = np.radians(0.4) * t  # a 0.4 deg/s bias on a straight road heading 0
+    kb = GyroBiasKalman(config=GateConfig(min_bias_span_s=3.0))
+    spans = []
+    for tk, phik in zip(t, phi, strict=True):
+        spans.append((tk - t[0], kb.add(tk, 0.0, phik, 10.0)))
+    for span, estimate in spans:
+        assert estimate.valid == (span >= 3.0)
+    assert spans[-1][1].n_used == len(t)
+    assert spans[-1][1].value == pytest.approx(np.radians(0.4), rel=0.05)
+    config = HeadingPipelineConfig(calibration="kalman")
+    cal = causal_calibration(
+        t,
+        np.full(t.size, 10.0),
+        np.zeros(t.size),
+        np.ones(t.size, bool),
+        np.full(t.size, 10.0),
+        phi,
+        config,
+    )
+    early = t < 3.0
+    np.testing.assert_array_equal(cal.bias_estimated, ~early)
+    np.testing.assert_array_equal(cal.bias[early], 0.0)
+    np.testing.assert_array_equal(cal.bias_sigma[early], config.prior_gyro_bias_sigma)
 
 
 def _comma_ground_truth():

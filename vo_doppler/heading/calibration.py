@@ -452,6 +452,16 @@ class GyroBiasKalman(_KalmanFit):
 
     index = 1
 
+    @property
+    def estimate(self) -> CalibrationEstimate:
+        """The filtered bias and its standard deviation, NaN until the accepted samples span
+        ``config.min_bias_span_s``: a bias is a slope, and over a shorter span one reflection
+        episode tilts it (:class:`GateConfig`), which the filter's σ does not show either."""
+        span = 0.0 if self._first_t is None else self._t - self._first_t
+        if span < self.config.min_bias_span_s:
+            return CalibrationEstimate(np.nan, np.nan, self.n_used, self.n_rejected)
+        return super().estimate
+
     def __init__(
         self,
         yaw_sigma_rad: float = np.radians(0.5),
@@ -467,6 +477,7 @@ class GyroBiasKalman(_KalmanFit):
         self.filter.P = np.diag([np.inf, prior_sigma**2])
         self.bias_walk = bias_walk_rad_s_per_sqrt_s
         self._gate = _StreamGate(config.max_yaw_jump_rad, config.max_yaw_drift_rad_s)
+        self._first_t: float | None = None
 
     def add(
         self,
@@ -484,7 +495,7 @@ class GyroBiasKalman(_KalmanFit):
             self.filter.x[0, 0] = float(wrap_angle(z))
             self.filter.P[0, 0] = self.filter.R[0, 0]
             self._gate.passes(t, 0.0)
-            self._t = t
+            self._t = self._first_t = t
             self.n_used = 1
             return self.estimate
         dt = max(t - self._t, 0.0)
