@@ -4,7 +4,6 @@ and the map and Allan-deviation figures (matplotlib Figure objects, rendered by 
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +13,7 @@ from vo_doppler.io.trajectory import write_tum
 from vo_doppler.lowcost.drift import DriftRow
 from vo_doppler.lowcost.pipeline import DeadReckonResult
 from vo_doppler.report.figure import new_figure
+from vo_doppler.report.json_text import json_text
 
 DRIFT_COLUMNS = (
     "variant",
@@ -145,12 +145,12 @@ def write_outputs(folder: str | Path, result: DeadReckonResult) -> dict[str, Pat
         "allan": folder / "allan_deviation.png",
     }
     write_tum(paths["trajectory"], result.selected_trajectory.trajectory())
-    paths["geojson"].write_text(json.dumps(geojson(result)))
+    paths["geojson"].write_text(json_text(geojson(result)))
     with paths["drift_table"].open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(DRIFT_COLUMNS)
         writer.writerows(drift_table_rows(result.rows))
-    paths["summary"].write_text(json.dumps(summary(result), indent=2, default=str))
+    paths["summary"].write_text(json_text(summary(result), indent=2, default=str))
     write_map_figure(paths["map"], result)
     write_allan_figure(paths["allan"], result)
     return paths

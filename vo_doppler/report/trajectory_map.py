@@ -8,13 +8,13 @@ raises no console errors there.
 from __future__ import annotations
 
 import html
-import json
 from pathlib import Path
 
 import numpy as np
 
 from vo_doppler.geo import EnuFrame, ecef_to_geodetic
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.report.json_text import json_text
 
 TRUTH = "truth"
 COLOURS = {
@@ -63,7 +63,7 @@ def write_geojson(
                 "geometry": {"type": "LineString", "coordinates": coordinates.tolist()},
             }
         )
-    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    path.write_text(json_text({"type": "FeatureCollection", "features": features}))
 
 
 def _points(positions: np.ndarray) -> str:
