@@ -10,7 +10,8 @@ import pytest
 
 from tests.conftest import require_shared
 from vo_doppler.cli import main
-from vo_doppler.io.trajectory import read_kitti, read_tum
+from vo_doppler.io.trajectory import read_kitti, read_tum, write_tum
+from vo_doppler.model.trajectory import Trajectory
 
 N = 14
 
@@ -113,3 +114,21 @@ def test_usage_and_input_errors(sequence, tmp_path, capsys):
     )
     assert code == 1
     assert f"3 timestamps for {N} images" in capsys.readouterr().err
+
+
+def test_ground_truth_on_other_times_is_not_evaluated_and_says_why(sequence, caplog):
+    folder, calib = sequence
+    poses = read_kitti(folder / "poses.txt")
+    times = np.loadtxt(folder / "times.txt")
+    elsewhere = folder / "elsewhere.tum"
+    write_tum(elsewhere, Trajectory(times + 1000.0, poses.positions, poses.orientations))
+    out = folder / "out_elsewhere"
+    command = ["vo", str(folder / "image_0"), "--calib", str(calib), "--gt", str(elsewhere)]
+    assert main([*command, "-o", str(out)]) == 0
+    stats = json.loads((out / "vo_stats.json").read_text())
+    assert "evaluation" not in stats
+    reason = stats["evaluation_skipped"]
+    assert reason.startswith(f"not evaluated against {elsewhere}: fewer than two timestamps match")
+    last = times[-1]
+    assert f"(images 0.000..{last:.3f} s, ground truth 1000.000..{last + 1000:.3f} s)" in reason
+    assert reason in caplog.text

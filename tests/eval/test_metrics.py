@@ -10,7 +10,13 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.cli import main
 from vo_doppler.eval.alignment import umeyama
-from vo_doppler.eval.metrics import evaluate, segment_lengths_note, segment_lengths_that_fit
+from vo_doppler.eval.metrics import (
+    evaluate,
+    evaluate_by_time,
+    segment_lengths_note,
+    segment_lengths_that_fit,
+    time_coverage,
+)
 from vo_doppler.io.trajectory import write_kitti, write_tum
 from vo_doppler.model.trajectory import Trajectory
 
@@ -108,3 +114,91 @@ def test_cli_eval_table_states_its_segments_and_units(tmp_path, capsys, n, expec
     assert expected in out
     assert "rotation [deg/100 m]" in out and "length [m]" in out
     assert "(sim3 alignment)" not in out and "independent of the alignment" in out
+
+
+def strict_json(text: str):
+    """``json.loads`` that rejects the bare NaN / Infinity strict readers reject."""
+
+    def refuse(word):
+        raise ValueError(f"not JSON: {word}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_a_static_path_has_no_figure_per_distance():
+    truth = straight(n=50, step=0.0)
+    turned = Rotation.from_euler("z", 2.0, degrees=True)
+    estimate = Trajectory(truth.t, truth.positions, turned * truth.orientations)
+    errors = evaluate(estimate, truth, "start")
+    assert segment_lengths_that_fit(truth.path_length) == ()
+    assert errors.segments == []
+    assert errors.mean_translation_pct is None and errors.mean_rotation_deg_per_100m is None
+    assert errors.final_drift_pct is None
+    assert errors.final_position_error_m == 0.0 and errors.ate_rmse_m == 0.0
+    assert errors.end_yaw_error_deg == pytest.approx(0.0, abs=1e-9)
+    assert errors.notes == [
+        "the ground-truth path is 0.0 m long, shorter than the 5 m that figures per distance "
+        "(error per 100 m, KITTI segment errors, drift in % of the path) need: they are not "
+        "available"
+    ]
+
+
+def test_time_coverage_and_its_note():
+    estimate_t = np.arange(0.0, 60.01, 0.05)
+    covered = time_coverage(estimate_t, estimate_t[(estimate_t >= 15.0) & (estimate_t <= 30.0)])
+    assert covered.estimate_s == pytest.approx(60.0)
+    assert covered.evaluated_s == pytest.approx(15.0)
+    assert covered.fraction == pytest.approx(0.25)
+    assert covered.starts_after_s == pytest.approx(15.0)
+    assert covered.ends_before_s == pytest.approx(30.0)
+    assert covered.note() == (
+        "only 15.0 s of the 60.0 s of the estimate (25%) were evaluated, from 15.00 s after its "
+        "first pose to 30.00 s before its last: the ground truth covers no more of it in time"
+    )
+    last_sample_missing = time_coverage(estimate_t, estimate_t[:-2])
+    assert last_sample_missing.ends_before_s == pytest.approx(0.1)
+    assert last_sample_missing.note() is None
+
+
+def test_evaluate_by_time_on_a_partial_overlap_and_none():
+    truth = straight(n=121)
+    assert evaluate_by_time(truth, truth.subset(slice(30, 61))).coverage.fraction == 0.25
+    errors = evaluate_by_time(truth, truth.subset(slice(30, 61)))
+    assert errors.path_length_m == pytest.approx(30.0)
+    assert errors.notes[0].startswith("only 30.0 s of the 120.0 s of the estimate (25%)")
+    far = Trajectory(truth.t + 1000.0, truth.positions, truth.orientations)
+    assert evaluate_by_time(truth, far) is None
+
+
+def test_cli_eval_static_path_json_is_valid_with_nulls(tmp_path, capsys, caplog):
+    truth = straight(n=40, step=0.0)
+    write_tum(tmp_path / "gt.tum", truth)
+    code = main(["eval", str(tmp_path / "gt.tum"), str(tmp_path / "gt.tum"), "--json"])
+    assert code == 0
+    captured = capsys.readouterr()
+    figures = strict_json(captured.out)
+    assert figures["mean_translation_pct"] is None and figures["final_drift_pct"] is None
+    assert figures["mean_rotation_deg_per_100m"] is None and figures["segments"] == []
+    assert "shorter than the 5 m" in caplog.text
+
+
+def test_cli_eval_static_path_table_shows_no_segment_and_a_dash(tmp_path, capsys):
+    truth = straight(n=40, step=0.0)
+    write_tum(tmp_path / "gt.tum", truth)
+    assert main(["eval", str(tmp_path / "gt.tum"), str(tmp_path / "gt.tum")]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "Segment errors: none, the ground-truth path is 0.0 m long" in out
+    assert "(— % of path)" in out and "deg/100 m" not in out
+
+
+def test_cli_eval_says_how_much_of_the_estimate_it_evaluated(tmp_path, capsys, caplog):
+    truth = straight(n=121)
+    write_tum(tmp_path / "est.tum", truth)
+    write_tum(tmp_path / "gt.tum", truth.subset(slice(30, 61)))
+    assert main(["eval", str(tmp_path / "est.tum"), str(tmp_path / "gt.tum")]) == 0
+    captured = capsys.readouterr()
+    assert "evaluated 30.0 s of the estimate's 120.0 s (25%)" in " ".join(captured.out.split())
+    assert "only 30.0 s of the 120.0 s of the estimate (25%) were evaluated" in caplog.text
+    assert main(["eval", str(tmp_path / "est.tum"), str(tmp_path / "gt.tum"), "--json"]) == 0
+    coverage = strict_json(capsys.readouterr().out)["coverage"]
+    assert coverage["fraction"] == pytest.approx(0.25) and coverage["starts_after_s"] == 30.0

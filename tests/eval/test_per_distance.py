@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.eval.per_distance import error_per_100m
+from vo_doppler.eval.per_distance import MIN_PATH_M, error_per_100m, too_short_for_distance_figures
 from vo_doppler.model.trajectory import Trajectory
 
 
@@ -58,3 +58,21 @@ def test_horizontal_error_ignores_height_drift():
     estimate = Trajectory(truth.t, climbing, truth.orientations)
     assert error_per_100m(estimate, truth).mean_m_per_100m == pytest.approx(1.0, rel=1e-9)
     assert error_per_100m(estimate, truth, horizontal=True).max_m_per_100m == pytest.approx(0.0)
+
+
+@pytest.mark.parametrize(("n", "step"), [(50, 0.0), (50, 1e-9), (50, 0.1)])
+def test_a_path_shorter_than_the_minimum_has_no_figure(n, step):
+    truth = line(n, step)
+    estimate = Trajectory(truth.t, truth.positions + np.array([0.0, 0.01, 0.0]), truth.orientations)
+    result = error_per_100m(estimate, truth)
+    assert result.mean_m_per_100m is None and result.max_m_per_100m is None
+    assert result.n_windows == 0 and result.errors_m.size == 0
+
+
+def test_the_minimum_path_is_the_boundary():
+    assert too_short_for_distance_figures(MIN_PATH_M) is None
+    reason = too_short_for_distance_figures(MIN_PATH_M - 0.1)
+    assert reason.startswith("the ground-truth path is 4.9 m long, shorter than the 5 m")
+    truth = line(51, MIN_PATH_M / 50)
+    estimate = Trajectory(truth.t, truth.positions * 1.01, truth.orientations)
+    assert error_per_100m(estimate, truth).mean_m_per_100m == pytest.approx(1.0, rel=1e-9)

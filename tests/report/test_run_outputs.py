@@ -1,13 +1,27 @@
 """Releasing a written figure: its reference cycles are collected, and when the caller froze
-what was alive, what survives the collection is frozen too (later passes skip it)."""
+what was alive, what survives the collection is frozen too (later passes skip it). The
+evaluation against a ground truth that covers part of the drive, none of it, or a path that
+does not move: every other output is written, and the summary says what was not evaluated."""
 
 from __future__ import annotations
 
+import dataclasses
 import gc
+import html
+import json
 import weakref
+from pathlib import Path
 
+import numpy as np
+import pytest
+
+from vo_doppler.io.sequence import read_sequence
+from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.report import run_outputs
 from vo_doppler.report.figure import new_figure
-from vo_doppler.report.run_outputs import release_figures
+from vo_doppler.report.run_outputs import SUMMARY_FILE, release_figures, write_run_outputs
+from vo_doppler.run import RunConfig, run_sequence
+from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
 
 def _tracked(value: object) -> bool:
@@ -42,3 +56,72 @@ def test_without_a_freeze_nothing_is_frozen():
     assert figure() is None
     assert gc.get_freeze_count() == 0
     assert _tracked(survivor)
+
+
+@pytest.fixture(scope="module")
+def drive_run(tmp_path_factory):
+    """A 10 s generated drive without images, its inputs and its run (the stages only)."""
+    folder = tmp_path_factory.mktemp("eval_drive") / "seq"
+    simulate_urban_canyon(folder, UrbanCanyonConfig(duration_s=10.0, seed=3, render=False))
+    sequence = read_sequence(folder)
+    return sequence, run_sequence(sequence)
+
+
+def _write(drive_run, out: Path, truth: Trajectory | None) -> dict:
+    sequence, result = drive_run
+    summary = write_run_outputs(
+        dataclasses.replace(sequence, truth=truth), result, RunConfig(), out
+    )
+    written = (out / SUMMARY_FILE).read_text()
+    assert json.loads(written, parse_constant=lambda word: 1 / 0) is not None
+    for name in ("trajectory_dr.tum", "heading.csv", "trajectories.png", "report.html"):
+        assert (out / name).stat().st_size > 0, name
+    return summary
+
+
+def test_a_ground_truth_starting_late_is_evaluated_over_the_overlap(drive_run, tmp_path):
+    truth = drive_run[0].truth
+    late = truth.subset(np.flatnonzero(truth.t >= truth.t[0] + 0.46))
+    summary = _write(drive_run, tmp_path, late)
+    dr = summary["evaluation"]["dr"]
+    assert dr["coverage"]["starts_after_s"] == pytest.approx(0.46, abs=0.05)
+    assert dr["error_per_100m_m"] is not None and (tmp_path / "error_per_100m.png").is_file()
+    (warning,) = [w for w in summary["warnings"] if "were evaluated" in w]
+    assert warning.startswith("wheel + gyro DR alone, wheel + gyro DR + GPS (conventional)")
+    assert "after its first pose" in warning
+    assert html.escape(warning) in (tmp_path / "report.html").read_text()
+
+
+def test_a_ground_truth_from_another_time_skips_the_evaluation_and_keeps_the_rest(
+    drive_run, tmp_path
+):
+    truth = drive_run[0].truth
+    elsewhere = Trajectory(truth.t + 1000.0, truth.positions, truth.orientations)
+    summary = _write(drive_run, tmp_path, elsewhere)
+    assert "evaluation" not in summary and not (tmp_path / "error_per_100m.png").exists()
+    assert any(w.startswith("not evaluated: wheel + gyro DR alone") for w in summary["warnings"])
+    assert "The ground truth could not be used" in (tmp_path / "report.html").read_text()
+
+
+def test_a_static_ground_truth_has_no_figure_per_distance(drive_run, tmp_path):
+    truth = drive_run[0].truth
+    still = Trajectory(truth.t, np.repeat(truth.positions[:1], len(truth), 0), truth.orientations)
+    summary = _write(drive_run, tmp_path, still)
+    for figures in summary["evaluation"].values():
+        assert figures["error_per_100m_m"] is None and figures["kitti_translation_pct"] is None
+    assert any("shorter than the 5 m" in w for w in summary["warnings"])
+    report = (tmp_path / "report.html").read_text()
+    assert "too short for errors per distance" in report and "<td>—</td>" in report
+
+
+def test_a_failing_evaluation_becomes_a_warning(drive_run, tmp_path, monkeypatch):
+    def broken(*_):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(run_outputs, "evaluate_pipelines", broken)
+    summary = _write(drive_run, tmp_path, drive_run[0].truth)
+    assert "evaluation" not in summary
+    assert any(
+        "evaluation against the ground truth failed (RuntimeError: boom" in w
+        for w in summary["warnings"]
+    )

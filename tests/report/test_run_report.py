@@ -9,6 +9,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tests.conftest import REPO_ROOT
+from tests.helpers.heading_table import plain_heading_table
 from vo_doppler.eval.pipelines import PipelineErrors
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
 from vo_doppler.io.sequence import read_manifest, read_sequence
@@ -61,19 +62,7 @@ def test_vo_alone_heading_use_is_a_dash_not_zero():
 
 
 def _table(n: int = 40) -> HeadingTable:
-    t = 100.0 + 0.1 * np.arange(n)
-    return HeadingTable(
-        t=t,
-        yaw_tc=np.zeros(n),
-        sigma_tc=np.full(n, np.radians(0.5)),
-        tc_reliable=np.ones(n, bool),
-        n_obs_window=np.full(n, 60),
-        n_sat_epoch=np.full(n, 3),
-        yaw_conv=np.zeros(n),
-        conv_valid=np.zeros(n, bool),
-        gyro_bias=np.zeros(n),
-        wheel_scale=np.ones(n),
-    )
+    return plain_heading_table(100.0 + 0.1 * np.arange(n), conv_valid=np.zeros(n, bool))
 
 
 def test_worst_errors_list_reliable_epochs_with_their_use_and_satellites():

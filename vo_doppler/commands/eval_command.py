@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import json
+import logging
 import sys
 
 import numpy as np
@@ -13,8 +13,18 @@ from rich.table import Table
 
 from vo_doppler.errors import InputError
 from vo_doppler.eval.alignment import ALIGNMENTS
-from vo_doppler.eval.metrics import TrajectoryErrors, associate, evaluate, segment_lengths_note
+from vo_doppler.eval.metrics import (
+    NO_MATCH,
+    TrajectoryErrors,
+    evaluate,
+    evaluate_by_time,
+    segment_lengths_note,
+)
 from vo_doppler.io.trajectory import read_trajectory
+from vo_doppler.report.json_text import json_text
+from vo_doppler.report.run_report import number_or_dash
+
+log = logging.getLogger(__name__)
 
 UP_AXES = {"z": (0.0, 0.0, 1.0), "-y": (0.0, -1.0, 0.0), "y": (0.0, 1.0, 0.0)}
 
@@ -67,22 +77,32 @@ def run(args: argparse.Namespace) -> int:
                 "(KITTI rows are matched one to one)",
                 args.estimate,
             )
+        errors = evaluate(estimate, truth, args.align, up(args.up, kitti_rows))
     else:
-        estimate, truth = associate(estimate, truth)
-        if len(estimate) < 2:
-            raise InputError("fewer than two timestamps match the ground truth", args.estimate)
-    up_name = args.up if args.up != "auto" else ("-y" if kitti_rows else "z")
-    errors = evaluate(estimate, truth, args.align, np.array(UP_AXES[up_name]))
+        errors = evaluate_by_time(estimate, truth, args.align, up(args.up, kitti_rows))
+        if errors is None:
+            raise InputError(NO_MATCH, args.estimate)
+    for text in errors.notes:
+        log.warning("%s", text)
     if args.json:
-        print(json.dumps(errors.to_dict(), indent=2))
+        print(json_text(errors.to_dict(), indent=2))
     else:
         print_errors(errors)
     return 0
 
 
+def up(name: str, kitti_rows: bool) -> np.ndarray:
+    """The world up axis of ``--up`` (auto: -y for KITTI camera poses, else z)."""
+    return np.array(UP_AXES[name if name != "auto" else ("-y" if kitti_rows else "z")])
+
+
 def print_errors(errors: TrajectoryErrors) -> None:
     console = Console(width=None if sys.stdout.isatty() else 120)
     lengths = tuple(s.length_m for s in errors.segments)
+    if not lengths:
+        console.print(
+            f"Segment errors: none, {segment_lengths_note(lengths, errors.path_length_m)}"
+        )
     table = Table(
         title="Segment errors (KITTI devkit: relative poses, independent of the alignment)",
         caption=segment_lengths_note(lengths, errors.path_length_m),
@@ -97,10 +117,18 @@ def print_errors(errors: TrajectoryErrors) -> None:
             f"{s.rotation_deg_per_100m:.4f}",
             str(s.count),
         )
-    console.print(table)
+    if lengths:
+        console.print(table)
+    evaluated = ""
+    if errors.coverage is not None:
+        evaluated = (
+            f" | evaluated {errors.coverage.evaluated_s:.1f} s of the estimate's "
+            f"{errors.coverage.estimate_s:.1f} s ({errors.coverage.fraction:.0%})"
+        )
     console.print(
         f"{errors.alignment} alignment: path {errors.path_length_m:.1f} m | final error "
-        f"{errors.final_position_error_m:.3f} m "
-        f"({errors.final_drift_pct:.3f} % of path) | end yaw error "
-        f"{errors.end_yaw_error_deg:.3f} deg | ATE RMSE {errors.ate_rmse_m:.3f} m"
+        f"{number_or_dash(errors.final_position_error_m, '{:.3f}')} m "
+        f"({number_or_dash(errors.final_drift_pct, '{:.3f}')} % of path) | end yaw error "
+        f"{number_or_dash(errors.end_yaw_error_deg, '{:.3f}')} deg | ATE RMSE "
+        f"{number_or_dash(errors.ate_rmse_m, '{:.3f}')} m{evaluated}"
     )

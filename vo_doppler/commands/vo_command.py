@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 from pathlib import Path
 
@@ -11,8 +10,9 @@ import numpy as np
 from rich.progress import Progress
 
 from vo_doppler.commands.arg_types import window_size
+from vo_doppler.commands.time_hints import span
 from vo_doppler.errors import InputError
-from vo_doppler.eval.metrics import associate, evaluate
+from vo_doppler.eval.metrics import NO_MATCH, evaluate_by_time
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import (
     find_times_file,
@@ -24,7 +24,9 @@ from vo_doppler.io.images import (
 from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
 from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
+from vo_doppler.report.json_text import json_text
 from vo_doppler.report.plots import plot_top_view
+from vo_doppler.report.run_report import number_or_dash
 from vo_doppler.vo.batch import run_visual_odometry
 from vo_doppler.vo.config import VoConfig
 
@@ -115,11 +117,19 @@ def run(args: argparse.Namespace) -> int:
     curves = {"VO" if output.metric else "VO (arbitrary scale)": output.trajectory}
     if args.gt is not None:
         truth = read_trajectory(args.gt, times=times)
-        estimate, matched = associate(output.trajectory, truth)
-        if len(estimate) >= 2:
-            stats["evaluation"] = evaluate(estimate, matched, "start", CAMERA_UP).to_dict()
+        errors = evaluate_by_time(output.trajectory, truth, "start", CAMERA_UP)
+        if errors is None:
+            stats["evaluation_skipped"] = (
+                f"not evaluated against {args.gt}: {NO_MATCH} (images {span(times)}, ground "
+                f"truth {span(truth.t)})"
+            )
+            log.warning("%s", stats["evaluation_skipped"])
+        else:
+            stats["evaluation"] = errors.to_dict()
+            for text in errors.notes:
+                log.warning("%s", text)
         curves["ground truth"] = truth
-    (args.output / "vo_stats.json").write_text(json.dumps(stats, indent=2))
+    (args.output / "vo_stats.json").write_text(json_text(stats, indent=2))
     plot_top_view(curves, args.output / "trajectory.png", ("x", "z"), "Top view (camera frame)")
     print(
         f"{stats['frames']} frames, {stats['keyframes']} keyframes, {stats['fps']:.1f} fps, "
@@ -130,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
         figures = stats["evaluation"]
         print(
             f"final error {figures['final_position_error_m']:.3f} m "
-            f"({figures['final_drift_pct']:.2f} % of path), end yaw error "
+            f"({number_or_dash(figures['final_drift_pct'], '{:.2f}')} % of path), end yaw error "
             f"{figures['end_yaw_error_deg']:.3f} deg, ATE {figures['ate_rmse_m']:.3f} m"
         )
     print(f"wrote {args.output}/trajectory.tum, trajectory.kitti, vo_stats.json, trajectory.png")

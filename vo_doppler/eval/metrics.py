@@ -3,6 +3,8 @@
 Segment errors follow the KITTI odometry devkit: for every start frame and segment length L,
 the end frame is the first whose ground-truth path distance from the start is ≥ L; the error is
 the relative pose ``inv(ΔT_gt) · ΔT_est``, translation in % of L and rotation in degrees per 100 m.
+On a path shorter than :data:`vo_doppler.eval.per_distance.MIN_PATH_M` no figure per distance
+is computed (``None``, with the reason in ``notes``).
 """
 
 from __future__ import annotations
@@ -13,10 +15,58 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.eval.alignment import align
+from vo_doppler.eval.per_distance import too_short_for_distance_figures
 from vo_doppler.model.trajectory import Trajectory
 
 KITTI_SEGMENT_LENGTHS_M = (100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 700.0, 800.0)
 SHORT_SEGMENT_LENGTHS_M = (10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0)
+MATCH_MAX_DT_S = 0.02
+"""Largest time difference (s) between an estimated pose and the ground-truth pose it is
+matched with."""
+COVERAGE_TOLERANCE_S = 0.25
+"""Time of an estimate left out of its evaluation (s) that goes unmentioned: a ground truth
+sampled at 10-20 Hz commonly ends a sample before the estimate."""
+
+
+@dataclass
+class Coverage:
+    """The part of an estimate's time span that was evaluated (it has ground truth)."""
+
+    estimate_s: float
+    """The estimate's time span (s)."""
+    evaluated_s: float
+    """The evaluated poses' time span (s)."""
+    fraction: float
+    """``evaluated_s / estimate_s`` (1 for an estimate of one instant)."""
+    starts_after_s: float
+    """Time from the estimate's first pose to the first evaluated one (s)."""
+    ends_before_s: float
+    """Time from the last evaluated pose to the estimate's last one (s)."""
+
+    def note(self, what: str = "the estimate") -> str | None:
+        """A sentence saying how much of ``what`` was evaluated, when more than
+        :data:`COVERAGE_TOLERANCE_S` was left out; else None."""
+        if self.starts_after_s + self.ends_before_s <= COVERAGE_TOLERANCE_S:
+            return None
+        return (
+            f"only {self.evaluated_s:.1f} s of the {self.estimate_s:.1f} s of {what} "
+            f"({self.fraction:.0%}) were evaluated, from {self.starts_after_s:.2f} s after its "
+            f"first pose to {self.ends_before_s:.2f} s before its last: the ground truth covers "
+            "no more of it in time"
+        )
+
+
+def time_coverage(estimate_t: np.ndarray, evaluated_t: np.ndarray) -> Coverage:
+    """How much of the span of ``estimate_t`` the (non-empty, sorted) ``evaluated_t`` cover."""
+    total = float(estimate_t[-1] - estimate_t[0])
+    evaluated = float(evaluated_t[-1] - evaluated_t[0])
+    return Coverage(
+        estimate_s=total,
+        evaluated_s=evaluated,
+        fraction=evaluated / total if total > 0 else 1.0,
+        starts_after_s=float(evaluated_t[0] - estimate_t[0]),
+        ends_before_s=float(estimate_t[-1] - evaluated_t[-1]),
+    )
 
 
 @dataclass
@@ -29,22 +79,32 @@ class SegmentError:
 
 @dataclass
 class TrajectoryErrors:
+    """The figures of :func:`evaluate`; ``None`` where a figure is not available (``notes``
+    says why), never a number that means nothing."""
+
     path_length_m: float
     alignment: str
     segments: list[SegmentError] = field(default_factory=list)
-    mean_translation_pct: float = float("nan")
-    mean_rotation_deg_per_100m: float = float("nan")
-    final_position_error_m: float = float("nan")
-    final_drift_pct: float = float("nan")
-    end_yaw_error_deg: float = float("nan")
-    ate_rmse_m: float = float("nan")
+    mean_translation_pct: float | None = None
+    mean_rotation_deg_per_100m: float | None = None
+    final_position_error_m: float | None = None
+    final_drift_pct: float | None = None
+    end_yaw_error_deg: float | None = None
+    ate_rmse_m: float | None = None
+    coverage: Coverage | None = None
+    """The share of the estimate evaluated, when rows were matched by time."""
+    notes: list[str] = field(default_factory=list)
+    """Why figures are missing or cover only part of the estimate."""
 
     def to_dict(self) -> dict:
         return asdict(self)
 
 
 def segment_lengths_that_fit(path_length: float) -> tuple[float, ...]:
-    """KITTI's 100…800 m lengths that fit the path; on short paths 10…80 m; else half the path."""
+    """KITTI's 100…800 m lengths that fit the path; on short paths 10…80 m; else half the path;
+    none on a path too short for figures per distance."""
+    if too_short_for_distance_figures(path_length):
+        return ()
     for lengths in (KITTI_SEGMENT_LENGTHS_M, SHORT_SEGMENT_LENGTHS_M):
         fit = tuple(length for length in lengths if length < path_length)
         if fit:
@@ -55,7 +115,9 @@ def segment_lengths_that_fit(path_length: float) -> tuple[float, ...]:
 def segment_lengths_note(lengths: tuple[float, ...], path_length: float) -> str:
     """Which segment lengths the errors use, in words (KITTI's or shorter ones, and why)."""
     if not lengths:
-        return f"no segment fits the {path_length:.0f} m path"
+        return too_short_for_distance_figures(path_length) or (
+            f"no segment fits the {path_length:.0f} m path"
+        )
     listed = ", ".join(f"{length:.0f}" for length in lengths)
     if lengths[0] >= KITTI_SEGMENT_LENGTHS_M[0]:
         return f"KITTI segments of {listed} m (those of KITTI's 100-800 m that fit the path)"
@@ -129,9 +191,12 @@ def evaluate(
         result.mean_rotation_deg_per_100m = float(
             np.average([s.rotation_deg_per_100m for s in segments], weights=weights)
         )
+    else:
+        result.notes.append(segment_lengths_note((), path_length))
     final_error = float(np.linalg.norm(aligned.positions[-1] - truth.positions[-1]))
     result.final_position_error_m = final_error
-    result.final_drift_pct = 100.0 * final_error / path_length if path_length > 0 else float("nan")
+    if not too_short_for_distance_figures(path_length):
+        result.final_drift_pct = 100.0 * final_error / path_length
     yaw_est = yaw_about(aligned.orientations[-1:], up)[0]
     yaw_gt = yaw_about(truth.orientations[-1:], up)[0]
     result.end_yaw_error_deg = float(np.degrees(np.angle(np.exp(1j * (yaw_est - yaw_gt)))))
@@ -140,7 +205,7 @@ def evaluate(
     return result
 
 
-def associate(estimate: Trajectory, truth: Trajectory, max_dt: float = 0.02) -> tuple:
+def associate(estimate: Trajectory, truth: Trajectory, max_dt: float = MATCH_MAX_DT_S) -> tuple:
     """Match rows by nearest timestamp within ``max_dt``; returns the matched pair."""
     index = np.clip(np.searchsorted(truth.t, estimate.t), 1, max(len(truth) - 1, 1))
     left = np.maximum(index - 1, 0)
@@ -149,6 +214,31 @@ def associate(estimate: Trajectory, truth: Trajectory, max_dt: float = 0.02) -> 
     )
     ok = np.abs(truth.t[nearer] - estimate.t) <= max_dt
     return estimate.subset(np.flatnonzero(ok)), truth.subset(nearer[ok])
+
+
+NO_MATCH = f"fewer than two timestamps match the ground truth's (within {MATCH_MAX_DT_S:g} s)"
+"""Why an estimate could not be evaluated by time."""
+
+
+def evaluate_by_time(
+    estimate: Trajectory,
+    truth: Trajectory,
+    alignment: str = "start",
+    up: np.ndarray | None = None,
+    max_dt: float = MATCH_MAX_DT_S,
+) -> TrajectoryErrors | None:
+    """:func:`evaluate` on the poses whose times match the ground truth's (:func:`associate`),
+    with the share of the estimate they cover (``coverage``, and a note when part is left out);
+    None when fewer than two match (:data:`NO_MATCH` says so)."""
+    matched, matched_truth = associate(estimate, truth, max_dt)
+    if len(matched) < 2:
+        return None
+    errors = evaluate(matched, matched_truth, alignment, up)
+    errors.coverage = time_coverage(estimate.t, matched.t)
+    note = errors.coverage.note()
+    if note:
+        errors.notes.insert(0, note)
+    return errors
 
 
 def attitude_roughness_deg(truth: Trajectory) -> np.ndarray:

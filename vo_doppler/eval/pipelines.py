@@ -1,5 +1,6 @@
 """Side-by-side evaluation of the pipelines' vehicle trajectories against ground truth:
-error per 100 m, KITTI segment errors, heading RMSE and heading availability."""
+error per 100 m, KITTI segment errors, heading RMSE and heading availability, over the time the
+ground truth covers (a reference system often starts late or stops early)."""
 
 from __future__ import annotations
 
@@ -8,8 +9,12 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from vo_doppler.eval.metrics import evaluate
-from vo_doppler.eval.per_distance import ErrorPerDistance, error_per_100m
+from vo_doppler.eval.metrics import Coverage, evaluate, time_coverage
+from vo_doppler.eval.per_distance import (
+    ErrorPerDistance,
+    error_per_100m,
+    too_short_for_distance_figures,
+)
 from vo_doppler.geo import wrap_angle, yaw_of
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
@@ -28,17 +33,21 @@ UNCORRECTED = ("vo", "dr")
 
 @dataclass
 class PipelineErrors:
-    """``error_per_100m_*`` are horizontal (east/north); ``error_per_100m_3d_m`` adds height."""
+    """``error_per_100m_*`` are horizontal (east/north); ``error_per_100m_3d_m`` adds height.
+    A figure per distance is ``None`` on a path too short for it
+    (:func:`vo_doppler.eval.per_distance.too_short_for_distance_figures`)."""
 
-    error_per_100m_m: float
-    error_per_100m_max_m: float
-    error_per_100m_3d_m: float
-    kitti_translation_pct: float
-    kitti_rotation_deg_per_100m: float
+    error_per_100m_m: float | None
+    error_per_100m_max_m: float | None
+    error_per_100m_3d_m: float | None
+    kitti_translation_pct: float | None
+    kitti_rotation_deg_per_100m: float | None
     heading_rmse_deg: float
     heading_availability: float
     final_position_error_m: float
     path_length_m: float
+    coverage: Coverage | None = None
+    """The part of the trajectory's time span inside the ground truth's (the part evaluated)."""
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -65,6 +74,8 @@ def heading_rmse_deg(estimate: Trajectory, truth: Trajectory) -> float:
 def evaluate_trajectory(
     estimate: Trajectory, truth: Trajectory, availability: float
 ) -> tuple[PipelineErrors, ErrorPerDistance]:
+    """The errors of ``estimate`` over the times inside the ground truth's span (at least two
+    of its poses must be: see :func:`overlap`)."""
     matched_truth, inside = truth_at(truth, estimate.t)
     matched = estimate.subset(np.flatnonzero(inside))
     per_100m = error_per_100m(matched, matched_truth, horizontal=True)
@@ -82,27 +93,35 @@ def evaluate_trajectory(
             np.linalg.norm(matched.positions[-1, :2] - matched_truth.positions[-1, :2])
         ),
         path_length_m=matched_truth.path_length,
+        coverage=time_coverage(estimate.t, matched.t),
     )
     return errors, per_100m
 
 
-def align_start_to_truth(estimate: Trajectory, truth: Trajectory) -> Trajectory:
-    """Translate the estimate so that its first position is the truth's at that time."""
-    start, _ = truth_at(truth, estimate.t[:1])
-    return estimate.transformed(np.eye(3), start.positions[0] - estimate.positions[0])
+def overlap(estimate: Trajectory, truth: Trajectory) -> np.ndarray:
+    """Indices of the estimate's poses inside the ground truth's time span."""
+    return np.flatnonzero((estimate.t >= truth.t[0]) & (estimate.t <= truth.t[-1]))
 
 
-def with_initial_heading(estimate: Trajectory, truth: Trajectory) -> Trajectory:
-    """Rotate the estimate about its start so its first yaw equals the truth's there."""
-    start, _ = truth_at(truth, estimate.t[:1])
+def align_start_to_truth(estimate: Trajectory, truth: Trajectory, first: int = 0) -> Trajectory:
+    """Translate the estimate so that its position at pose ``first`` (the first inside the
+    ground truth's span) is the truth's at that time."""
+    start, _ = truth_at(truth, estimate.t[first : first + 1])
+    return estimate.transformed(np.eye(3), start.positions[0] - estimate.positions[first])
+
+
+def with_initial_heading(estimate: Trajectory, truth: Trajectory, first: int = 0) -> Trajectory:
+    """Rotate the estimate about its pose ``first`` (the first inside the ground truth's span)
+    so that its yaw there equals the truth's."""
+    start, _ = truth_at(truth, estimate.t[first : first + 1])
     turn = float(
         wrap_angle(
             yaw_of(start.orientations.as_matrix())[0]
-            - yaw_of(estimate.orientations[:1].as_matrix())[0]
+            - yaw_of(estimate.orientations[first : first + 1].as_matrix())[0]
         )
     )
     rotation = Rotation.from_euler("z", turn).as_matrix()
-    origin = estimate.positions[0]
+    origin = estimate.positions[first]
     return estimate.transformed(rotation, origin - rotation @ origin)
 
 
@@ -127,14 +146,58 @@ def evaluate_pipelines(
     truth: Trajectory,
 ) -> tuple[dict[str, PipelineErrors], dict[str, ErrorPerDistance], dict[str, Trajectory]]:
     """Errors of every pipeline, its per-window errors, and the trajectories as evaluated:
-    translated to the truth's start, the uncorrected ones also turned to the truth's initial
-    heading."""
+    translated to the truth at their first pose inside the truth's time span, the uncorrected
+    ones also turned to the truth's heading there.
+
+    Only the time the ground truth covers is evaluated (``PipelineErrors.coverage`` says how
+    much); a trajectory with fewer than two poses in it is left out of all three dictionaries
+    (:func:`evaluation_warnings` says so)."""
     availability = heading_availability(table, tc_usable)
     errors, per_100m, shown = {}, {}, {}
     for name, trajectory in trajectories.items():
-        estimate = with_initial_heading(trajectory, truth) if name in UNCORRECTED else trajectory
-        shown[name] = align_start_to_truth(estimate, truth)
+        inside = overlap(trajectory, truth)
+        if inside.size < 2:
+            continue
+        first = int(inside[0])
+        estimate = trajectory
+        if name in UNCORRECTED:
+            estimate = with_initial_heading(trajectory, truth, first)
+        shown[name] = align_start_to_truth(estimate, truth, first)
         errors[name], per_100m[name] = evaluate_trajectory(
             shown[name], truth, availability.get(name, float("nan"))
         )
     return errors, per_100m, shown
+
+
+def evaluation_warnings(
+    trajectories: dict[str, Trajectory], errors: dict[str, PipelineErrors], truth: Trajectory
+) -> list[str]:
+    """What the evaluation of :func:`evaluate_pipelines` could not do, in sentences: the
+    trajectories the ground truth does not cover, the part of the others it covers when that
+    is not all of them, and the figures a too short path leaves out."""
+    found = []
+    missing = [name for name in trajectories if name not in errors]
+    if missing:
+        names = ", ".join(PIPELINE_LABELS.get(name, name) for name in missing)
+        spans = [trajectories[name].t for name in missing]
+        first, last = min(t[0] for t in spans), max(t[-1] for t in spans)
+        found.append(
+            f"not evaluated: {names}: the ground truth (GPS time {truth.t[0]:.2f} to "
+            f"{truth.t[-1]:.2f} s) covers fewer than two of their poses "
+            f"({first:.2f} to {last:.2f} s)"
+        )
+    partial: dict[str, list[str]] = {}
+    for name, error in errors.items():
+        if error.coverage is not None and error.coverage.note() is not None:
+            partial.setdefault(error.coverage.note(), []).append(name)
+    for names in partial.values():
+        what = "the trajectory" if len(names) == 1 else "each trajectory"
+        found.append(
+            f"{', '.join(PIPELINE_LABELS.get(name, name) for name in names)}: "
+            f"{errors[names[0]].coverage.note(what)} (moved to the truth's position at the "
+            "first pose evaluated)"
+        )
+    lengths = {error.path_length_m for error in errors.values()}
+    short = {too_short_for_distance_figures(length) for length in lengths} - {None}
+    found += sorted(short)
+    return found

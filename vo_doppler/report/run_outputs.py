@@ -5,7 +5,6 @@
 from __future__ import annotations
 
 import gc
-import json
 import logging
 from pathlib import Path
 
@@ -19,14 +18,16 @@ from vo_doppler.checks import (
 )
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
-from vo_doppler.eval.pipelines import evaluate_pipelines
+from vo_doppler.eval.pipelines import evaluate_pipelines, evaluation_warnings
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.io.sequence import InputReport
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import travelled_distance
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.heading_figure import build_heading_figure
+from vo_doppler.report.json_text import json_text
 from vo_doppler.report.provenance import (
     command_line,
     config_rows,
@@ -234,7 +235,6 @@ def write_run_outputs(
     summary["heading_correction"] = correction_label(config)
     summary.update(checks or {})
     table, truth = result.heading, sequence.truth
-    heading_t0 = float(table.t[0]) if len(table) else 0.0
     report = RunReport(
         title=f"vo-doppler run: {sequence.name}",
         headline="",
@@ -252,26 +252,7 @@ def write_run_outputs(
     truth_yaw = truth.yaw_at(table.t) if truth is not None else None
     shown = result.trajectories
     if truth is not None:
-        errors, per_100m, shown = evaluate_pipelines(
-            result.trajectories, table, result.tc_usable, truth
-        )
-        summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
-        report.errors = errors
-        report.tracks = {TRUTH: truth, **shown}
-        report.error_figure = png_data_uri(
-            build_error_per_100m_figure(per_100m, sequence.name), out / "error_per_100m.png"
-        )
-        release_figures()
-        report.heading_error_figure = png_data_uri(
-            build_heading_error_figure(shown, truth, heading_t0, sequence.name),
-            out / "heading_error.png",
-        )
-        release_figures()
-        report.worst = worst_reliable_tight_errors(table, result.tc_usable, truth_yaw)
-        lengths = segment_lengths_that_fit(truth.path_length)
-        report.segment_note = (
-            "KITTI translation error: " + segment_lengths_note(lengths, truth.path_length) + "."
-        )
+        shown = evaluate_into(summary, report, sequence, result, out)
     trajectories_figure(out / "trajectories.png", shown, truth, sequence.name)
     release_figures()
     write_geojson(out / "trajectories.geojson", report.tracks, TRACK_LABELS, sequence.enu)
@@ -280,11 +261,65 @@ def write_run_outputs(
         out / "heading.png",
     )
     release_figures()
-    report.headline = headline(report.errors, summary["tight_heading_used"])
+    report.headline = headline(
+        report.errors, summary["tight_heading_used"], truth is not None and not report.errors
+    )
     report.facts = readable_facts(summary)
-    (out / SUMMARY_FILE).write_text(json.dumps(summary, indent=2))
+    (out / SUMMARY_FILE).write_text(json_text(summary, indent=2))
     write_run_report(out / "report.html", report)
     return summary
+
+
+def evaluate_into(
+    summary: dict, report: RunReport, sequence: Sequence, result: RunResult, out: Path
+) -> dict[str, Trajectory]:
+    """Evaluate the trajectories against the sequence's ground truth into ``summary``
+    (``evaluation``, and ``warnings`` for what it could not evaluate) and ``report`` (table,
+    figures written to ``out``); return the trajectories as evaluated (moved to the truth).
+
+    The evaluation never costs the run its other outputs: when it fails, the failure becomes a
+    warning and the trajectories are shown as computed."""
+    truth, table = sequence.truth, result.heading
+    warnings = summary.setdefault("warnings", [])
+    try:
+        errors, per_100m, shown = evaluate_pipelines(
+            result.trajectories, table, result.tc_usable, truth
+        )
+        found = evaluation_warnings(result.trajectories, errors, truth)
+    except Exception as exc:  # a bug in the evaluation must not lose the trajectories
+        log.debug("the evaluation failed", exc_info=True)
+        found = [
+            f"the evaluation against the ground truth failed ({type(exc).__name__}: {exc}; a "
+            "bug, please report it): the trajectories and figures are written without it"
+        ]
+        errors, per_100m, shown = {}, {}, dict(result.trajectories)
+    for text in found:
+        log.warning("%s", text)
+    warnings += found
+    report.warnings += found
+    report.tracks = {TRUTH: truth, **shown}
+    if not errors:
+        return shown
+    summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
+    report.errors = errors
+    report.error_figure = png_data_uri(
+        build_error_per_100m_figure(per_100m, sequence.name), out / "error_per_100m.png"
+    )
+    release_figures()
+    heading_t0 = float(table.t[0]) if len(table) else 0.0
+    report.heading_error_figure = png_data_uri(
+        build_heading_error_figure(shown, truth, heading_t0, sequence.name),
+        out / "heading_error.png",
+    )
+    release_figures()
+    report.worst = worst_reliable_tight_errors(table, result.tc_usable, truth.yaw_at(table.t))
+    path_length = max(e.path_length_m for e in errors.values())
+    report.segment_note = (
+        "KITTI translation error: "
+        + segment_lengths_note(segment_lengths_that_fit(path_length), path_length)
+        + "."
+    )
+    return shown
 
 
 def require_tight_heading(result: RunResult, folder: Path, out: Path) -> None:

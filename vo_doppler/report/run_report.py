@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from vo_doppler.eval.per_distance import ErrorPerDistance
+from vo_doppler.eval.per_distance import MIN_PATH_M, ErrorPerDistance
 from vo_doppler.eval.pipelines import PIPELINE_LABELS, UNCORRECTED, PipelineErrors
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.model.heading import HeadingTable
@@ -48,7 +48,8 @@ GLOSSARY = (
         "For every 100 m stretch of the ground-truth path (one starting every metre), the "
         "horizontal distance between where the estimate moved and where the vehicle moved over "
         "that stretch; the mean and the largest over all stretches, in metres. 1 m per 100 m "
-        "is a 1 % drift. On a path shorter than 100 m the whole path is scaled to 100 m.",
+        "is a 1 % drift. On a path shorter than 100 m the whole path is scaled to 100 m; on one "
+        f"shorter than {MIN_PATH_M:.0f} m it is not available (—).",
     ),
     ("3-D error per 100 m", "The same with the height difference included."),
     (
@@ -115,6 +116,11 @@ def table_cell(name: str, key: str, value: float, fmt: str) -> str:
     use) or is unknown (NaN), else ``fmt``."""
     if key == "heading_availability" and name in UNCORRECTED:
         return "—"
+    return number_or_dash(value, fmt)
+
+
+def number_or_dash(value: float | None, fmt: str) -> str:
+    """``fmt.format(value)``, or "—" for a figure that is not available (None or NaN)."""
     if value is None or not np.isfinite(value):
         return "—"
     return fmt.format(value)
@@ -153,6 +159,10 @@ def trajectories_figure(
     fig.savefig(path, dpi=110)
 
 
+def _mean_text(mean_m: float | None) -> str:
+    return "path too short: not available" if mean_m is None else f"mean {mean_m:.2f} m"
+
+
 def build_error_per_100m_figure(per_100m: dict[str, ErrorPerDistance], title: str) -> Figure:
     """Per pipeline, the error of each 100 m stretch against where the stretch starts."""
     fig = new_figure(figsize=(9, 3.8))
@@ -163,7 +173,7 @@ def build_error_per_100m_figure(per_100m: dict[str, ErrorPerDistance], title: st
             result.errors_m,
             lw=1.4,
             c=COLOURS.get(name),
-            label=f"{label(name)} (mean {result.mean_m_per_100m:.2f} m)",
+            label=f"{label(name)} ({_mean_text(result.mean_m_per_100m)})",
         )
     window = next(iter(per_100m.values())).window_m if per_100m else 100.0
     ax.set_xlabel("distance along the ground-truth path where the stretch starts [m]")
@@ -261,15 +271,30 @@ def worst_reliable_tight_errors(
     ]
 
 
-def headline(errors: dict[str, PipelineErrors], used_fraction: float) -> str:
+def headline(
+    errors: dict[str, PipelineErrors], used_fraction: float, truth_unused: bool = False
+) -> str:
     """The result in one sentence: how much the tightly coupled heading changed the VO's error
-    per 100 m, or the wheel + gyro dead reckoning's without a camera (or, without ground truth,
-    how often it was used)."""
+    per 100 m, or the wheel + gyro dead reckoning's without a camera (or, without ground truth
+    or with one that could not be used (``truth_unused``), how often it was used)."""
+    used = (
+        f"The tightly coupled heading was used by the correction at {used_fraction:.0%} of the "
+        "GNSS epochs."
+    )
+    if truth_unused:
+        return (
+            "The ground truth could not be used (see the warnings): this report shows the "
+            f"trajectories and headings but cannot say how accurate they are. {used}"
+        )
     if not errors:
         return (
             "No ground truth: this report shows the trajectories and headings but cannot say "
-            f"how accurate they are. The tightly coupled heading was used by the correction at "
-            f"{used_fraction:.0%} of the GNSS epochs."
+            f"how accurate they are. {used}"
+        )
+    if any(e.error_per_100m_m is None for e in errors.values()):
+        return (
+            "The ground-truth path is too short for errors per distance (see the warnings); "
+            f"the table shows the heading errors. {used}"
         )
     base = "vo" if "vo" in errors else "dr"
     if base not in errors or f"{base}_gps_tc" not in errors:
@@ -319,7 +344,8 @@ class RunReport:
     heading_error_figure: str | None = None
     worst: list[WorstEpoch] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
-    """What the input checks found (time order, clocks, origin), shown under the data."""
+    """What the input checks found (time order, clocks, origin) and what the evaluation could
+    not do (ground truth covering part of the drive), shown under the data."""
 
 
 STYLE = (
@@ -407,7 +433,7 @@ def render(report: RunReport) -> str:
         "<h2>The data</h2>",
         _definitions(about),
         *(
-            ["<p>Input warnings:</p><ul>"]
+            ["<p>Warnings:</p><ul>"]
             + [f"<li>{html.escape(w)}</li>" for w in report.warnings]
             + ["</ul>"]
             if report.warnings
@@ -425,8 +451,9 @@ def render(report: RunReport) -> str:
     if report.errors:
         parts += [
             "<h2>Pipelines against ground truth</h2>",
-            "<p class='note'>Every trajectory starts at the ground truth's first position; the "
-            "VO alone is also turned to the truth's initial heading. Definitions below the "
+            "<p class='note'>Every trajectory is evaluated over the time the ground truth "
+            "covers and starts there at the ground truth's position; the VO and dead reckoning "
+            "alone are also turned to the truth's heading there. Definitions below the "
             f"figures. {html.escape(report.segment_note)}</p>",
             _errors_table(report),
         ]
