@@ -49,7 +49,7 @@ def evaluate_methods(
             result.heading,
             vehicle_trajectory(result.vo.trajectory, inputs.camera.T_vehicle_camera),
             result.calibrated_speed,
-            result.start_enu,
+            result.antenna,
             config,
         )
         evaluated[name] = evaluate_pipelines(

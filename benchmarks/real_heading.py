@@ -49,7 +49,14 @@ from vo_doppler.heading.pipeline import CALIBRATION_METHODS
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.run import Pipeline, RunConfig, correct_all, sequence_gnss, sequence_heading
+from vo_doppler.run import (
+    AntennaTrack,
+    Pipeline,
+    RunConfig,
+    correct_all,
+    sequence_gnss,
+    sequence_heading,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 CANYON_SATS = 2
@@ -165,7 +172,8 @@ def dead_reckoning_figures(sequence: Sequence, table: HeadingTable, config: RunC
     """Error per 100 m (m) of the wheel + gyro dead reckoning alone, corrected by the
     conventional and by the tightly coupled heading of ``table`` (``run``'s pipelines)."""
     speed = table.calibrated_speed(sequence.wheel_speed)
-    trajectories = correct_all(sequence, table, None, speed, np.zeros(3), config)
+    origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)))  # the figures align the starts
+    trajectories = correct_all(sequence, table, None, speed, origin, config)
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
     errors, _, _ = evaluate_pipelines(trajectories, table, usable, sequence.truth)
     return {str(name): errors[name].error_per_100m_m for name in DEAD_RECKONING if name in errors}

@@ -9,12 +9,20 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.cli import main
-from vo_doppler.geo import wrap_angle
+from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.trajectory import read_tum
+from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
-from vo_doppler.run import _malloc_trim, initial_yaw_offset, release_free_heap
+from vo_doppler.run import (
+    AntennaTrack,
+    _malloc_trim,
+    antenna_track,
+    initial_yaw_offset,
+    level_with_yaw,
+    release_free_heap,
+)
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
 
@@ -74,6 +82,19 @@ def test_run_recovers_calibration_and_heading(sequence, run_output):
     tc = evaluation["vo_gps_tc"]
     assert tc["heading_rmse_deg"] < 3.0
     assert tc["error_per_100m_m"] < 2.0
+
+
+def test_every_trajectory_starts_where_the_vehicle_was(sequence, run_output):
+    """The canyon's first valid fixes come 21 s into the drive: carried back along each
+    trajectory they put its first pose 0.3-0.7 m from the truth's horizontally and 1.2-1.9 m
+    vertically (the antenna 1.6 m up taken off); the median of the first 5 s of fixes put it
+    118 m off, at the car's position 21 s later."""
+    truth = read_tum(sequence / "ground_truth.tum")
+    for path in sorted(run_output.glob("trajectory_*.tum")):
+        first = read_tum(path)
+        start = [np.interp(first.t[0], truth.t, truth.positions[:, i]) for i in range(3)]
+        error = first.positions[0] - start
+        assert np.linalg.norm(error[:2]) < 1.5 and abs(error[2]) < 2.5, path.name
 
 
 def test_corrected_trajectory_is_finite_and_covers_every_image(sequence, run_output):
@@ -189,3 +210,128 @@ def test_reliable_tight_headings_too_vague_to_correct_still_start_the_trajectory
     assert initial_yaw_offset(table, none, trajectory) == pytest.approx(0.5, abs=1e-12)
     with_conventional = _heading_table(t, yaw_tc, t >= 3.0, np.full(len(t), 1.25), ~none)
     assert initial_yaw_offset(with_conventional, none, trajectory) == pytest.approx(1.0, abs=1e-12)
+
+
+ENU = EnuFrame(np.radians(37.7), np.radians(-122.5), 30.0)
+
+
+def _gnss_solutions(t, fixes_enu, fix_sigma_m, velocity_enu, velocity_sigma_mps):
+    """SPP and Doppler solutions (ECEF) from ENU fixes (NaN rows: no fix) and velocities."""
+    n = len(t)
+    fixes = ENU.enu_to_ecef(fixes_enu)
+    valid = np.all(np.isfinite(fixes), axis=1)
+    spp = SppSolution(
+        t, fixes, {"G": np.zeros(n)}, np.full(n, 8), np.ones(n), np.full(n, 2.0), valid, 0,
+        horizontal_sigma_m=np.full(n, np.sqrt(2.0) * fix_sigma_m),
+    )  # fmt: skip
+    velocity = VelocitySolution(
+        t, velocity_enu @ ENU.rotation, velocity_enu, np.zeros(n),
+        np.tile(np.eye(4) * velocity_sigma_mps**2, (n, 1, 1)), np.ones((n, 5)), np.full(n, 8),
+        np.full(n, 8), np.zeros(n, dtype=int), np.zeros(n), np.ones(n, dtype=bool),
+        untestable=np.zeros(n, dtype=bool),
+    )  # fmt: skip
+    return spp, velocity
+
+
+def test_the_antenna_track_puts_a_moving_car_where_it_was_at_each_epoch_despite_a_bad_fix():
+    """A car at a constant 20.6 m/s with fixes of σ 2 m per horizontal axis (4 m up) and exact
+    Doppler velocities (σ 0.02 m/s): the track at the first epoch is the fixes carried back, a
+    robust mean of N = 99 good fixes: σ/√(0.95 N) (the Cauchy weights' 95 % efficiency),
+    0.21 m per horizontal axis and 0.41 m up, within 4 σ. The first fix, 200 m off, would move
+    a plain mean by 2 m; the old median of the first 5 s of fixes lay 51.5 m ahead."""
+    rng = np.random.default_rng(7)
+    t = 1000.0 + np.arange(100) * 0.1
+    velocity = np.tile([20.0, 5.0, 0.2], (t.size, 1))
+    truth = np.array([30.0, -40.0, 12.0]) + (t - t[0])[:, None] * velocity[0]
+    noise = rng.normal(size=truth.shape) * [2.0, 2.0, 4.0]
+    fixes = truth + noise
+    fixes[0, 0] += 200.0
+    spp, doppler = _gnss_solutions(t, fixes, 2.0, velocity, 0.02)
+    track = antenna_track(spp, doppler, None, ENU)
+    np.testing.assert_array_equal(track.t, t)
+    bound = 4.0 / np.sqrt(0.95 * 99) * np.array([2.0, 2.0, 4.0])
+    assert np.all(np.abs(track.position[0] - truth[0]) < bound)
+    assert np.all(np.abs(track.position - truth) < bound)
+
+
+def test_the_antenna_track_falls_back_to_one_fix_then_the_approximate_position(caplog):
+    t = np.arange(5.0)
+    fixes = np.full((5, 3), np.nan)
+    fixes[2] = [10.0, 20.0, 3.0]
+    spp, doppler = _gnss_solutions(t, fixes, 2.0, np.zeros((5, 3)), 0.02)
+    one = antenna_track(spp, doppler, None, ENU)
+    np.testing.assert_array_equal(one.t, [2.0])
+    np.testing.assert_allclose(one.position, [[10.0, 20.0, 3.0]], atol=1e-6)
+    spp, doppler = _gnss_solutions(t, np.full((5, 3), np.nan), 2.0, np.zeros((5, 3)), 0.02)
+    approx = ENU.enu_to_ecef(np.array([-5.0, 7.0, 1.0]))
+    with caplog.at_level("WARNING"):
+        header = antenna_track(spp, doppler, approx, ENU)
+        origin = antenna_track(spp, doppler, None, ENU)
+    assert header.t.size == 0 and origin.t.size == 0
+    np.testing.assert_allclose(header.position, [[-5.0, 7.0, 1.0]], atol=1e-6)
+    np.testing.assert_array_equal(origin.position, np.zeros((1, 3)))
+    assert "RINEX approximate position" in caplog.text and "at the origin" in caplog.text
+
+
+LEVER = (1.5, -0.3, 1.6)
+
+
+def _placed_straight_drive(t_dr, t_gnss, heading):
+    """A straight drive at 15 m/s along ``heading``: dead reckoning from its own origin facing
+    x, placed by the exact antenna track; returns the placed trajectory and the truth."""
+    direction = np.array([np.cos(heading), np.sin(heading), 0.0])
+
+    def vehicle(t):
+        return np.array([100.0, -50.0, 2.0]) + 15.0 * (t - 0.4)[:, None] * direction
+
+    own = Trajectory(
+        t_dr, 15.0 * (t_dr - t_dr[0])[:, None] * [1.0, 0.0, 0.0], Rotation.identity(t_dr.size)
+    )
+    antenna = vehicle(t_gnss) + Rotation.from_euler("z", heading).apply(LEVER)
+    placed = level_with_yaw(own, heading, AntennaTrack(t_gnss, antenna), LEVER)
+    return placed, vehicle(t_dr)
+
+
+def test_a_trajectory_is_placed_where_the_vehicle_was_at_its_first_gnss_epoch():
+    """The vehicle, not the antenna 1.5 m ahead, 0.3 m right and 1.6 m up, is on the truth at
+    every pose: whether the trajectory starts between GNSS epochs or 0.5 s before the first
+    (the dead reckoning carries it back), to rounding."""
+    t_dr = 0.43 + np.arange(100) * 0.05
+    for t_gnss in (np.arange(0.0, 6.0, 0.1), np.arange(0.93, 6.0, 1.0)):
+        placed, truth = _placed_straight_drive(t_dr, t_gnss, np.radians(30.0))
+        np.testing.assert_allclose(placed.positions, truth, atol=1e-9)
+        assert np.degrees(placed.yaw()[0]) == pytest.approx(30.0, abs=1e-9)
+
+
+def test_fixes_only_seconds_later_are_carried_back_along_the_trajectory():
+    """A street canyon: the first valid fixes 20 s after the start (σ 1 m, one of the first
+    eleven 100 m off) and a turning drive. The median of the eleven fixes carried back along
+    the trajectory: 1.25 σ/√10 = 0.4 m per axis for the ten good ones, the bad one shifting it
+    by at most half a gap between them; 1.5 m bounds it. (A track carried back along Doppler
+    velocities there drifted by 37 m in the simulated canyon of ``run_output``.)"""
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 30.0, 0.05)
+    yaw = 0.4 + 0.03 * t
+    truth = np.column_stack([np.cumsum(10.0 * np.cos(yaw)), np.cumsum(10.0 * np.sin(yaw))])
+    truth = np.column_stack([truth * 0.05 + [200.0, -80.0], np.full(t.size, 3.0)])
+    turn = Rotation.from_euler("z", (yaw - 0.4)[:, None])
+    own = Trajectory(t, (truth - truth[0]) @ Rotation.from_euler("z", -0.4).as_matrix().T, turn)
+    fixes = np.flatnonzero(t >= 20.0)[::10]
+    antenna = truth[fixes] + Rotation.from_euler("z", yaw[fixes, None]).apply(LEVER)
+    antenna += rng.normal(size=antenna.shape)
+    antenna[3] += [100.0, -60.0, 20.0]
+    placed = level_with_yaw(own, 0.4, AntennaTrack(t[fixes], antenna), LEVER)
+    assert np.all(np.abs(placed.positions[0] - truth[0]) < 1.5)
+    np.testing.assert_allclose(placed.positions - placed.positions[0], truth - truth[0], atol=1e-9)
+
+
+def test_a_trajectory_without_a_gnss_epoch_is_placed_by_the_nearest_one_with_a_warning(caplog):
+    t_dr = np.arange(100) * 0.05
+    with caplog.at_level("WARNING"):
+        placed, truth = _placed_straight_drive(t_dr, np.array([-3.0, 7.0]), 0.0)
+    # the epoch 2.05 s after the end places the end: 30.75 m ahead, driven meanwhile
+    np.testing.assert_allclose(placed.positions - truth, np.tile([30.75, 0, 0], (100, 1)))
+    assert "antenna position 2.0 s outside it" in caplog.text
+    untimed = AntennaTrack(np.zeros(0), np.array([[1.0, 2.0, 3.0]]))
+    own = Trajectory(t_dr, np.zeros((100, 3)), Rotation.identity(100))
+    np.testing.assert_allclose(level_with_yaw(own, 0.0, untimed).positions[0], [1.0, 2.0, 3.0])

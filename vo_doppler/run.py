@@ -40,13 +40,14 @@ from vo_doppler.fusion.correction import (
 )
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
+from vo_doppler.gnss.receiver_track import smoothed_track
+from vo_doppler.gnss.spp import EARTH_SURFACE_M, nearest_time
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.lowcost.dead_reckoning import wheel_gyro_track
 from vo_doppler.model.doppler import DopplerRows
-from vo_doppler.model.gnss_solutions import VelocitySolution
+from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.heading import HeadingTable
-from vo_doppler.model.observations import Observations
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
@@ -94,37 +95,110 @@ class RunResult:
     calibrated_speed: SensorSeries
     trajectories: dict[Pipeline, Trajectory]
     """Vehicle poses in ENU."""
-    start_enu: np.ndarray
+    antenna: AntennaTrack
+    """The antenna positions that placed the trajectories."""
     tc_usable: np.ndarray
     """Epochs whose tightly coupled heading was allowed to correct."""
 
 
-def start_position(
-    gnss: GnssVelocityResult, obs: Observations, enu: EnuFrame, span_s: float = 5.0
-) -> np.ndarray:
-    """Median SPP position (ENU) over the first ``span_s`` seconds of valid fixes; without any
-    fix, the RINEX header's approximate position; without that, the ENU origin."""
-    spp = gnss.spp
+@dataclass(frozen=True)
+class AntennaTrack:
+    """Where the trajectories are placed: the GNSS antenna's ENU positions ``position`` (N, 3, m)
+    at the GPS times ``t`` (N,) of the valid SPP fixes; ``t`` empty with one untimed position
+    (no fix: the RINEX approximate position or the origin)."""
+
+    t: np.ndarray
+    position: np.ndarray
+
+
+def antenna_track(
+    spp: SppSolution,
+    velocity: VelocitySolution,
+    approx_position: np.ndarray | None,
+    enu: EnuFrame,
+) -> AntennaTrack:
+    """The antenna's positions that place every trajectory (:func:`level_with_yaw`).
+
+    At the epochs of the valid SPP fixes, the fixes smoothed along the final Doppler velocities
+    (:func:`vo_doppler.gnss.receiver_track.smoothed_track`, robust: Huber, then Cauchy
+    weights, so that one bad fix among its neighbours barely moves the track). Only there: an
+    epoch without a fix would be the fixes carried to it by the Doppler velocities, which in a
+    street canyon (few satellites, reflections) drift by tens of metres over seconds; the
+    trajectory itself carries the fixes back to its start. With one valid fix, that fix;
+    without any, ``approx_position`` (ECEF, the RINEX header's), else the ENU origin (untimed,
+    with a warning).
+    """
     valid = np.flatnonzero(spp.valid)
+    if valid.size >= 2:
+        fixes = np.where(spp.valid[:, None], spp.position_ecef, np.nan)
+        known = velocity.valid
+        if velocity.untestable is not None:
+            known = known | velocity.untestable
+        track = smoothed_track(
+            spp.t, fixes, spp.horizontal_sigma_m, velocity.velocity_ecef, velocity.covariance, known
+        )
+        if track is not None:
+            return AntennaTrack(spp.t[valid], enu.ecef_to_enu(track[valid]))
     if valid.size:
-        near = valid[spp.t[valid] <= spp.t[valid[0]] + span_s]
-        return np.median(enu.ecef_to_enu(spp.position_ecef[near]), axis=0)
-    approx = obs.header.approx_position
-    if approx is not None and np.all(np.isfinite(approx)) and np.linalg.norm(approx) > 6.0e6:
+        return AntennaTrack(spp.t[valid], enu.ecef_to_enu(spp.position_ecef[valid]))
+    approx = np.asarray(approx_position if approx_position is not None else np.nan, dtype=float)
+    if np.all(np.isfinite(approx)) and np.linalg.norm(approx) > EARTH_SURFACE_M:
         log.warning("no SPP fix: the trajectories start at the RINEX approximate position")
-        return enu.ecef_to_enu(np.asarray(approx, dtype=float))
+        return AntennaTrack(np.zeros(0), enu.ecef_to_enu(approx.reshape(1, 3)))
     log.warning("no SPP fix and no approximate position: the trajectories start at the origin")
-    return np.zeros(3)
+    return AntennaTrack(np.zeros(0), np.zeros((1, 3)))
 
 
-def level_with_yaw(trajectory: Trajectory, turn: float, start: np.ndarray) -> Trajectory:
-    """Rotate vehicle poses (first-vehicle frame) about z by ``turn`` (rad) and move them to
-    ``start``."""
+PLACEMENT_SPAN_S = 5.0
+"""Seconds of antenna positions, from the first inside a trajectory, that place it."""
+PLACEMENT_MIN_FIXES = 5
+"""At least this many antenna positions place a trajectory (if it has them), however long."""
+
+
+def level_with_yaw(
+    trajectory: Trajectory,
+    turn: float,
+    antenna: AntennaTrack,
+    lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0),
+) -> Trajectory:
+    """Rotate vehicle poses (first-vehicle frame) about z by ``turn`` (rad), then move them by
+    the median, per axis, of (antenna position − the trajectory's antenna) over the antenna
+    positions of the first ``PLACEMENT_SPAN_S`` seconds inside the trajectory's times (at least
+    ``PLACEMENT_MIN_FIXES``): each fix is carried back to the start along the trajectory
+    itself, the vehicle placed where it was then, not where it was seconds later, and one bad
+    fix cannot move it. The trajectory's antenna at a fix's time: its position interpolated
+    there plus the lever arm (``lever_arm_m`` from the vehicle's origin, x forward, y left,
+    z up) turned by its pose nearest in time. Without an antenna position inside, the one
+    nearest in time places the trajectory's nearest end (with a warning); an untimed one, the
+    first pose.
+    """
     rotation = np.eye(4)
     rotation[:3, :3] = Rotation.from_euler("z", turn).as_matrix()
     out = rotation @ trajectory.matrices
-    out[:, :3, 3] += start - out[0, :3, 3]
-    return Trajectory.from_matrices(trajectory.t, out)
+    t = trajectory.t
+    if not antenna.t.size:
+        out[:, :3, 3] += antenna.position[0] - out[0, :3, 3]
+        return Trajectory.from_matrices(t, out)
+    outside_s = np.maximum(t[0] - antenna.t, antenna.t - t[-1])
+    rows = np.flatnonzero(outside_s <= 0.0)
+    if rows.size:
+        span = antenna.t[rows] <= antenna.t[rows[0]] + PLACEMENT_SPAN_S
+        rows = rows[: max(int(span.sum()), PLACEMENT_MIN_FIXES)]
+    else:
+        rows = np.array([int(np.argmin(outside_s))])
+        log.warning(
+            "no GNSS fix within the trajectory from %.1f to %.1f s: it is placed by the antenna "
+            "position %.1f s outside it",
+            t[0],
+            t[-1],
+            outside_s[rows[0]],
+        )
+    t_fix = np.clip(antenna.t[rows], t[0], t[-1])
+    carried = np.column_stack([np.interp(t_fix, t, out[:, axis, 3]) for axis in range(3)])
+    nearest = nearest_time(t, t_fix)
+    carried += out[nearest, :3, :3] @ np.asarray(lever_arm_m, dtype=float)
+    out[:, :3, 3] += np.median(antenna.position[rows] - carried, axis=0)
+    return Trajectory.from_matrices(t, out)
 
 
 def yaw_offset(trajectory: Trajectory, t: np.ndarray, yaw: np.ndarray) -> float:
@@ -171,14 +245,15 @@ def correct_all(
     table: HeadingTable,
     vo_vehicle: Trajectory | None,
     speed: SensorSeries,
-    start: np.ndarray,
+    antenna: AntennaTrack,
     config: RunConfig,
 ) -> dict[Pipeline, Trajectory]:
     """The VO and the wheel + gyro dead reckoning, each alone and corrected by the conventional
     and by the tightly coupled heading (vehicle poses, ENU).
 
-    Every trajectory starts at ``start``, turned to the absolute headings of its first seconds
-    (:func:`initial_yaw_offset`). Only usable tightly coupled headings correct.
+    Every trajectory is turned to the absolute headings of its first seconds
+    (:func:`initial_yaw_offset`) and placed by the antenna track (:func:`level_with_yaw`). Only
+    usable tightly coupled headings correct.
     """
     yaw_rate = table.calibrated_yaw_rate(sequence.yaw_rate)
     begin, end = max(speed.t[0], yaw_rate.t[0]), min(speed.t[-1], yaw_rate.t[-1])
@@ -189,16 +264,19 @@ def correct_all(
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
     tight = tight_absolute_heading(table, config.correction)
     conventional = conventional_absolute_heading(table)
+    lever = sequence.antenna_lever_arm_m
     trajectories: dict[Pipeline, Trajectory] = {}
     if vo_vehicle is not None:
-        vo_level = level_with_yaw(vo_vehicle, initial_yaw_offset(table, usable, vo_vehicle), start)
+        vo_level = level_with_yaw(
+            vo_vehicle, initial_yaw_offset(table, usable, vo_vehicle), antenna, lever
+        )
         trajectories[Pipeline.VO] = vo_level
         trajectories[Pipeline.VO_GPS_CONV] = correct(
             vo_level, conventional, config.correction
         ).vehicle
         trajectories[Pipeline.VO_GPS_TC] = correct(vo_level, tight, config.correction).vehicle
     if dr is not None:
-        dr_level = level_with_yaw(dr, initial_yaw_offset(table, usable, dr), start)
+        dr_level = level_with_yaw(dr, initial_yaw_offset(table, usable, dr), antenna, lever)
         trajectories[Pipeline.DR] = dr_level
         trajectories[Pipeline.DR_GPS_CONV] = correct(
             dr_level, conventional, config.correction
@@ -301,8 +379,8 @@ def run_sequence(
         release_free_heap()
     else:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
-    start = start_position(gnss, obs, sequence.enu)
-    trajectories = correct_all(sequence, table, vo_vehicle, speed, start, config)
+    antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
+    trajectories = correct_all(sequence, table, vo_vehicle, speed, antenna, config)
     release_free_heap()
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
-    return RunResult(gnss, table, vo, speed, trajectories, start, usable)
+    return RunResult(gnss, table, vo, speed, trajectories, antenna, usable)

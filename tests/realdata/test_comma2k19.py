@@ -19,7 +19,8 @@ from tests.helpers.comma2k19 import COMMA, checked_conventional_figures, importe
 from vo_doppler.geo import ecef_to_enu_rotation
 from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.io.comma2k19 import read_vehicle_poses
-from vo_doppler.run import RunConfig, sequence_heading
+from vo_doppler.model.timeseries import sample
+from vo_doppler.run import RunConfig, antenna_track, correct_all, sequence_heading
 
 pytestmark = pytest.mark.shared_data
 
@@ -66,6 +67,27 @@ def test_device_orientation_convention():
     up = positions / np.linalg.norm(positions, axis=1, keepdims=True)
     assert np.all(np.einsum("ni,ni->n", vehicle_to_ecef[:, :, 2], up) > 0.99)
     assert abs(np.degrees(mount)) == pytest.approx(0.89, abs=0.05)
+
+
+def test_trajectories_start_where_the_car_was(comma):
+    """The car accelerates from 8 to 15 m/s over the first 5 s. The antenna track (the fixes
+    smoothed along the Doppler velocities) is 0.47 m from the truth at the median epoch, and
+    every trajectory's first pose (0.04 s into global_pose) 0.64 m horizontally: the fixes'
+    own bias (the first is 0.52 m off). The median of the first 5 s of fixes put them 25.2 m
+    ahead. (The fixes' height is 7 m above global_pose's all along.)"""
+    sequence, gnss, config = comma
+    obs = sequence.observations
+    antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
+    truth = sequence.truth
+    expected = np.column_stack([sample(truth.t, truth.positions[:, i], antenna.t) for i in (0, 1)])
+    assert np.nanmedian(np.linalg.norm(antenna.position[:, :2] - expected, axis=1)) < 1.0
+    table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
+    speed = table.calibrated_speed(sequence.wheel_speed)
+    trajectories = correct_all(sequence, table, None, speed, antenna, config)
+    assert len(trajectories) == 3
+    for trajectory in trajectories.values():
+        start = [np.interp(trajectory.t[0], truth.t, truth.positions[:, i]) for i in (0, 1)]
+        assert np.linalg.norm(trajectory.positions[0, :2] - start) < 1.5
 
 
 def test_conventional_velocity_against_global_pose(comma):
