@@ -16,6 +16,7 @@ import yaml
 from tests.conftest import require_shared
 from vo_doppler.errors import InputError
 from vo_doppler.io.calibration import read_camera
+from vo_doppler.io.comma2k19 import DeviceMount
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.comma2k19_video import decode_video, eon_camera
 from vo_doppler.io.sequence import read_sequence
@@ -31,16 +32,26 @@ def write_video(path, frames: int, width: int = 116, height: int = 88) -> None:
     avi.rename(path)
 
 
-def test_eon_camera_scales_with_the_frame_and_turns_by_the_mounting_yaw():
-    full = eon_camera(1164, 874, 0.0)
+LEVEL = DeviceMount(0.0, 0.0, 0.0)
+
+
+def test_eon_camera_scales_with_the_frame_and_turns_by_the_mounting():
+    full = eon_camera(1164, 874, LEVEL)
     assert (full.fx, full.fy, full.cx, full.cy) == (910.0, 910.0, 582.0, 437.0)
-    half = eon_camera(582, 437, 0.0)
+    half = eon_camera(582, 437, LEVEL)
     assert (half.fx, half.cy) == pytest.approx((455.0, 218.5))
-    yaw = np.radians(2.0)
-    optical_axis = eon_camera(1164, 874, yaw).T_vehicle_camera[:3, 2]
+    yaw, pitch = np.radians(2.0), np.radians(3.8)
+    optical_axis = eon_camera(1164, 874, DeviceMount(yaw, 0.0, 0.0)).T_vehicle_camera[:3, 2]
     np.testing.assert_allclose(optical_axis, [np.cos(-yaw), np.sin(-yaw), 0.0], atol=1e-12)
-    down = eon_camera(1164, 874, yaw).T_vehicle_camera[:3, 1]
+    down = eon_camera(1164, 874, DeviceMount(yaw, 0.0, 0.0)).T_vehicle_camera[:3, 1]
     np.testing.assert_allclose(down, [0.0, 0.0, -1.0], atol=1e-12)
+    # the travel 3.8° above the device's forward axis: the camera looks 3.8° below the vehicle's
+    pitched = eon_camera(1164, 874, DeviceMount(0.0, pitch, 0.0)).T_vehicle_camera[:3, 2]
+    np.testing.assert_allclose(pitched, [np.cos(pitch), 0.0, -np.sin(pitch)], atol=1e-12)
+    # rolled: the image's right (camera x) is the device's, tilted about the forward axis
+    roll = np.radians(1.2)
+    right = eon_camera(1164, 874, DeviceMount(0.0, 0.0, roll)).T_vehicle_camera[:3, 0]
+    np.testing.assert_allclose(right, [0.0, -np.cos(roll), np.sin(roll)], atol=1e-12)
 
 
 def test_frames_times_and_calibration_are_written(tmp_path, caplog):
@@ -48,7 +59,7 @@ def test_frames_times_and_calibration_are_written(tmp_path, caplog):
     write_video(video, frames=6)
     times = 100.0 + 0.05 * np.arange(5)
     with caplog.at_level(logging.WARNING):
-        decoded = decode_video(video, times, tmp_path / "seq", 0.0)
+        decoded = decode_video(video, times, tmp_path / "seq", LEVEL)
     assert (decoded.frames, decoded.width, decoded.height) == (5, 116, 88)
     assert "more frames in the video for 5 frame times" in caplog.text
     images = sorted((tmp_path / "seq" / "image_0").glob("*.jpg"))
@@ -64,7 +75,7 @@ def test_a_short_video_keeps_its_frames_and_says_so(tmp_path, caplog):
     video = tmp_path / "video.hevc"
     write_video(video, frames=3)
     with caplog.at_level(logging.WARNING):
-        decoded = decode_video(video, np.arange(10.0), tmp_path / "seq", 0.0)
+        decoded = decode_video(video, np.arange(10.0), tmp_path / "seq", LEVEL)
     assert decoded.frames == 3
     assert "3 frames in the video for 10 frame times; the first 3 are used" in caplog.text
     assert np.loadtxt(tmp_path / "seq" / "times.txt").shape == (3,)
@@ -74,7 +85,7 @@ def test_an_undecodable_video_is_named(tmp_path):
     video = tmp_path / "video.hevc"
     video.write_bytes(b"\x00\x00\x01 not a video" * 50)
     with pytest.raises(InputError, match=r"video\.hevc") as caught:
-        decode_video(video, np.arange(3.0), tmp_path / "seq", 0.0)
+        decode_video(video, np.arange(3.0), tmp_path / "seq", LEVEL)
     assert "decode" in str(caught.value) or "open" in str(caught.value)
 
 

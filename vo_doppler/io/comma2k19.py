@@ -247,29 +247,75 @@ def _constant_offset(week_and_seconds: np.ndarray, log_t: np.ndarray, path: Path
 MOVING_MPS = 5.0
 
 
-def read_vehicle_poses(base: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+@dataclass(frozen=True)
+class DeviceMount:
+    """How the device sits on the vehicle (rad), estimated by :func:`read_vehicle_poses`: the
+    vehicle frame (x forward, y left, z up) is the device frame (x forward, y left, z up: its
+    own y and z flipped) turned by Rz(yaw) · Ry(−pitch) · Rx(roll). ``yaw`` and ``pitch``: the
+    direction of travel left of and above the device's forward axis; ``roll``: about that
+    direction, so that the vehicle's y axis is level on average."""
+
+    yaw: float
+    pitch: float
+    roll: float
+
+    @property
+    def vehicle_to_device(self) -> np.ndarray:
+        """3×3 rotation: vehicle coordinates → device coordinates (x forward, y left, z up)."""
+        return Rotation.from_euler("ZYX", [self.yaw, -self.pitch, self.roll]).as_matrix()
+
+
+def read_vehicle_poses(
+    base: str | Path,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, DeviceMount]:
     """``global_pose`` as vehicle poses: times on the log clock (``frame_times``, s; add
     ``gps_minus_log`` for GPS time), ECEF positions (m), vehicle→ECEF rotation matrices
-    (vehicle x forward, y left, z up) and the device's mounting yaw (rad).
+    (vehicle x forward, y left, z up) and the device's mounting on the vehicle.
 
     ``frame_orientations`` (w, x, y, z) rotate the device frame (x forward, y right, z down)
     into ECEF: checked, its x axis follows ``frame_velocities`` to within the mounting angle.
-    The vehicle frame is the device's with y and z flipped, turned about the vertical by the
-    median angle from the device's forward axis to the velocity while moving (> 5 m/s; a car
-    does not slip), so that the vehicle's x axis is its direction of travel.
+    The device sits on the windscreen turned by a few degrees (the example segment: the
+    direction of travel 3.8° above its forward axis and 0.8° right of it, 1.2° of roll), which
+    the vehicle frame must not keep: its x axis is the direction of travel (a car does not
+    slip, sideways or vertically) and its y axis level on average
+    (:func:`estimate_device_mount`).
     """
     t = load_array(base, "global_pose", "frame_times")
     positions = load_array(base, "global_pose", "frame_positions")
     velocity = load_array(base, "global_pose", "frame_velocities")
     quaternion_wxyz = load_array(base, "global_pose", "frame_orientations")
     device_to_ecef = Rotation.from_quat(quaternion_wxyz[:, [1, 2, 3, 0]]).as_matrix()
+    device_to_ecef = device_to_ecef * np.array([1.0, -1.0, -1.0])  # y left, z up
     lat, lon, _ = ecef_to_geodetic(positions)
-    to_enu = np.stack([ecef_to_enu_rotation(a, b) for a, b in zip(lat, lon, strict=True)])
-    forward = np.einsum("nij,nj->ni", to_enu, device_to_ecef[:, :, 0])
-    travel = np.einsum("nij,nj->ni", to_enu, velocity)
-    moving = np.linalg.norm(travel[:, :2], axis=1) > MOVING_MPS
-    offset = np.arctan2(travel[:, 1], travel[:, 0]) - np.arctan2(forward[:, 1], forward[:, 0])
-    mount = float(np.median(np.angle(np.exp(1j * offset[moving])))) if moving.any() else 0.0
-    turn = Rotation.from_euler("z", mount).as_matrix()
-    vehicle_to_ecef = (device_to_ecef * np.array([1.0, -1.0, -1.0])) @ turn
-    return t, positions, vehicle_to_ecef, mount
+    up = np.stack([ecef_to_enu_rotation(a, b)[2] for a, b in zip(lat, lon, strict=True)])
+    mount = estimate_device_mount(device_to_ecef, velocity, up)
+    return t, positions, device_to_ecef @ mount.vehicle_to_device, mount
+
+
+def estimate_device_mount(
+    device_to_world: np.ndarray, velocity: np.ndarray, up: np.ndarray
+) -> DeviceMount:
+    """The device's mounting from its attitude ``device_to_world`` (N, 3, 3; device x forward,
+    y left, z up), the vehicle's velocity (N, 3) and the local vertical (N, 3), all in one
+    world frame (e.g. ECEF), over the epochs faster than ``MOVING_MPS``.
+
+    Yaw and pitch: the medians of the azimuth and elevation of the velocity in the device frame
+    (a car's body points along its velocity; the median ignores the moments of wheel spin or
+    suspension pitch). Roll: the median of the angle about that axis that levels the vehicle's
+    y axis, i.e. the device's up axis against the local vertical. The data cannot tell the
+    mounting roll from the road's: this takes the car's mean roll over the drive as zero. A
+    road's crown (1.5–2 % across a lane) and a steady sideways slope would leave up to about
+    1° in it; the yaw and the heading do not depend on it. Without a moving epoch, no turn.
+    """
+    moving = np.linalg.norm(velocity, axis=1) > MOVING_MPS
+    if not moving.any():
+        return DeviceMount(0.0, 0.0, 0.0)
+    frames = device_to_world[moving]
+    travel = np.einsum("nji,nj->ni", frames, velocity[moving])
+    azimuth = np.arctan2(travel[:, 1], travel[:, 0])
+    yaw = float(np.median(np.angle(np.exp(1j * azimuth))))
+    pitch = float(np.median(np.arctan2(travel[:, 2], np.hypot(travel[:, 0], travel[:, 1]))))
+    unrolled = DeviceMount(yaw, pitch, 0.0).vehicle_to_device
+    vertical = np.einsum("ji,nkj,nk->ni", unrolled, frames, up[moving])
+    roll = float(np.median(np.arctan2(-vertical[:, 1], vertical[:, 2])))
+    return DeviceMount(yaw, pitch, roll)

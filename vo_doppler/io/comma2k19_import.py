@@ -191,7 +191,9 @@ def import_comma2k19(
         },
         "ground_truth": {
             "trajectory": "ground_truth.tum",
-            "device_mount_yaw_deg": float(np.degrees(mount)),
+            "device_mount_yaw_deg": float(np.degrees(mount.yaw)),
+            "device_mount_pitch_deg": float(np.degrees(mount.pitch)),
+            "device_mount_roll_deg": float(np.degrees(mount.roll)),
         },
         "clock_offsets": {
             "log_to_gps_s": offset,

@@ -8,8 +8,9 @@ for its EON road camera at 1164 × 874 px (fx = fy = 910, principal point (582, 
 distortion model), scaled to the decoded size if the video was resized. The camera looks along
 the device's forward axis (device frame: x forward, y right, z down, as ``frame_orientations``
 give it), so in the vehicle frame of the imported ground truth (the device's, with y and z
-flipped and turned about the vertical by the mounting yaw ψ_m) the optical axis is the vehicle's
-x axis turned by −ψ_m. The camera's position on the vehicle is not published: the extrinsic has
+flipped and turned by the device's mounting, :class:`vo_doppler.io.comma2k19.DeviceMount`) the
+optical axis is the device's forward axis: the vehicle's x axis turned back by the mounting's
+yaw, pitch and roll. The camera's position on the vehicle is not published: the extrinsic has
 no translation.
 """
 
@@ -24,6 +25,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.calibration import write_camera_yaml
+from vo_doppler.io.comma2k19 import DeviceMount
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD, Camera
 
 log = logging.getLogger(__name__)
@@ -45,12 +47,11 @@ class DecodedVideo:
     height: int
 
 
-def eon_camera(width: int, height: int, mount_yaw_rad: float) -> Camera:
+def eon_camera(width: int, height: int, mount: DeviceMount) -> Camera:
     """The road camera's intrinsics at ``width`` × ``height`` and its mounting on the vehicle."""
     sx, sy = width / EON_SIZE_PX[0], height / EON_SIZE_PX[1]
     turn = np.eye(4)
-    c, s = np.cos(-mount_yaw_rad), np.sin(-mount_yaw_rad)
-    turn[:2, :2] = [[c, -s], [s, c]]
+    turn[:3, :3] = mount.vehicle_to_device.T
     return Camera(
         fx=EON_FOCAL_PX * sx,
         fy=EON_FOCAL_PX * sy,
@@ -63,7 +64,7 @@ def eon_camera(width: int, height: int, mount_yaw_rad: float) -> Camera:
 
 
 def decode_video(
-    video: str | Path, frame_times: np.ndarray, output: str | Path, mount_yaw_rad: float
+    video: str | Path, frame_times: np.ndarray, output: str | Path, mount: DeviceMount
 ) -> DecodedVideo:
     """Write the camera of ``output`` (images, ``times.txt``, ``calib.yaml``) from ``video``,
     frame k at ``frame_times[k]``; frames beyond either count are dropped with a warning."""
@@ -108,5 +109,5 @@ def decode_video(
             count,
         )
     np.savetxt(output / TIMES, np.asarray(frame_times[:count], dtype=float), fmt="%.6f")
-    write_camera_yaml(output / CALIB, eon_camera(*size, mount_yaw_rad))
+    write_camera_yaml(output / CALIB, eon_camera(*size, mount))
     return DecodedVideo(count, *size)
