@@ -36,6 +36,8 @@ from vo_doppler.batch import (
     run_batch,
 )
 from vo_doppler.errors import InputError, OutputError
+from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
+from vo_doppler.io.output_folder import RUN, mark_output, open_output_folder, written_by
 from vo_doppler.run import RunConfig
 from vo_doppler.vo.config import VoConfig
 
@@ -113,9 +115,45 @@ def test_a_rerun_leaves_no_stale_output_beside_the_new_ones(tmp_path):
     stale = tmp_path / "out" / "bug" / "trajectories.png"
     stale.parent.mkdir(parents=True)
     stale.write_bytes(b"from an earlier run")
+    mark_output(stale.parent, RUN)
     result = run_batch([source], tmp_path / "out", workers=1, prepare=die_or_fail)
     assert result.outcomes[0].category is Failure.INTERNAL
-    assert sorted(p.name for p in stale.parent.iterdir()) == ["run.log"]
+    assert sorted(p.name for p in stale.parent.iterdir()) == [OUTPUT_MARKER, "run.log"]
+    assert written_by(stale.parent, RUN) == (True, [])
+
+
+def test_a_batch_never_replaces_a_recording_or_a_folder_it_did_not_write(tmp_path, monkeypatch):
+    """Every refusal comes before any work, with nothing touched: the output folder holding
+    the recording (OUT/<name> would be the recording itself), one holding files of someone
+    else's, a recording's folder with someone else's files, a recording's folder that is not
+    a batch's, and the current directory as a recording's folder."""
+    recording = tmp_path / "data" / "drive"
+    recording.mkdir(parents=True)
+    (recording / "sequence.yaml").write_text("precious")
+    with pytest.raises(OutputError, match=r"contains the input .*drive"):
+        run_batch([recording], recording.parent, workers=1, prepare=die_or_fail)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(OutputError, match="not empty and was not written by 'vo-doppler batch'"):
+        run_batch([recording], out, workers=1, prepare=die_or_fail)
+    (out / "notes.txt").unlink()
+    open_output_folder(out, "batch")
+    (out / "drive").mkdir()
+    (out / "drive" / "notes.txt").write_text("mine")
+    with pytest.raises(OutputError, match=r"out/drive: .*not written by 'vo-doppler run' or"):
+        run_batch([recording], out, workers=1, prepare=die_or_fail)
+    mark_output(out / "drive", RUN)
+    (out / "drive" / "later.txt").write_text("added after the run")
+    with pytest.raises(OutputError, match=r"did not write \(later\.txt\)"):
+        run_batch([recording], out, workers=1, prepare=die_or_fail)
+    monkeypatch.chdir(out / "drive")
+    (out / "drive" / "later.txt").unlink()
+    with pytest.raises(OutputError, match="the current directory"):
+        run_batch([recording], out, workers=1, prepare=die_or_fail)
+    assert (recording / "sequence.yaml").read_text() == "precious"
+    assert sorted(p.name for p in (out / "drive").iterdir()) == [OUTPUT_MARKER, "notes.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [OUTPUT_MARKER, "drive"]
 
 
 def test_an_output_that_is_a_file_fails_before_any_work(tmp_path):

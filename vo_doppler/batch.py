@@ -9,6 +9,12 @@ configuration. A batch started again with ``resume=True`` skips every recording 
 holds the current fingerprint and whose listed outputs still exist; a recording that was cut
 off (killed process, crash, power loss) has no marker and runs again from the start.
 
+``OUT`` must be new, empty or a batch's own, and hold no recording; each ``OUT/<name>/`` is
+emptied before its recording runs, so it must be new, empty or one that ``run`` or ``batch``
+wrote, with nothing added since, and no recording (``vo_doppler.io.output_folder``). All of
+this is checked for every recording before any runs: a refused folder stops the batch with
+nothing touched.
+
 The fingerprint hashes the package version, the configuration, the ``prepare`` step's name
 (or, for a callable object, its ``repr``: e.g. the orbits an importer uses) and, for every file
 under ``SOURCE``, its relative path, size and modification time (the quick
@@ -48,7 +54,13 @@ from pathlib import Path
 
 from vo_doppler import __version__
 from vo_doppler.errors import InputError, VoDopplerError
-from vo_doppler.io.output_folder import check_output_folder
+from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
+from vo_doppler.io.output_folder import (
+    RUN,
+    check_output_folder,
+    mark_output,
+    open_output_folder,
+)
 from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
 from vo_doppler.io.tables import write_csv_and_parquet
 from vo_doppler.report.batch_summary import (
@@ -227,10 +239,15 @@ def process_recording(job: RecordingJob) -> RecordingOutcome:
     """Run one recording and write its outputs and, last, its marker; never raises for a
     failure of the recording itself (the outcome says what failed). The recording's folder is
     emptied first, so no output of an earlier run stays beside the new ones (a failed
-    recording's folder holds its ``run.log``)."""
+    recording's folder holds its ``run.log``); a folder that a run did not write, or that holds
+    the recording, is refused and left as it is."""
     start = time.perf_counter()
+    try:
+        check_output_folder(job.out, RUN, [job.source], replace=True)
+    except VoDopplerError as exc:
+        return _failed(job, Failure.INPUT, str(exc))
     shutil.rmtree(job.out, ignore_errors=True)
-    job.out.mkdir(parents=True, exist_ok=True)
+    open_output_folder(job.out, RUN)
     handler = logging.FileHandler(job.out / LOG_FILE, mode="w")
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     package_log = logging.getLogger("vo_doppler")
@@ -241,16 +258,25 @@ def process_recording(job: RecordingJob) -> RecordingOutcome:
         summary = _run_job(job)
     except VoDopplerError as exc:
         package_log.error("%s", exc)
-        return _failed(job, Failure.INPUT, str(exc), time.perf_counter() - start)
+        outcome = _failed(job, Failure.INPUT, str(exc), time.perf_counter() - start)
     except Exception as exc:
         package_log.error("%s", traceback.format_exc())
         message = f"{type(exc).__name__}: {exc}"
-        return _failed(job, Failure.INTERNAL, message, time.perf_counter() - start)
+        outcome = _failed(job, Failure.INTERNAL, message, time.perf_counter() - start)
+    else:
+        outcome = _done(job, summary, time.perf_counter() - start)
     finally:
         package_log.removeHandler(handler)
         handler.close()
-    seconds = time.perf_counter() - start
-    outputs = sorted(p.name for p in job.out.iterdir() if p.is_file() and p.name != MARKER)
+    mark_output(job.out, RUN)
+    return outcome
+
+
+def _done(job: RecordingJob, summary: dict, seconds: float) -> RecordingOutcome:
+    """A finished recording's outcome, after its completion marker (module docstring)."""
+    outputs = sorted(
+        p.name for p in job.out.iterdir() if p.is_file() and p.name not in (MARKER, OUTPUT_MARKER)
+    )
     marker = {
         "fingerprint": job.fingerprint,
         "source": str(job.source),
@@ -426,9 +452,12 @@ def run_batch(
     if workers is not None and workers < 1:
         raise InputError(f"workers must be at least 1, got {workers}")
     config = config or RunConfig()
-    check_output_folder(out)
-    out.mkdir(parents=True, exist_ok=True)
-    jobs = plan(folders, out, config, prepare)
+    sources = [Path(folder) for folder in folders]
+    check_output_folder(out, "batch", sources)
+    jobs = plan(sources, out, config, prepare)
+    for job in jobs:
+        check_output_folder(job.out, RUN, sources, replace=True)
+    open_output_folder(out, "batch")
     outcomes: dict[str, RecordingOutcome] = {}
     todo = []
     for job in jobs:

@@ -21,6 +21,7 @@ import yaml
 from vo_doppler.cli import main
 from vo_doppler.errors import EXIT_FAILURE, EXIT_OK
 from vo_doppler.io.heading_csv import read_heading_csv
+from vo_doppler.io.output_folder import RUN, mark_output
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
@@ -303,6 +304,56 @@ def test_output_that_is_a_file_fails_before_any_work(tmp_path, capsys):
     assert target.read_text() == "a file"
 
 
+def tree(folder: Path) -> dict[str, bytes]:
+    """Every file under ``folder`` with its bytes (to see that nothing was touched)."""
+    return {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+
+@pytest.mark.parametrize(
+    ("output", "cwd", "message"),
+    [
+        ("par/seq", ".", "par/seq: the output folder is the input par/seq"),
+        ("par", ".", "par: the output folder contains the input par/seq"),
+        ("par/seq/gnss", ".", "par/seq/gnss: the output folder contains the input par/seq/gnss"),
+        ("orbits", ".", "orbits: the output folder contains the input par/seq/../../orbits/x.sp3"),
+        (
+            "other",
+            ".",
+            "other: the output folder is not empty and was not written by 'vo-doppler "
+            "run' or 'vo-doppler batch'; choose a new or empty folder",
+        ),
+        (".", "empty", ".: the output folder is the current directory or contains it"),
+        ("..", "empty", "..: the output folder contains the input ../par/seq"),
+    ],
+)
+def test_run_refuses_its_inputs_the_current_directory_and_a_folder_it_did_not_write(
+    tmp_path, capsys, monkeypatch, output, cwd, message
+):
+    """The QA report's cases (`run selfrun -o selfrun`, `run par/seq -o par`, `-o other` with
+    notes in it, `-o .`) and the manifest's inputs, refused before any reading with nothing
+    touched."""
+    sequence = tmp_path / "par" / "seq"
+    (sequence / "gnss").mkdir(parents=True)
+    (sequence / "gnss" / "rover.obs").write_text("observations")
+    (tmp_path / "orbits").mkdir()
+    (tmp_path / "orbits" / "x.sp3").write_text("orbits")
+    (sequence / "sequence.yaml").write_text(
+        "format: vo-doppler-sequence/1\ngnss: {obs: gnss/rover.obs, orbits: ../../orbits/x.sp3}\n"
+    )
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "notes.txt").write_text("precious")
+    (tmp_path / "empty").mkdir()
+    before = tree(tmp_path)
+    monkeypatch.chdir(tmp_path / cwd)
+    seq = "par/seq" if cwd == "." else "../par/seq"
+    code = main(["run", seq, "-o", output, "--allow-outside-paths"])
+    err = capsys.readouterr().err
+    assert code == EXIT_FAILURE
+    assert f"vo-doppler run: error: {message}" in err
+    assert tree(tmp_path) == before
+    assert sorted(p.name for p in (tmp_path / "empty").iterdir()) == []
+
+
 def test_failed_run_keeps_the_previous_results_and_says_so(clean, clean_run, tmp_path, caplog):
     folder = damaged_copy(clean, tmp_path)
     edit_manifest(folder, "can", "time_offset_s", float("inf"))
@@ -332,6 +383,7 @@ def test_duplicated_can_frames_and_a_distant_origin_are_warned_and_stale_files_g
     out = tmp_path / "out"
     shutil.copytree(clean_run, out)
     (out / "stale_figure.png").write_bytes(b"old")
+    mark_output(out, RUN)  # an earlier run wrote it
     with caplog.at_level(logging.INFO):
         assert main(["run", str(folder), "-o", str(out)]) == EXIT_OK
     assert not (out / "stale_figure.png").exists()

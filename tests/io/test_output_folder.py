@@ -1,49 +1,218 @@
-"""Output folders written all at once."""
+"""Output folders written all at once, and never a folder whose content vo-doppler did not
+write."""
 
 from __future__ import annotations
+
+import json
+from pathlib import Path
 
 import pytest
 
 from vo_doppler.errors import OutputError
-from vo_doppler.io.output_folder import check_output_folder, staged_output, untouched
+from vo_doppler.io.output_folder import (
+    MARKER,
+    RUN,
+    check_output_folder,
+    mark_output,
+    open_output_folder,
+    staged_output,
+    untouched,
+    written_by,
+)
+
+
+def earlier_run(folder, *names):
+    """A folder as an earlier ``run`` left it: ``names`` and the marker listing them."""
+    folder.mkdir(parents=True)
+    for name in names:
+        (folder / name).write_text("old")
+    mark_output(folder, RUN)
+    return folder
 
 
 def test_a_file_is_refused(tmp_path):
     target = tmp_path / "out"
     target.write_text("x")
     with pytest.raises(OutputError, match="the output exists and is not a folder"):
-        check_output_folder(target)
+        check_output_folder(target, RUN)
     with pytest.raises(OutputError, match="is not a folder"):
-        check_output_folder(target / "below")
+        check_output_folder(target / "below", RUN)
 
 
 def test_success_replaces_the_previous_folder_without_stale_files(tmp_path):
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "stale.png").write_text("old")
-    with staged_output(out) as staging:
+    out = earlier_run(tmp_path / "out", "stale.png")
+    with staged_output(out, RUN) as staging:
         assert staging.parent == out.parent and staging != out
         (staging / "new.txt").write_text("new")
         assert (out / "stale.png").exists()  # the old results stay until the end
-    assert sorted(p.name for p in out.iterdir()) == ["new.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "new.txt"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    marker = json.loads((out / MARKER).read_text())
+    assert marker == {"format": "vo-doppler-output/1", "command": "run", "entries": ["new.txt"]}
 
 
 def test_failure_leaves_the_previous_folder_and_no_staging(tmp_path):
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "old.txt").write_text("old")
-    with pytest.raises(RuntimeError), staged_output(out) as staging:
+    out = earlier_run(tmp_path / "out", "old.txt")
+    with pytest.raises(RuntimeError), staged_output(out, RUN) as staging:
         (staging / "half.txt").write_text("half")
         raise RuntimeError
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
-    assert [p.name for p in out.iterdir()] == ["old.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "old.txt"]
     assert untouched(out) == f"nothing written: {out} left as it was"
     assert untouched(tmp_path / "new") == f"nothing written: {tmp_path / 'new'} not created"
 
 
 def test_nested_new_folder_is_created(tmp_path):
     out = tmp_path / "a" / "b"
-    with staged_output(out) as staging:
+    with staged_output(out, RUN) as staging:
         (staging / "x").write_text("1")
     assert (out / "x").read_text() == "1"
+
+
+def test_an_empty_folder_is_accepted_and_a_foreign_one_refused_untouched(tmp_path):
+    (tmp_path / "empty").mkdir()
+    assert check_output_folder(tmp_path / "empty", RUN, replace=True) == tmp_path / "empty"
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("precious")
+    for replace in (False, True):
+        with pytest.raises(OutputError, match="other: the output folder is not empty and was not"):
+            check_output_folder(other, RUN, replace=replace)
+    with pytest.raises(OutputError, match="not written by"), staged_output(other, RUN):
+        pytest.fail("the body must not run")
+    assert [p.name for p in other.iterdir()] == ["notes.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "other"]
+
+
+def test_an_entry_added_after_the_run_makes_replacing_refused(tmp_path):
+    out = earlier_run(tmp_path / "out", "summary.json")
+    (out / "notes.txt").write_text("mine")
+    assert written_by(out, RUN) == (True, ["notes.txt"])
+    with pytest.raises(OutputError, match=r"did not write \(notes\.txt\), which replacing"):
+        check_output_folder(out, RUN, replace=True)
+    check_output_folder(out, RUN)  # writing in place deletes nothing
+
+
+def test_another_commands_folder_is_refused(tmp_path):
+    sequence = open_output_folder(tmp_path / "sim", "simulate")
+    (sequence / "sequence.yaml").write_text("format: vo-doppler-sequence/1\n")
+    assert written_by(sequence, "simulate") == (True, [])
+    assert written_by(sequence, RUN) == (False, [])
+    with pytest.raises(OutputError, match="not written by 'vo-doppler run' or 'vo-doppler batch'"):
+        check_output_folder(sequence, RUN, replace=True)
+    check_output_folder(sequence, "simulate")
+
+
+def test_the_inputs_and_what_holds_them_are_refused(tmp_path):
+    recording = tmp_path / "par" / "seq"
+    (recording / "gnss").mkdir(parents=True)
+    obs = recording / "gnss" / "rover.obs"
+    obs.write_text("o")
+    inputs = [recording, obs, None]
+    for output, relation in ((recording, "is"), (tmp_path / "par", "contains")):
+        with pytest.raises(OutputError, match=f"the output folder {relation} the input "):
+            check_output_folder(output, RUN, inputs)
+    with pytest.raises(OutputError, match=r"contains the input .*rover\.obs"):
+        check_output_folder(recording / "gnss", RUN, [obs])
+    assert check_output_folder(recording / "out", RUN, inputs) == recording / "out"
+    link = tmp_path / "link"
+    link.symlink_to(recording, target_is_directory=True)
+    with pytest.raises(OutputError, match="the output folder is the input"):
+        check_output_folder(link, RUN, inputs)
+
+
+def test_the_current_directory_and_its_parents_are_never_replaced(tmp_path, monkeypatch):
+    here = tmp_path / "a" / "here"
+    here.mkdir(parents=True)
+    monkeypatch.chdir(here)
+    for output in (".", "..", here, tmp_path):
+        with pytest.raises(OutputError, match="the current directory or contains it"):
+            check_output_folder(output, RUN, replace=True)
+    assert check_output_folder(".", "vo") == Path(".")  # in place: empty is fine
+
+
+@pytest.mark.parametrize(
+    ("files", "folders", "replaceable"),
+    [
+        (
+            {
+                "summary.json": {
+                    "gnss_epochs": 1,
+                    "tight_heading_availability": 0.5,
+                    "final_wheel_scale": 1.0,
+                },
+                "heading.png": None,
+            },
+            (),
+            True,
+        ),
+        (
+            {"batch_done.json": {"fingerprint": "f", "outputs": []}, "run.log": None},
+            ["prepared"],
+            True,
+        ),
+        ({"run.log": None}, (), True),
+        ({"summary.json": {"gnss_epochs": 1}, "heading.png": None}, (), False),
+        (
+            {
+                "summary.json": {
+                    "gnss_epochs": 1,
+                    "tight_heading_availability": 0.5,
+                    "final_wheel_scale": 1.0,
+                },
+                "notes.txt": None,
+            },
+            (),
+            False,
+        ),
+        ({"run.log": None}, ["gnss"], False),
+        ({"run.log": None, "sequence.yaml": None}, (), False),
+    ],
+)
+def test_an_unmarked_earlier_run_is_recognised_by_its_own_files(
+    tmp_path, files, folders, replaceable
+):
+    out = tmp_path / "out"
+    out.mkdir()
+    for name, content in files.items():
+        (out / name).write_text("x" if content is None else json.dumps(content))
+    for name in folders:
+        (out / name).mkdir()
+    assert written_by(out, RUN) == (replaceable, [])
+
+
+def test_the_in_place_commands_are_recognised_by_their_own_files(tmp_path):
+    vo = tmp_path / "vo"
+    vo.mkdir()
+    (vo / "vo_stats.json").write_text('{"metric_scale": true}')
+    assert written_by(vo, "vo") == (True, [])
+    assert written_by(vo, "deadreckon") == (False, [])
+    imported = tmp_path / "imported"
+    imported.mkdir()
+    (imported / "sequence.yaml").write_text(
+        "format: vo-doppler-sequence/1\nsource: comma2k19 segment s (vo-doppler import comma2k19)\n"
+    )
+    assert written_by(imported, "import") == (True, [])
+    assert written_by(imported, "simulate") == (False, [])
+
+
+def test_a_folder_filled_meanwhile_is_not_replaced_at_the_end(tmp_path):
+    out = tmp_path / "out"
+    with pytest.raises(OutputError, match="not written by"), staged_output(out, RUN) as staging:
+        (staging / "result.txt").write_text("new")
+        out.mkdir()
+        (out / "notes.txt").write_text("someone else's")
+    assert [p.name for p in out.iterdir()] == ["notes.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_a_batch_cut_off_before_its_aggregate_is_recognised_by_its_recordings(tmp_path):
+    out = tmp_path / "out"
+    earlier_run(out / "drive1", "summary.json")
+    assert written_by(out, "batch") == (True, [])
+    (out / "drive2").mkdir()
+    assert written_by(out, "batch") == (False, [])
+    (out / "drive2").rmdir()
+    (out / "batch_summary.csv").write_text("recording\n")
+    (out / "notes").mkdir()
+    assert written_by(out, "batch") == (True, [])

@@ -8,7 +8,12 @@ import yaml
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, YAW_RATE_COLUMN, write_sensor_csv
-from vo_doppler.io.sequence import read_manifest, read_sequence, read_sequence_with_report
+from vo_doppler.io.sequence import (
+    manifest_inputs,
+    read_manifest,
+    read_sequence,
+    read_sequence_with_report,
+)
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
@@ -20,6 +25,31 @@ def write_manifest(folder, data) -> None:
 def test_missing_manifest(tmp_path):
     with pytest.raises(InputError, match=r"sequence.yaml: cannot read the sequence manifest"):
         read_manifest(tmp_path)
+
+
+def test_manifest_inputs_are_every_existing_path_it_names(tmp_path):
+    """Paths in any section and in lists, inside the folder or outside it; signal names and
+    paths that do not exist name no input."""
+    folder = tmp_path / "seq"
+    (folder / "gnss").mkdir(parents=True)
+    for name in ("gnss/a.obs", "gnss/b.nav"):
+        (folder / name).write_text("x")
+    (tmp_path / "shared.sp3").write_text("x")
+    (folder / "sequence.yaml").write_text(
+        "format: vo-doppler-sequence/1\n"
+        "gnss: {obs: gnss/a.obs, nav: [gnss/b.nav, gnss/missing.nav], orbits: ../shared.sp3}\n"
+        "can: {yaw_rate: YAW.RATE, wheel_speed: [WHEEL.FL]}\n"
+        "ground_truth: {trajectory: truth.tum}\n"
+    )
+    assert manifest_inputs(folder) == [
+        folder,
+        folder / "sequence.yaml",
+        folder / "gnss/a.obs",
+        folder / "gnss/b.nav",
+        folder / "../shared.sp3",
+    ]
+    with pytest.raises(InputError, match="sequence"):
+        manifest_inputs(tmp_path)
 
 
 def test_wrong_format_is_named(tmp_path):

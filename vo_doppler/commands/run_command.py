@@ -16,11 +16,12 @@ from rich.table import Table
 
 from vo_doppler.commands.arg_types import window_size
 from vo_doppler.commands.time_hints import overlap_error, overlaps
+from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
-from vo_doppler.io.output_folder import check_output_folder, staged_output, untouched
-from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
+from vo_doppler.io.output_folder import RUN, check_output_folder, staged_output, untouched
+from vo_doppler.io.sequence import manifest_inputs, read_manifest, read_sequence_with_report
 from vo_doppler.report.run_outputs import (
     input_warnings,
     require_tight_heading,
@@ -102,7 +103,7 @@ def run_config(args: argparse.Namespace) -> RunConfig:
 
 
 def run(args: argparse.Namespace) -> int:
-    check_output_folder(args.output)
+    check_output_folder(args.output, RUN, sequence_inputs(args.sequence), replace=True)
     try:
         result = run_and_write(args)
     except BaseException:
@@ -112,6 +113,15 @@ def run(args: argparse.Namespace) -> int:
         gc.unfreeze()
     require_tight_heading(result, args.sequence, args.output)
     return 0
+
+
+def sequence_inputs(sequence: Path) -> list[Path]:
+    """What the output must not hold: the manifest's inputs, or only the sequence folder when
+    the manifest cannot be read (which reading the sequence then reports)."""
+    try:
+        return manifest_inputs(sequence)
+    except InputError:
+        return [sequence]
 
 
 def run_and_write(args: argparse.Namespace) -> RunResult:
@@ -141,7 +151,7 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
         result = run_sequence(inputs, config, lambda _: progress.advance(task))
     gc.freeze()
     checks = result_checks(inputs, report, result, warnings)
-    with staged_output(args.output) as out:
+    with staged_output(args.output, RUN, sequence_inputs(args.sequence)) as out:
         summary = write_run_outputs(
             inputs, result, config, out, checks, read_manifest(args.sequence)
         )

@@ -1,25 +1,183 @@
-"""An output folder written all at once: checked before any work, filled in a temporary folder
-beside it, and moved into place only when complete, so a failed run leaves the previous results
-untouched and a rerun leaves no stale files."""
+"""Output folders: checked before any work, and never a folder whose content vo-doppler did not
+write.
+
+A command's ``-o`` folder must be new, empty or written by an earlier run of the same command
+(:func:`written_by`), must not be or contain one of the command's inputs, and, when the command
+replaces the whole folder (``run``; ``batch`` for each recording's folder), must not be the
+current directory or hold it. ``vo-doppler run`` fills a temporary folder beside the output and
+swaps it in only when complete (:func:`staged_output`), so a failed run leaves the previous
+results untouched and a rerun leaves no stale files.
+
+How a folder is recognised as written by a command: the marker file :data:`MARKER` that every
+command writes into the folders it makes, naming the command and, for a folder that is
+replaced as a whole, every entry it wrote (an entry added later by someone else would be
+deleted with the folder, so it makes replacing refused); or, for folders written before the
+marker existed, the command's own files (:data:`_OWN_FILES`).
+"""
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
+from fnmatch import fnmatch
 from pathlib import Path
 
-from vo_doppler.errors import OutputError
+from vo_doppler.errors import InputError, OutputError
+from vo_doppler.io.yaml_file import load_yaml
+
+MARKER = ".vo-doppler-output.json"
+MARKER_FORMAT = "vo-doppler-output/1"
+MARKER_MAX_BYTES = 1 << 20
+RUN = "run"
+"""The kind of folder ``run`` writes and ``batch`` writes per recording (one replaces the other)."""
+
+_RUN_SUMMARY_KEYS = {"gnss_epochs", "tight_heading_availability", "final_wheel_scale"}
+"""Keys every ``summary.json`` of ``run`` has held (the recognition of unmarked older outputs)."""
+_RUN_FILES = ("*.tum", "*.png", "*.csv", "*.json", "*.html", "*.geojson", "*.log")
+"""Name patterns of every file ``run`` and a ``batch`` recording have written."""
+_WRITERS = {RUN: "'vo-doppler run' or 'vo-doppler batch'"}
+"""Who writes a kind of folder, for messages (default: ``'vo-doppler COMMAND'``)."""
+_BATCH_PREPARED = "prepared"
+"""The sub-folder of a ``batch --comma2k19`` recording that holds its imported sequence."""
 
 
-def check_output_folder(path: str | Path) -> Path:
-    """``path`` when it can become the output folder: not an existing file, and its nearest
-    existing ancestor (or itself) a writable folder; an :class:`OutputError` otherwise."""
+def _read_json(path: Path) -> object:
+    """The JSON value in ``path``, or None when there is none to read (missing, too large, not
+    JSON)."""
+    try:
+        if path.stat().st_size > MARKER_MAX_BYTES:
+            return None
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def _json_with_keys(path: Path, keys: set[str]) -> bool:
+    """Whether ``path`` is a JSON object holding ``keys``."""
+    data = _read_json(path)
+    return isinstance(data, dict) and keys <= data.keys()
+
+
+def _manifest_with(folder: Path, test: Callable[[dict], bool]) -> bool:
+    """Whether ``folder``'s ``sequence.yaml`` parses to a mapping that passes ``test``."""
+    try:
+        manifest = load_yaml(folder / "sequence.yaml", "the sequence manifest")
+    except (InputError, OSError):
+        return False
+    return isinstance(manifest, dict) and test(manifest)
+
+
+def _unmarked_run(folder: Path) -> bool:
+    """A ``run`` output or ``batch`` recording folder from before the marker: its summary, batch
+    marker or (a failed recording) log, and nothing else than files named like its outputs and
+    a batch's ``prepared`` sequence."""
+    entries = list(folder.iterdir())
+    for entry in entries:
+        if entry.name == _BATCH_PREPARED and entry.is_dir():
+            continue
+        if not entry.is_file() or not any(fnmatch(entry.name, p) for p in _RUN_FILES):
+            return False
+    names = {entry.name for entry in entries}
+    return (
+        _json_with_keys(folder / "summary.json", _RUN_SUMMARY_KEYS)
+        or _json_with_keys(folder / "batch_done.json", {"fingerprint", "outputs"})
+        or ("run.log" in names and names <= {"run.log", _BATCH_PREPARED})
+    )
+
+
+def _only_recordings(folder: Path) -> bool:
+    """A batch's folder cut off before its aggregate: recording folders and nothing else."""
+    return all(e.is_dir() and written_by(e, RUN)[0] for e in folder.iterdir())
+
+
+_OWN_FILES: dict[str, Callable[[Path], bool]] = {
+    RUN: _unmarked_run,
+    "batch": lambda f: (f / "batch_summary.csv").is_file() or _only_recordings(f),
+    "vo": lambda f: _json_with_keys(f / "vo_stats.json", {"metric_scale"}),
+    "deadreckon": lambda f: (f / "deadreckon_summary.json").is_file(),
+    "simulate": lambda f: _manifest_with(f, lambda m: {"scenario", "command"} <= m.keys()),
+    "import": lambda f: _manifest_with(
+        f, lambda m: "vo-doppler import comma2k19" in str(m.get("source", ""))
+    ),
+}
+"""Per command, how a folder it wrote without a marker is recognised: by its own files."""
+
+
+def _marker(folder: Path) -> dict | None:
+    data = _read_json(folder / MARKER)
+    if not isinstance(data, dict) or data.get("format") != MARKER_FORMAT:
+        return None
+    return data
+
+
+def written_by(folder: str | Path, command: str) -> tuple[bool, list[str]]:
+    """Whether ``folder`` (an existing folder) was written by ``command``, and the entries in it
+    that the command's marker does not list (which make it foreign; empty when it has no list)."""
+    folder = Path(folder)
+    marker = _marker(folder)
+    if marker is None:
+        return _OWN_FILES[command](folder), []
+    if marker.get("command") != command:
+        return False, []
+    listed = marker.get("entries")
+    if not isinstance(listed, list):
+        return True, []
+    foreign = sorted(p.name for p in folder.iterdir() if p.name != MARKER and p.name not in listed)
+    return True, foreign
+
+
+def mark_output(folder: str | Path, command: str, complete: bool = True) -> None:
+    """Write the marker that :func:`written_by` recognises into ``folder``; ``complete``: the
+    folder holds everything the command writes, so its entries are listed."""
+    folder = Path(folder)
+    marker: dict = {"format": MARKER_FORMAT, "command": command}
+    if complete:
+        marker["entries"] = sorted(p.name for p in folder.iterdir() if p.name != MARKER)
+    (folder / MARKER).write_text(json.dumps(marker, indent=1) + "\n")
+
+
+def open_output_folder(path: str | Path, command: str) -> Path:
+    """Create ``path`` (and its parents) for ``command`` to write into in place, marked as its
+    own; the entries are not listed, as a command writing in place never deletes any."""
+    path = Path(path)
+    path.mkdir(parents=True, exist_ok=True)
+    mark_output(path, command, complete=False)
+    return path
+
+
+def _holds(folder: Path, other: Path) -> bool:
+    return other == folder or other.is_relative_to(folder)
+
+
+def check_output_folder(
+    path: str | Path,
+    command: str,
+    inputs: Iterable[str | Path | None] = (),
+    replace: bool = False,
+) -> Path:
+    """``path`` when ``command`` may write it (module docstring), an :class:`OutputError` saying
+    why not otherwise. ``inputs``: the files and folders the command reads (None: an input not
+    given); ``replace``: the command replaces the whole folder (its content is deleted), so it
+    must not hold the current directory either. Nothing is created or changed."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise OutputError(f"{path}: the output exists and is not a folder")
+    resolved = path.resolve()
+    for item in filter(None, inputs):
+        if _holds(resolved, Path(item).resolve()):
+            relation = "is" if Path(item).resolve() == resolved else "contains"
+            raise OutputError(
+                f"{path}: the output folder {relation} the input {item}; choose another folder"
+            )
+    if replace and _holds(resolved, Path.cwd().resolve()):
+        raise OutputError(
+            f"{path}: the output folder is the current directory or contains it, and its "
+            "content would be replaced; choose another folder"
+        )
     ancestor = path.absolute()
     while not ancestor.exists():
         ancestor = ancestor.parent
@@ -29,18 +187,42 @@ def check_output_folder(path: str | Path) -> Path:
         path.exists() and not os.access(path.absolute().parent, os.W_OK | os.X_OK)
     ):
         raise OutputError(f"{path}: no permission to write there")
+    try:
+        if not path.is_dir() or not any(path.iterdir()):
+            return path
+        ours, foreign = written_by(path, command)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot read the output folder: {exc.strerror}") from exc
+    writer = _WRITERS.get(command, f"'vo-doppler {command}'")
+    if not ours:
+        raise OutputError(
+            f"{path}: the output folder is not empty and was not written by {writer}; "
+            "choose a new or empty folder"
+        )
+    if replace and foreign:
+        raise OutputError(
+            f"{path}: the output folder holds what {writer} did not write "
+            f"({', '.join(foreign)}), which replacing it would delete; move that away or "
+            "choose another folder"
+        )
     return path
 
 
 @contextmanager
-def staged_output(path: str | Path) -> Iterator[Path]:
-    """A temporary folder beside ``path`` to write into; on normal exit it replaces ``path``
-    (the previous folder is removed), on an exception it is removed and ``path`` is unchanged."""
-    path = check_output_folder(path).absolute()
+def staged_output(
+    path: str | Path, command: str, inputs: Iterable[str | Path | None] = ()
+) -> Iterator[Path]:
+    """A temporary folder beside ``path`` to write into; on normal exit it is marked as
+    ``command``'s and replaces ``path`` (checked again, then the previous folder is removed), on
+    an exception it is removed and ``path`` is unchanged."""
+    inputs = list(inputs)
+    path = check_output_folder(path, command, inputs, replace=True).absolute()
     path.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.partial-", dir=path.parent))
     try:
         yield staging
+        mark_output(staging, command)
+        check_output_folder(path, command, inputs, replace=True)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise

@@ -77,6 +77,30 @@ def read_manifest(folder: str | Path) -> dict[str, Any]:
     return manifest
 
 
+def manifest_inputs(folder: str | Path) -> list[Path]:
+    """The sequence folder, its manifest and every existing file or folder a string of the
+    manifest names (relative to the folder, or absolute): what an output must never replace.
+    Strings that are not paths name nothing that exists and drop out."""
+    manifest = read_manifest(folder)
+    root = manifest["_path"].parent
+    found = [root, manifest["_path"]]
+    pending = [manifest]
+    while pending:  # depth first, in the manifest's order
+        value = pending.pop()
+        if isinstance(value, dict):
+            pending += reversed(value.values())
+        elif isinstance(value, list):
+            pending += reversed(value)
+        elif isinstance(value, str) and value.strip():
+            try:
+                path = root / value
+                if path.exists():
+                    found.append(path)
+            except (OSError, ValueError):  # a name too long or with a NUL names no input
+                continue
+    return found
+
+
 class Manifest:
     """Typed access to a parsed manifest: every value is checked for its type and range, and
     every path for staying inside the sequence folder (unless ``allow_outside``); a bad value is
