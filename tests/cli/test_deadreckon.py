@@ -96,3 +96,18 @@ def test_standstill_interval_that_moves_is_exit_1_with_the_speed(inputs, tmp_pat
     assert code == 1 and "Traceback" not in err
     t0, t1 = (f"{t:.2f}" for t in moving)
     assert f"standstill {t0}–{t1} s: the GPS track speed shows the vehicle moving" in err
+
+
+def test_an_output_folder_holding_an_input_or_someone_elses_files_is_refused(
+    inputs, tmp_path, capsys
+):
+    _, paths = inputs
+    assert main(_args(paths, paths["gyro1"].parent)) == 1
+    assert "the output folder contains the input" in capsys.readouterr().err
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine")
+    assert main(_args(paths, other)) == 1
+    err = capsys.readouterr().err
+    assert f"{other}: the output folder is not empty and was not written by 'vo-doppler " in err
+    assert [p.name for p in other.iterdir()] == ["notes.txt"]

@@ -97,6 +97,9 @@ def test_usage_and_input_errors(sequence, tmp_path, capsys):
     empty = tmp_path / "empty"
     empty.mkdir()
     assert main(["vo", str(empty), "--calib", str(calib), "--fps", "10", "-o", str(tmp_path)]) == 1
+    assert f"{tmp_path}: the output folder contains the input {empty}" in capsys.readouterr().err
+    out = str(tmp_path / "out")
+    assert main(["vo", str(empty), "--calib", str(calib), "--fps", "10", "-o", out]) == 1
     assert "no PNG/JPG images" in capsys.readouterr().err
     bad_times = tmp_path / "times.txt"
     bad_times.write_text("0\n0.1\n0.1\n")
@@ -109,7 +112,7 @@ def test_usage_and_input_errors(sequence, tmp_path, capsys):
             "--times",
             str(bad_times),
             "-o",
-            str(tmp_path),
+            out,
         ]
     )
     assert code == 1

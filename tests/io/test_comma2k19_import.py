@@ -10,7 +10,7 @@ import pytest
 
 from tests.conftest import require_shared
 from tests.helpers.precise_text import sp3_text
-from vo_doppler.errors import InputError
+from vo_doppler.errors import InputError, OutputError
 from vo_doppler.io.comma2k19 import read_gyro_yaw_rate, read_wheel_speed
 from vo_doppler.io.comma2k19_import import (
     Comma2k19Import,
@@ -103,3 +103,27 @@ def test_a_signal_of_the_wrong_shape_is_named(tmp_path):
         np.save(stream, np.ones((5, 3)))
     with pytest.raises(InputError, match=r"wheel_speed: .*value \(5, 3\); expected .*\(N, 4\)"):
         read_wheel_speed(tmp_path)
+
+
+def test_the_import_never_writes_into_its_segment_or_a_foreign_folder(tmp_path):
+    """Checked before anything is read: the segment itself, a folder holding it, and a
+    non-empty folder that no import wrote are refused, untouched."""
+    segment = tmp_path / "route" / "segment"
+    segment.mkdir(parents=True)
+    (segment / "raw.bin").write_text("data")
+    orbits = tmp_path / "orbits.sp3"
+    for output in (segment, segment.parent):
+        with pytest.raises(OutputError, match="the input"):
+            import_comma2k19(segment, output, orbits)
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "sequence.yaml").write_text("format: vo-doppler-sequence/1\n")
+    with pytest.raises(OutputError, match="not written by 'vo-doppler import'"):
+        import_comma2k19(segment, other, orbits)
+    assert sorted(p.name for p in tmp_path.rglob("*")) == [
+        "other",
+        "raw.bin",
+        "route",
+        "segment",
+        "sequence.yaml",
+    ]

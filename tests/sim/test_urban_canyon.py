@@ -204,3 +204,17 @@ def test_cli_receives_reflections_unless_told_not_to(tmp_path):
     direct = _manifest(tmp_path / "direct", "--no-nlos")
     assert direct["truth"]["gnss"]["nlos"] is False
     assert "--no-nlos" in direct["command"].split()
+
+
+def test_cli_writes_only_into_a_new_empty_or_earlier_simulated_folder(tmp_path, capsys):
+    """A second simulation into its own folder is fine; a folder with someone else's files is
+    refused before any work, untouched."""
+    out = tmp_path / "sim"
+    _manifest(out)
+    _manifest(out)
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "sequence.yaml").write_text("a recording of someone else's")
+    assert main(["simulate", "--duration", "3", "--no-images", "-o", str(other)]) == 1
+    assert "not written by 'vo-doppler simulate'" in capsys.readouterr().err
+    assert [p.name for p in other.iterdir()] == ["sequence.yaml"]

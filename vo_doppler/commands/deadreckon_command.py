@@ -12,6 +12,7 @@ from vo_doppler.checks import check_standstill_is_still
 from vo_doppler.commands.arg_types import positive_int
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.gps_fixes import read_gps_fixes
+from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.io.sensor_csv import read_numeric_csv, read_yaw_rate_csv
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon, smoothed_track_speed
 from vo_doppler.report.deadreckon import drift_table_rows, write_outputs
@@ -116,6 +117,9 @@ def _track_speed(fixes) -> tuple[np.ndarray, np.ndarray]:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output_folder(
+        args.output, "deadreckon", [args.gyro1, args.gyro2, args.gps, args.wheel_speed]
+    )
     gyro1 = read_yaw_rate_csv(args.gyro1)
     gyro2 = read_yaw_rate_csv(args.gyro2)
     fixes = read_gps_fixes(args.gps)

@@ -266,7 +266,7 @@ def _command_line(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    check_output_folder(args.output)
+    check_output_folder(args.output, "simulate")
     defaults = UrbanCanyonConfig()
     if set(args.systems) - set("GE") or not args.systems:
         raise InputError(f"--systems {args.systems!r}: the simulator has G and E")

@@ -21,7 +21,7 @@ from vo_doppler.io.images import (
     read_times,
     times_from_fps,
 )
-from vo_doppler.io.output_folder import check_output_folder
+from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
 from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
 from vo_doppler.report.json_text import json_text
@@ -66,7 +66,9 @@ def register(subparsers, summary: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    check_output_folder(args.output)
+    check_output_folder(
+        args.output, "vo", [args.images, args.calib, args.times, args.speed, args.gt]
+    )
     files = list_images(args.images)
     camera = read_camera(args.calib)
     if args.fps is not None:
@@ -106,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(
             f"only {decoded[0]} of the {len(files)} images could be decoded", args.images
         )
-    args.output.mkdir(parents=True, exist_ok=True)
+    open_output_folder(args.output, "vo")
     write_tum(args.output / "trajectory.tum", output.trajectory)
     write_kitti(args.output / "trajectory.kitti", output.trajectory)
     stats = output.stats.to_dict()

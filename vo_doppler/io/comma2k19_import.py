@@ -45,6 +45,7 @@ from vo_doppler.io.comma2k19 import (
 )
 from vo_doppler.io.comma2k19_video import CALIB, IMAGES, TIMES, VIDEO, decode_video
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
+from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.rinex_write import ObsEpochs, write_obs
 from vo_doppler.io.sensor_csv import (
     FORWARD_ACCELERATION_COLUMN,
@@ -93,8 +94,10 @@ def import_comma2k19(
     clocks: str | Path | None = None,
     dbc: str | Path | None = None,
 ) -> ImportSummary:
-    """Write the sequence folder ``output`` from the segment folder ``segment``."""
+    """Write the sequence folder ``output`` from the segment folder ``segment`` (checked first:
+    new, empty or an earlier import's, and none of the inputs inside it)."""
     segment, output = Path(segment), Path(output)
+    check_output_folder(output, "import", [segment, orbits, clocks, dbc])
     if dbc is not None and not Path(dbc).is_file():
         raise InputError("the DBC for the CAN log is not a file", dbc)
     dbc = Path(dbc) if dbc is not None else segment / DBC
@@ -106,6 +109,7 @@ def import_comma2k19(
             DBC,
         )
         dbc = None
+    open_output_folder(output, "import")
     for folder in ("gnss", "imu", "can" if dbc else "vehicle"):
         (output / folder).mkdir(parents=True, exist_ok=True)
     offset = gps_minus_log(segment)

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.geo import EnuFrame, ecef_to_geodetic
+from vo_doppler.io.output_folder import open_output_folder
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.lowcost.drift import DriftRow
 from vo_doppler.lowcost.pipeline import DeadReckonResult
@@ -134,8 +135,7 @@ def write_allan_figure(path: Path, result: DeadReckonResult) -> None:
 
 def write_outputs(folder: str | Path, result: DeadReckonResult) -> dict[str, Path]:
     """Write every output file into ``folder`` (created) and return their paths by name."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = open_output_folder(folder, "deadreckon")
     paths = {
         "trajectory": folder / "trajectory.tum",
         "geojson": folder / "trajectory.geojson",

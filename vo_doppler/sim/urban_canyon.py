@@ -65,6 +65,7 @@ from rich.progress import track
 
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import write_camera_yaml
+from vo_doppler.io.output_folder import open_output_folder
 from vo_doppler.io.rinex_write import write_nav, write_obs
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.camera import Camera
@@ -252,7 +253,7 @@ def simulate_urban_canyon(
     out_dir: str | Path, config: UrbanCanyonConfig, command: str = "", progress: bool = False
 ) -> UrbanCanyonSimulation:
     """Generate a complete sequence folder (layout in the module docstring)."""
-    out = Path(out_dir)
+    out = open_output_folder(out_dir, "simulate")
     for sub in ("gnss", "can"):
         (out / sub).mkdir(parents=True, exist_ok=True)
     seconds: dict[str, float] = {}
