@@ -222,9 +222,9 @@ def test_bad_signal_names_and_units(dbc_path):
 
 
 @settings(max_examples=40, deadline=None)
-@given(
-    yaw=st.floats(-300, 300, allow_nan=False).map(lambda v: round(v, 2)),
-    kmh=st.floats(0, 600, allow_nan=False).map(lambda v: round(v, 2)),
+@given(  # what a car can report (vo_doppler.io.vehicle_limits): ±286 deg/s, 540 km/h
+    yaw=st.floats(-286, 286, allow_nan=False).map(lambda v: round(v, 2)),
+    kmh=st.floats(0, 540, allow_nan=False).map(lambda v: round(v, 2)),
 )
 def test_decode_round_trip_property(yaw, kmh):
     db = cantools.database.load_string(DBC_TEXT, "dbc")
@@ -335,3 +335,70 @@ def test_an_acceleration_signal_that_is_not_one_is_named(tmp_path, dbc_path):
     path.write_text("(1600000000.000000) can0 028#00C8000000\n")
     with pytest.raises(InputError, match=r"WHEELS\.WL is in m/s, not m/s²"):
         read_can_motion(path, dbc_path, forward_acceleration="WHEELS.WL")
+
+
+def _wheel_log(path, db, kmh) -> None:
+    """A candump log of WHEELS frames at 100 Hz from T0, WL = WR = ``kmh[k]``."""
+    wheels = db.get_message_by_name("WHEELS")
+    with can.Logger(str(path)) as writer:
+        for k, value in enumerate(kmh):
+            writer.on_message_received(
+                can.Message(
+                    timestamp=T0 + 0.01 * k,
+                    arbitration_id=170,
+                    data=wheels.encode({"WL": value, "WR": value}),
+                    is_extended_id=False,
+                    channel=0,
+                )
+            )
+
+
+def test_an_isolated_wheel_speed_beyond_a_car_is_skipped_and_named(tmp_path, dbc_path):
+    kmh = np.full(200, 36.0)
+    kmh[57] = 599.0  # 166 m/s: beyond any road vehicle
+    path = tmp_path / "bus.log"
+    _wheel_log(path, load_dbc(dbc_path), kmh)
+    motion = read_can_motion(path, dbc_path, wheel_speed="WHEELS.WL,WHEELS.WR")
+    assert len(motion.speed) == 199 and np.all(motion.speed.value == pytest.approx(10.0))
+    assert T0 + 0.57 not in motion.speed.t
+    problems = motion.report.problems()
+    assert len(problems) == 2  # one per wheel signal
+    assert "1 of the 200 samples of WHEELS.WL" in problems[0]
+    assert f"at t = {T0 + 0.57:.6f} s" in problems[0] and "[-10, 150] m/s" in problems[0]
+
+
+def test_a_wheel_speed_often_beyond_a_car_is_an_error_naming_signal_and_time(tmp_path, dbc_path):
+    kmh = np.full(200, 36.0)
+    kmh[[20, 90, 150]] = 599.0  # 1.5 % of the samples: a wrong factor, not a glitch
+    path = tmp_path / "bus.log"
+    _wheel_log(path, load_dbc(dbc_path), kmh)
+    with pytest.raises(InputError, match="check the DBC factor") as info:
+        read_can_motion(path, dbc_path, wheel_speed="WHEELS.WL")
+    message = str(info.value)
+    assert message.startswith(f"{path}: 3 of the 200 samples of WHEELS.WL")
+    assert f"at t = {T0 + 0.2:.6f} s" in message
+
+
+def test_a_candump_log_named_asc_is_an_error_saying_what_it_looks_like(tmp_path, dbc_path):
+    path = tmp_path / "bus.asc"
+    _wheel_log(tmp_path / "bus.log", load_dbc(dbc_path), np.full(5, 36.0))
+    path.write_bytes((tmp_path / "bus.log").read_bytes())
+    with pytest.raises(InputError) as info:
+        read_can_motion(path, dbc_path, wheel_speed="WHEELS.WL")
+    message = str(info.value)
+    assert message.startswith(f"{path}: no CAN frame in this ASC log")
+    assert "none of its 5 lines is one" in message
+    assert "a candump -l line: name the file .log" in message
+    assert not message.rstrip().endswith(";")
+
+
+def test_a_log_without_the_requested_message_is_an_error(tmp_path, dbc_path):
+    path = tmp_path / "bus.log"
+    _wheel_log(path, load_dbc(dbc_path), np.full(5, 36.0))
+    with pytest.raises(InputError, match=r"no decodable frame of message\(s\) KIN in the log "):
+        read_can_motion(path, dbc_path, "KIN.YAW_RATE", "WHEELS.WL")
+    with pytest.raises(InputError, match=r"from the log on channel 'can9' \(0 frames"):
+        read_can_motion(path, dbc_path, wheel_speed="WHEELS.WL", channel="can9")
+    path.write_text("0.010000 1 0AA Rx d 8 00 00 00 00 00 00 00 00\n" * 3)  # ASC lines
+    with pytest.raises(InputError, match=r"log \(0 frames, .*, 3 unreadable log lines\)"):
+        read_can_motion(path, dbc_path, wheel_speed="WHEELS.WL")

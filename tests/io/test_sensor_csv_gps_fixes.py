@@ -22,14 +22,19 @@ from vo_doppler.io.gps_fixes import (
     write_gps_csv,
 )
 from vo_doppler.io.sensor_csv import (
+    FORWARD_ACCELERATION_COLUMN,
+    SPEED_COLUMN,
     YAW_RATE_COLUMN,
     read_numeric_csv,
+    read_sensor_csv,
+    read_speed_csv,
     read_yaw_rate_csv,
     write_sensor_csv,
 )
 from vo_doppler.model.series import SensorSeries
 
 finite = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)
+yaw_rates = st.floats(-5.0, 5.0, allow_nan=False)  # what a car can report (vehicle_limits)
 tmp_settings = settings(
     max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
@@ -41,7 +46,7 @@ def in_time_order(rows: list[tuple]) -> list[tuple]:
 
 
 @tmp_settings
-@given(st.lists(st.tuples(finite, finite), min_size=1, max_size=50).map(in_time_order))
+@given(st.lists(st.tuples(finite, yaw_rates), min_size=1, max_size=50).map(in_time_order))
 def test_gyro_csv_round_trip(tmp_path, rows):
     t, rate = np.array(sorted(rows)).T  # sensor times never go backwards (the reader's rule)
     path = tmp_path / "gyro.csv"
@@ -83,7 +88,58 @@ def test_gyro_csv_bad_rows_are_skipped_and_counted(tmp_path, caplog):
     _, report = read_numeric_csv(path, ("t", YAW_RATE_COLUMN))
     assert (report.n_malformed, report.n_non_finite) == (2, 2)
     assert report.skipped_lines == [4, 5, 6, 9] and report.row_lines == [3, 8]
-    assert "skipped 2 malformed and 2 non-finite" in caplog.text
+    assert "skipped 2 malformed, 2 non-finite and 0 out-of-range rows" in caplog.text
+
+
+def _speed_rows(n: int, bad: dict[int, str]) -> str:
+    """A ``t,speed_mps`` CSV of ``n`` rows at 10 m/s, row k replaced by ``bad[k]``."""
+    rows = [f"{0.01 * k:.2f},{bad.get(k, '10.0')}" for k in range(n)]
+    return "t,speed_mps\n" + "\n".join(rows) + "\n"
+
+
+@pytest.mark.parametrize("value", ["1e9", "400", "-10.5"])
+def test_an_isolated_speed_beyond_a_car_is_skipped_counted_and_named(tmp_path, caplog, value):
+    path = tmp_path / "speed.csv"
+    path.write_text(_speed_rows(200, {57: value}))
+    with caplog.at_level(logging.WARNING):
+        series = read_speed_csv(path)
+    assert len(series) == 199 and series.n_skipped == 1 and np.all(series.value == 10.0)
+    assert 0.57 not in series.t
+    _, report = read_numeric_csv(path, ("t", SPEED_COLUMN))
+    assert report.n_out_of_range == 1 and report.skipped_lines == [59]  # header is line 1
+    expected = (
+        f"{path}: skipped 0 malformed, 0 non-finite and 1 out-of-range rows (speed_mps "
+        f"{float(value):g} beyond [-10, 150] m/s) (first lines: 59)"
+    )
+    assert report.problems() == [expected] and expected in caplog.text
+
+
+def test_signals_at_a_cars_limits_are_kept(tmp_path):
+    path = tmp_path / "speed.csv"
+    path.write_text(_speed_rows(4, {0: "-10", 1: "150", 2: "0"}))
+    np.testing.assert_array_equal(read_speed_csv(path).value, [-10.0, 150.0, 0.0, 10.0])
+    path = tmp_path / "yaw.csv"
+    path.write_text(
+        "t,yaw_rate_rad_s\n0,-5\n1,5\n2,5.001\n" + "".join(f"{3 + k},0.1\n" for k in range(100))
+    )
+    series = read_yaw_rate_csv(path)
+    assert series.value[:2].tolist() == [-5.0, 5.0] and series.n_skipped == 1
+    path = tmp_path / "acc.csv"
+    path.write_text("t,forward_acceleration_mps2\n0,-50\n1,50\n")
+    assert read_sensor_csv(path, FORWARD_ACCELERATION_COLUMN).value.tolist() == [-50.0, 50.0]
+
+
+def test_a_column_often_beyond_a_car_is_an_error_naming_the_first_line(tmp_path):
+    path = tmp_path / "yaw.csv"  # deg/s written as rad/s: the turns go beyond 5
+    rows = [f"{k},{30.0 if 40 <= k < 43 else 1.0}" for k in range(200)]
+    path.write_text("t,yaw_rate_rad_s\n" + "\n".join(rows) + "\n")
+    with pytest.raises(InputError) as info:
+        read_yaw_rate_csv(path)
+    assert str(info.value) == (
+        f"{path}:42: yaw_rate_rad_s = 30 is outside what a vehicle can report, "
+        "[-5, 5] rad/s, and so are 3 of the 200 rows: not isolated bad rows; check the "
+        "column's unit"
+    )
 
 
 @pytest.mark.parametrize(

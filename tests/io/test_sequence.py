@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import yaml
 
-from vo_doppler.errors import InputError
+from vo_doppler.errors import InputError, ManifestError
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, YAW_RATE_COLUMN, write_sensor_csv
 from vo_doppler.io.sequence import (
     manifest_inputs,
@@ -94,6 +94,31 @@ def test_antenna_lever_arm_is_read_and_defaults_to_zero(tmp_path):
         write_manifest(tmp_path, manifest)
         with pytest.raises(InputError, match=r"gnss\.antenna_lever_arm_m .* not three numbers"):
             read_sequence(tmp_path)
+    manifest["gnss"]["antenna_lever_arm_m"] = [19.0, 0.0, 5.0]  # 19.6 m: an articulated bus
+    write_manifest(tmp_path, manifest)
+    assert read_sequence(tmp_path).antenna_lever_arm_m == (19.0, 0.0, 5.0)
+    manifest["gnss"]["antenna_lever_arm_m"] = [1000, 0, 0]  # millimetres, or a typo
+    write_manifest(tmp_path, manifest)
+    with pytest.raises(ManifestError) as info:
+        read_sequence(tmp_path)
+    assert info.value.key == "gnss.antenna_lever_arm_m"
+    assert "[1000.0, 0.0, 0.0]: the lever arm is 1000 m long, beyond any road vehicle (20 m)" in (
+        str(info.value)
+    )
+
+
+def test_a_ground_truth_file_named_but_absent_is_an_error_naming_the_key(tmp_path):
+    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=1.0, seed=1, image_size=(64, 36)))
+    assert read_sequence(tmp_path).truth is not None
+    manifest = yaml.safe_load((tmp_path / "sequence.yaml").read_text())
+    manifest["ground_truth"]["trajectory"] = "nothere.tum"
+    write_manifest(tmp_path, manifest)
+    with pytest.raises(ManifestError, match=r"nothere\.tum: cannot read") as info:
+        read_sequence(tmp_path)
+    assert info.value.key == "ground_truth.trajectory"
+    del manifest["ground_truth"]  # no ground truth at all: a run without evaluation
+    write_manifest(tmp_path, manifest)
+    assert read_sequence(tmp_path).truth is None
 
 
 def test_forward_acceleration_from_the_can_bus_or_a_csv_but_not_both(tmp_path):
@@ -176,3 +201,25 @@ def test_vehicle_signals_from_sensor_csvs_instead_of_a_can_log(tmp_path):
     write_manifest(tmp_path, manifest)
     with pytest.raises(InputError, match="section 'vehicle' lacks 'wheel_speed'"):
         read_sequence(tmp_path)
+
+
+def test_vehicle_rows_skipped_by_the_readers_are_warnings_of_the_run(tmp_path):
+    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
+    from_can = read_sequence(tmp_path)
+    speed = from_can.wheel_speed.value.copy()
+    speed[50] = 1.0e9  # one corrupt row: 5,174 km of dead reckoning if it were integrated
+    write_sensor_csv(
+        tmp_path / "speed.csv", SensorSeries(from_can.wheel_speed.t, speed), SPEED_COLUMN
+    )
+    write_sensor_csv(tmp_path / "yaw.csv", from_can.yaw_rate, YAW_RATE_COLUMN)
+    manifest = yaml.safe_load((tmp_path / "sequence.yaml").read_text())
+    del manifest["can"]
+    manifest["vehicle"] = {"yaw_rate": "yaw.csv", "wheel_speed": "speed.csv"}
+    write_manifest(tmp_path, manifest)
+    sequence, report = read_sequence_with_report(tmp_path)
+    assert len(sequence.wheel_speed) == len(speed) - 1
+    assert np.max(sequence.wheel_speed.value) == np.max(np.delete(speed, 50))
+    assert report.warnings() == [
+        f"{tmp_path / 'speed.csv'}: skipped 0 malformed, 0 non-finite and 1 out-of-range rows "
+        "(speed_mps 1e+09 beyond [-10, 150] m/s) (first lines: 52)"
+    ]

@@ -12,7 +12,11 @@ for sources known to drop trailing zero bytes (comma2k19's ``raw_can`` arrays). 
 cannot be decoded, and log lines that cannot be read (including non-finite times and ids
 beyond 29 bits), are counted, logged and skipped — the result keeps every frame that could be
 decoded. After a bad line the line formats resume at the next line (linear time); ASC and BLF
-keep what came before a corrupt record. ASC times are on UTC whatever the reading machine's
+keep what came before a corrupt record; a log in which no frame at all could be read, or without
+a single frame of a requested message, is an error saying what was found. Decoded values beyond
+what a car can report (:mod:`vo_doppler.io.vehicle_limits`) are skipped and counted when
+isolated (1 % of the signal's samples at most); more is an error naming the signal and the time
+of the first one (a wrong DBC factor or unit). ASC times are on UTC whatever the reading machine's
 timezone. Decoding is streamed: frames are decoded as they are read into compact arrays, so
 memory grows with the decoded samples only. Time order follows the ``"sort"`` policy of
 :mod:`vo_doppler.io.time_order` per message (a frame more than 0.5 s late is an error).
@@ -24,6 +28,7 @@ import calendar
 import datetime
 import logging
 import math
+import re
 from array import array
 from collections import Counter
 from dataclasses import dataclass, field
@@ -42,6 +47,13 @@ from vo_doppler.io.textfile import (
     regular_file,
 )
 from vo_doppler.io.time_order import TimeOrderReport, order_samples
+from vo_doppler.io.vehicle_limits import (
+    FORWARD_ACCELERATION,
+    SPEED,
+    YAW_RATE,
+    SignalBounds,
+    too_many_out_of_range,
+)
 from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
@@ -99,6 +111,8 @@ class CanDecodeReport:
     """Per decoded message, what its time order needed."""
     dbc_units: dict[str, str] = field(default_factory=dict)
     """Unit string the DBC declares for each decoded ``MESSAGE.SIGNAL``."""
+    out_of_range: dict[str, str] = field(default_factory=dict)
+    """Per ``MESSAGE.SIGNAL``, what was skipped as beyond a vehicle's range (a sentence)."""
 
     def summary(self) -> str:
         ids = ", ".join(f"0x{k:X}×{v}" for k, v in sorted(self.undecodable_by_id.items()))
@@ -108,6 +122,10 @@ class CanDecodeReport:
             f"{self.n_undecodable} undecodable{f' ({ids})' if ids else ''}, "
             f"{self.n_unreadable_lines} unreadable log lines"
         )
+
+    def problems(self) -> list[str]:
+        """Sentences for the warnings of a run: the samples skipped as out of range."""
+        return list(self.out_of_range.values())
 
 
 @dataclass
@@ -148,12 +166,6 @@ def parse_signal_list(text: str) -> list[SignalRef]:
     return [SignalRef.parse(part) for part in text.split(",") if part.strip()]
 
 
-MAX_YAW_RATE = 10.0
-"""rad/s: no car turns faster (a decoded rate beyond it is a wrong factor or unit)."""
-MAX_WHEEL_SPEED = 200.0
-"""m/s (720 km/h): no road vehicle's wheel speed beyond it."""
-MAX_ACCELERATION = 50.0
-"""m/s² (5 g): no car's longitudinal acceleration beyond it, crashes aside."""
 UNIT_NAMES = {"rad/s": "an angular rate", "m/s^2": "m/s²"}
 """How an error names the SI unit a signal should have had."""
 MAX_UNREADABLE_LOGGED = 10
@@ -259,6 +271,8 @@ def _record_messages(path: Path, report: CanDecodeReport):
         for message in reader:
             n += 1
             yield message, None
+        if n == 0 and path.suffix.lower() == ".asc":
+            raise InputError(_not_asc(path), path)
     except InputError:
         raise
     except Exception as exc:  # python-can raises many types on corrupt files
@@ -266,6 +280,29 @@ def _record_messages(path: Path, report: CanDecodeReport):
             raise InputError(f"cannot read the CAN log: {type(exc).__name__}: {exc}", path) from exc
         log.warning("%s: reading stopped after %d frames: %s", path, n, exc)
         report.n_unreadable_lines += 1
+
+
+_CANDUMP_LINE = re.compile(r"^\(\s*[-+0-9.eE]+\)\s+\S+\s+[0-9A-Fa-f]+#")
+"""A candump ``-l`` line: ``(time) interface id#data``."""
+
+
+def _not_asc(path: Path) -> str:
+    """Why an ``.asc`` file gave no frame: what an ASC frame line is, what the file holds."""
+    n_lines, first = 0, ""
+    with path.open("rb") as handle:
+        for raw in handle:
+            n_lines += 1
+            if not first and raw.strip():
+                first = raw.strip()[:80].decode("utf-8", "replace")
+    expected = (
+        "no CAN frame in this ASC log: Vector ASC frame lines look like "
+        "'0.010000 1 123 Rx d 8 11 22 33 44 55 66 77 88', after a 'date' and a 'base hex "
+        f"timestamps absolute' header; none of its {n_lines} lines is one"
+    )
+    if not first:
+        return expected
+    kind = ", a candump -l line: name the file .log" if _CANDUMP_LINE.match(first) else ""
+    return f"{expected} (its first line: {first!r}{kind})"
 
 
 def iter_can_frames(path: str | Path, report: CanDecodeReport):
@@ -540,14 +577,40 @@ def _check_sign(yaw_rate_sign: float) -> None:
         raise InputError(f"yaw_rate_sign must be +1 or -1, not {yaw_rate_sign!r}")
 
 
-def _single(decoded, ref, unit, kind, offset_s, sign, name) -> SensorSeries | None:
-    """The decoded signal ``ref`` (None if not asked for) in ``unit``, times sign, shifted."""
+def _single(decoded, ref, unit, kind, offset_s, sign, name, bounds, report) -> SensorSeries | None:
+    """The decoded signal ``ref`` (None if not asked for) in ``unit``, times sign, shifted,
+    without isolated samples beyond ``bounds``."""
     if ref is None:
         return None
     raw = decoded[ref]
     if raw.unit != unit:
         raise SignalError(f"{kind} signal {ref} is in {raw.unit}, not {UNIT_NAMES[unit]}")
-    return SensorSeries(raw.t + offset_s, sign * raw.value, name, unit)
+    series = SensorSeries(raw.t + offset_s, sign * raw.value, name, unit)
+    return _within_bounds(series, ref, bounds, report)
+
+
+def _within_bounds(
+    series: SensorSeries, ref: SignalRef, bounds: SignalBounds, report: CanDecodeReport
+) -> SensorSeries:
+    """``series`` without its samples beyond ``bounds`` when they are isolated (counted in the
+    report and logged); when they are more, an :class:`InputError` naming the signal and the
+    time of the first one (on GPS time when the offset is applied)."""
+    beyond = bounds.outside(series.value)
+    n_out = int(beyond.sum())
+    if not n_out:
+        return series
+    first = int(np.flatnonzero(beyond)[0])
+    where = (
+        f"{n_out} of the {len(series)} samples of {ref} are outside what a vehicle can report, "
+        f"{bounds} (the first, {series.value[first]:.4g} {series.unit}, at t = "
+        f"{series.t[first]:.6f} s)"
+    )
+    if too_many_out_of_range(n_out, len(series)):
+        raise InputError(f"{where}: check the DBC factor and unit")
+    report.out_of_range[str(ref)] = f"CAN {where}: skipped"
+    log.warning("CAN decoding: %s: skipped", where)
+    keep = ~beyond
+    return SensorSeries(series.t[keep], series.value[keep], series.name, series.unit)
 
 
 def _motion(
@@ -564,7 +627,15 @@ def _motion(
     (shifted as the yaw rate: both come from the same inertial sensor cluster) from decoded
     series."""
     yaw_series = _single(
-        decoded, yaw_rate, "rad/s", "yaw-rate", yaw_rate_offset_s, yaw_rate_sign, "yaw_rate_rad_s"
+        decoded,
+        yaw_rate,
+        "rad/s",
+        "yaw-rate",
+        yaw_rate_offset_s,
+        yaw_rate_sign,
+        "yaw_rate_rad_s",
+        YAW_RATE,
+        report,
     )
     speed_series = None
     if wheels:
@@ -572,7 +643,11 @@ def _motion(
         bad = [str(ref) for ref, s in zip(wheels, parts, strict=True) if s.unit != "m/s"]
         if bad:
             raise SignalError(f"wheel-speed signals {bad} are not speeds")
-        speed_series = mean_of_series(parts, "speed_mps").shifted(speed_offset_s)
+        parts = [
+            _within_bounds(part.shifted(speed_offset_s), ref, SPEED, report)
+            for ref, part in zip(wheels, parts, strict=True)
+        ]
+        speed_series = mean_of_series(parts, "speed_mps")
     acceleration_series = _single(
         decoded,
         acceleration,
@@ -581,19 +656,32 @@ def _motion(
         yaw_rate_offset_s,
         1.0,
         "forward_acceleration_mps2",
+        FORWARD_ACCELERATION,
+        report,
     )
-    for series, ref, limit in (
-        (yaw_series, yaw_rate, MAX_YAW_RATE),
-        (speed_series, ",".join(map(str, wheels)), MAX_WHEEL_SPEED),
-        (acceleration_series, acceleration, MAX_ACCELERATION),
-    ):
-        if series is not None and len(series) and np.abs(series.value).max() > limit:
-            worst = float(np.abs(series.value).max())
-            raise InputError(
-                f"{ref} decodes to {worst:.4g} {series.unit}, beyond any car's {limit:g} "
-                f"{series.unit}: check the DBC factor and unit"
-            )
     return CanMotion(yaw_series, speed_series, report, acceleration_series)
+
+
+def _require_frames(
+    decoded: dict[SignalRef, SensorSeries],
+    report: CanDecodeReport,
+    channel: str | None,
+    path: str | Path,
+) -> None:
+    """An :class:`InputError` when the log gave no frame at all, or none of a message whose
+    signals were asked for (the counts of what was read say why)."""
+    on_channel = f" on channel {channel!r}" if channel is not None else ""
+    if report.n_frames == 0:
+        raise InputError(
+            f"no CAN frame could be read from the log{on_channel} ({report.summary()})", path
+        )
+    empty = sorted({ref.message for ref, series in decoded.items() if not len(series)})
+    if empty:
+        raise InputError(
+            f"no decodable frame of message(s) {', '.join(empty)}{on_channel} in the log "
+            f"({report.summary()})",
+            path,
+        )
 
 
 def read_can_motion(
@@ -647,5 +735,8 @@ def read_can_motion(
         )
     except SignalError as exc:
         raise SignalError(str(exc), dbc_path) from exc
+    except InputError as exc:  # beyond a vehicle's range
+        raise InputError(str(exc), log_path) from exc
+    _require_frames(decoded, report, channel, log_path)
     log.info("%s: %s", log_path, motion.report.summary())
     return motion

@@ -71,7 +71,7 @@ def read_gps_csv(path: str | Path) -> GpsFixes:
         np.radians(columns["lon_deg"][good]),
         speed[good],
         Path(path),
-        report.n_malformed + report.n_non_finite + int(np.sum(bad)),
+        report.n_skipped + int(np.sum(bad)),
     )
 
 

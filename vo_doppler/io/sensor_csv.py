@@ -3,11 +3,16 @@
 
 One header row naming the columns, then one sample per row; ``#`` comments and blank lines are
 allowed. Rows that cannot be read or hold non-finite numbers are skipped, counted and logged; a
-file without a single usable row is an error. A file with a ``t`` column follows the ``"error"``
-time-order policy of :mod:`vo_doppler.io.time_order` (a row going back raises naming its line;
-duplicate times are dropped and counted). Times are seconds on the sensor's clock, and a
-per-sensor offset maps them to GPS time. Files are read through :mod:`vo_doppler.io.textfile`
-(bounded, UTF-8, no binary).
+file without a single usable row is an error. A column that holds a vehicle signal
+(``speed_mps``, ``yaw_rate_rad_s``, ``forward_acceleration_mps2``, in whichever file it
+appears) is checked against what a car can report (:mod:`vo_doppler.io.vehicle_limits`):
+isolated rows beyond it are skipped, counted and logged like non-finite ones; more than 1 % of
+the rows beyond it is an error naming the first such line (the column's unit or scale is
+wrong). A file with a ``t`` column follows the ``"error"`` time-order policy of
+:mod:`vo_doppler.io.time_order` (a row going back raises naming its line; duplicate times are
+dropped and counted). Times are seconds on the sensor's clock, and a per-sensor offset maps
+them to GPS time. Files are read through :mod:`vo_doppler.io.textfile` (bounded, UTF-8, no
+binary).
 """
 
 from __future__ import annotations
@@ -21,6 +26,13 @@ import numpy as np
 from vo_doppler.errors import InputError
 from vo_doppler.io.textfile import read_text
 from vo_doppler.io.time_order import TimeOrderReport, order_samples
+from vo_doppler.io.vehicle_limits import (
+    FORWARD_ACCELERATION,
+    SPEED,
+    YAW_RATE,
+    SignalBounds,
+    too_many_out_of_range,
+)
 from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
@@ -34,20 +46,32 @@ class CsvReadReport:
     n_rows: int = 0
     n_malformed: int = 0
     n_non_finite: int = 0
+    n_out_of_range: int = 0
+    """Rows with a vehicle signal beyond what a car can report (isolated: skipped)."""
+    first_out_of_range: str = ""
+    """The first out-of-range value and its bounds, for the warning."""
     skipped_lines: list[int] = field(default_factory=list)
     row_lines: list[int] = field(default_factory=list)
     """Line of every row read, in order."""
     time_order: TimeOrderReport | None = None
 
+    @property
+    def n_skipped(self) -> int:
+        return self.n_malformed + self.n_non_finite + self.n_out_of_range
+
+    def problems(self) -> list[str]:
+        """One sentence for the warnings of a run (empty when every row was used)."""
+        if not self.n_skipped:
+            return []
+        return [
+            f"{self.path}: skipped {self.n_malformed} malformed, {self.n_non_finite} non-finite "
+            f"and {self.n_out_of_range} out-of-range rows{self.first_out_of_range} (first "
+            f"lines: {', '.join(map(str, self.skipped_lines[:5]))})"
+        ]
+
     def log_summary(self) -> None:
-        if self.n_malformed or self.n_non_finite:
-            log.warning(
-                "%s: skipped %d malformed and %d non-finite rows (first lines: %s)",
-                self.path,
-                self.n_malformed,
-                self.n_non_finite,
-                self.skipped_lines[:5],
-            )
+        for problem in self.problems():
+            log.warning("%s", problem)
 
 
 def read_numeric_csv(
@@ -61,6 +85,9 @@ def read_numeric_csv(
     header: list[str] | None = None
     index: dict[str, int] = {}
     rows: list[list[float]] = []
+    bounds = COLUMN_BOUNDS
+    bounded: list[tuple[int, str]] = []
+    out_of_range: list[tuple[int, str, float]] = []
     for number, line in enumerate(lines, start=1):
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
@@ -77,6 +104,7 @@ def read_numeric_csv(
                     number,
                 )
             index = {name: header.index(name) for name in (*required, *optional) if name in header}
+            bounded = [(j, name) for j, name in enumerate(index) if name in bounds]
             continue
         try:
             if len(fields) != len(header):
@@ -90,10 +118,28 @@ def read_numeric_csv(
             report.n_non_finite += 1
             report.skipped_lines.append(number)
             continue
+        beyond = [(name, values[j]) for j, name in bounded if bounds[name].outside(values[j])]
+        if beyond:
+            if not out_of_range:
+                name, value = beyond[0]
+                report.first_out_of_range = f" ({name} {value:g} beyond {bounds[name]})"
+            out_of_range.append((number, *beyond[0]))
+            report.n_out_of_range += 1
+            report.skipped_lines.append(number)
+            continue
         rows.append(values)
         report.row_lines.append(number)
     if header is None:
         raise InputError("CSV file is empty", path)
+    if too_many_out_of_range(len(out_of_range), len(rows) + len(out_of_range)):
+        line, name, value = out_of_range[0]
+        raise InputError(
+            f"{name} = {value:g} is outside what a vehicle can report, {bounds[name]}, and so "
+            f"are {len(out_of_range)} of the {len(rows) + len(out_of_range)} rows: not isolated "
+            "bad rows; check the column's unit",
+            path,
+            line,
+        )
     if not rows:
         raise InputError("CSV file has no usable data rows", path)
     report.n_rows = len(rows)
@@ -109,17 +155,31 @@ def read_numeric_csv(
 
 def read_sensor_csv(path: str | Path, column: str, time_offset_s: float = 0.0) -> SensorSeries:
     """The ``t,<column>`` signal of a headed CSV, ``time_offset_s`` added to its times."""
+    return read_sensor_csv_with_report(path, column, time_offset_s)[0]
+
+
+def read_sensor_csv_with_report(
+    path: str | Path, column: str, time_offset_s: float = 0.0
+) -> tuple[SensorSeries, CsvReadReport]:
+    """:func:`read_sensor_csv` and what reading skipped (for the warnings of a run)."""
     columns, report = read_numeric_csv(path, ("t", column))
-    unit = {YAW_RATE_COLUMN: "rad/s", SPEED_COLUMN: "m/s", FORWARD_ACCELERATION_COLUMN: "m/s²"}
-    unit = unit.get(column, "")
-    skipped = report.n_malformed + report.n_non_finite
-    return SensorSeries(columns["t"] + time_offset_s, columns[column], column, unit, skipped)
+    unit = COLUMN_BOUNDS[column].unit if column in COLUMN_BOUNDS else ""
+    series = SensorSeries(
+        columns["t"] + time_offset_s, columns[column], column, unit, report.n_skipped
+    )
+    return series, report
 
 
 YAW_RATE_COLUMN = "yaw_rate_rad_s"
 SPEED_COLUMN = "speed_mps"
 FORWARD_ACCELERATION_COLUMN = "forward_acceleration_mps2"
 """Specific force along the vehicle's forward axis (an accelerometer's reading), m/s²."""
+COLUMN_BOUNDS: dict[str, SignalBounds] = {
+    SPEED_COLUMN: SPEED,
+    YAW_RATE_COLUMN: YAW_RATE,
+    FORWARD_ACCELERATION_COLUMN: FORWARD_ACCELERATION,
+}
+"""The columns checked against what a vehicle can report, wherever they appear."""
 
 
 def read_yaw_rate_csv(path: str | Path, time_offset_s: float = 0.0) -> SensorSeries:

@@ -28,13 +28,14 @@ from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.satellite_states import read_satellite_states
 from vo_doppler.io.sensor_csv import (
     FORWARD_ACCELERATION_COLUMN,
-    read_sensor_csv,
-    read_speed_csv,
-    read_yaw_rate_csv,
+    SPEED_COLUMN,
+    YAW_RATE_COLUMN,
+    read_sensor_csv_with_report,
 )
 from vo_doppler.io.textfile import regular_file
 from vo_doppler.io.time_order import TimeOrderReport
 from vo_doppler.io.trajectory import read_tum
+from vo_doppler.io.vehicle_limits import lever_arm_problem
 from vo_doppler.io.yaml_file import load_yaml
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
@@ -59,9 +60,13 @@ class InputReport:
     vehicle_time_offset_s: float = 0.0
     """The clock offset of the yaw rate and wheel speed, from ``can`` or ``vehicle`` (``can``
     None: they came from the ``vehicle`` section's CSVs)."""
+    skipped: list[str] = field(default_factory=list)
+    """Sensor samples the readers skipped (unreadable, non-finite, beyond a vehicle's range),
+    one sentence per file or CAN signal."""
 
     def warnings(self) -> list[str]:
-        return [text for report in self.time_order for text in report.problems()]
+        order = [text for report in self.time_order for text in report.problems()]
+        return self.skipped + order
 
 
 def read_manifest(folder: str | Path) -> dict[str, Any]:
@@ -243,18 +248,13 @@ def read_sequence_with_report(
     )
     lever_arm = _lever_arm(m.value("gnss", "antenna_lever_arm_m", (0.0, 0.0, 0.0)), m.path)
     truth = None
-    truth_cfg = m.data.get("ground_truth")
-    if isinstance(truth_cfg, dict) and "trajectory" in truth_cfg:
-        truth_path = m.resolve("ground_truth.trajectory", truth_cfg["trajectory"])
-        if truth_path.exists():
-            truth = read_tum(m.file("ground_truth", "trajectory"))
+    if "ground_truth" in m.data:  # optional, but a named file must be there, as every input
+        truth = read_tum(m.file("ground_truth", "trajectory"))
     forward_acceleration = motion.forward_acceleration
     imu = m.data.get("imu")
     if isinstance(imu, dict) and "forward_acceleration" in imu:
-        forward_acceleration = read_sensor_csv(
-            m.file("imu", "forward_acceleration"),
-            FORWARD_ACCELERATION_COLUMN,
-            m.number("imu", "time_offset_s", 0.0),
+        forward_acceleration = _sensor_csv(
+            m, "imu", "forward_acceleration", FORWARD_ACCELERATION_COLUMN, report
         )
     name = m.data.get("name", m.root.name)
     if not isinstance(name, str | int | float) or isinstance(name, bool):
@@ -304,11 +304,23 @@ def _vehicle_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
     if has["can"]:
         return _can_motion(m, report)
     offset = m.number("vehicle", "time_offset_s", 0.0)
-    yaw_rate = read_yaw_rate_csv(m.file("vehicle", "yaw_rate"), offset)
-    speed = read_speed_csv(m.file("vehicle", "wheel_speed"), offset)
+    yaw_rate = _sensor_csv(m, "vehicle", "yaw_rate", YAW_RATE_COLUMN, report)
+    speed = _sensor_csv(m, "vehicle", "wheel_speed", SPEED_COLUMN, report)
     report.yaw_rate_dbc_unit = "rad/s"
     report.vehicle_time_offset_s = offset
     return _VehicleMotion(yaw_rate, speed, None, "vehicle", offset)
+
+
+def _sensor_csv(
+    m: Manifest, section: str, key: str, column: str, report: InputReport
+) -> SensorSeries:
+    """The ``t,<column>`` CSV named by ``section.key`` on GPS time (the section's
+    ``time_offset_s``); the rows it skipped go to the report's warnings."""
+    series, csv_report = read_sensor_csv_with_report(
+        m.file(section, key), column, m.number(section, "time_offset_s", 0.0)
+    )
+    report.skipped.extend(csv_report.problems())
+    return series
 
 
 def _can_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
@@ -373,4 +385,7 @@ def _lever_arm(value, path: Path) -> tuple[float, float, float]:
             f"gnss.antenna_lever_arm_m is {value!r}, not three numbers (m)",
             path,
         )
+    problem = lever_arm_problem(arm)
+    if problem:
+        raise ManifestError("gnss.antenna_lever_arm_m", f"{list(arm)}: {problem}", path)
     return arm

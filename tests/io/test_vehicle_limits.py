@@ -1,0 +1,33 @@
+"""The bounds of what a road vehicle's sensors can report and of its antenna lever arm."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vo_doppler.io.vehicle_limits import (
+    SPEED,
+    YAW_RATE,
+    lever_arm_problem,
+    too_many_out_of_range,
+)
+
+
+def test_the_bounds_are_closed_and_nan_is_outside():
+    values = np.array([-10.0, -10.001, 150.0, 150.001, np.nan, 0.0])
+    np.testing.assert_array_equal(SPEED.outside(values), [0, 1, 0, 1, 1, 0])
+    np.testing.assert_array_equal(YAW_RATE.outside([-5.0, 5.0, 5.1]), [0, 0, 1])
+    assert str(SPEED) == "[-10, 150] m/s"
+
+
+def test_isolated_means_one_percent_at_most():
+    assert not too_many_out_of_range(1, 100)
+    assert too_many_out_of_range(2, 100)
+    assert too_many_out_of_range(1, 99)
+    assert not too_many_out_of_range(0, 0)
+
+
+def test_a_lever_arm_longer_than_a_vehicle_is_named():
+    assert lever_arm_problem((1.2, -0.3, 1.5)) is None
+    assert lever_arm_problem((12.0, 16.0)) is None  # exactly 20 m
+    problem = lever_arm_problem((1000.0, 0.0, 0.0))
+    assert problem is not None and problem.startswith("the lever arm is 1000 m long")
