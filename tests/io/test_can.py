@@ -16,6 +16,7 @@ from vo_doppler.errors import InputError
 from vo_doppler.io.can import (
     CanDecodeReport,
     SignalRef,
+    check_dbc,
     decode_motion,
     decode_signals,
     frames_from_arrays,
@@ -402,3 +403,11 @@ def test_a_log_without_the_requested_message_is_an_error(tmp_path, dbc_path):
     path.write_text("0.010000 1 0AA Rx d 8 00 00 00 00 00 00 00 00\n" * 3)  # ASC lines
     with pytest.raises(InputError, match=r"log \(0 frames, .*, 3 unreadable log lines\)"):
         read_can_motion(path, dbc_path, wheel_speed="WHEELS.WL")
+
+
+def test_check_dbc_names_the_file_and_the_missing_or_wrong_signal(dbc_path):
+    check_dbc(dbc_path, "KIN.YAW_RATE", "WHEELS.WL,REAR.W3")
+    with pytest.raises(InputError, match=r"test.dbc: signal WHEELS.NOPE is not in the DBC"):
+        check_dbc(dbc_path, "KIN.YAW_RATE", "WHEELS.WL,WHEELS.NOPE")
+    with pytest.raises(InputError, match=r"test.dbc: KIN.YAW_RATE is in rad/s, not m/s"):
+        check_dbc(dbc_path, "KIN.YAW_RATE", "KIN.YAW_RATE")

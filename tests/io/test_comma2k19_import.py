@@ -127,3 +127,48 @@ def test_the_import_never_writes_into_its_segment_or_a_foreign_folder(tmp_path):
         "segment",
         "sequence.yaml",
     ]
+
+
+@pytest.mark.shared_data
+@pytest.mark.parametrize(
+    ("orbits", "message"),
+    [
+        ("garbage", r"garbage\.sp3:1: not an SP3-c/d file"),
+        ("truncated", r"truncated\.sp3:1: 6 epochs, header declares 20"),
+        ("other_day", r"other_day\.sp3: the orbits do not cover the segment .*GPS week 2012"),
+    ],
+)
+def test_orbits_run_would_refuse_stop_the_import_before_it_writes(tmp_path, orbits, message):
+    segment = require_shared(COMMA)
+    path = tmp_path / f"{orbits}.sp3"
+    if orbits == "garbage":
+        path.write_bytes(bytes(range(256)) * 4)
+    elif orbits == "truncated":  # the first 6 of the day's 20 epochs
+        lines = (segment / SP3).read_text().splitlines(keepends=True)
+        cut = [k for k, line in enumerate(lines) if line.startswith("*  ")][6]
+        path.write_text("".join(lines[:cut]))
+    else:
+        write_orbit_day(path, segment_gps_span(segment)[0] - 30 * 3600.0, 24.0)
+    with pytest.raises(InputError, match=message):
+        import_comma2k19(segment, tmp_path / "out", path)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.shared_data
+def test_a_dbc_run_would_refuse_stops_the_import_before_it_writes(tmp_path):
+    segment = require_shared(COMMA)
+    sp3 = segment / SP3
+    not_a_dbc = tmp_path / "base.nav"
+    not_a_dbc.write_text(
+        "     3.04           N: GNSS NAV DATA    M: MIXED            RINEX VERSION\n"
+    )
+    with pytest.raises(InputError, match=r"base\.nav: cannot load the CAN database"):
+        import_comma2k19(segment, tmp_path / "out", sp3, dbc=not_a_dbc)
+    other = tmp_path / "other.dbc"
+    other.write_text(
+        'VERSION ""\nBS_:\nBU_: XXX\nBO_ 36 KIN: 8 XXX\n SG_ YAW : 7|16@0- (0.01,0) '
+        '[-300|300] "deg/s" XXX\n'
+    )
+    with pytest.raises(InputError, match=r"other\.dbc: message 'KINEMATICS' is not in the DBC"):
+        import_comma2k19(segment, tmp_path / "out", sp3, dbc=other)
+    assert not (tmp_path / "out").exists()

@@ -390,6 +390,50 @@ def si_factor(unit: str | None, where: str) -> tuple[float, str]:
     return UNIT_TO_SI[key]
 
 
+def _resolve_signals(db, refs: list[SignalRef], report: CanDecodeReport):
+    """Per frame id the DBC message and the references in it, and per reference the factor and
+    SI unit of its DBC unit; a message or signal the DBC lacks, or a unit without an SI
+    conversion, is a :class:`SignalError`."""
+    by_message: dict[str, list[SignalRef]] = {}
+    for ref in refs:
+        by_message.setdefault(ref.message, []).append(ref)
+    messages, factors = {}, {}
+    for message_name, message_refs in by_message.items():
+        try:
+            message = db.get_message_by_name(message_name)
+        except KeyError as exc:
+            raise SignalError(f"message {message_name!r} is not in the DBC") from exc
+        for ref in message_refs:
+            try:
+                signal = message.get_signal_by_name(ref.signal)
+            except KeyError as exc:
+                raise SignalError(f"signal {ref} is not in the DBC") from exc
+            factors[ref] = si_factor(signal.unit, str(ref))
+            report.dbc_units[str(ref)] = signal.unit or ""
+        messages[message.frame_id] = (message, message_refs)
+    return messages, factors
+
+
+def check_dbc(dbc_path: str | Path, yaw_rate: str, wheel_speed: str) -> None:
+    """Load a DBC and check that it defines the yaw-rate signal (``MSG.SIG``, an angular rate)
+    and the wheel-speed signals (``MSG.A,MSG.B``, speeds): what decoding a log with it needs,
+    checked before the log is read; an :class:`InputError` naming the DBC otherwise."""
+    db = load_dbc(dbc_path)
+    try:
+        expected = {SignalRef.parse(yaw_rate): "rad/s"}
+        expected |= {ref: "m/s" for ref in parse_signal_list(wheel_speed)}
+        factors = _resolve_signals(db, list(expected), CanDecodeReport())[1]
+        wrong = [
+            f"{ref} is in {factors[ref][1]}, not {unit}"
+            for ref, unit in expected.items()
+            if factors[ref][1] != unit
+        ]
+        if wrong:
+            raise SignalError("; ".join(wrong))
+    except InputError as exc:
+        raise SignalError(str(exc), dbc_path) from exc
+
+
 class _StreamDecoder:
     """Decodes frames one at a time into compact per-message arrays (time, line, one value per
     referenced signal), counting short, undecodable and foreign-channel frames."""
@@ -403,24 +447,7 @@ class _StreamDecoder:
         self.source = source
         self.first_short: tuple[float, int, int, int] | None = None
         self.undecodable: Counter[int] = Counter(report.undecodable_by_id)
-        by_message: dict[str, list[SignalRef]] = {}
-        for ref in refs:
-            by_message.setdefault(ref.message, []).append(ref)
-        self.messages = {}
-        self.factors = {}
-        for message_name, message_refs in by_message.items():
-            try:
-                message = db.get_message_by_name(message_name)
-            except KeyError as exc:
-                raise SignalError(f"message {message_name!r} is not in the DBC") from exc
-            for ref in message_refs:
-                try:
-                    signal = message.get_signal_by_name(ref.signal)
-                except KeyError as exc:
-                    raise SignalError(f"signal {ref} is not in the DBC") from exc
-                self.factors[ref] = si_factor(signal.unit, str(ref))
-                report.dbc_units[str(ref)] = signal.unit or ""
-            self.messages[message.frame_id] = (message, message_refs)
+        self.messages, self.factors = _resolve_signals(db, refs, report)
         self.t = {frame_id: array("d") for frame_id in self.messages}
         self.lines = {frame_id: array("q") for frame_id in self.messages}
         self.values = {frame_id: array("d") for frame_id in self.messages}

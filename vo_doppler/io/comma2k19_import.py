@@ -33,6 +33,7 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.io.can import check_dbc
 from vo_doppler.io.comma2k19 import (
     gps_minus_log,
     gps_minus_mono,
@@ -47,6 +48,7 @@ from vo_doppler.io.comma2k19_video import CALIB, IMAGES, TIMES, VIDEO, decode_vi
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.rinex_write import ObsEpochs, write_obs
+from vo_doppler.io.satellite_states import read_satellite_states
 from vo_doppler.io.sensor_csv import (
     FORWARD_ACCELERATION_COLUMN,
     SPEED_COLUMN,
@@ -95,7 +97,10 @@ def import_comma2k19(
     dbc: str | Path | None = None,
 ) -> ImportSummary:
     """Write the sequence folder ``output`` from the segment folder ``segment`` (checked first:
-    new, empty or an earlier import's, and none of the inputs inside it)."""
+    new, empty or an earlier import's, and none of the inputs inside it).
+
+    The orbits (and clocks) and the DBC are read first, with the readers ``run`` uses, so that
+    a file ``run`` would refuse stops the import before anything is written."""
     segment, output = Path(segment), Path(output)
     check_output_folder(output, "import", [segment, orbits, clocks, dbc])
     if dbc is not None and not Path(dbc).is_file():
@@ -109,6 +114,9 @@ def import_comma2k19(
             DBC,
         )
         dbc = None
+    else:
+        check_dbc(dbc, YAW_RATE_SIGNAL, WHEEL_SIGNALS)
+    _check_orbits(segment, Path(orbits), clocks)
     open_output_folder(output, "import")
     for folder in ("gnss", "imu", "can" if dbc else "vehicle"):
         (output / folder).mkdir(parents=True, exist_ok=True)
@@ -283,6 +291,22 @@ def segment_gps_span(segment: str | Path) -> tuple[float, float]:
     return float(t.min()), float(t.max())
 
 
+def _uncovered(segment: Path, start: float, end: float) -> str:
+    """The segment and its GPS span, for an error about orbits that do not cover it."""
+    return (
+        f"the segment {segment} (GPS week {int(start // SECONDS_PER_WEEK)}, seconds of week "
+        f"{start % SECONDS_PER_WEEK:.0f}–{end % SECONDS_PER_WEEK:.0f})"
+    )
+
+
+def _check_orbits(segment: Path, orbits: Path, clocks: str | Path | None) -> None:
+    """Read the orbits (and clocks) as ``run`` will and check that they cover the segment."""
+    product = read_satellite_states(orbits=orbits, clocks=None if clocks is None else Path(clocks))
+    start, end = segment_gps_span(segment)
+    if min(start - product.t[0], product.t[-1] - end) < 0:
+        raise InputError(f"the orbits do not cover {_uncovered(segment, start, end)}", orbits)
+
+
 def orbits_for_segment(segment: str | Path, orbits: str | Path) -> Path:
     """``orbits`` if it is a file; for a folder, its SP3 file (``*.sp3``, any case) whose epochs
     reach furthest beyond the segment on both sides (the interpolation needs epochs around it)."""
@@ -298,11 +322,7 @@ def orbits_for_segment(segment: str | Path, orbits: str | Path) -> Path:
         raise InputError("no SP3 files (*.sp3) in the orbits folder", orbits)
     best = max(margins, key=margins.get)
     if margins[best] < 0:
-        raise InputError(
-            f"no SP3 file covers the segment {segment} (GPS week {int(start // SECONDS_PER_WEEK)},"
-            f" seconds of week {start % SECONDS_PER_WEEK:.0f}–{end % SECONDS_PER_WEEK:.0f})",
-            orbits,
-        )
+        raise InputError(f"no SP3 file covers {_uncovered(segment, start, end)}", orbits)
     return best
 
 
