@@ -5,13 +5,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.helpers.velocity import velocity_solution
 from vo_doppler.checks import (
+    calibration_warnings,
     check_standstill_is_still,
     check_yaw_rate_unit,
     clock_warning,
+    coverage_warning,
     estimate_clock_offset,
     moving_yaw_rate_medians,
     origin_warning,
+    wheel_scale_warning,
 )
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame
@@ -99,3 +103,48 @@ def test_standstill_that_moves_is_an_error_and_a_still_one_passes():
     moving = r"standstill 8\.00–20\.00 s: the wheel speed shows .*median 8\.00"
     with pytest.raises(InputError, match=moving):
         check_standstill_is_still((8.0, 20.0), t, speed, "wheel speed")
+
+
+def test_a_wheel_speed_covering_half_the_epochs_is_a_warning_naming_the_offset():
+    """The QA case: the CAN clock 30 s off, so half the GNSS epochs have no wheel speed (the
+    lag search of ±5 s cannot find such an offset)."""
+    t_gnss = np.arange(0.0, 60.0, 0.1)
+    late = SensorSeries(T + 30.0, SPEED.value)
+    warning = coverage_warning("CAN", late, t_gnss, 12.5, "--time-offset-can")
+    assert "CAN clock: the wheel speed covers only 50% of the GNSS epochs" in warning
+    assert "(it starts +30.0 s and ends +30.1 s from them)" in warning
+    assert warning.endswith("check --time-offset-can 12.500 s")
+    assert coverage_warning("CAN", SensorSeries(T + 5.0, SPEED.value), t_gnss, 0.0, "x") is None
+    assert coverage_warning("CAN", SensorSeries(T + 7.0, SPEED.value), t_gnss, 0.0, "x")
+
+
+@pytest.mark.parametrize("scale", [1.0, 1.099, 0.901, float("nan")])
+def test_wheel_scales_within_ten_percent_pass(scale):
+    assert wheel_scale_warning(scale) is None
+
+
+@pytest.mark.parametrize("scale", [1 / 3.6, 1.101, 0.899, 1.609])
+def test_wheel_scales_beyond_ten_percent_are_a_warning(scale):
+    assert f"the calibration gives {scale:.3f}, beyond 1 ± 0.1" in wheel_scale_warning(scale)
+
+
+def test_calibration_warnings_gather_the_clock_and_the_scale():
+    t_gnss = np.arange(5.0, 55.0, 0.2)
+    gnss = np.interp(t_gnss, SPEED.t, SPEED.value)
+    gnss[::4] = np.nan
+    velocity = velocity_solution(
+        t_gnss,
+        np.column_stack([np.zeros_like(gnss), np.nan_to_num(gnss), np.zeros_like(gnss)]),
+        np.isfinite(gnss),
+    )
+    estimate, found = calibration_warnings(SPEED, velocity, 1.0, "CAN", 0.0)
+    assert estimate.residual_s == pytest.approx(0.0, abs=0.01) and found == []
+    late = SensorSeries(T, SPEED.value * 3.6).shifted(-1.0)  # km/h, 1 s late
+    estimate, found = calibration_warnings(late, velocity, 1 / 3.6, "speed CSV", 2.0, "--x")
+    assert estimate.residual_s == pytest.approx(1.0, abs=0.01)
+    assert len(found) == 2
+    assert (
+        found[0].startswith("speed CSV clock") and "--x 2.000 s should be about 3.000" in found[0]
+    )
+    assert found[1].startswith("wheel scale: the calibration gives 0.278")
+    assert calibration_warnings(late, velocity, None, "speed CSV", 2.0, "--x")[1] == found[:1]

@@ -13,6 +13,13 @@ summary. Each check states its threshold:
   epochs, by the median absolute difference (robust to the reflected epochs that pass the
   velocity's own tests, up to half of them), is the residual clock offset; beyond 0.2 s it is a
   warning reporting the estimate next to the manifest's ``time_offset_s``;
+* the wheel-speed times against the GNSS epochs: when more than 10 % of the epochs lie outside
+  the wheel speed's time span, it is a warning, since those epochs get no tightly coupled
+  heading and a clock offset wrong by more than the ±5 s searched looks like this (comma2k19
+  with its CAN clock 30 s off: half the epochs, and a best lag of +2.2 s that is no offset);
+* the calibrated wheel scale: beyond 1 ± 0.10 it is a warning, since a tyre's rolling radius
+  changes by a few per cent with wear and pressure, and a scale far from 1 means a speed in
+  other units (km/h: 0.28, mph: 0.45) or a wheel speed that is not this drive's;
 * the ENU origin against the RINEX approximate position: more than 10 km apart is a warning;
 * a standstill interval given by hand against the measured speed: a median speed above
   0.5 m/s inside it (GNSS speed noise at rest is a few cm/s to 0.2 m/s) is an error, since the
@@ -27,6 +34,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame
+from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.series import SensorSeries
 
 MOVING_SPEED_MPS = 2.0
@@ -41,6 +49,8 @@ CLOCK_RATE_HZ = 10.0
 MIN_CLOCK_CONTRAST = 0.1
 """Share of its largest value by which the agreement must vary over the lags: below, the speed
 profile is too featureless (a constant speed) to estimate a lag."""
+MIN_SPEED_COVERAGE = 0.9
+WHEEL_SCALE_TOLERANCE = 0.10
 STANDSTILL_MAX_MEDIAN_SPEED_MPS = 0.5
 ORIGIN_TOLERANCE_M = 10_000.0
 EARTH_SURFACE_M = (6.3e6, 6.4e6)
@@ -143,18 +153,80 @@ def _speed_difference(speed: SensorSeries, t: np.ndarray, reference: np.ndarray,
 
 
 def clock_warning(
-    sensor: str, estimate: ClockOffsetEstimate | None, manifest_offset_s: float
+    sensor: str,
+    estimate: ClockOffsetEstimate | None,
+    manifest_offset_s: float,
+    offset_name: str = "the manifest's time_offset_s",
 ) -> str | None:
-    """A warning when the estimated residual offset exceeds 0.2 s."""
-    if estimate is None or abs(estimate.residual_s) <= CLOCK_TOLERANCE_S:
+    """A warning when the estimated residual offset exceeds 0.2 s; ``offset_name`` names the
+    setting to fix."""
+    if estimate is None:
+        return None
+    if abs(estimate.residual_s) <= CLOCK_TOLERANCE_S:
         return None
     return (
         f"{sensor} clock: the wheel speed matches the GNSS Doppler speed best when shifted by "
         f"{estimate.residual_s:+.2f} s (median difference {estimate.difference_mps:.2f} m/s, "
-        f"{estimate.unshifted_difference_mps:.2f} m/s unshifted); the manifest's "
-        f"time_offset_s {manifest_offset_s:.3f} s should be about "
+        f"{estimate.unshifted_difference_mps:.2f} m/s unshifted); {offset_name} "
+        f"{manifest_offset_s:.3f} s should be about "
         f"{manifest_offset_s + estimate.residual_s:.3f} s"
     )
+
+
+def coverage_warning(
+    sensor: str, speed: SensorSeries, t_gnss: np.ndarray, offset_s: float, offset_name: str
+) -> str | None:
+    """A warning when more than 10 % of the GNSS epochs lie outside the wheel speed's time
+    span (module docstring)."""
+    t_gnss = np.asarray(t_gnss, dtype=float)
+    if t_gnss.size == 0 or len(speed) == 0:
+        return None
+    inside = (t_gnss >= speed.t[0]) & (t_gnss <= speed.t[-1])
+    if inside.mean() >= MIN_SPEED_COVERAGE:
+        return None
+    return (
+        f"{sensor} clock: the wheel speed covers only {inside.mean():.0%} of the GNSS epochs "
+        f"(it starts {speed.t[0] - t_gnss[0]:+.1f} s and ends {speed.t[-1] - t_gnss[-1]:+.1f} s "
+        "from them), and the epochs outside get no tightly coupled heading; a clock offset "
+        f"wrong by more than the ±{CLOCK_SEARCH_S:g} s the clock check searches looks like "
+        f"this: check {offset_name} {offset_s:.3f} s"
+    )
+
+
+def wheel_scale_warning(scale: float) -> str | None:
+    """A warning when the calibrated wheel scale lies beyond 1 ± 0.10 (module docstring)."""
+    if not np.isfinite(scale) or abs(scale - 1.0) <= WHEEL_SCALE_TOLERANCE:
+        return None
+    return (
+        f"wheel scale: the calibration gives {scale:.3f}, beyond 1 ± {WHEEL_SCALE_TOLERANCE:g} "
+        "(a tyre's radius changes by a few per cent): is the wheel speed in m/s (km/h reads "
+        "0.278, mph 0.447) and its clock offset right?"
+    )
+
+
+def calibration_warnings(
+    wheel_speed: SensorSeries,
+    velocity: VelocitySolution,
+    wheel_scale: float | None,
+    sensor: str,
+    offset_s: float,
+    offset_name: str = "the manifest's time_offset_s",
+) -> tuple[ClockOffsetEstimate | None, list[str]]:
+    """The checks of a heading calibration, for ``run`` and ``heading`` alike: the wheel-speed
+    times against the GNSS epochs (``coverage_warning``), its clock against the horizontal
+    Doppler speed at the valid epochs (``clock_warning``) and the
+    calibrated ``wheel_scale`` (``wheel_scale_warning``; None when the scale was fixed, not
+    calibrated). Returns the clock estimate and the warnings."""
+    horizontal = np.where(
+        velocity.valid, np.linalg.norm(velocity.velocity_enu[:, :2], axis=1), np.nan
+    )
+    estimate = estimate_clock_offset(wheel_speed, velocity.t, horizontal)
+    found = [
+        coverage_warning(sensor, wheel_speed, velocity.t, offset_s, offset_name),
+        clock_warning(sensor, estimate, offset_s, offset_name),
+        None if wheel_scale is None else wheel_scale_warning(wheel_scale),
+    ]
+    return estimate, [warning for warning in found if warning]
 
 
 def origin_warning(enu: EnuFrame, approx_position_ecef: np.ndarray | None) -> str | None:

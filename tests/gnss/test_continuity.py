@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from tests.helpers.velocity import velocity_solution
 from vo_doppler.gnss.continuity import continuity_checked
 from vo_doppler.model.gnss_solutions import VelocitySolution
 
@@ -25,18 +26,9 @@ def _solution(rate_hz: float, seed: int = 1) -> tuple[VelocitySolution, np.ndarr
         [noisy_speed * np.cos(noisy_course), noisy_speed * np.sin(noisy_course), np.zeros(t.size)]
     )
     n = t.size
-    solution = VelocitySolution(
-        t=t,
-        velocity_ecef=enu,
-        velocity_enu=enu,
-        clock_drift_mps=np.zeros(n),
-        covariance=np.full((n, 4, 4), np.nan),
-        dop=np.full((n, 5), np.nan),
-        n_sat=np.full(n, 8),
-        n_obs=np.full(n, 8),
-        n_excluded=np.zeros(n, dtype=int),
-        residual_rms_mps=np.full(n, 0.05),
-        valid=np.ones(n, dtype=bool),
+    solution = velocity_solution(
+        t,
+        enu,
         verified=np.ones(n, dtype=bool),
         speed_sigma_mps=np.full(n, SPEED_SIGMA),
         course_sigma_rad=np.full(n, COURSE_SIGMA),

@@ -10,12 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.checks import (
-    check_yaw_rate_unit,
-    clock_warning,
-    estimate_clock_offset,
-    origin_warning,
-)
+from vo_doppler.checks import calibration_warnings, check_yaw_rate_unit, origin_warning
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
 from vo_doppler.eval.pipelines import evaluate_pipelines, evaluation_warnings
@@ -153,18 +148,20 @@ def result_checks(
 ) -> dict:
     """The summary's ``checks``: the input ``warnings``, what the GNSS readers skipped
     (:func:`file_problems`, already logged by them), the CAN clock against the GNSS Doppler
-    speed (the estimate, and a warning beyond 0.2 s, logged), the time order per sensor."""
-    velocity = result.gnss.velocity
-    horizontal = np.where(
-        velocity.valid, np.linalg.norm(velocity.velocity_enu[:, :2], axis=1), np.nan
-    )
-    estimate = estimate_clock_offset(inputs.wheel_speed, velocity.t, horizontal)
+    speed (the estimate, and a warning beyond 0.2 s, logged) and the calibrated wheel scale
+    (:func:`~vo_doppler.checks.calibration_warnings`), the time order per sensor."""
     sensor = "CAN" if report.can is not None else "vehicle signals"
-    warning = clock_warning(sensor, estimate, report.vehicle_time_offset_s)
-    if warning:
+    estimate, found = calibration_warnings(
+        inputs.wheel_speed,
+        result.gnss.velocity,
+        float(result.heading.wheel_scale[-1]),
+        sensor,
+        report.vehicle_time_offset_s,
+    )
+    for warning in found:
         log.warning("%s", warning)
     return {
-        "warnings": warnings + file_problems(inputs) + ([warning] if warning else []),
+        "warnings": warnings + file_problems(inputs) + found,
         "can_clock_residual_offset_s": None if estimate is None else estimate.residual_s,
         "time_order": {r.sensor: r.as_dict() for r in report.time_order},
     }
