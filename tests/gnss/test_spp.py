@@ -10,6 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tests.conftest import require_shared
+from tests.helpers.rinex_text import field, rinex3_epoch, rinex3_header
+from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
 from vo_doppler.gnss.atmosphere import klobuchar_delay, troposphere_delay
 from vo_doppler.gnss.spp import nearest_time, receiver_positions, solve_spp
@@ -112,3 +114,19 @@ def test_nearest_time_on_a_long_record_keeps_memory_linear():
         tracemalloc.stop()
     assert np.array_equal(index, np.arange(t.size) // 2)
     assert peak < 10 * t.nbytes
+
+
+def test_systems_absent_from_the_file_are_an_input_error_naming_those_it_has(tmp_path):
+    """GPS pseudoranges and a GLONASS Doppler only: asking for Galileo names G (the one system
+    with pseudoranges) before any satellite state is needed."""
+    text = rinex3_header({"G": ["C1C", "D1C"], "R": ["D1C"]}) + rinex3_epoch(
+        "2024 06 24 08 20  0.0000000",
+        [("G05", [field(2.1e7), field(-500.0)]), ("R07", [field(300.0)])],
+    )
+    path = tmp_path / "gps_only.obs"
+    path.write_text(text)
+    obs = read_obs(path)
+    with pytest.raises(InputError, match=r"no pseudoranges of the systems 'E'; .* of G \(e\.g\."):
+        solve_spp(obs, None, "E")
+    with pytest.raises(InputError, match=r"gps_only\.obs"):
+        solve_spp(obs, None, "RE")

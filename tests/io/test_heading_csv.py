@@ -4,7 +4,9 @@ without those columns read as NaN."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from vo_doppler.errors import InputError
 from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
 from vo_doppler.model.heading import HeadingTable
 
@@ -81,3 +83,12 @@ def test_files_without_the_gnss_only_columns_take_the_checked_ones(tmp_path):
     valid, sigma = back.published_conventional
     np.testing.assert_array_equal(valid, back.conv_valid)
     np.testing.assert_array_equal(sigma, back.sigma_conv)
+
+
+def test_a_header_without_rows_is_an_input_error(tmp_path):
+    """The QA case: `correct` on such a file failed with an IndexError (exit 3)."""
+    path = tmp_path / "heading.csv"
+    write_heading_csv(path, _table())
+    path.write_text(path.read_text().splitlines()[0] + "\n")
+    with pytest.raises(InputError, match=r"heading\.csv: heading CSV has its header but no rows"):
+        read_heading_csv(path)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
 from vo_doppler.gnss.ephemeris import rotate_earth
@@ -51,6 +52,16 @@ def pseudorange_codes(obs: Observations, systems: str) -> dict[str, str]:
     return chosen
 
 
+def no_system_message(obs: Observations, systems: str) -> str:
+    """Why none of ``systems`` can be used: the systems whose pseudoranges the file holds."""
+    in_file = "".join(sorted(set(np.unique(obs.system).tolist())))
+    usable = "".join(pseudorange_codes(obs, in_file))
+    message = f"the file has no pseudoranges of the systems {systems!r}"
+    if usable:
+        return message + f"; it has those of {usable} (e.g. --systems {usable})"
+    return message + f"; it has none of any system (observations of {in_file or 'none'})"
+
+
 def elevation_azimuth(
     receiver_ecef: np.ndarray, los: np.ndarray, lat_lon: tuple[float, float] | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -76,8 +87,10 @@ def solve_spp(
 ) -> SppSolution:
     """Single-point position per data epoch of ``obs`` (invalid epochs NaN, never guessed),
     satellite states from ``source`` (broadcast or precise, ``satellite_source``)."""
-    source = satellite_source(source)
     codes = pseudorange_codes(obs, systems)
+    if not codes:
+        raise InputError(no_system_message(obs, systems), obs.header.path)
+    source = satellite_source(source)
     rows = np.zeros(len(obs), dtype=bool)
     for system, code in codes.items():
         rows |= obs.mask(system, code)

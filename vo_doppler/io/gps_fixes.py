@@ -62,6 +62,12 @@ def read_gps_csv(path: str | Path) -> GpsFixes:
     columns, report = read_numeric_csv(path, ("t", "lat_deg", "lon_deg"), ("speed_mps",))
     speed = columns.get("speed_mps", np.full(len(columns["t"]), np.nan))
     bad = (np.abs(columns["lat_deg"]) > 90) | (np.abs(columns["lon_deg"]) > 180)
+    if np.all(bad) and bad.size:
+        raise InputError(
+            f"all {bad.size} fixes lie outside lat ±90°, lon ±180°: are the lat_deg and lon_deg "
+            "columns swapped?",
+            path,
+        )
     if np.any(bad):
         log.warning("%s: skipped %d fixes outside lat ±90°, lon ±180°", path, int(np.sum(bad)))
     good = ~bad

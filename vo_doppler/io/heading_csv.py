@@ -122,6 +122,8 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
             raise InputError(
                 f"gps_time_s {rows[-1][0]} is not after the previous row's", path, number
             )
+    if not rows:
+        raise InputError("heading CSV has its header but no rows", path)
     data = np.array(rows, dtype=float).reshape(-1, len(index))
     _check_values(data, lines, path)
     optional = {

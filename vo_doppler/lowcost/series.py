@@ -42,7 +42,7 @@ def clean_series(
     values = np.asarray(values, dtype=float)
     if len(values) != len(t):
         raise InputError(f"{name}: {len(t)} times but {len(values)} values")
-    finite = np.isfinite(t) & np.all(np.isfinite(values.reshape(len(t), -1)), axis=1)
+    finite = np.isfinite(t) & np.all(np.isfinite(values), axis=tuple(range(1, values.ndim)))
     n_non_finite = int(np.sum(~finite))
     t, values = t[finite], values[finite]
     n_unordered = int(np.sum(np.diff(t) < 0))
