@@ -47,4 +47,5 @@ class ManifestError(InputError):
 
 
 class OutputError(VoDopplerError):
-    """An output location is unusable (a file where a folder is wanted, not writable)."""
+    """An output location is unusable (a file where a folder is wanted, not writable) or is
+    one of the command's inputs (writing it would destroy the input)."""

@@ -128,10 +128,12 @@ def test_cli_writes_a_sequence(tmp_path, capsys):
     assert "satellites" in capsys.readouterr().out
 
 
-def test_cli_rejects_unknown_system(tmp_path, capsys):
-    code = main(["simulate", "--duration", "3", "--systems", "GR", "-o", str(tmp_path / "x")])
-    assert code == 1
-    assert "G and E" in capsys.readouterr().err
+def test_cli_rejects_unknown_system_as_a_usage_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["simulate", "--duration", "3", "--systems", "GR", "-o", str(tmp_path / "x")])
+    assert stop.value.code == 2
+    assert "systems are letters of GE, got 'GR'" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
 
 
 def test_route_has_turns_stops_and_a_speed_limit(tmp_path):

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable
 
 
 def positive_int(text: str) -> int:
@@ -22,3 +24,90 @@ def window_size(text: str) -> int:
     if value < 3:
         raise argparse.ArgumentTypeError(f"must be at least 3 frames, got {value}")
     return value
+
+
+def number_in(
+    low: float | None = None,
+    high: float | None = None,
+    *,
+    low_open: bool = False,
+    high_open: bool = False,
+    unit: str = "",
+) -> Callable[[str], float]:
+    """argparse type: a finite number within ``[low, high]`` (a bound None is absent, an open
+    bound excluded). NaN and infinities are refused: no option of a physical quantity means
+    anything with them, and they pass every comparison a later check would make."""
+    bounds = []
+    if low is not None:
+        bounds.append(f"{'>' if low_open else '≥'} {low:g}")
+    if high is not None:
+        bounds.append(f"{'<' if high_open else '≤'} {high:g}")
+    wanted = "a number " + " and ".join(bounds) if bounds else "a finite number"
+    wanted += f" ({unit})" if unit else ""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        inside = math.isfinite(value)
+        if inside and low is not None:
+            inside = value > low if low_open else value >= low
+        if inside and high is not None:
+            inside = value < high if high_open else value <= high
+        if not inside:
+            raise argparse.ArgumentTypeError(f"expected {wanted}, got {text!r}")
+        return value
+
+    parse.__name__ = wanted
+    return parse
+
+
+finite_float = number_in()
+"""A finite number (an offset, a bias: any sign)."""
+positive_float = number_in(0.0, low_open=True)
+"""A number > 0 (a duration, a rate, a scale)."""
+non_negative_float = number_in(0.0)
+"""A number ≥ 0 (a distance or threshold where 0 switches the step off)."""
+elevation_mask_deg = number_in(0.0, 90.0, high_open=True, unit="degrees")
+"""An elevation mask: 0 keeps every satellite above the horizon, 90 none."""
+
+
+def int_in(low: int, high: int | None = None) -> Callable[[str], int]:
+    """argparse type: an integer within ``[low, high]`` (no upper bound when None)."""
+    wanted = f"an integer ≥ {low}" + ("" if high is None else f" and ≤ {high}")
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(f"expected {wanted}, got {text!r}") from exc
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"expected {wanted}, got {text!r}")
+        return value
+
+    parse.__name__ = wanted
+    return parse
+
+
+def band_digits(text: str) -> str:
+    """argparse type: RINEX band digits (1-9), e.g. ``12`` for L1 and L2."""
+    if not text or set(text) - set("123456789"):
+        raise argparse.ArgumentTypeError(
+            f"expected RINEX band digits 1-9, e.g. 1 or 15, got {text!r}"
+        )
+    return text
+
+
+def system_letters(allowed: str) -> Callable[[str], str]:
+    """argparse type: GNSS system letters (RINEX: G, R, E, C, J, ...) among ``allowed``, upper
+    case, e.g. ``GE``."""
+
+    def parse(text: str) -> str:
+        letters = text.upper()
+        if not letters or set(letters) - set(allowed):
+            raise argparse.ArgumentTypeError(f"systems are letters of {allowed}, got {text!r}")
+        return letters
+
+    parse.__name__ = f"letters of {allowed}"
+    return parse

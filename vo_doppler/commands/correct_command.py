@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.commands.arg_types import finite_float, non_negative_float, positive_float
+from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.commands.time_hints import frame_index_hint, offset_hint, span
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.correction import (
@@ -51,7 +53,10 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("--times", help="timestamps file for a KITTI trajectory (one per line)")
     parser.add_argument(
-        "--time-offset", type=float, default=0.0, help="seconds added to trajectory times -> GPS"
+        "--time-offset",
+        type=finite_float,
+        default=0.0,
+        help="seconds added to trajectory times -> GPS",
     )
     parser.add_argument(
         "--correction",
@@ -66,7 +71,10 @@ def register(subparsers, summary: str) -> None:
         help="kalman: forward filter only (each pose uses the headings up to its time)",
     )
     parser.add_argument(
-        "--window-s", type=float, default=2.0, help="window method's W (s), [TK18] Eq. 11-13"
+        "--window-s",
+        type=positive_float,
+        default=2.0,
+        help="window method's W (s), [TK18] Eq. 11-13",
     )
     parser.add_argument(
         "--source",
@@ -90,7 +98,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--max-gap-s",
-        type=float,
+        type=non_negative_float,
         default=1.5,
         help="longest gap (s) across which absolute headings are interpolated",
     )
@@ -115,6 +123,9 @@ def _times(path: str | None) -> np.ndarray | None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output_files(
+        {"output": args.output}, [args.trajectory, args.heading, args.calib, args.times]
+    )
     trajectory = read_trajectory(args.trajectory, args.format, _times(args.times))
     trajectory.t = trajectory.t + args.time_offset
     table = read_heading_csv(args.heading)

@@ -9,31 +9,34 @@ from rich.console import Console
 from rich.table import Table
 
 from vo_doppler.checks import check_standstill_is_still
-from vo_doppler.commands.arg_types import positive_int
+from vo_doppler.commands.arg_types import (
+    non_negative_float,
+    number_in,
+    positive_float,
+    positive_int,
+)
+from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.gps_fixes import read_gps_fixes
 from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.io.sensor_csv import read_numeric_csv, read_yaw_rate_csv
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon, smoothed_track_speed
-from vo_doppler.report.deadreckon import drift_table_rows, write_outputs
+from vo_doppler.report.deadreckon import drift_table_rows, output_files, write_outputs
 
 TABLE_HEADERS = ("variant", "drift °/min", "final error °", "gap m", "gap %", "length m")
 
 
-def _auto_or_float(text: str) -> float | None:
-    if text == "auto":
-        return None
-    try:
-        return float(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(f"expected 'auto' or a number, got {text!r}") from exc
+_k_number = number_in(0.0, 2.0)
 
 
 def _k_value(text: str) -> float | None:
-    value = _auto_or_float(text)
-    if value is not None and not 0.0 <= value <= 2.0:
-        raise argparse.ArgumentTypeError(f"k must lie in [0, 2], got {value}")
-    return value
+    """'auto' (None) or a weight of gyro 2 in [0, 2]."""
+    return None if text == "auto" else _k_number(text)
+
+
+def _tau_value(text: str) -> float | None:
+    """'auto' (None) or a bias averaging time > 0 (s)."""
+    return None if text == "auto" else positive_float(text)
 
 
 def _interval(text: str) -> tuple[float, float]:
@@ -41,6 +44,8 @@ def _interval(text: str) -> tuple[float, float]:
         t0, t1 = (float(part) for part in text.split(","))
     except ValueError as exc:
         raise argparse.ArgumentTypeError(f"expected T0,T1 in seconds, got {text!r}") from exc
+    if not (np.isfinite(t0) and np.isfinite(t1)):
+        raise argparse.ArgumentTypeError(f"expected finite T0,T1 in seconds, got {text!r}")
     if t1 <= t0:
         raise argparse.ArgumentTypeError(f"the interval must end after it starts: {text!r}")
     return t0, t1
@@ -63,7 +68,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--tau",
-        type=_auto_or_float,
+        type=_tau_value,
         default=None,
         help="bias averaging time s, or auto: the Allan minimum over a standstill, the whole "
         "window over a straight stretch (never longer than the window)",
@@ -83,12 +88,15 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--threshold",
-        type=float,
+        type=non_negative_float,
         help="threshold h (rad/s) of [KZ] Eq. 9; default 3σ of the de-biased standstill rate",
     )
     parser.add_argument("--downsample", type=positive_int, default=1, help="keep every M-th fix")
     parser.add_argument(
-        "--cluster-m", type=float, default=3.0, help="drop fixes closer than this (m)"
+        "--cluster-m",
+        type=non_negative_float,
+        default=3.0,
+        help="drop fixes closer than this (m)",
     )
     parser.add_argument("-o", "--output", required=True, help="output folder")
     parser.set_defaults(func=run)
@@ -117,9 +125,9 @@ def _track_speed(fixes) -> tuple[np.ndarray, np.ndarray]:
 
 
 def run(args: argparse.Namespace) -> int:
-    check_output_folder(
-        args.output, "deadreckon", [args.gyro1, args.gyro2, args.gps, args.wheel_speed]
-    )
+    inputs = (args.gyro1, args.gyro2, args.gps, args.wheel_speed)
+    check_output_folder(args.output, "deadreckon", list(inputs))
+    check_output_files(output_files(args.output), inputs)
     gyro1 = read_yaw_rate_csv(args.gyro1)
     gyro2 = read_yaw_rate_csv(args.gyro2)
     fixes = read_gps_fixes(args.gps)

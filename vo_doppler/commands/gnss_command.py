@@ -10,25 +10,25 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.commands.satellite_options import add_satellite_options, satellite_states
+from vo_doppler.commands.arg_types import band_digits, elevation_mask_deg, system_letters
+from vo_doppler.commands.output_paths import check_output_files
+from vo_doppler.commands.satellite_options import (
+    add_satellite_options,
+    satellite_inputs,
+    satellite_states,
+)
 from vo_doppler.errors import InputError, VoDopplerError
+from vo_doppler.gnss.doppler_velocity import doppler_codes
 from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
 from vo_doppler.gnss.spp import solve_spp
 from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
 from vo_doppler.io.receiver_file import read_observation_file
 from vo_doppler.io.rinex_obs import SYSTEMS
 from vo_doppler.io.satellite_states import state_problems
+from vo_doppler.model.observations import Observations
 from vo_doppler.report.gnss import spp_figure, velocity_figure
 
 log = logging.getLogger(__name__)
-
-
-def _systems(text: str) -> str:
-    letters = text.upper()
-    unknown = sorted(set(letters) - set(SYSTEMS))
-    if not letters or unknown:
-        raise argparse.ArgumentTypeError(f"systems are letters of {SYSTEMS}, got {text!r}")
-    return letters
 
 
 def _common(parser: argparse.ArgumentParser) -> None:
@@ -39,8 +39,12 @@ def _common(parser: argparse.ArgumentParser) -> None:
         "or GSDC device_gnss.csv (recognised by content)",
     )
     add_satellite_options(parser, required=False)
-    parser.add_argument("--systems", type=_systems, default="GREJC", help="default GREJC")
-    parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees (default 10)")
+    parser.add_argument(
+        "--systems", type=system_letters(SYSTEMS), default="GREJC", help="default GREJC"
+    )
+    parser.add_argument(
+        "--elev-mask", type=elevation_mask_deg, default=10.0, help="degrees in [0, 90) (default 10)"
+    )
     parser.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
 
@@ -59,7 +63,9 @@ def register(subparsers, summary: str) -> None:
         "than four satellites are written with valid = 0.",
     )
     _common(velocity)
-    velocity.add_argument("--bands", help="band digits to use, e.g. 12 (default all)")
+    velocity.add_argument(
+        "--bands", type=band_digits, help="RINEX band digits to use, e.g. 12 (default all)"
+    )
     velocity.add_argument(
         "--range-rate",
         choices=RANGE_RATE_SOURCES,
@@ -72,13 +78,30 @@ def register(subparsers, summary: str) -> None:
     spp.set_defaults(func=run)
 
 
+def _check_doppler(obs: Observations, systems: str, bands: str | None) -> None:
+    """Raise when the file has no Doppler of the chosen systems and bands, naming those it has
+    (instead of failing later at every epoch for want of satellites)."""
+    if doppler_codes(obs, systems, bands):
+        return
+    available = doppler_codes(obs, "".join(sorted(set(obs.system.tolist()))))
+    chosen = f"systems {systems!r}" + (f", bands {bands!r}" if bands else "")
+    raise InputError(
+        f"the file has no Doppler of the {chosen}; its Doppler observables: "
+        + (", ".join(available) or "none"),
+        obs.header.path,
+    )
+
+
 def run(args: argparse.Namespace) -> int:
+    figure = args.figure or args.output.with_suffix(".png")
+    check_output_files(
+        {"output": args.output, "figure": figure}, [args.obs, *satellite_inputs(args)]
+    )
     obs, embedded = read_observation_file(args.obs)
     nav = satellite_states(args) if args.nav or args.orbits else embedded
     if nav is None:
         raise InputError("no satellite states: give --nav or --orbits", args.obs)
     mask = np.deg2rad(args.elev_mask)
-    figure = args.figure or args.output.with_suffix(".png")
     title = f"{args.obs.name} ({args.systems})"
     if args.gnss_command == "spp":
         solution = solve_spp(obs, nav, args.systems, mask)
@@ -86,6 +109,7 @@ def run(args: argparse.Namespace) -> int:
         spp_figure(figure, solution, title)
         valid = solution.valid
     else:
+        _check_doppler(obs, args.systems, args.bands)
         result = gnss_velocity(obs, nav, args.systems, mask, args.bands, args.range_rate)
         solution = result.velocity
         write_velocity_csv(args.output, solution)

@@ -10,7 +10,21 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.commands.satellite_options import add_satellite_options, satellite_states
+from vo_doppler.checks import calibration_warnings
+from vo_doppler.commands.arg_types import (
+    elevation_mask_deg,
+    finite_float,
+    non_negative_float,
+    positive_float,
+    positive_int,
+    system_letters,
+)
+from vo_doppler.commands.output_paths import check_output_files
+from vo_doppler.commands.satellite_options import (
+    add_satellite_options,
+    satellite_inputs,
+    satellite_states,
+)
 from vo_doppler.commands.time_hints import overlap_error
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
@@ -20,7 +34,7 @@ from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConf
 from vo_doppler.heading.tight_heading import TightHeadingConfig
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.heading_csv import write_heading_csv
-from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
 from vo_doppler.model.timeseries import sample
@@ -41,9 +55,14 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("obs", type=Path, help="RINEX observation file")
     add_satellite_options(parser)
     parser.add_argument(
-        "--systems", default="GREJC", help="GNSS systems to use (RINEX letters: G, R, E, J, C)"
+        "--systems",
+        type=system_letters(SYSTEMS),
+        default="GREJC",
+        help="GNSS systems to use (RINEX letters: G, R, E, J, C)",
     )
-    parser.add_argument("--elev-mask", type=float, default=10.0, help="degrees")
+    parser.add_argument(
+        "--elev-mask", type=elevation_mask_deg, default=10.0, help="degrees in [0, 90)"
+    )
     sensors = parser.add_argument_group("vehicle sensors (CAN log + DBC, or two CSV files)")
     sensors.add_argument("--can", type=Path, help="candump -l, .asc, .blf or python-can .csv")
     sensors.add_argument("--dbc", type=Path, help="DBC file decoding the CAN log's signals")
@@ -68,20 +87,20 @@ def register(subparsers, summary: str) -> None:
     sensors.add_argument("--speed-csv", type=Path, help="CSV t,speed_mps")
     sensors.add_argument(
         "--time-offset-can",
-        type=float,
+        type=finite_float,
         default=0.0,
         help="seconds added to CAN times to give GPS time (a log in Unix time needs the "
         "GPS-Unix offset: -315964800 + leap seconds, e.g. -315964782 in 2017-2026)",
     )
     sensors.add_argument(
         "--time-offset-yaw",
-        type=float,
+        type=finite_float,
         default=0.0,
         help="extra seconds added to the yaw-rate times",
     )
     sensors.add_argument(
         "--time-offset-speed",
-        type=float,
+        type=finite_float,
         default=0.0,
         help="extra seconds added to the speed times",
     )
@@ -92,7 +111,7 @@ def register(subparsers, summary: str) -> None:
         help="GNSS antenna X,Y[,Z] m in the vehicle frame (x forward, y left) from the point "
         "whose heading is wanted; the Doppler is then the antenna's in turns",
     )
-    parser.add_argument("--window-s", type=float, default=2.0, help="heading window (s)")
+    parser.add_argument("--window-s", type=positive_float, default=2.0, help="heading window (s)")
     parser.add_argument(
         "--no-nlos-rejection",
         action="store_true",
@@ -105,12 +124,14 @@ def register(subparsers, summary: str) -> None:
         help="wheel-scale and gyro-bias calibration from the conventional Doppler velocity "
         "([TK18] sec. 3.3-3.4): ls (least squares over a sliding window), kalman, or none",
     )
-    parser.add_argument("--gyro-bias", type=float, help="fixed gyro bias (deg/s) instead")
-    parser.add_argument("--wheel-scale", type=float, help="fixed wheel scale instead")
-    parser.add_argument("--max-sats", type=int, help="emulated canyon: satellites kept per epoch")
+    parser.add_argument("--gyro-bias", type=finite_float, help="fixed gyro bias (deg/s) instead")
+    parser.add_argument("--wheel-scale", type=positive_float, help="fixed wheel scale instead")
+    parser.add_argument(
+        "--max-sats", type=positive_int, help="emulated canyon: satellites kept per epoch"
+    )
     parser.add_argument(
         "--max-sats-after",
-        type=float,
+        type=non_negative_float,
         default=0.0,
         help="seconds after the first epoch from which --max-sats applies",
     )
@@ -167,10 +188,16 @@ def _local_frame(receiver_ecef: np.ndarray, obs) -> EnuFrame:
 
 
 def run(args: argparse.Namespace) -> int:
+    figure = args.figure or args.output.with_suffix(".png")
+    sensor_files = (args.can, args.dbc, args.yaw_rate_csv, args.speed_csv, args.gt)
+    check_output_files(
+        {"output": args.output, "figure": figure},
+        [args.obs, *satellite_inputs(args), *sensor_files],
+    )
     speed, yaw_rate = _sensors(args)
     obs = read_obs(args.obs)
     nav = satellite_states(args)
-    systems, mask = args.systems.upper(), np.radians(args.elev_mask)
+    systems, mask = args.systems, np.radians(args.elev_mask)
     if args.max_sats is None:
         gnss = gnss_velocity(obs, nav, systems, mask)
         rows, conventional = gnss.rows, gnss.velocity
@@ -200,10 +227,20 @@ def run(args: argparse.Namespace) -> int:
         config,
         args.antenna_lever_arm,
     )
-    args.output.parent.mkdir(parents=True, exist_ok=True)
+    _, warnings = calibration_warnings(
+        speed,
+        conventional,
+        float(table.wheel_scale[-1]) if args.wheel_scale is None else None,
+        "CAN" if args.can else "speed CSV",
+        args.time_offset_can if args.can else args.time_offset_speed,
+        "--time-offset-can" if args.can else "--time-offset-speed",
+    )
+    for warning in warnings:
+        log.warning("%s", warning)
+    for path in (args.output, figure):
+        path.parent.mkdir(parents=True, exist_ok=True)
     write_heading_csv(args.output, table)
     truth = read_trajectory(args.gt).yaw_at(table.t) if args.gt else None
-    figure = args.figure or args.output.with_suffix(".png")
     heading_figure(figure, table, truth, args.obs.name)
     summary = {
         "epochs": len(table),
@@ -217,6 +254,7 @@ def run(args: argparse.Namespace) -> int:
         "wheel_scale": float(table.wheel_scale[-1]),
         "output": str(args.output),
         "figure": str(figure),
+        "warnings": warnings,
     }
     print(json.dumps(summary))
     if not table.tc_available.any() and not table.conv_valid.any():

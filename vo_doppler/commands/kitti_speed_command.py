@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.errors import InputError
 from vo_doppler.eval.reference_speed import speed_from_poses
 from vo_doppler.io.images import read_times
@@ -35,6 +36,7 @@ def register(subparsers, summary: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output_files({"output": args.output}, [args.poses, args.times])
     truth = read_trajectory(args.poses)
     if args.times is not None:
         truth.t = read_times(args.times, len(truth))

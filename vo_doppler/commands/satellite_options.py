@@ -25,6 +25,11 @@ def add_satellite_options(parser: argparse.ArgumentParser, required: bool = True
     parser.add_argument("--clocks", type=Path, help="RINEX clock file beside --orbits")
 
 
+def satellite_inputs(args: argparse.Namespace) -> list[Path]:
+    """The satellite-state files the options name (for the output checks)."""
+    return [*(args.nav or ()), *(p for p in (args.orbits, args.clocks) if p is not None)]
+
+
 def satellite_states(args: argparse.Namespace) -> Navigation | PreciseOrbits:
     """The navigation files or the precise orbits (+ clocks) the options name."""
     return read_satellite_states(args.nav, args.orbits, args.clocks)

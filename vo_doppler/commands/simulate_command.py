@@ -5,16 +5,28 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import shlex
+from collections.abc import Callable
 from dataclasses import replace
+from typing import Any
 
 from rich.console import Console
 from rich.table import Table
 
+from vo_doppler.commands.arg_types import (
+    finite_float,
+    int_in,
+    non_negative_float,
+    number_in,
+    positive_float,
+    positive_int,
+    system_letters,
+)
 from vo_doppler.errors import InputError
 from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.sim.camera_effects import CameraEffects
 from vo_doppler.sim.urban_canyon import (
+    MAX_DURATION_S,
     SCENARIOS,
     CityConfig,
     UrbanCanyonConfig,
@@ -22,31 +34,55 @@ from vo_doppler.sim.urban_canyon import (
 )
 
 
-def _numbers(text: str, count: int, kind=float) -> tuple:
-    try:
-        values = tuple(kind(v) for v in text.split(","))
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: expected {count} numbers") from exc
-    if len(values) != count:
+def _numbers(text: str, count: int, kind: Callable[[str], Any] = finite_float) -> tuple:
+    """``count`` comma-separated values, each parsed by the argparse type ``kind``."""
+    parts = text.split(",")
+    if len(parts) != count:
         raise argparse.ArgumentTypeError(f"{text!r}: expected {count} comma-separated numbers")
-    return values
+    try:
+        return tuple(kind(v) for v in parts)
+    except (ValueError, argparse.ArgumentTypeError) as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: {exc}") from exc
 
 
-def _pair(text: str) -> tuple:
-    return _numbers(text, 2)
+def _positive_pair(text: str) -> tuple:
+    return _numbers(text, 2, positive_float)
+
+
+def _heights(text: str) -> tuple:
+    low, high = _positive_pair(text)
+    if high < low:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected MIN,MAX with MIN ≤ MAX")
+    return low, high
 
 
 def _int_pair(text: str) -> tuple:
-    return _numbers(text, 2, int)
+    return _numbers(text, 2, positive_int)
 
 
 def _loop(text: str) -> tuple:
-    i0, j0, i1, j1 = _numbers(text, 4, int)
+    i0, j0, i1, j1 = _numbers(text, 4, int_in(0))
     return ((i0, j0), (i1, j1))
 
 
 def _triple(text: str) -> tuple:
     return _numbers(text, 3)
+
+
+MAX_ROAD_SPEED_KMH = 300.0
+"""Upper bound of the speed options: faster than any road car (the route is laid out for
+max speed × duration, so an absurd speed would exhaust the memory)."""
+_road_speed = number_in(0.0, MAX_ROAD_SPEED_KMH, low_open=True, unit="km/h")
+_latitude = number_in(-90.0, 90.0, unit="degrees")
+_longitude = number_in(-180.0, 180.0, unit="degrees")
+
+
+def _origin(text: str) -> tuple:
+    lat, lon, height = _triple(text)
+    try:
+        return _latitude(str(lat)), _longitude(str(lon)), height
+    except argparse.ArgumentTypeError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: LAT,LON,H: {exc}") from exc
 
 
 SWITCHES = {
@@ -109,14 +145,22 @@ def register(subparsers, summary: str) -> None:
         "ground truth and sequence.yaml (deterministic per seed).",
     )
     parser.add_argument("--scenario", choices=SCENARIOS, default="urban-canyon", help="the drive")
-    parser.add_argument("--duration", type=float, default=defaults.duration_s, help="seconds")
+    parser.add_argument(
+        "--duration",
+        type=number_in(0.0, MAX_DURATION_S, low_open=True, unit="s"),
+        default=defaults.duration_s,
+        help=f"seconds (at most {MAX_DURATION_S:g}: the drive is held in memory, about 1 MB/s)",
+    )
     parser.add_argument("--seed", type=int, default=0, help="random seed (same seed, same data)")
     parser.add_argument("-o", "--output", required=True, help="sequence folder to write")
-    parser.add_argument("--fps", type=float, default=defaults.fps, help="camera rate (Hz)")
+    parser.add_argument("--fps", type=positive_float, default=defaults.fps, help="camera rate (Hz)")
     parser.add_argument("--size", type=_int_pair, default=defaults.image_size, help="W,H px")
     parser.add_argument("--image-format", choices=("png", "jpg"), default="png", help="images")
     parser.add_argument(
-        "--jpeg-quality", type=int, default=defaults.jpeg_quality, help="JPEG quality (1-100)"
+        "--jpeg-quality",
+        type=int_in(1, 100),
+        default=defaults.jpeg_quality,
+        help="JPEG quality (1-100)",
     )
     parser.add_argument("--no-images", action="store_true", help="skip rendering (fast)")
     parser.add_argument(
@@ -130,26 +174,26 @@ def register(subparsers, summary: str) -> None:
     effects = defaults.camera_effects
     parser.add_argument(
         "--distortion-error",
-        type=float,
+        type=finite_float,
         default=effects.distortion_error[0],
         help="error of the calibrated radial coefficient k1 (true lens k1 "
         f"{effects.distortion[0]:g}, k2 {effects.distortion[1]:g}; default %(default)g)",
     )
     parser.add_argument(
         "--readout-ms",
-        type=float,
+        type=non_negative_float,
         default=effects.readout_s * 1e3,
         help="rolling-shutter readout time, first to last row (default %(default)g ms)",
     )
     parser.add_argument(
         "--exposure-ms",
-        type=float,
+        type=non_negative_float,
         default=effects.exposure_s * 1e3,
         help="exposure time, for the motion blur (default %(default)g ms)",
     )
     parser.add_argument(
         "--traffic",
-        type=float,
+        type=non_negative_float,
         default=defaults.traffic.vehicles_per_km,
         help="moving vehicles per km of lane (default %(default)g)",
     )
@@ -163,10 +207,17 @@ def register(subparsers, summary: str) -> None:
         "facades, full-contrast ground, exact calibration unless --calib-error is given",
     )
     parser.add_argument("--blocks", type=_int_pair, default=city.blocks, help="NX,NY blocks")
-    parser.add_argument("--block-size", type=_pair, default=city.block_size_m, help="X,Y m")
-    parser.add_argument("--street-width", type=float, default=city.street_width_m, help="m")
     parser.add_argument(
-        "--heights", type=_pair, default=city.height_range_m, help="building heights MIN,MAX m"
+        "--block-size", type=_positive_pair, default=city.block_size_m, help="X,Y m"
+    )
+    parser.add_argument(
+        "--street-width", type=positive_float, default=city.street_width_m, help="m"
+    )
+    parser.add_argument(
+        "--heights",
+        type=_heights,
+        default=city.height_range_m,
+        help="building heights MIN,MAX m",
     )
     parser.add_argument(
         "--loop",
@@ -175,16 +226,29 @@ def register(subparsers, summary: str) -> None:
         help="street lines I0,J0,I1,J1 of the loop's corners",
     )
     parser.add_argument(
-        "--max-speed", type=float, default=defaults.max_speed_mps * 3.6, help="km/h"
+        "--max-speed",
+        type=_road_speed,
+        default=defaults.max_speed_mps * 3.6,
+        help=f"km/h (at most {MAX_ROAD_SPEED_KMH:g})",
     )
     parser.add_argument(
-        "--initial-speed", type=float, default=0.0, help="km/h at the start (default: from rest)"
+        "--initial-speed",
+        type=number_in(0.0, MAX_ROAD_SPEED_KMH, unit="km/h"),
+        default=0.0,
+        help="km/h at the start (default: from rest)",
     )
     parser.add_argument(
-        "--stops-per-lap", type=int, default=defaults.stops_per_lap, help="standstills per lap"
+        "--stops-per-lap",
+        type=int_in(0),
+        default=defaults.stops_per_lap,
+        help="standstills per lap",
     )
-    parser.add_argument("--gnss-rate", type=float, default=defaults.gnss.rate_hz, help="Hz")
-    parser.add_argument("--systems", default=defaults.gnss.systems, help="G, E or GE")
+    parser.add_argument(
+        "--gnss-rate", type=positive_float, default=defaults.gnss.rate_hz, help="Hz"
+    )
+    parser.add_argument(
+        "--systems", type=system_letters("GE"), default=defaults.gnss.systems, help="G, E or GE"
+    )
     parser.add_argument(
         "--nlos",
         action=argparse.BooleanOptionalAction,
@@ -195,19 +259,20 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--no-noise", action="store_true", help="noise-free GNSS observations")
     parser.add_argument(
         "--wheel-scale-error",
-        type=float,
+        type=number_in(-1.0, low_open=True),
         default=defaults.can.wheel_scale_error,
         help="wheel speed scale error (fraction, 0.02: the wheels read 2 %% fast)",
     )
     parser.add_argument(
-        "--yaw-bias", type=float, default=defaults.can.yaw_rate_bias_dps, help="deg/s"
+        "--yaw-bias", type=finite_float, default=defaults.can.yaw_rate_bias_dps, help="deg/s"
     )
     parser.add_argument(
         "--start",
+        type=_iso_time,
         default=None,
         help="GPS start time YYYY-MM-DDTHH:MM:SS (default 2025-03-14T02:10)",
     )
-    parser.add_argument("--origin", type=_triple, default=defaults.origin, help="LAT,LON,H")
+    parser.add_argument("--origin", type=_origin, default=defaults.origin, help="LAT,LON,H")
     parser.add_argument(
         "--antenna-lever-arm",
         type=_triple,
@@ -218,13 +283,19 @@ def register(subparsers, summary: str) -> None:
     parser.set_defaults(func=run)
 
 
+def _iso_time(text: str) -> str:
+    """argparse type: an ISO date and time (kept as written, for the command line)."""
+    try:
+        dt.datetime.fromisoformat(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an ISO date and time") from exc
+    return text
+
+
 def _start_gps(text: str | None, default: float) -> float:
     if text is None:
         return default
-    try:
-        when = dt.datetime.fromisoformat(text)
-    except ValueError as exc:
-        raise InputError(f"--start {text!r} is not an ISO date and time") from exc
+    when = dt.datetime.fromisoformat(text)
     seconds = when.second + when.microsecond * 1e-6
     return float(
         calendar_to_gps_seconds(when.year, when.month, when.day, when.hour, when.minute, seconds)
@@ -268,10 +339,6 @@ def _command_line(args: argparse.Namespace) -> str:
 def run(args: argparse.Namespace) -> int:
     check_output_folder(args.output, "simulate")
     defaults = UrbanCanyonConfig()
-    if set(args.systems) - set("GE") or not args.systems:
-        raise InputError(f"--systems {args.systems!r}: the simulator has G and E")
-    if args.duration <= 0.0:
-        raise InputError("--duration must be positive")
     config = replace(
         defaults,
         duration_s=args.duration,

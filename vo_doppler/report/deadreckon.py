@@ -133,10 +133,10 @@ def write_allan_figure(path: Path, result: DeadReckonResult) -> None:
     fig.savefig(path, dpi=120, bbox_inches="tight")
 
 
-def write_outputs(folder: str | Path, result: DeadReckonResult) -> dict[str, Path]:
-    """Write every output file into ``folder`` (created) and return their paths by name."""
-    folder = open_output_folder(folder, "deadreckon")
-    paths = {
+def output_files(folder: str | Path) -> dict[str, Path]:
+    """The files :func:`write_outputs` writes into ``folder``, by name."""
+    folder = Path(folder)
+    return {
         "trajectory": folder / "trajectory.tum",
         "geojson": folder / "trajectory.geojson",
         "drift_table": folder / "drift_table.csv",
@@ -144,6 +144,11 @@ def write_outputs(folder: str | Path, result: DeadReckonResult) -> dict[str, Pat
         "map": folder / "map.png",
         "allan": folder / "allan_deviation.png",
     }
+
+
+def write_outputs(folder: str | Path, result: DeadReckonResult) -> dict[str, Path]:
+    """Write every output file into ``folder`` (created) and return their paths by name."""
+    paths = output_files(open_output_folder(folder, "deadreckon"))
     write_tum(paths["trajectory"], result.selected_trajectory.trajectory())
     paths["geojson"].write_text(json_text(geojson(result)))
     with paths["drift_table"].open("w", newline="") as handle:

@@ -118,6 +118,13 @@ TRAFFIC_STREAM = 0x7AFF1C
 CAMERA_START_DELAY_S = 0.02
 
 
+MAX_DURATION_S = 3600.0
+"""Longest drive simulated (s). The whole drive is held in memory until written: measured
+without images, the peak is 0.3 GB at 60 s, 0.7 GB at 600 s and 1.3 GB at 1200 s, about 1 MB
+per second, so an hour needs about 4 GB; a longer one would exhaust an ordinary machine
+before writing anything."""
+
+
 @dataclass(frozen=True)
 class CityConfig:
     """Street grid and buildings (``vo_doppler.sim.scene.city_scene``)."""

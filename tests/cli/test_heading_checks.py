@@ -1,0 +1,57 @@
+"""``vo-doppler heading`` gives the calibration warnings ``run`` gives (one shared check): a
+CAN clock off by 2 s and wheels reading 3.6 times fast (a speed in km/h) on an open-sky
+simulated drive, whose true CAN offset is the GPS-Unix offset."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from vo_doppler.cli import main
+
+GPS_MINUS_UNIX_S = -315964782.0
+
+
+@pytest.fixture(scope="module")
+def kmh_drive(tmp_path_factory):
+    """40 s with the wheel speed scaled by 3.6 (scale error 2.6), low buildings, no NLOS."""
+    folder = tmp_path_factory.mktemp("sim") / "kmh"
+    argv = ["-q", "simulate", "--no-images", "--duration", "40", "--heights", "1,2"]
+    argv += ["--no-nlos", "--wheel-scale-error", "2.6", "--gnss-rate", "5", "-o", str(folder)]
+    assert main(argv) == 0
+    return folder
+
+
+def _heading(folder, offset_s: float, out, capsys, caplog) -> dict:
+    capsys.readouterr()
+    caplog.clear()
+    argv = ["-q", "heading", str(folder / "gnss/rover.obs"), "--nav", str(folder / "gnss/brdc.nav")]
+    argv += ["--can", str(folder / "can/vehicle.log"), "--dbc", str(folder / "can/vehicle.dbc")]
+    argv += ["--yaw-rate", "VEHICLE_DYNAMICS.YAW_RATE"]
+    argv += ["--wheel-speed", "WHEEL_SPEEDS.WHEEL_SPEED_RL,WHEEL_SPEEDS.WHEEL_SPEED_RR"]
+    argv += ["--time-offset-can", f"{offset_s}", "-o", str(out)]
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out)
+    for warning in summary["warnings"]:
+        assert warning in caplog.text  # logged as well
+    return summary
+
+
+def test_a_wheel_scale_far_from_one_is_a_warning(kmh_drive, tmp_path, capsys, caplog):
+    summary = _heading(kmh_drive, GPS_MINUS_UNIX_S, tmp_path / "h.csv", capsys, caplog)
+    assert summary["wheel_scale"] == pytest.approx(1 / 3.6, abs=0.02)
+    (warning,) = summary["warnings"]
+    assert f"wheel scale: the calibration gives {summary['wheel_scale']:.3f}" in warning
+
+
+def test_a_can_clock_2_s_off_is_a_warning_with_the_right_offset(
+    kmh_drive, tmp_path, capsys, caplog
+):
+    summary = _heading(kmh_drive, GPS_MINUS_UNIX_S + 2.0, tmp_path / "h.csv", capsys, caplog)
+    clock = [w for w in summary["warnings"] if w.startswith("CAN clock")]
+    assert len(clock) == 1
+    assert "shifted by -2.00 s" in clock[0]
+    assert f"--time-offset-can {GPS_MINUS_UNIX_S + 2.0:.3f} s should be about" in clock[0]
+    suggested = float(clock[0].rsplit("about ", 1)[1].removesuffix(" s"))
+    assert suggested == pytest.approx(GPS_MINUS_UNIX_S, abs=0.05)
