@@ -21,6 +21,10 @@ def inputs(tmp_path_factory):
     return record, write_two_gyro(record, folder)
 
 
+def summary_of(out):
+    return json.loads((out / "deadreckon_summary.json").read_text())
+
+
 def _args(paths, out, *extra):
     return [
         "deadreckon",
@@ -44,6 +48,7 @@ def test_cli_writes_every_output(inputs, tmp_path, capsys):
     assert code == 0
     printed = capsys.readouterr().out
     assert "combined + ε0" in printed and "k used 1.130" in printed
+    assert "does not close" not in printed
 
     trajectory = read_tum(out / "trajectory.tum")
     n_fixes = len(record.gps[0])
@@ -55,6 +60,8 @@ def test_cli_writes_every_output(inputs, tmp_path, capsys):
         rows = list(csv.DictReader(handle))
     assert [row["variant"] for row in rows] == list(VARIANTS)
     drift = {row["variant"]: abs(float(row["drift_deg_per_min"])) for row in rows}
+    assert float(rows[4]["loop_gap_percent"]) < 1.0 and float(rows[4]["end_error_m"]) >= 0.0
+    assert summary_of(out)["route_closes"] is True
     assert drift["combined + ε0 removed"] < drift["sensor 1"] / 50.0
 
     geo = json.loads((out / "trajectory.geojson").read_text())
@@ -111,3 +118,23 @@ def test_an_output_folder_holding_an_input_or_someone_elses_files_is_refused(
     err = capsys.readouterr().err
     assert f"{other}: the output folder is not empty and was not written by 'vo-doppler " in err
     assert [p.name for p in other.iterdir()] == ["notes.txt"]
+
+
+def test_an_open_route_gets_the_end_error_and_no_loop_gap(inputs, tmp_path, capsys):
+    """The QA case: a start-to-end "gap" reported on a route that is no loop (here the first
+    60 s of the loop's drive)."""
+    record, paths = inputs
+    lines = paths["gps"].read_text().splitlines()
+    half = tmp_path / "half.csv"
+    half.write_text("\n".join(lines[:661]) + "\n")  # header, 600 s still, 60 s driving
+    t0, t1 = record.standstill
+    out = tmp_path / "out"
+    assert main(_args({**paths, "gps": half}, out, "--standstill", f"{t0},{t1}")) == 0
+    printed = capsys.readouterr().out
+    assert "the GPS route does not close" in printed
+    with (out / "drift_table.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert all(row["loop_gap_m"] == "nan" for row in rows)
+    best = rows[VARIANTS.index("combined + ε0 removed")]
+    assert 0.0 < float(best["end_error_percent"]) < 5.0
+    assert summary_of(out)["route_closes"] is False

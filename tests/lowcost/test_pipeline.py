@@ -69,6 +69,7 @@ def test_closed_loop_gap_below_one_percent(record, calibrated_k):
     gap = result.rows[VARIANTS.index("combined + ε0 removed")].gap
     assert gap.length_m == pytest.approx(record.spec.loop_length_m, rel=0.02)
     assert gap.percent <= 1.0
+    assert gap.closed and gap.end_error_m <= 0.01 * gap.length_m
 
 
 def test_auto_choices_on_the_same_record(record):

@@ -23,7 +23,19 @@ from vo_doppler.io.sensor_csv import read_numeric_csv, read_yaw_rate_csv
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, run_deadreckon, smoothed_track_speed
 from vo_doppler.report.deadreckon import drift_table_rows, output_files, write_outputs
 
-TABLE_HEADERS = ("variant", "drift °/min", "final error °", "gap m", "gap %", "length m")
+TABLE_HEADERS = (
+    "variant",
+    "drift °/min",
+    "final error °",
+    "loop gap m",
+    "loop gap %",
+    "end error m",
+    "end error %",
+    "length m",
+)
+"""The columns of ``drift_table_rows``; the terminal shows the loop gap on a route that closes,
+else the end error (the CSV has both)."""
+LOOP_GAP_COLUMNS, END_ERROR_COLUMNS = (3, 4), (5, 6)
 
 
 _k_number = number_in(0.0, 2.0)
@@ -153,11 +165,19 @@ def run(args: argparse.Namespace) -> int:
     window = "standstill" if args.straight is None else "straight stretch"
     console = Console()
     table = Table(title=f"Heading drift (reference: {result.reference_source})")
-    for header in TABLE_HEADERS:
-        table.add_column(header, justify="left" if header == "variant" else "right")
+    closed = bool(result.rows) and result.rows[0].gap.closed
+    hidden = END_ERROR_COLUMNS if closed else LOOP_GAP_COLUMNS
+    shown = [i for i in range(len(TABLE_HEADERS)) if i not in hidden]
+    for i in shown:
+        table.add_column(TABLE_HEADERS[i], justify="left" if i == 0 else "right", no_wrap=i == 0)
     for row in drift_table_rows(result.rows):
-        table.add_row(*(str(v) for v in row))
+        table.add_row(*(str(row[i]) for i in shown))
     console.print(table)
+    if not closed:
+        console.print(
+            "the GPS route does not close (it ends more than 5 % of its length and 10 m from "
+            "its start): no loop gap; the end error is the distance from the GPS track's end"
+        )
     choices = ", ".join(f"{c.method} {c.k:.3f}" for c in model.k_choices.as_list())
     console.print(
         f"k used {model.k:.3f} ({choices}); τ {model.tau:.3g} s; "

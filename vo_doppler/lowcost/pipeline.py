@@ -316,7 +316,7 @@ def run_deadreckon(
                 name,
                 drift_rate_deg_per_min(epochs[valid], error, config.drift_window_s),
                 float(np.degrees(error[-1])),
-                closed_loop_gap(dr.east, dr.north),
+                closed_loop_gap(dr.east, dr.north, epoch_enu),
             )
         )
     return result

@@ -22,8 +22,12 @@ DRIFT_COLUMNS = (
     "final_heading_error_deg",
     "loop_gap_m",
     "loop_gap_percent",
+    "end_error_m",
+    "end_error_percent",
     "path_length_m",
 )
+"""The loop gap is NaN on a route that does not close (``lowcost.drift.route_closes``); the end
+error is the distance from the reconstructed GPS track's end."""
 
 
 def enu_to_lonlat(frame: EnuFrame, east: np.ndarray, north: np.ndarray) -> np.ndarray:
@@ -63,6 +67,8 @@ def drift_table_rows(rows: list[DriftRow]) -> list[list]:
             round(row.final_heading_error_deg, 6),
             round(row.gap.gap_m, 4),
             round(row.gap.percent, 4),
+            round(row.gap.end_error_m, 4),
+            round(row.gap.end_error_percent, 4),
             round(row.gap.length_m, 3),
         ]
         for row in rows
@@ -86,6 +92,7 @@ def summary(result: DeadReckonResult) -> dict:
         "standstills": [list(iv) for iv in prepared.standstills],
         "reference": result.reference_source,
         "selected_variant": result.selected,
+        "route_closes": bool(result.rows[0].gap.closed) if result.rows else None,
         "origin_lat_lon_deg": [
             float(np.degrees(prepared.frame.lat_rad)),
             float(np.degrees(prepared.frame.lon_rad)),
