@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from pyubx2 import UBXMessage
 
+from tests.conftest import require_shared
 from tests.helpers.lnav import EXAMPLE, encode_ephemeris
 from tests.io.test_android import synthetic_rows, write_log
 from vo_doppler.cli import main
@@ -135,3 +136,14 @@ def test_android_log_without_nav_is_an_error_naming_the_file(tmp_path, capsys):
     code = main(["gnss", "velocity", str(path), "-o", str(tmp_path / "v.csv")])
     assert code != 0
     assert "gnss_log.txt: no satellite states: give --nav or --orbits" in capsys.readouterr().err
+
+
+@pytest.mark.shared_data
+def test_gsdc_file_without_nav_is_an_error_pointing_to_the_docs(tmp_path, capsys):
+    """The command takes no satellite states from a GSDC file (docs/formats.md says so)."""
+    path = require_shared("android_pixel7pro/device_gnss.csv")
+    assert main(["gnss", "velocity", str(path), "-o", str(tmp_path / "v.csv")]) == 1
+    err = capsys.readouterr().err
+    assert "device_gnss.csv: no satellite states: give --nav or --orbits" in err
+    assert "GSDC file's satellite states are for the library only" in err
+    assert not (tmp_path / "v.csv").exists()

@@ -100,7 +100,12 @@ def run(args: argparse.Namespace) -> int:
     obs, embedded = read_observation_file(args.obs)
     nav = satellite_states(args) if args.nav or args.orbits else embedded
     if nav is None:
-        raise InputError("no satellite states: give --nav or --orbits", args.obs)
+        raise InputError(
+            "no satellite states: give --nav or --orbits (of the files this command reads, only "
+            "a UBX log with GPS subframes carries its own; a GSDC file's satellite states are "
+            "for the library only, docs/formats.md)",
+            args.obs,
+        )
     mask = np.deg2rad(args.elev_mask)
     title = f"{args.obs.name} ({args.systems})"
     if args.gnss_command == "spp":

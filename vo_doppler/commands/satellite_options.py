@@ -19,7 +19,13 @@ def add_satellite_options(parser: argparse.ArgumentParser, required: bool = True
         type=Path,
         action="append",
         help="RINEX navigation file (repeat)"
-        + ("" if required else "; optional for a UBX log with GPS subframes"),
+        + (
+            ""
+            if required
+            else "; optional only for a UBX log with GPS subframes (a GnssLogger or GSDC "
+            "device_gnss.csv file needs it or --orbits: the GSDC file's own satellite states "
+            "are for the library only)"
+        ),
     )
     choice.add_argument("--orbits", type=Path, help="SP3-c/d precise orbits (instead of --nav)")
     parser.add_argument("--clocks", type=Path, help="RINEX clock file beside --orbits")
