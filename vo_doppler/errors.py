@@ -24,16 +24,26 @@ class VoDopplerError(Exception):
 
 
 class InputError(VoDopplerError):
-    """An input file or value is unusable: the message names the file, line or epoch."""
+    """An input file or value is unusable: the message names the file, line or epoch, or for
+    a binary file the byte offset (``FILE, byte N``: ``FILE:N`` would read as a line)."""
 
-    def __init__(self, message: str, path: str | Path | None = None, line: int | None = None):
+    def __init__(
+        self,
+        message: str,
+        path: str | Path | None = None,
+        line: int | None = None,
+        byte: int | None = None,
+    ):
         self.path = None if path is None else Path(path)
         self.line = line
+        self.byte = byte
         where = ""
         if path is not None:
             where = f"{path}"
             if line is not None:
                 where += f":{line}"
+            if byte is not None:
+                where += f", byte {byte}"
             where += ": "
         super().__init__(where + message)
 

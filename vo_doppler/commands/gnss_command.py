@@ -123,9 +123,8 @@ def run(args: argparse.Namespace) -> int:
         rows = result.rows
         if rows.n_no_ephemeris:
             log.warning(
-                "%d Doppler rows skipped without ephemeris: %s",
+                "%d Doppler rows skipped without ephemeris (the satellites above)",
                 rows.n_no_ephemeris,
-                "; ".join(rows.missing),
             )
         if valid.any():
             speed = solution.speed_mps[valid]

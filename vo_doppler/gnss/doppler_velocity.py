@@ -86,13 +86,16 @@ def doppler_rows(
     elevation_mask_rad: float = np.deg2rad(10.0),
     sigma0: float = SIGMA_RANGE_RATE_MPS,
     reported_sigma: ReportedSigma | None = None,
+    log_missing: bool = True,
 ) -> DopplerRows:
     """Doppler rows of the chosen systems/bands with satellite states and geometry.
 
     ``receiver_ecef``: (3,) or one position per observation epoch (E, 3; NaN rows are skipped).
     Satellite states are taken at signal transmission (travel time from the geometric range) in
     the ECEF frame of reception, from ``source`` (broadcast or precise, ``satellite_source``).
-    Rows without ephemeris or wavelength are dropped and counted.
+    Rows without ephemeris or wavelength are dropped and counted, the satellites without one
+    logged unless ``log_missing`` is False (a second pass over the same file, which would
+    repeat the warning).
     """
     source = satellite_source(source)
     n_epochs = obs.epoch_time.size
@@ -127,6 +130,9 @@ def doppler_rows(
     no_eph = np.zeros(len(sel), dtype=bool)
     no_eph[np.flatnonzero(usable)[~states.valid]] = True
     missing = _missing_messages(sel, no_eph)
+    if log_missing:
+        for message in missing:
+            log.warning("satellite %s skipped", message)
     vector = states.position - position[usable]
     los = vector / np.linalg.norm(vector, axis=1, keepdims=True)
     elevation, azimuth = elevation_azimuth(position[usable], los)
@@ -190,7 +196,6 @@ def _missing_messages(sel: Observations, no_eph: np.ndarray) -> tuple[str, ...]:
             first = times[sats == sat].min()
             count = int((sats == sat).sum())
             messages.append(f"{sat}: no healthy ephemeris from GPS time {first:.1f} ({count} rows)")
-            log.warning("satellite %s skipped", messages[-1])
     return tuple(messages)
 
 

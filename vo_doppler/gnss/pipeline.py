@@ -71,7 +71,7 @@ def gnss_velocity(
     )
     measured = carrier_phase_doppler(obs) if range_rate == "phase" else obs
 
-    def rows_at(position):
+    def rows_at(position, log_missing=True):
         return doppler_rows(
             measured,
             source,
@@ -80,6 +80,7 @@ def gnss_velocity(
             bands=bands,
             elevation_mask_rad=elevation_mask_rad,
             reported_sigma=reported_sigma,
+            log_missing=log_missing,
         )
 
     rows = rows_at(position)
@@ -96,7 +97,7 @@ def gnss_velocity(
         )
         if track is not None:
             position = track
-            rows = rows_at(position)
+            rows = rows_at(position, log_missing=False)  # the first pass logged them
     if fit_noise:
         velocity, rows, models = solve_with_fitted_noise(rows, obs.epoch_time)
     else:

@@ -4,7 +4,7 @@ Framing (u-blox interface description, "UBX frame structure"): sync 0xB5 0x62, c
 little-endian length, payload, 8-bit Fletcher checksum over class…payload. The stream is
 scanned here so that every problem names its byte offset; bytes between frames (NMEA, RTCM)
 are skipped and counted; a frame with a bad checksum or a payload pyubx2 cannot parse is
-skipped with a message ``FILE@OFFSET: …`` in ``problems``; a truncated last frame likewise.
+skipped with a message ``FILE, byte OFFSET: …`` in ``problems``; a truncated last frame likewise.
 
 - RXM-RAWX → :class:`Observations`, epoch = week·604800 + rcvTow (receiver time, like a RINEX
   epoch). Per signal (gnssId, sigId → RINEX 3 code, ``SIGNAL_CODES``): pseudorange ``C`` when
@@ -147,7 +147,7 @@ def frames(data: bytes, path: Path, problems: list[str]):
 
 
 def _problem(problems: list[str], path: Path, offset: int, message: str) -> None:
-    text = f"{path}@{offset}: {message}"
+    text = f"{path}, byte {offset}: {message}"
     log.warning(text)
     problems.append(text)
 
@@ -221,7 +221,7 @@ class _RawxRows:
             raise InputError(
                 f"RXM-RAWX epoch {t:.3f} before the previous one {self.time[-1]:.3f}",
                 path,
-                offset,
+                byte=offset,
             )
         self.week = week if self.week is None else self.week
         for k in range(1, int(message.numMeas) + 1):
@@ -338,7 +338,7 @@ def _in_order(pvt: list[dict[str, float]], t: float, offset: int, path: Path, pr
         _problem(problems, path, offset, "NAV-PVT repeats the previous fix's time: skipped")
         return False
     raise InputError(
-        f"NAV-PVT time {t:.3f} before the previous one {pvt[-1]['t']:.3f}", path, offset
+        f"NAV-PVT time {t:.3f} before the previous one {pvt[-1]['t']:.3f}", path, byte=offset
     )
 
 
