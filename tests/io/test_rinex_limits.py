@@ -4,6 +4,7 @@ the file (never zlib.error, HatanakaException, UnicodeDecodeError or MemoryError
 from __future__ import annotations
 
 import gzip
+import re
 import resource
 
 import hatanaka
@@ -24,7 +25,7 @@ def _text(n_epochs: int = 3) -> str:
     text = rinex3_header(TYPES)
     for k in range(n_epochs):
         records = [(s, [field(2.0e7 + k), field(-1000.0 - k)]) for s in ("G05", "G07", "E11")]
-        text += rinex3_epoch(f"2024 06 24 08 20 {k:2d}.0000000", records)
+        text += rinex3_epoch(f"2024 06 24 08 {20 + k // 60:2d} {k % 60:2d}.0000000", records)
     return text
 
 
@@ -51,7 +52,7 @@ def _write(tmp_path, name: str, data: bytes):
 @pytest.mark.parametrize(
     ("name", "data", "message"),
     [
-        ("cut.24o.gz", gzip.compress(_text().encode())[:-30], "cannot decompress"),
+        ("cut.24o.gz", gzip.compress(_text().encode())[:14], "cannot decompress"),
         ("flip.24o.gz", gzip.compress(_text().encode())[:12] + b"\xff" * 40, "cannot decompress"),
         ("cut.crx", hatanaka.rnx2crx(_text().encode())[:-25], "cannot decompress"),
         ("bad.crx", b"1.0                 COMPACT RINEX FORMAT\ngarbage\n", "cannot decompress"),
@@ -63,6 +64,38 @@ def test_corrupt_compressed_files_are_input_errors(tmp_path, name, data, message
     with pytest.raises(InputError, match=message) as error:
         read_obs(path)
     assert str(path) in str(error.value)
+
+
+@pytest.mark.parametrize("damage", ["cut", "flipped"])
+def test_a_damaged_gzip_keeps_the_epochs_before_the_damage(tmp_path, damage):
+    """As for a truncated plain file (QA report: a truncated .obs.gz was rejected whole): the
+    complete lines decoded before the damage are read, and a problem names the first line
+    lost; the navigation reader does the same."""
+    plain = _text(400).encode()
+    packed = gzip.compress(plain, compresslevel=1)
+    middle = len(packed) // 2
+    if damage == "cut":
+        packed = packed[:middle]
+    else:
+        packed = packed[:middle] + bytes(b ^ 0x5A for b in packed[middle : middle + 64])
+    obs = read_obs(_write(tmp_path, "damaged.24o.gz", packed))
+    full = read_obs(_write(tmp_path, "plain.24o", plain))
+    n = obs.epoch_time.size
+    assert 50 < n < 400
+    np.testing.assert_array_equal(obs.epoch_time, full.epoch_time[:n])
+    np.testing.assert_array_equal(obs.value[: len(obs) - 6], full.value[: len(obs) - 6])
+    (lost,) = [p for p in obs.problems if "gzip data damaged or cut short here" in p]
+    where = re.match(rf"{re.escape(str(tmp_path))}/damaged.24o.gz:(\d+): .*: the (\d+) lines", lost)
+    assert where is not None and int(where[1]) == int(where[2]) + 1
+    if damage == "cut":  # flipped bytes may inflate to wrong text before deflate fails
+        assert plain.startswith(read_rinex_bytes(tmp_path / "damaged.24o.gz", []))
+
+
+def test_a_damaged_gzip_without_a_problem_list_is_still_an_error(tmp_path):
+    packed = gzip.compress(_text(400).encode())
+    path = _write(tmp_path, "cut.24o.gz", packed[: len(packed) // 2])
+    with pytest.raises(InputError, match="cannot decompress"):
+        read_rinex_bytes(path)
 
 
 def test_gzip_bomb_is_refused_without_filling_memory(tmp_path):

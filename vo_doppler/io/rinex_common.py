@@ -74,13 +74,16 @@ def expanded_limit(compressed_size: int) -> int:
     return min(MAX_TEXT_BYTES, max(MIN_EXPANDED_LIMIT, EXPANSION_RATIO * compressed_size))
 
 
-def read_rinex_bytes(path: str | Path) -> bytes:
+def read_rinex_bytes(path: str | Path, problems: list[str] | None = None) -> bytes:
     """File contents as plain RINEX text (bytes, ``\\n`` line ends).
 
     gzip (``.gz``), Unix compress (``.Z``) and Hatanaka-compressed (``.crx``, ``.YYd``) files are
     expanded, streamed with a cap (:func:`expanded_limit`); Hatanaka decoding runs the ``crx2rnx``
     program shipped with the ``hatanaka`` package (RNXCMP format 1.0 and 3.0). Every failure
-    (unreadable file, corrupt or oversized compressed data) is an InputError naming the file.
+    (unreadable file, corrupt or oversized compressed data) is an InputError naming the file,
+    except a gzip stream damaged or cut short after whole lines of text when ``problems`` is
+    given: the complete lines before the damage are returned, as for a truncated plain file,
+    and the damage is added to ``problems`` naming the first line lost.
     """
     path = Path(path)
     try:
@@ -95,11 +98,21 @@ def read_rinex_bytes(path: str | Path) -> bytes:
     limit = expanded_limit(len(raw))
     try:
         if raw[:2] == b"\x1f\x8b":
-            raw = _gunzip(raw, limit)
+            raw = _gunzip(raw, limit, keep_partial=problems is not None)
         elif raw[:2] == b"\x1f\x9d":
             raw = _uncompress(raw, limit)
         if b"COMPACT RINEX" in raw[:80]:
             raw = _crx2rnx(raw, limit)
+    except _DamagedStreamError as damaged:
+        raw = damaged.text[: damaged.text.rfind(b"\n") + 1]
+        lines = raw.count(b"\n")
+        add_problem(
+            problems,
+            path,
+            lines + 1,
+            f"gzip data damaged or cut short here ({_one_line(damaged.cause)}): the {lines} "
+            "lines before are read, the rest of the file is lost",
+        )
     except SizeLimitError as exc:
         raise InputError(f"decompressed data exceed {limit >> 20} MiB: {exc}", path) from exc
     except (OSError, EOFError, ValueError, RuntimeError, zlib.error) as exc:
@@ -114,14 +127,29 @@ def _one_line(exc: Exception) -> str:
     return (text[:200] + "…") if len(text) > 200 else text or type(exc).__name__
 
 
-def _gunzip(raw: bytes, limit: int) -> bytes:
-    """gzip members decompressed in chunks, stopping as soon as the output exceeds ``limit``."""
+class _DamagedStreamError(Exception):
+    """A compressed stream that broke after ``text`` was decoded (``cause``: why)."""
+
+    def __init__(self, text: bytes, cause: Exception):
+        super().__init__(str(cause))
+        self.text, self.cause = text, cause
+
+
+def _gunzip(raw: bytes, limit: int, keep_partial: bool = False) -> bytes:
+    """gzip members decompressed in chunks, stopping as soon as the output exceeds ``limit``;
+    with ``keep_partial`` a stream that breaks after a complete line raises
+    :class:`_DamagedStreamError` with the text decoded so far."""
     out = bytearray()
     with gzip.GzipFile(fileobj=io.BytesIO(raw)) as stream:
-        while chunk := stream.read(_CHUNK):
-            out += chunk
-            if len(out) > limit:
-                raise SizeLimitError("gzip data expand further")
+        try:
+            while chunk := stream.read1(_CHUNK):  # read1: what was decoded before a break
+                out += chunk
+                if len(out) > limit:
+                    raise SizeLimitError("gzip data expand further")
+        except (OSError, EOFError, zlib.error) as exc:
+            if keep_partial and b"\n" in out:
+                raise _DamagedStreamError(bytes(out), exc) from exc
+            raise
     return bytes(out)
 
 

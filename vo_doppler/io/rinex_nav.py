@@ -95,11 +95,11 @@ def read_nav(paths: str | Path | list[str | Path] | tuple[str | Path, ...]) -> N
 
 
 def _read_one(path: Path) -> Navigation:
-    header, body = split_header(path, read_rinex_bytes(path))
+    problems: list[str] = []
+    header, body = split_header(path, read_rinex_bytes(path, problems))
     version, file_type, system = parse_version_line(path, header, "NGH")
     if version < 3:
         system = {"N": "G", "G": "R", "H": "S"}[file_type]
-    problems: list[str] = []
     leap = None
     for number, line in enumerate(header, start=1):
         if label(line) == "LEAP SECONDS":

@@ -96,9 +96,9 @@ def read_obs(path: str | Path) -> Observations:
     - a file from which no observation at all can be read is an InputError.
     """
     path = Path(path)
-    text = read_rinex_bytes(path)
-    header_lines, body = split_header(path, text)
     problems: list[str] = []
+    text = read_rinex_bytes(path, problems)
+    header_lines, body = split_header(path, text)
     header = _parse_header(path, header_lines, problems)
     typesets = [dict(header.obs_types)]
     if header.version < 3:
