@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import require_shared
+from tests.helpers.rinex_text import field, rinex3_epoch, rinex3_header
 from vo_doppler.cli import main
 from vo_doppler.io.gnss_csv import SPP_COLUMNS, VELOCITY_COLUMNS
 
@@ -53,3 +54,21 @@ def test_missing_file_is_a_runtime_error(tmp_path, capsys):
     code = main(["gnss", "spp", str(tmp_path / "none.obs"), "--nav", "x", "-o", "p.csv"])
     assert code == 1
     assert "none.obs" in capsys.readouterr().err
+
+
+def test_systems_or_bands_without_doppler_in_the_file_name_what_it_has(tmp_path, capsys):
+    """Checked before the navigation file is read: --systems E or --bands 2 on a GPS L1 file
+    named the file's Doppler observables (was: 'too few satellites with ephemerides', or an
+    internal error for a system absent from the file)."""
+    obs = tmp_path / "gps.obs"
+    obs.write_text(
+        rinex3_header({"G": ["C1C", "D1C"]})
+        + rinex3_epoch("2024 06 24 08 20  0.0000000", [("G05", [field(2.1e7), field(-500.0)])])
+    )
+    for option in (["--systems", "E"], ["--bands", "2"]):
+        out = str(tmp_path / "v.csv")
+        argv = ["gnss", "velocity", str(obs), "--nav", "none.nav", *option, "-o", out]
+        assert main(argv) == 1
+        err = capsys.readouterr().err
+        assert "gps.obs: the file has no Doppler of the systems" in err
+        assert err.strip().endswith("its Doppler observables: G D1C")

@@ -83,11 +83,15 @@ def _check_doppler(obs: Observations, systems: str, bands: str | None) -> None:
     (instead of failing later at every epoch for want of satellites)."""
     if doppler_codes(obs, systems, bands):
         return
-    available = doppler_codes(obs, "".join(sorted(set(obs.system.tolist()))))
+    available = [
+        f"{system} {' '.join(codes)}"
+        for system in sorted(set(obs.system.tolist()))
+        if (codes := doppler_codes(obs, system))
+    ]
     chosen = f"systems {systems!r}" + (f", bands {bands!r}" if bands else "")
     raise InputError(
         f"the file has no Doppler of the {chosen}; its Doppler observables: "
-        + (", ".join(available) or "none"),
+        + ("; ".join(available) or "none"),
         obs.header.path,
     )
 
@@ -98,6 +102,8 @@ def run(args: argparse.Namespace) -> int:
         {"output": args.output, "figure": figure}, [args.obs, *satellite_inputs(args)]
     )
     obs, embedded = read_observation_file(args.obs)
+    if args.gnss_command == "velocity":
+        _check_doppler(obs, args.systems, args.bands)
     nav = satellite_states(args) if args.nav or args.orbits else embedded
     if nav is None:
         raise InputError(
@@ -114,7 +120,6 @@ def run(args: argparse.Namespace) -> int:
         spp_figure(figure, solution, title)
         valid = solution.valid
     else:
-        _check_doppler(obs, args.systems, args.bands)
         result = gnss_velocity(obs, nav, args.systems, mask, args.bands, args.range_rate)
         solution = result.velocity
         write_velocity_csv(args.output, solution)
