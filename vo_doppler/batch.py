@@ -69,6 +69,7 @@ from vo_doppler.report.batch_summary import (
     recording_row,
     write_batch_html,
 )
+from vo_doppler.report.json_text import json_text
 from vo_doppler.report.run_outputs import (
     input_warnings,
     require_tight_heading,
@@ -284,7 +285,7 @@ def _done(job: RecordingJob, summary: dict, seconds: float) -> RecordingOutcome:
         "outputs": outputs,
         "summary": summary,
     }
-    _write_atomically(job.out / MARKER, json.dumps(marker, indent=2))
+    _write_atomically(job.out / MARKER, json_text(marker, indent=2))
     return RecordingOutcome(job.name, job.source, Status.DONE, seconds, summary)
 
 

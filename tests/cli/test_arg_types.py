@@ -13,6 +13,7 @@ from vo_doppler.commands.arg_types import (
     elevation_mask_deg,
     finite_float,
     int_in,
+    lever_arm,
     non_negative_float,
     number_in,
     positive_float,
@@ -88,3 +89,20 @@ def test_band_digits_and_system_letters():
     for text in ("XZ", "GR", ""):
         with pytest.raises(argparse.ArgumentTypeError, match="letters of GE"):
             systems(text)
+
+
+def test_a_lever_arm_is_metres_a_vehicle_can_hold():
+    parse = lever_arm()
+    assert parse("1.5,0") == (1.5, 0.0)
+    assert parse("1.5,0,1.6") == (1.5, 0.0, 1.6)
+    assert parse("19.9,0,0") == (19.9, 0.0, 0.0)
+    for text, message in (
+        ("1000,0,0", "beyond any road vehicle"),
+        ("1,2,3,4", "expected X,Y or X,Y,Z"),
+        ("1,nan", "expected X,Y or X,Y,Z"),
+        ("a,b", "expected X,Y or X,Y,Z"),
+    ):
+        with pytest.raises(argparse.ArgumentTypeError, match=message):
+            parse(text)
+    with pytest.raises(argparse.ArgumentTypeError, match="expected X,Y,Z"):
+        lever_arm((3,))("1,2")

@@ -53,6 +53,11 @@ def test_overlap_error_shows_plain_spans_without_numpy_brackets():
     assert not overlaps(np.array([0.0, 0.5]), np.array([1.0, 3.0]))
 
 
+def test_overlap_error_without_samples_has_no_dangling_hint():
+    text = str(overlap_error("CAN", np.array([]), np.array([1.4e9, 1.4e9 + 10]), "--time-offset"))
+    assert text.endswith("GPS time)"), text
+
+
 def test_swapped_rinex_files_say_what_they_look_like(tmp_path):
     with pytest.raises(InputError, match=r"looks like a navigation file .*swapped"):
         read_obs(SAMPLE / "gnss" / "brdc.nav")

@@ -6,6 +6,8 @@ import argparse
 import math
 from collections.abc import Callable
 
+from vo_doppler.io.vehicle_limits import lever_arm_problem
+
 
 def positive_int(text: str) -> int:
     """An integer ≥ 1 (e.g. a worker count or a downsampling factor)."""
@@ -110,4 +112,25 @@ def system_letters(allowed: str) -> Callable[[str], str]:
         return letters
 
     parse.__name__ = f"letters of {allowed}"
+    return parse
+
+
+def lever_arm(components: tuple[int, ...] = (2, 3)) -> Callable[[str], tuple[float, ...]]:
+    """argparse type: a GNSS antenna lever arm ``X,Y[,Z]`` in metres (as many components as
+    ``components`` allows), finite and no longer than a vehicle
+    (:func:`vo_doppler.io.vehicle_limits.lever_arm_problem`, as for sequence.yaml)."""
+    shape = " or ".join(",".join("XYZ"[:n]) for n in components)
+
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(v) for v in text.split(","))
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {shape} (m)") from exc
+        if len(values) not in components or not all(math.isfinite(v) for v in values):
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {shape} (m)")
+        problem = lever_arm_problem(values)
+        if problem:
+            raise argparse.ArgumentTypeError(f"{text!r}: {problem}")
+        return values
+
     return parse

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD
+from vo_doppler.report.json_text import json_text
 from vo_doppler.vo.frames import WORLDS, camera_trajectory, vehicle_trajectory
 
 log = logging.getLogger(__name__)
@@ -175,6 +175,6 @@ def run(args: argparse.Namespace) -> int:
         summary["heading_sigma_scale"] = result.noise.scale
         summary["outlier_fraction"] = result.noise.outlier_fraction
         summary["correlation_floor_s"] = result.noise.correlation_floor_s
-    log.info("correct: %s", json.dumps(summary))
-    print(json.dumps(summary))
+    log.info("correct: %s", json_text(summary))
+    print(json_text(summary))
     return 0

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 from dataclasses import replace
 from pathlib import Path
@@ -14,6 +13,7 @@ from vo_doppler.checks import calibration_warnings
 from vo_doppler.commands.arg_types import (
     elevation_mask_deg,
     finite_float,
+    lever_arm,
     non_negative_float,
     positive_float,
     positive_int,
@@ -39,6 +39,7 @@ from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
 from vo_doppler.model.timeseries import sample
 from vo_doppler.report.heading_figure import heading_figure
+from vo_doppler.report.json_text import json_text
 
 log = logging.getLogger(__name__)
 
@@ -106,7 +107,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--antenna-lever-arm",
-        type=_lever_arm,
+        type=lever_arm(),
         default=(0.0, 0.0),
         help="GNSS antenna X,Y[,Z] m in the vehicle frame (x forward, y left) from the point "
         "whose heading is wanted; the Doppler is then the antenna's in turns",
@@ -139,16 +140,6 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("-o", "--output", type=Path, required=True, help="heading CSV")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
     parser.set_defaults(func=run)
-
-
-def _lever_arm(text: str) -> tuple[float, ...]:
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: expected X,Y or X,Y,Z (m)") from exc
-    if len(values) not in (2, 3) or not all(np.isfinite(values)):
-        raise argparse.ArgumentTypeError(f"{text!r}: expected X,Y or X,Y,Z (m)")
-    return values
 
 
 def _sensors(args):
@@ -256,7 +247,7 @@ def run(args: argparse.Namespace) -> int:
         "figure": str(figure),
         "warnings": warnings,
     }
-    print(json.dumps(summary))
+    print(json_text(summary))
     if not table.tc_available.any() and not table.conv_valid.any():
         raise VoDopplerError("no heading could be computed at any epoch")
     return 0

@@ -15,6 +15,7 @@ from rich.table import Table
 from vo_doppler.commands.arg_types import (
     finite_float,
     int_in,
+    lever_arm,
     non_negative_float,
     number_in,
     positive_float,
@@ -275,7 +276,7 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--origin", type=_origin, default=defaults.origin, help="LAT,LON,H")
     parser.add_argument(
         "--antenna-lever-arm",
-        type=_triple,
+        type=lever_arm((3,)),
         default=defaults.antenna_lever_arm_m,
         help="GNSS antenna X,Y,Z m in the vehicle frame (x forward, y left, z up) from the "
         "rear-axle centre on the ground",

@@ -60,6 +60,6 @@ def overlap_error(what: str, t: np.ndarray, epochs: np.ndarray, option: str, pat
     hint = offset_hint(float(t[0]), float(epochs[0]), option) if len(t) and len(epochs) else ""
     return InputError(
         f"the {what} times ({span(t)}) do not overlap the GNSS epochs ({span(epochs)}, GPS "
-        f"time); {hint}",
+        f"time)" + (f"; {hint}" if hint else ""),
         path,
     )
