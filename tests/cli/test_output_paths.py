@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from vo_doppler.cli import main
-from vo_doppler.commands.output_paths import check_output_files, check_output_folder_for
+from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.errors import OutputError
 
 CONTENT = "precious input\n"
@@ -65,18 +65,6 @@ def test_checking_creates_and_changes_nothing(source, tmp_path):
     assert not new.exists() and not (tmp_path / "not").exists()
     check_output_files({"output": source}, [])  # an existing file that is no input: replaced later
     assert source.read_text() == CONTENT
-
-
-def test_an_output_folder_holding_an_input_is_refused(source, tmp_path):
-    inside = tmp_path / "seg" / "raw.log"
-    inside.parent.mkdir()
-    inside.write_text(CONTENT)
-    for folder in (tmp_path / "seg", tmp_path):
-        with pytest.raises(OutputError, match=rf"is or contains the input {inside}"):
-            check_output_folder_for(folder, [inside])
-    with pytest.raises(OutputError, match="not a folder"):
-        check_output_folder_for(source, [])
-    assert check_output_folder_for(tmp_path / "seg" / "out", [inside]) == tmp_path / "seg" / "out"
 
 
 def _commands(tmp_path: Path, victim: Path) -> dict[str, list[str]]:

@@ -7,7 +7,6 @@ import argparse
 import logging
 from pathlib import Path
 
-from vo_doppler.commands.output_paths import check_output_folder_for
 from vo_doppler.io.comma2k19_import import import_comma2k19
 
 log = logging.getLogger(__name__)
@@ -41,7 +40,6 @@ def register(subparsers, summary: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    check_output_folder_for(args.output, [args.segment, args.orbits, args.clocks, args.dbc])
     summary = import_comma2k19(args.segment, args.output, args.orbits, args.clocks, args.dbc)
     log.info(
         "wrote %s: %d GNSS epochs (%d rows, %d rows of other systems dropped), %d ground-truth "

@@ -13,7 +13,6 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 from vo_doppler.errors import OutputError
-from vo_doppler.io.output_folder import check_output_folder
 
 PathLike = str | Path
 
@@ -41,11 +40,6 @@ def _same(a: Path, b: Path) -> bool:
         return False
 
 
-def _inside(path: Path, folder: Path) -> bool:
-    """Whether ``path`` lies inside ``folder`` (or is it)."""
-    return path.resolve().is_relative_to(folder.resolve()) or _same(path, folder)
-
-
 def check_output_files(
     outputs: Mapping[str, PathLike | None], inputs: Iterable[PathLike | None]
 ) -> None:
@@ -68,19 +62,6 @@ def check_output_files(
                     "different paths)"
                 )
         _check_writable_file(output)
-
-
-def check_output_folder_for(folder: PathLike, inputs: Iterable[PathLike | None]) -> Path:
-    """``folder`` when it can become an output folder that holds none of the ``inputs`` (a
-    folder written into could replace them); an :class:`OutputError` otherwise."""
-    folder = check_output_folder(folder)
-    for source in _given(inputs):
-        if _inside(source, folder):
-            raise OutputError(
-                f"{folder}: the output folder is or contains the input {source}; writing it "
-                "could destroy the input (choose another output folder)"
-            )
-    return folder
 
 
 def _check_writable_file(path: Path) -> None:
