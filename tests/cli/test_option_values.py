@@ -13,6 +13,8 @@ HEADING = ["heading", "r.obs", "--nav", "r.nav", "--speed-csv", "s.csv", "-o", "
 DEADRECKON = ["deadreckon", "--gyro1", "a.csv", "--gyro2", "b.csv", "--gps", "g.csv", "-o", "d"]
 SIMULATE = ["simulate", "--no-images", "-o", "sim"]
 CORRECT = ["correct", "t.tum", "--heading", "h.csv", "-o", "c.tum"]
+RUN = ["run", "seq", "-o", "out"]
+BATCH = ["batch", "seq", "-o", "out"]
 
 
 @pytest.mark.parametrize(
@@ -39,6 +41,11 @@ CORRECT = ["correct", "t.tum", "--heading", "h.csv", "-o", "c.tum"]
         ([*SIMULATE, "--systems", "XZ"], "--systems"),
         ([*SIMULATE, "--start", "2025-13-01"], "--start"),
         ([*CORRECT, "--window-s", "0"], "--window-s"),
+        ([*CORRECT, "--max-gap-s", "0"], "--max-gap-s"),
+        ([*RUN, "--elev-mask", "nan"], "--elev-mask"),
+        ([*RUN, "--elev-mask", "90"], "--elev-mask"),
+        ([*RUN, "--systems", "X"], "--systems"),
+        ([*BATCH, "--elev-mask", "-1"], "--elev-mask"),
     ],
 )
 def test_out_of_domain_option_is_exit_2_naming_it(argv, option, capsys, tmp_path, monkeypatch):

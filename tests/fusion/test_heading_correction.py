@@ -236,6 +236,22 @@ def test_correct_cli_recovers_the_enu_trajectory(tmp_path):
     )  # no --time-offset: times do not overlap
 
 
+def test_correct_cli_without_a_usable_heading_writes_nothing_and_says_so(tmp_path, capsys):
+    """Headings that exist but none usable (here unreliable) left the trajectory as it was,
+    exit 0 and a correction of 0°: a silently uncorrected 'corrected' file."""
+    t, yaw, gt = _ground_truth(n=80)
+    gps_offset = 1.4e9
+    write_tum(tmp_path / "vo.tum", _vo_output(gt))
+    none = np.zeros(len(t), bool)
+    write_heading_csv(tmp_path / "heading.csv", _table(t + gps_offset, yaw, none, none))
+    out = tmp_path / "corrected.tum"
+    argv = ["correct", str(tmp_path / "vo.tum"), "--heading", str(tmp_path / "heading.csv")]
+    code = main([*argv, "--time-offset", str(gps_offset), "--source", "tc", "-o", str(out)])
+    assert code == 1
+    assert "no usable tc heading within the trajectory's times" in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_correct_cli_reads_the_extrinsic_and_writes_kitti(tmp_path):
     calib = REPO_ROOT / "calib" / "synthetic.yaml"
     mount = read_camera(calib).T_vehicle_camera

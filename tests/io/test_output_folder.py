@@ -20,6 +20,9 @@ from vo_doppler.io.output_folder import (
     written_by,
 )
 
+BATCH_LOG = "2026-11-24 09:00:00,123 INFO vo_doppler.batch: the recording started\n"
+IMPORTED = "source: comma2k19 segment /data/seg (vo-doppler import comma2k19)\n"
+
 
 def earlier_run(folder, *names):
     """A folder as an earlier ``run`` left it: ``names`` and the marker listing them."""
@@ -147,11 +150,12 @@ def test_the_current_directory_and_its_parents_are_never_replaced(tmp_path, monk
             True,
         ),
         (
-            {"batch_done.json": {"fingerprint": "f", "outputs": []}, "run.log": None},
+            {"batch_done.json": {"fingerprint": "f", "outputs": []}, "run.log": BATCH_LOG},
             ["prepared"],
             True,
         ),
-        ({"run.log": None}, (), True),
+        ({"run.log": BATCH_LOG}, (), True),
+        ({"run.log": "my own notes\n"}, (), False),
         ({"summary.json": {"gnss_epochs": 1}, "heading.png": None}, (), False),
         (
             {
@@ -165,8 +169,19 @@ def test_the_current_directory_and_its_parents_are_never_replaced(tmp_path, monk
             (),
             False,
         ),
-        ({"run.log": None}, ["gnss"], False),
-        ({"run.log": None, "sequence.yaml": None}, (), False),
+        ({"run.log": BATCH_LOG}, ["gnss"], False),
+        ({"run.log": BATCH_LOG, "sequence.yaml": None}, (), False),
+        (
+            {
+                "summary.json": {
+                    "gnss_epochs": 1,
+                    "tight_heading_availability": 0.5,
+                    "final_wheel_scale": 1.0,
+                }
+            },
+            ["prepared:mine"],
+            False,
+        ),
     ],
 )
 def test_an_unmarked_earlier_run_is_recognised_by_its_own_files(
@@ -175,10 +190,40 @@ def test_an_unmarked_earlier_run_is_recognised_by_its_own_files(
     out = tmp_path / "out"
     out.mkdir()
     for name, content in files.items():
-        (out / name).write_text("x" if content is None else json.dumps(content))
+        text = content if isinstance(content, str) else json.dumps(content)
+        (out / name).write_text("x" if content is None else text)
     for name in folders:
+        name, _, mine = name.partition(":")
         (out / name).mkdir()
+        if name == "prepared":  # a batch's imported sequence, or (":mine") a user's files
+            (out / name / ("notes.txt" if mine else "sequence.yaml")).write_text(IMPORTED)
     assert written_by(out, RUN) == (replaceable, [])
+
+
+def test_links_and_dotted_paths_are_checked_as_what_they_are(tmp_path):
+    """A link to nothing is refused before any work (a folder command failed at its very end,
+    exit 3); a link to an earlier run is refused where the folder is replaced as a whole (the
+    link was replaced by a plain folder, an '.old' link left behind); ``out/y/..`` is ``out``
+    (staging created ``out/y`` and then refused its own folder)."""
+    dangling = tmp_path / "dangling"
+    dangling.symlink_to(tmp_path / "nowhere")
+    for command, replace in ((RUN, True), ("vo", False), ("simulate", False)):
+        with pytest.raises(OutputError, match="a symbolic link to nothing"):
+            check_output_folder(dangling, command, replace=replace)
+    out = earlier_run(tmp_path / "out", "summary.json")
+    link = tmp_path / "link"
+    link.symlink_to(out)
+    with pytest.raises(OutputError, match="a symbolic link, and the output folder is replaced"):
+        check_output_folder(link, RUN, replace=True)
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (tmp_path / "to_empty").symlink_to(empty)
+    # written into in place, a link's target is the folder
+    assert check_output_folder(tmp_path / "to_empty", "vo") == tmp_path / "to_empty"
+    with staged_output(out / "y" / "..", RUN) as staging:
+        (staging / "summary.json").write_text("new")
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "summary.json"]
+    assert (out / "summary.json").read_text() == "new"
 
 
 def test_the_in_place_commands_are_recognised_by_their_own_files(tmp_path):

@@ -220,3 +220,15 @@ def test_cli_writes_only_into_a_new_empty_or_earlier_simulated_folder(tmp_path, 
     assert main(["simulate", "--duration", "3", "--no-images", "-o", str(other)]) == 1
     assert "not written by 'vo-doppler simulate'" in capsys.readouterr().err
     assert [p.name for p in other.iterdir()] == ["sequence.yaml"]
+
+
+def test_a_shorter_simulation_into_its_own_folder_leaves_no_stale_frames(tmp_path):
+    """Frames of an earlier, longer simulation (or of its other image format) used to stay, and
+    the new sequence's times no longer matched its images."""
+    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(seed=1, **SMALL))
+    assert len(list((tmp_path / "image_0").iterdir())) == 30
+    shorter = {**SMALL, "duration_s": 2.0}
+    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(seed=1, image_format="jpg", **shorter))
+    frames = sorted(p.name for p in (tmp_path / "image_0").iterdir())
+    times = (tmp_path / "times.txt").read_text().split()
+    assert frames == [f"{k:06d}.jpg" for k in range(len(times))] and len(times) == 10

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.commands.arg_types import finite_float, non_negative_float, positive_float
+from vo_doppler.commands.arg_types import finite_float, positive_float
 from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.commands.time_hints import frame_index_hint, offset_hint, span
 from vo_doppler.errors import InputError
@@ -98,7 +98,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--max-gap-s",
-        type=non_negative_float,
+        type=positive_float,
         default=1.5,
         help="longest gap (s) across which absolute headings are interpolated",
     )
@@ -152,6 +152,12 @@ def run(args: argparse.Namespace) -> int:
     )
     vehicle = vehicle_trajectory(trajectory, extrinsic, args.world)
     result = correct(vehicle, absolute_heading(table, args.source, config), config)
+    if not result.has_absolute.any():
+        raise InputError(
+            f"no usable {args.source} heading within the trajectory's times: nothing to correct "
+            "it with (heading.csv's usable epochs, --source, --max-gap-s)",
+            args.heading,
+        )
     out = result.vehicle if args.body == "vehicle" else camera_trajectory(result.vehicle, extrinsic)
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)

@@ -10,10 +10,11 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.commands.arg_types import band_digits, elevation_mask_deg, system_letters
+from vo_doppler.commands.arg_types import band_digits
 from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.commands.satellite_options import (
     add_satellite_options,
+    add_selection_options,
     satellite_inputs,
     satellite_states,
 )
@@ -23,7 +24,6 @@ from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
 from vo_doppler.gnss.spp import solve_spp
 from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
 from vo_doppler.io.receiver_file import read_observation_file
-from vo_doppler.io.rinex_obs import SYSTEMS
 from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.model.observations import Observations
 from vo_doppler.report.gnss import spp_figure, velocity_figure
@@ -39,12 +39,7 @@ def _common(parser: argparse.ArgumentParser) -> None:
         "or GSDC device_gnss.csv (recognised by content)",
     )
     add_satellite_options(parser, required=False)
-    parser.add_argument(
-        "--systems", type=system_letters(SYSTEMS), default="GREJC", help="default GREJC"
-    )
-    parser.add_argument(
-        "--elev-mask", type=elevation_mask_deg, default=10.0, help="degrees in [0, 90) (default 10)"
-    )
+    add_selection_options(parser)
     parser.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
 

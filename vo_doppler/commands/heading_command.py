@@ -11,17 +11,16 @@ import numpy as np
 
 from vo_doppler.checks import calibration_warnings
 from vo_doppler.commands.arg_types import (
-    elevation_mask_deg,
     finite_float,
     lever_arm,
     non_negative_float,
     positive_float,
     positive_int,
-    system_letters,
 )
 from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.commands.satellite_options import (
     add_satellite_options,
+    add_selection_options,
     satellite_inputs,
     satellite_states,
 )
@@ -34,7 +33,7 @@ from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConf
 from vo_doppler.heading.tight_heading import TightHeadingConfig
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.heading_csv import write_heading_csv
-from vo_doppler.io.rinex_obs import SYSTEMS, read_obs
+from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
 from vo_doppler.model.timeseries import sample
@@ -55,15 +54,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("obs", type=Path, help="RINEX observation file")
     add_satellite_options(parser)
-    parser.add_argument(
-        "--systems",
-        type=system_letters(SYSTEMS),
-        default="GREJC",
-        help="GNSS systems to use (RINEX letters: G, R, E, J, C)",
-    )
-    parser.add_argument(
-        "--elev-mask", type=elevation_mask_deg, default=10.0, help="degrees in [0, 90)"
-    )
+    add_selection_options(parser)
     sensors = parser.add_argument_group("vehicle sensors (CAN log + DBC, or two CSV files)")
     sensors.add_argument("--can", type=Path, help="candump -l, .asc, .blf or python-can .csv")
     sensors.add_argument("--dbc", type=Path, help="DBC file decoding the CAN log's signals")

@@ -15,6 +15,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from vo_doppler.commands.arg_types import window_size
+from vo_doppler.commands.satellite_options import add_selection_options
 from vo_doppler.commands.time_hints import overlap_error, overlaps
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
@@ -57,10 +58,7 @@ def register(subparsers, summary: str) -> None:
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:
     """The main job's options (shared by ``run`` and ``batch``); see :func:`run_config`."""
-    parser.add_argument(
-        "--systems", default="GREJC", help="GNSS systems to use (RINEX letters: G, R, E, J, C)"
-    )
-    parser.add_argument("--elev-mask", type=float, default=10.0, help="elevation mask (deg)")
+    add_selection_options(parser)
     parser.add_argument(
         "--window",
         type=window_size,

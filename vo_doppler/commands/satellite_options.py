@@ -1,10 +1,13 @@
-"""The satellite-state options of the GNSS commands: ``--nav``, or ``--orbits`` + ``--clocks``."""
+"""The satellite options of the GNSS commands: ``--nav``, or ``--orbits`` + ``--clocks``, and
+which satellites to use (``--systems``, ``--elev-mask``)."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
+from vo_doppler.commands.arg_types import elevation_mask_deg, system_letters
+from vo_doppler.io.rinex_obs import SYSTEMS
 from vo_doppler.io.satellite_states import read_satellite_states
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.precise_orbits import PreciseOrbits
@@ -29,6 +32,19 @@ def add_satellite_options(parser: argparse.ArgumentParser, required: bool = True
     )
     choice.add_argument("--orbits", type=Path, help="SP3-c/d precise orbits (instead of --nav)")
     parser.add_argument("--clocks", type=Path, help="RINEX clock file beside --orbits")
+
+
+def add_selection_options(parser: argparse.ArgumentParser) -> None:
+    """``--systems`` (RINEX letters) and ``--elev-mask`` (degrees), checked as usage errors."""
+    parser.add_argument(
+        "--systems",
+        type=system_letters(SYSTEMS),
+        default="GREJC",
+        help="GNSS systems to use (RINEX letters: G, R, E, J, C; default GREJC)",
+    )
+    parser.add_argument(
+        "--elev-mask", type=elevation_mask_deg, default=10.0, help="degrees in [0, 90) (default 10)"
+    )
 
 
 def satellite_inputs(args: argparse.Namespace) -> list[Path]:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Callable, Iterable, Iterator
@@ -71,13 +72,29 @@ def _manifest_with(folder: Path, test: Callable[[dict], bool]) -> bool:
     return isinstance(manifest, dict) and test(manifest)
 
 
+_LOG_LINE = re.compile(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d,\d{3} [A-Z]+ vo_doppler[.\w]*: ")
+"""The start of a line of a ``batch`` recording's ``run.log`` (``batch.process_recording``)."""
+
+
+def _batch_log(path: Path) -> bool:
+    """Whether ``path`` begins as a ``batch`` recording's log does."""
+    try:
+        with path.open(errors="replace") as stream:
+            first = stream.readline(1000)
+    except OSError:
+        return False
+    return bool(_LOG_LINE.match(first))
+
+
 def _unmarked_run(folder: Path) -> bool:
     """A ``run`` output or ``batch`` recording folder from before the marker: its summary, batch
     marker or (a failed recording) log, and nothing else than files named like its outputs and
-    a batch's ``prepared`` sequence."""
+    a batch's ``prepared`` sequence (a folder an import wrote)."""
     entries = list(folder.iterdir())
     for entry in entries:
         if entry.name == _BATCH_PREPARED and entry.is_dir():
+            if not written_by(entry, "import")[0]:
+                return False
             continue
         if not entry.is_file() or not any(fnmatch(entry.name, p) for p in _RUN_FILES):
             return False
@@ -85,7 +102,11 @@ def _unmarked_run(folder: Path) -> bool:
     return (
         _json_with_keys(folder / "summary.json", _RUN_SUMMARY_KEYS)
         or _json_with_keys(folder / "batch_done.json", {"fingerprint", "outputs"})
-        or ("run.log" in names and names <= {"run.log", _BATCH_PREPARED})
+        or (
+            "run.log" in names
+            and names <= {"run.log", _BATCH_PREPARED}
+            and _batch_log(folder / "run.log")
+        )
     )
 
 
@@ -164,8 +185,17 @@ def check_output_folder(
     given); ``replace``: the command replaces the whole folder (its content is deleted), so it
     must not hold the current directory either. Nothing is created or changed."""
     path = Path(path)
+    if path.is_symlink() and not path.exists():
+        raise OutputError(
+            f"{path}: a symbolic link to nothing ({os.readlink(path)}); give a folder"
+        )
     if path.exists() and not path.is_dir():
         raise OutputError(f"{path}: the output exists and is not a folder")
+    if replace and path.is_symlink():
+        raise OutputError(
+            f"{path}: a symbolic link, and the output folder is replaced as a whole; give the "
+            f"folder itself ({path.resolve()})"
+        )
     resolved = path.resolve()
     for item in filter(None, inputs):
         if _holds(resolved, Path(item).resolve()):
@@ -216,7 +246,9 @@ def staged_output(
     ``command``'s and replaces ``path`` (checked again, then the previous folder is removed), on
     an exception it is removed and ``path`` is unchanged."""
     inputs = list(inputs)
-    path = check_output_folder(path, command, inputs, replace=True).absolute()
+    path = Path(
+        os.path.normpath(check_output_folder(path, command, inputs, replace=True).absolute())
+    )
     path.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.partial-", dir=path.parent))
     try:

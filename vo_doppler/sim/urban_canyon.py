@@ -101,6 +101,7 @@ from vo_doppler.sim.vo_sequence import (
     VoPlan,
     drive,
     loop_route,
+    remove_stale_frames,
     render_frames,
     synthetic_camera,
 )
@@ -419,10 +420,13 @@ def _render(out: Path, config, scene, camera, vehicle, times: np.ndarray, progre
         frames = track(frames, total=len(times), description="rendering")
     suffix = ".jpg" if config.image_format == "jpg" else ".png"
     params = [cv2.IMWRITE_JPEG_QUALITY, config.jpeg_quality] if suffix == ".jpg" else []
+    names = set()
     for k, image in enumerate(frames):
         path = image_dir / f"{k:06d}{suffix}"
         if not cv2.imwrite(str(path), image, params):
             raise OSError(f"cannot write {path}")
+        names.add(path.name)
+    remove_stale_frames(image_dir, names)
 
 
 def _runs(flags: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -326,13 +326,20 @@ def generate_vo_sequence(
         if not cv2.imwrite(str(path), image, params):
             raise OSError(f"cannot write {path}")
         names.add(path.name)
-    for stale in sorted(image_dir.glob("[0-9][0-9][0-9][0-9][0-9][0-9].*")):
-        if stale.suffix in (".png", ".jpg") and stale.name not in names:
-            log.info("removing %s left by an earlier run", stale)
-            stale.unlink()
+    remove_stale_frames(image_dir, names)
     write_sequence_files(out, plan)
     log.info("wrote %d frames to %s", len(plan.times), out)
     return plan
+
+
+def remove_stale_frames(image_dir: Path, kept: set[str]) -> None:
+    """Remove the numbered frames (``000000.png``, ``.jpg``) in ``image_dir`` that are not
+    ``kept``: an earlier, longer run's, or its other image format's, which would otherwise
+    outnumber the new times."""
+    for stale in sorted(image_dir.glob("[0-9][0-9][0-9][0-9][0-9][0-9].*")):
+        if stale.suffix in (".png", ".jpg") and stale.name not in kept:
+            log.info("removing %s left by an earlier run", stale)
+            stale.unlink()
 
 
 def write_sequence_files(out: Path, plan: VoPlan) -> None:
