@@ -220,6 +220,10 @@ def test_links_and_dotted_paths_are_checked_as_what_they_are(tmp_path):
     (tmp_path / "to_empty").symlink_to(empty)
     # written into in place, a link's target is the folder
     assert check_output_folder(tmp_path / "to_empty", "vo") == tmp_path / "to_empty"
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(OutputError, match="the output folder holds what"):
+        check_output_folder(out / "y" / "..", RUN, replace=True)  # refused before any work
+    (out / "notes.txt").unlink()
     with staged_output(out / "y" / "..", RUN) as staging:
         (staging / "summary.json").write_text("new")
     assert sorted(p.name for p in out.iterdir()) == [MARKER, "summary.json"]

@@ -184,7 +184,7 @@ def check_output_folder(
     why not otherwise. ``inputs``: the files and folders the command reads (None: an input not
     given); ``replace``: the command replaces the whole folder (its content is deleted), so it
     must not hold the current directory either. Nothing is created or changed."""
-    path = Path(path)
+    path = Path(os.path.normpath(path))
     if path.is_symlink() and not path.exists():
         raise OutputError(
             f"{path}: a symbolic link to nothing ({os.readlink(path)}); give a folder"
@@ -246,9 +246,7 @@ def staged_output(
     ``command``'s and replaces ``path`` (checked again, then the previous folder is removed), on
     an exception it is removed and ``path`` is unchanged."""
     inputs = list(inputs)
-    path = Path(
-        os.path.normpath(check_output_folder(path, command, inputs, replace=True).absolute())
-    )
+    path = check_output_folder(path, command, inputs, replace=True).absolute()
     path.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.partial-", dir=path.parent))
     try:
