@@ -14,6 +14,7 @@ DEADRECKON = ["deadreckon", "--gyro1", "a.csv", "--gyro2", "b.csv", "--gps", "g.
 SIMULATE = ["simulate", "--no-images", "-o", "sim"]
 CORRECT = ["correct", "t.tum", "--heading", "h.csv", "-o", "c.tum"]
 RUN = ["run", "seq", "-o", "out"]
+VO = ["vo", "images", "--calib", "c.yaml", "-o", "out"]
 BATCH = ["batch", "seq", "-o", "out"]
 
 
@@ -46,6 +47,10 @@ BATCH = ["batch", "seq", "-o", "out"]
         ([*RUN, "--elev-mask", "90"], "--elev-mask"),
         ([*RUN, "--systems", "X"], "--systems"),
         ([*BATCH, "--elev-mask", "-1"], "--elev-mask"),
+        ([*VO, "--fps", "nan"], "--fps"),
+        ([*VO, "--fps", "inf"], "--fps"),
+        ([*VO, "--fps", "0"], "--fps"),
+        ([*VO, "--fps", "1e6"], "--fps"),
     ],
 )
 def test_out_of_domain_option_is_exit_2_naming_it(argv, option, capsys, tmp_path, monkeypatch):

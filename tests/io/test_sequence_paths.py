@@ -32,8 +32,11 @@ def set_times(folder: Path, value: str) -> None:
 def test_symlink_leaving_the_folder_is_refused(sequence):
     (sequence / "link.txt").symlink_to("/etc/passwd")
     set_times(sequence, "link.txt")
-    with pytest.raises(ManifestError, match=r"camera\.times: the path leaves the sequence folder"):
+    with pytest.raises(
+        ManifestError, match=r"camera\.times: the path leaves the sequence folder"
+    ) as info:
         read_sequence(sequence)
+    assert "--allow-outside-paths" in str(info.value)  # the message says how to allow it
 
 
 def test_absolute_path_is_read_only_when_allowed(sequence, tmp_path):
@@ -43,6 +46,7 @@ def test_absolute_path_is_read_only_when_allowed(sequence, tmp_path):
     with pytest.raises(ManifestError, match=r"camera\.times: absolute paths are refused") as info:
         read_sequence(sequence)
     assert info.value.key == "camera.times"
+    assert "allow_outside=True" in str(info.value)
     inputs = read_sequence(sequence, allow_outside=True)
     assert len(inputs.image_times) == len(inputs.image_paths)
 

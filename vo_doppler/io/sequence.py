@@ -169,12 +169,15 @@ class Manifest:
                 raise self.error(
                     key,
                     "absolute paths are refused; give a path relative to the sequence "
-                    "folder (or allow paths outside it)",
+                    "folder (or allow paths outside it: vo-doppler run --allow-outside-paths, "
+                    "read_sequence(..., allow_outside=True))",
                 )
             inside = (self.root / path).resolve()
             if not inside.is_relative_to(self.root.resolve()):
                 raise self.error(
-                    key, "the path leaves the sequence folder (allow paths outside it to use it)"
+                    key,
+                    "the path leaves the sequence folder (to use it, allow paths outside it: "
+                    "vo-doppler run --allow-outside-paths, read_sequence(..., allow_outside=True))",
                 )
         return self.root / path
 
