@@ -293,6 +293,36 @@ def test_the_epochs_before_the_first_estimate_take_the_median_value_with_the_pri
     assert cal.scale_estimated.all()
 
 
+def test_the_bias_estimates_before_the_first_precise_one_take_the_median_of_the_rest():
+    estimated = np.array([False, True, True, True, True, True])
+    cal = CalibrationSeries(
+        bias=np.array([0.0, 0.001, 0.002, 0.005, 0.006, 0.004]),
+        scale=np.array([1.0, 1.01, 1.02, 1.03, 1.04, 1.05]),
+        bias_sigma=np.array([0.5, 0.3, 0.1, 0.0008, 0.0006, 0.0005]),
+        scale_sigma=np.array([0.03, 0.02, 0.01, 0.005, 0.004, 0.003]),
+        bias_estimated=estimated.copy(),
+        scale_estimated=estimated.copy(),
+    )
+    backfill_start(cal, max_bias_sigma=0.001)
+    np.testing.assert_array_equal(cal.bias, [0.005] * 3 + [0.005, 0.006, 0.004])
+    np.testing.assert_array_equal(cal.bias_sigma, [0.5, 0.3, 0.1, 0.0008, 0.0006, 0.0005])
+    assert cal.bias_estimated.all()
+    np.testing.assert_array_equal(cal.scale, [1.03, 1.01, 1.02, 1.03, 1.04, 1.05])
+
+
+def test_without_a_precise_bias_estimate_the_first_estimate_bounds_the_backfill():
+    cal = CalibrationSeries(
+        bias=np.array([0.0, 0.01, 0.03]),
+        scale=np.ones(3),
+        bias_sigma=np.array([0.5, 0.2, 0.1]),
+        scale_sigma=np.full(3, 0.03),
+        bias_estimated=np.array([False, True, True]),
+        scale_estimated=np.zeros(3, dtype=bool),
+    )
+    backfill_start(cal, max_bias_sigma=0.001)
+    np.testing.assert_array_equal(cal.bias, [0.02, 0.01, 0.03])
+
+
 def test_a_drive_without_any_estimate_keeps_the_prior_for_the_tight_pass():
     cal = CalibrationSeries(
         np.zeros(4), np.ones(4), np.full(4, 0.5), np.full(4, 0.03), *np.zeros((2, 4), dtype=bool)

@@ -105,7 +105,9 @@ def test_vehicle_heading_from_antenna_inverts_the_antenna_velocity(yaw, speed, o
 def test_heading_cli_on_a_simulated_drive_with_an_offset_antenna(tmp_path):
     """20 s through a 9-m-radius corner, antenna 1.5 m ahead of the rear axle: with
     --antenna-lever-arm the tight heading in the turn is within a degree of the truth, without
-    it several degrees off (the antenna's sideslip ≈ r_x / corner radius ≈ 9°)."""
+    it several degrees off (the antenna's sideslip ≈ r_x / corner radius ≈ 9°). Every
+    available heading counts: without the lever arm the reliability test flags most of the
+    wrong ones, which is not what this test is about."""
     config = UrbanCanyonConfig(
         duration_s=20.0,
         seed=5,
@@ -128,7 +130,7 @@ def test_heading_cli_on_a_simulated_drive_with_an_offset_antenna(tmp_path):
         assert main([*args, *extra, "-o", str(out)]) == 0
         table = read_heading_csv(out)
         turning = np.abs(sample(truth.t, turn_rate, table.t)) > np.radians(10.0)
-        used = table.tc_available & table.tc_reliable & turning
+        used = table.tc_available & turning
         error = np.abs(wrap_angle(table.yaw_tc - truth.yaw_at(table.t)))[used]
         errors[name] = np.degrees(np.sqrt(np.mean(error**2)))
     assert errors["applied"] < 1.0
