@@ -7,7 +7,12 @@ import argparse
 import pytest
 
 from vo_doppler.cli import build_parser
-from vo_doppler.commands.help_format import has_default, shown_default
+from vo_doppler.commands.help_format import (
+    OptionsParser,
+    has_default,
+    joined_dash_choices,
+    shown_default,
+)
 
 
 def _parsers(parser: argparse.ArgumentParser, name: str = "vo-doppler"):
@@ -70,3 +75,49 @@ def test_defaults_are_shown_as_typed():
     assert shown_default((640, 360)) == "640,360"
     assert shown_default(((1, 1), (4, 3))) == "1,1,4,3"
     assert shown_default(2.0) == "2.0"
+
+
+def _up_parser() -> OptionsParser:
+    parser = OptionsParser(prog="p")
+    parser.add_argument("--up", choices=("z", "-y", "y"), default="z", help="up axis")
+    parser.add_argument("-y", "--yes", action="store_true", help="a flag spelt like a choice")
+    parser.add_argument("rest", nargs="*", help="anything")
+    return parser
+
+
+@pytest.mark.parametrize(
+    ("words", "up", "yes", "rest"),
+    [
+        (["--up", "-y"], "-y", False, []),
+        (["--up=-y"], "-y", False, []),
+        (["--up", "y", "-y"], "y", True, []),
+        (["-y", "--up", "z"], "z", True, []),
+        (["--", "--up", "-y"], "z", False, ["--up", "-y"]),
+    ],
+)
+def test_a_choice_starting_with_a_dash_is_the_options_value(words, up, yes, rest):
+    args = _up_parser().parse_args(words)
+    assert (args.up, args.yes, args.rest) == (up, yes, rest)
+
+
+def test_only_exact_choices_are_joined():
+    parser = _up_parser()
+    assert joined_dash_choices(parser, ["--up", "-x", "--up", "-y"]) == ["--up", "-x", "--up=-y"]
+    assert joined_dash_choices(parser, ["--up"]) == ["--up"]
+
+
+def test_a_failed_check_is_a_usage_error_after_parsing(capsys):
+    parser = _up_parser()
+    seen = []
+    parser.add_check(lambda args: seen.append(args.up) or None)
+
+    def yes_with_y(args):
+        return "--yes contradicts --up y" if args.yes and args.up == "y" else None
+
+    parser.add_check(yes_with_y)
+    assert parser.parse_args(["--up", "-y", "-y"]).yes
+    with pytest.raises(SystemExit) as stop:
+        parser.parse_args(["--up", "y", "--yes"])
+    assert stop.value.code == 2
+    assert "p: error: --yes contradicts --up y" in capsys.readouterr().err
+    assert seen == ["-y", "y"]
