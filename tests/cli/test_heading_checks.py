@@ -55,3 +55,45 @@ def test_a_can_clock_2_s_off_is_a_warning_with_the_right_offset(
     assert f"--time-offset-can {GPS_MINUS_UNIX_S + 2.0:.3f} s should be about" in clock[0]
     suggested = float(clock[0].rsplit("about ", 1)[1].removesuffix(" s"))
     assert suggested == pytest.approx(GPS_MINUS_UNIX_S, abs=0.05)
+
+
+HEADING = ["heading", "r.obs", "--nav", "r.nav", "-o", "h.csv"]
+CAN_SOURCE = ["--can", "c.log", "--dbc", "c.dbc", "--yaw-rate", "M.Y", "--wheel-speed", "M.W"]
+
+
+@pytest.mark.parametrize(
+    ("sensors", "message"),
+    [
+        ([], "no vehicle sensors: give --can LOG --dbc DBC"),
+        (["--can", "c.log"], "--can needs --dbc, --yaw-rate, --wheel-speed"),
+        (CAN_SOURCE[:6], "--can, --dbc, --yaw-rate needs --wheel-speed"),
+        (["--yaw-rate-csv", "y.csv"], "--yaw-rate-csv needs --speed-csv"),
+        (["--speed-csv", "s.csv"], "--speed-csv needs --yaw-rate-csv"),
+        (
+            [*CAN_SOURCE, "--speed-csv", "s.csv"],
+            "give the CAN log or the CSV files, not both (--can, --dbc, --yaw-rate, "
+            "--wheel-speed and --speed-csv)",
+        ),
+    ],
+)
+def test_sensor_options_that_name_no_one_source_are_exit_2(
+    sensors, message, capsys, tmp_path, monkeypatch
+):
+    """Checked before anything is read: none of the named files exists."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as stop:
+        main([*HEADING, *sensors])
+    assert stop.value.code == 2
+    assert f"vo-doppler heading: error: {message}" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "sensors", [CAN_SOURCE, ["--yaw-rate-csv", "y.csv", "--speed-csv", "s.csv"]]
+)
+def test_one_whole_sensor_source_passes_the_check(sensors, capsys, tmp_path, monkeypatch):
+    """Past the check, the missing input is the failure (exit 1, naming it)."""
+    monkeypatch.chdir(tmp_path)
+    assert main([*HEADING, *sensors]) == 1
+    err = capsys.readouterr().err
+    assert "No such file or directory" in err and "usage:" not in err

@@ -77,7 +77,9 @@ def _commands(tmp_path: Path, victim: Path) -> dict[str, list[str]]:
     return {
         "gnss spp -o obs": ["gnss", "spp", v, *nav, "-o", v],
         "gnss velocity figure": ["gnss", "velocity", str(png), *nav, "-o", str(victim)],
-        "heading -o speed": ["heading", other, *nav, "--speed-csv", v, "-o", v],
+        "heading -o speed": [
+            *("heading", other, *nav, "--speed-csv", v, "--yaw-rate-csv", other, "-o", v),
+        ],
         "correct -o trajectory": ["correct", v, "--heading", other, "-o", v],
         "correct -o heading": ["correct", other, "--heading", v, "-o", v],
         "kitti-speed -o poses": ["kitti-speed", v, "--times", other, "-o", v],

@@ -130,13 +130,44 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--gt", type=Path, help="ground truth TUM (GPS time, z-up world)")
     parser.add_argument("-o", "--output", type=Path, required=True, help="heading CSV")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
+    parser.add_check(sensor_options_problem)
     parser.set_defaults(func=run)
+
+
+def sensor_options_problem(args: argparse.Namespace) -> str | None:
+    """The problem when the sensor options name neither a whole CAN source (--can with --dbc,
+    --yaw-rate and --wheel-speed) nor both CSV files, or name both kinds (one would be
+    ignored)."""
+    can_options = {
+        "--can": args.can,
+        "--dbc": args.dbc,
+        "--yaw-rate": args.yaw_rate,
+        "--wheel-speed": args.wheel_speed,
+    }
+    csv_options = {"--yaw-rate-csv": args.yaw_rate_csv, "--speed-csv": args.speed_csv}
+    can_given = [name for name, value in can_options.items() if value is not None]
+    csv_given = [name for name, value in csv_options.items() if value is not None]
+    if can_given and csv_given:
+        return (
+            f"give the CAN log or the CSV files, not both ({', '.join(can_given)} and "
+            f"{', '.join(csv_given)})"
+        )
+    if can_given:
+        missing = [name for name, value in can_options.items() if value is None]
+        return f"{', '.join(can_given)} needs {', '.join(missing)}" if missing else None
+    if len(csv_given) == 1:
+        missing = next(name for name, value in csv_options.items() if value is None)
+        return f"{csv_given[0]} needs {missing}"
+    if not csv_given:
+        return (
+            "no vehicle sensors: give --can LOG --dbc DBC --yaw-rate MSG.SIG --wheel-speed "
+            "MSG.SIG, or --yaw-rate-csv FILE --speed-csv FILE"
+        )
+    return None
 
 
 def _sensors(args):
     if args.can is not None:
-        if not (args.dbc and args.yaw_rate and args.wheel_speed):
-            raise InputError("--can needs --dbc, --yaw-rate and --wheel-speed")
         motion = read_can_motion(
             args.can,
             args.dbc,
@@ -149,8 +180,6 @@ def _sensors(args):
             args.can_short_frames,
         )
         return motion.speed, motion.yaw_rate
-    if args.yaw_rate_csv is None or args.speed_csv is None:
-        raise InputError("give --can/--dbc/--yaw-rate/--wheel-speed or --yaw-rate-csv/--speed-csv")
     return (
         read_speed_csv(args.speed_csv, args.time_offset_speed),
         read_yaw_rate_csv(args.yaw_rate_csv, args.time_offset_yaw),
