@@ -10,6 +10,7 @@ from vo_doppler.cli import main
 
 GNSS = ["gnss", "velocity", "r.obs", "--nav", "r.nav", "-o", "v.csv"]
 HEADING = ["heading", "r.obs", "--nav", "r.nav", "--speed-csv", "s.csv", "-o", "h.csv"]
+HEADING += ["--yaw-rate-csv", "y.csv"]
 DEADRECKON = ["deadreckon", "--gyro1", "a.csv", "--gyro2", "b.csv", "--gps", "g.csv", "-o", "d"]
 SIMULATE = ["simulate", "--no-images", "-o", "sim"]
 CORRECT = ["correct", "t.tum", "--heading", "h.csv", "-o", "c.tum"]
@@ -40,6 +41,8 @@ BATCH = ["batch", "seq", "-o", "out"]
         ([*SIMULATE, "--max-speed", "-3"], "--max-speed"),
         ([*SIMULATE, "--gnss-rate", "0"], "--gnss-rate"),
         ([*SIMULATE, "--systems", "XZ"], "--systems"),
+        ([*SIMULATE, "--fps", "1e9"], "--fps"),
+        ([*SIMULATE, "--fps", "0"], "--fps"),
         ([*SIMULATE, "--start", "2025-13-01"], "--start"),
         ([*CORRECT, "--window-s", "0"], "--window-s"),
         ([*CORRECT, "--max-gap-s", "0"], "--max-gap-s"),

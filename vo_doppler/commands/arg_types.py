@@ -73,6 +73,10 @@ non_negative_float = number_in(0.0)
 """A number ≥ 0 (a distance or threshold where 0 switches the step off)."""
 elevation_mask_deg = number_in(0.0, 90.0, high_open=True, unit="degrees")
 """An elevation mask: 0 keeps every satellite above the horizon, 90 none."""
+MAX_FPS = 1000.0
+"""Upper bound of a camera frame rate (Hz): beyond any camera a VO could track with."""
+frame_rate = number_in(0.0, MAX_FPS, low_open=True, unit="Hz")
+"""A camera frame rate in (0, MAX_FPS] Hz (``vo --fps``, ``simulate --fps``)."""
 
 
 def int_in(low: int, high: int | None = None) -> Callable[[str], int]:

@@ -14,6 +14,7 @@ from rich.table import Table
 
 from vo_doppler.commands.arg_types import (
     finite_float,
+    frame_rate,
     int_in,
     lever_arm,
     non_negative_float,
@@ -154,7 +155,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("--seed", type=int, default=0, help="random seed (same seed, same data)")
     parser.add_argument("-o", "--output", required=True, help="sequence folder to write")
-    parser.add_argument("--fps", type=positive_float, default=defaults.fps, help="camera rate (Hz)")
+    parser.add_argument("--fps", type=frame_rate, default=defaults.fps, help="camera rate (Hz)")
     parser.add_argument("--size", type=_int_pair, default=defaults.image_size, help="W,H px")
     parser.add_argument("--image-format", choices=("png", "jpg"), default="png", help="images")
     parser.add_argument(

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 from rich.progress import Progress
 
-from vo_doppler.commands.arg_types import number_in, window_size
+from vo_doppler.commands.arg_types import frame_rate, window_size
 from vo_doppler.commands.time_hints import span
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import NO_MATCH, evaluate_by_time
@@ -32,8 +32,6 @@ from vo_doppler.vo.config import VoConfig
 
 log = logging.getLogger(__name__)
 
-MAX_FPS = 1000.0
-"""Upper bound of ``--fps`` (Hz): beyond any camera a VO could track with."""
 CAMERA_UP = np.array([0.0, -1.0, 0.0])
 
 
@@ -56,7 +54,7 @@ def register(subparsers, summary: str) -> None:
     )
     timing.add_argument(
         "--fps",
-        type=number_in(0.0, MAX_FPS, low_open=True, unit="Hz"),
+        type=frame_rate,
         help="fixed frame rate (Hz)",
     )
     parser.add_argument("--speed", type=Path, help="CSV t,speed_mps for metric scale")
