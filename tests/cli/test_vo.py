@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from tests.conftest import require_shared
+from tests.conftest import REPO_ROOT, require_shared
 from vo_doppler.cli import main
 from vo_doppler.io.trajectory import read_kitti, read_tum, write_tum
 from vo_doppler.model.trajectory import Trajectory
@@ -135,3 +135,29 @@ def test_ground_truth_on_other_times_is_not_evaluated_and_says_why(sequence, cap
     last = times[-1]
     assert f"(images 0.000..{last:.3f} s, ground truth 1000.000..{last + 1000:.3f} s)" in reason
     assert reason in caplog.text
+
+
+@pytest.mark.parametrize("problem", ["missing", "rows"])
+def test_ground_truth_is_read_before_the_vo(problem, tmp_path, monkeypatch, capsys):
+    """A missing ground truth, or a KITTI one with more poses than images, stops the command
+    before the VO runs and before the output folder exists."""
+    images = tmp_path / "images"
+    images.mkdir()
+    for i in range(3):
+        (images / f"{i:06d}.png").write_bytes(b"not decoded: the VO must not start")
+    truth = tmp_path / "gt.txt"
+    if problem == "rows":
+        truth.write_text("1 0 0 0 0 1 0 0 0 0 1 0\n" * 4)
+
+    def no_vo(*args, **kwargs):
+        raise AssertionError("the VO ran before the ground truth was read")
+
+    monkeypatch.setattr("vo_doppler.commands.vo_command.run_visual_odometry", no_vo)
+    out = tmp_path / "out"
+    calib = str(REPO_ROOT / "calib" / "synthetic.yaml")
+    command = ["vo", str(images), "--calib", calib, "--fps", "10", "--gt", str(truth)]
+    assert main([*command, "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    expected = "No such file or directory" if problem == "missing" else "4 poses but 3 timestamps"
+    assert f"{truth}: " in err and expected in err
+    assert not out.exists()

@@ -84,6 +84,8 @@ def run(args: argparse.Namespace) -> int:
         if args.times is None:
             log.info("image times from %s (found beside the images; --times overrides)", times_path)
         times = read_times(times_path, len(files))
+    # Read before the VO (the long part): a missing or bad file stops the command first.
+    truth = None if args.gt is None else read_trajectory(args.gt, times=times)
     speed = None
     if args.speed is not None:
         series = read_sensor_csv(args.speed, SPEED_COLUMN)
@@ -121,8 +123,7 @@ def run(args: argparse.Namespace) -> int:
         {**flag, "file": files[flag["index"]].name} for flag in stats["flagged_frames"]
     ]
     curves = {"VO" if output.metric else "VO (arbitrary scale)": output.trajectory}
-    if args.gt is not None:
-        truth = read_trajectory(args.gt, times=times)
+    if truth is not None:
         errors = evaluate_by_time(output.trajectory, truth, "start", CAMERA_UP)
         if errors is None:
             stats["evaluation_skipped"] = (
