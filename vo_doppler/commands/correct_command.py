@@ -9,24 +9,34 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.commands.arg_types import finite_float, positive_float
+from vo_doppler.commands.correction_options import add_correction_options, correction_config
 from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.commands.time_hints import frame_index_hint, offset_hint, span
-from vo_doppler.errors import InputError
+from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.fusion.correction import (
-    CORRECTION_METHODS,
     HEADING_SOURCES,
-    REFERENCES,
-    CorrectionConfig,
     absolute_heading,
     correct,
 )
-from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.heading_csv import read_heading_csv
-from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
+from vo_doppler.io.trajectory import (
+    read_trajectory,
+    trajectory_format,
+    write_kitti,
+    write_tum,
+)
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.json_text import json_text
-from vo_doppler.vo.frames import WORLDS, camera_trajectory, vehicle_trajectory
+from vo_doppler.vo.frames import (
+    MAX_ROAD_CLIMB,
+    WORLDS,
+    WRONG_WORLD_FRACTION,
+    camera_trajectory,
+    steep_path_fraction,
+    vehicle_trajectory,
+)
 
 log = logging.getLogger(__name__)
 
@@ -58,24 +68,7 @@ def register(subparsers, summary: str) -> None:
         default=0.0,
         help="seconds added to trajectory times -> GPS",
     )
-    parser.add_argument(
-        "--correction",
-        choices=CORRECTION_METHODS,
-        default=CorrectionConfig().method,
-        help="window: the window method of [TK18] (Takeyama & Kojima 2018) Eq. 11-13; kalman: "
-        "the adaptive blend",
-    )
-    parser.add_argument(
-        "--causal",
-        action="store_true",
-        help="kalman: forward filter only (each pose uses the headings up to its time)",
-    )
-    parser.add_argument(
-        "--window-s",
-        type=positive_float,
-        default=2.0,
-        help="window method's W (s), [TK18] Eq. 11-13",
-    )
+    add_correction_options(parser, window_s=True)
     parser.add_argument(
         "--source",
         choices=HEADING_SOURCES,
@@ -102,15 +95,27 @@ def register(subparsers, summary: str) -> None:
         default=1.5,
         help="longest gap (s) across which absolute headings are interpolated",
     )
-    parser.add_argument(
-        "--reference",
-        choices=REFERENCES,
-        default="course",
-        help="compare the absolute heading with the VO's direction of travel (course) or with "
-        "its orientation yaw (orientation: [TK18] sec. 3.6 as the paper writes it)",
-    )
     parser.add_argument("-o", "--output", required=True, help="corrected trajectory (.tum/.kitti)")
+    parser.add_check(times_of_a_tum_trajectory)
     parser.set_defaults(func=run)
+
+
+def times_of_a_tum_trajectory(args: argparse.Namespace) -> str | None:
+    """The problem of ``--times`` given with a TUM trajectory, which carries its own times and
+    keeps them. A trajectory that cannot be read is left to :func:`run` to report."""
+    if args.times is None:
+        return None
+    try:
+        fmt = trajectory_format(args.trajectory, args.format)
+    except VoDopplerError:
+        return None
+    if fmt != "tum":
+        return None
+    given = "--format tum" if args.format == "tum" else f"{args.trajectory} is TUM"
+    return (
+        f"--times applies to a KITTI trajectory only, but {given}: a TUM trajectory carries "
+        "its own times (drop --times)"
+    )
 
 
 def _times(path: str | None) -> np.ndarray | None:
@@ -120,6 +125,27 @@ def _times(path: str | None) -> np.ndarray | None:
         return np.loadtxt(path, dtype=float, ndmin=1)
     except (OSError, ValueError) as exc:
         raise InputError(f"cannot read times: {exc}", path) from exc
+
+
+OTHER_WORLD = {
+    "first_camera": "already level, z up (e.g. ENU, as run's trajectory_*.tum): give --world level",
+    "level": "camera poses in the first camera's frame (what VO systems write): give --world "
+    "first_camera",
+}
+
+
+def world_warnings(vehicle: Trajectory, world: str) -> list[str]:
+    """A warning when the vehicle poses in ``--world`` climb or fall steeper than any road
+    along much of the path (:func:`vo_doppler.vo.frames.steep_path_fraction`): the correction
+    only turns the heading, so in a wrong world its result is wrong."""
+    fraction = steep_path_fraction(vehicle)
+    if fraction <= WRONG_WORLD_FRACTION:
+        return []
+    return [
+        f"with --world {world} the vehicle climbs or falls more steeply than "
+        f"{np.degrees(MAX_ROAD_CLIMB):.0f} deg along {fraction:.0%} of its path, which no road "
+        f"does: the trajectory's world is probably {OTHER_WORLD[world]}"
+    ]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -144,13 +170,11 @@ def run(args: argparse.Namespace) -> int:
             f"({span(table.t)}, GPS time){hint}",
             args.trajectory,
         )
-    config = CorrectionConfig(
-        method=args.correction,
-        reference=args.reference,
-        window_s=args.window_s,
-        blend=BlendConfig(smooth=not args.causal, max_gap_s=args.max_gap_s),
-    )
+    config = correction_config(args, max_gap_s=args.max_gap_s)
     vehicle = vehicle_trajectory(trajectory, extrinsic, args.world)
+    warnings = world_warnings(vehicle, args.world)
+    for text in warnings:
+        log.warning("%s", text)
     result = correct(vehicle, absolute_heading(table, args.source, config), config)
     if not result.has_absolute.any():
         raise InputError(
@@ -171,6 +195,7 @@ def run(args: argparse.Namespace) -> int:
         "final_correction_deg": float(np.degrees(result.correction[-1])),
         "correction": args.correction,
         "output": str(output),
+        "warnings": warnings,
     }
     if args.correction == "kalman":
         summary["fitted_noise"] = result.noise.fitted

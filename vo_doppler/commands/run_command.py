@@ -15,12 +15,11 @@ from rich.progress import Progress
 from rich.table import Table
 
 from vo_doppler.commands.arg_types import window_size
+from vo_doppler.commands.correction_options import add_correction_options, correction_config
 from vo_doppler.commands.satellite_options import add_selection_options
 from vo_doppler.commands.time_hints import overlap_error, overlaps
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
-from vo_doppler.fusion.correction import CORRECTION_METHODS, CorrectionConfig
-from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.io.output_folder import RUN, check_output_folder, staged_output, untouched
 from vo_doppler.io.sequence import manifest_inputs, read_manifest, read_sequence_with_report
 from vo_doppler.report.run_outputs import (
@@ -65,25 +64,7 @@ def add_run_options(parser: argparse.ArgumentParser) -> None:
         default=VoConfig().window_size,
         help="VO window (frames, >= 3)",
     )
-    parser.add_argument(
-        "--reference",
-        choices=("course", "orientation"),
-        default="course",
-        help="heading correction compares the absolute heading with the VO's course or its "
-        "orientation yaw (orientation: [TK18] sec. 3.6 as the paper writes it)",
-    )
-    parser.add_argument(
-        "--correction",
-        choices=CORRECTION_METHODS,
-        default=CorrectionConfig().method,
-        help="heading correction: window (the window method of [TK18], Takeyama & Kojima 2018, "
-        "Eq. 11-13) or kalman (adaptive blend: filter and smoother on the VO heading offset)",
-    )
-    parser.add_argument(
-        "--causal",
-        action="store_true",
-        help="kalman: forward filter only (each pose uses the headings up to its time)",
-    )
+    add_correction_options(parser)
 
 
 def run_config(args: argparse.Namespace) -> RunConfig:
@@ -92,11 +73,7 @@ def run_config(args: argparse.Namespace) -> RunConfig:
         systems=args.systems.upper(),
         elevation_mask=np.radians(args.elev_mask),
         vo=VoConfig(window_size=args.window),
-        correction=CorrectionConfig(
-            method=args.correction,
-            reference=args.reference,
-            blend=BlendConfig(smooth=not args.causal),
-        ),
+        correction=correction_config(args),
     )
 
 

@@ -97,13 +97,18 @@ def write_kitti(path: str | Path, trajectory: Trajectory) -> None:
 def read_trajectory(path: str | Path, fmt: str = "auto", times=None) -> Trajectory:
     """Read TUM or KITTI; ``auto`` picks by the number of columns of the first data row."""
     path = Path(path)
-    if fmt == "auto":
-        fmt = _sniff_format(path)
+    fmt = trajectory_format(path, fmt)
     if fmt == "tum":
         return read_tum(path)
     if fmt == "kitti":
         return read_kitti(path, times)
     raise ValueError(f"unknown trajectory format {fmt!r} (expected tum, kitti or auto)")
+
+
+def trajectory_format(path: str | Path, fmt: str = "auto") -> str:
+    """``fmt``, or for "auto" the format of ``path`` by the number of columns of its first data
+    row: "tum" (8) or "kitti" (12); anything else is an :class:`InputError`."""
+    return _sniff_format(Path(path)) if fmt == "auto" else fmt
 
 
 def _sniff_format(path: Path) -> str:

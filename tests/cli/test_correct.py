@@ -1,0 +1,70 @@
+"""``vo-doppler correct``: --times only with a KITTI trajectory (a usage error otherwise, before
+any work), and a warning when the trajectory's world is probably not the --world given."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from tests.helpers.heading_table import plain_heading_table
+from tests.helpers.level_track import level_turn
+from vo_doppler.cli import main
+from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.io.trajectory import read_tum, write_kitti, write_tum
+
+
+@pytest.fixture
+def drive(tmp_path):
+    """A level track (vehicle poses, ENU: 60 m east, a left turn, 40 m north) with a heading
+    table whose headings are the track's, on the track's clock."""
+    track = level_turn()
+    write_tum(tmp_path / "track.tum", track)
+    write_kitti(tmp_path / "track.kitti", track)
+    np.savetxt(tmp_path / "times.txt", track.t)
+    t = np.arange(0.0, track.t[-1] + 0.05, 0.2)
+    yaw = np.interp(t, track.t, np.unwrap(track.yaw()))
+    write_heading_csv(tmp_path / "heading.csv", plain_heading_table(t, yaw_tc=yaw, yaw_conv=yaw))
+    return tmp_path
+
+
+@pytest.mark.parametrize(
+    ("format_options", "given"),
+    [([], "track.tum is TUM"), (["--format", "tum"], "--format tum")],
+)
+def test_times_with_a_tum_trajectory_is_exit_2(drive, format_options, given, capsys):
+    argv = ["correct", str(drive / "track.tum"), "--heading", str(drive / "heading.csv")]
+    argv += ["--times", str(drive / "times.txt"), *format_options, "-o", str(drive / "c.tum")]
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert "--times applies to a KITTI trajectory only" in err and given in err
+    assert not (drive / "c.tum").exists()
+
+
+def test_times_with_a_kitti_trajectory_are_its_times(drive, capsys):
+    argv = ["correct", str(drive / "track.kitti"), "--heading", str(drive / "heading.csv")]
+    argv += ["--times", str(drive / "times.txt"), "--world", "level", "-o", str(drive / "c.tum")]
+    assert main(argv) == 0
+    np.testing.assert_allclose(read_tum(drive / "c.tum").t, level_turn().t, atol=1e-9)
+
+
+@pytest.mark.parametrize(("world", "warned"), [("first_camera", True), ("level", False)])
+def test_a_level_track_read_as_first_camera_is_warned_and_kept(
+    drive, world, warned, capsys, caplog
+):
+    argv = ["correct", str(drive / "track.tum"), "--heading", str(drive / "heading.csv")]
+    argv += ["--world", world, "-o", str(drive / "c.tum")]
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    if warned:
+        [warning] = summary["warnings"]
+        assert warning.startswith("with --world first_camera the vehicle climbs or falls")
+        assert "along 38% of its path" in warning and "give --world level" in warning
+        assert warning in caplog.text
+        assert abs(summary["final_correction_deg"]) > 45.0  # what the warning explains
+    else:
+        assert summary["warnings"] == []
+        assert abs(summary["final_correction_deg"]) < 0.1
