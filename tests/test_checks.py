@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -79,10 +81,70 @@ def test_clock_offset_holds_with_a_third_of_the_epochs_reflected_and_a_scale_err
     assert (estimate.unshifted_difference_mps > 2 * estimate.difference_mps) == (shift > 0)
 
 
-def test_featureless_speed_gives_no_estimate():
+def test_featureless_speed_gives_no_lag_and_says_why():
     flat = SensorSeries(T, np.full_like(T, 10.0), "speed", "m/s")
     t_gnss = np.arange(5.0, 55.0, 0.2)
-    assert estimate_clock_offset(flat, t_gnss, np.full_like(t_gnss, 10.0)) is None
+    estimate = estimate_clock_offset(flat, t_gnss, np.full_like(t_gnss, 10.0))
+    assert estimate.residual_s is None and "not below half their median" in estimate.no_lag_reason
+
+
+def _random_drive(seed: int) -> SensorSeries:
+    """120 s of a wheel speed at 100 Hz around 12 m/s (σ 3 m/s) with smooth random
+    accelerations: no two stretches of it alike, unlike a sum of sines."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 120.0, 0.01)
+    acceleration = np.convolve(rng.normal(0.0, 10.0, t.size), np.full(200, 1 / 200), "same")
+    v = np.cumsum(acceleration) * 0.01
+    return SensorSeries(t, 12.0 + 3.0 * (v - v.mean()) / v.std(), "speed", "m/s")
+
+
+def _noisy_gnss_speed(wheel: SensorSeries) -> tuple[np.ndarray, np.ndarray]:
+    """The true speed at 10 Hz with a Doppler speed's noise (σ 0.05 m/s)."""
+    t_gnss = np.arange(0.0, 120.0, 0.1)
+    noise = np.random.default_rng(1).normal(0.0, 0.05, t_gnss.size)
+    return t_gnss, np.interp(t_gnss, wheel.t, wheel.value) + noise
+
+
+@pytest.mark.parametrize("shift", [-3.7, 2.3, 4.9])
+def test_a_lag_inside_the_range_is_found_to_within_a_gnss_sample(shift):
+    wheel = _random_drive(0)
+    assert wheel.value.min() > 2.0  # moving throughout
+    estimate = estimate_clock_offset(wheel.shifted(-shift), *_noisy_gnss_speed(wheel))
+    assert estimate.residual_s == pytest.approx(shift, abs=0.1) and not estimate.no_lag_reason
+    assert estimate.difference_mps < 0.1
+
+
+@pytest.mark.parametrize(
+    ("shift", "why"),
+    [
+        (6.0, r"^the agreement is best at the edge of the range, \+5\.0 s \(0\.\d\d m/s\): the "),
+        (30.0, r"^no shift matches, the smallest median difference \(\d\.\d\d m/s\) is not "),
+        (-30.0, r"^no shift matches"),
+    ],
+)
+def test_an_offset_beyond_the_range_gives_no_lag_and_no_number(shift, why):
+    """The QA case (comma2k19 with its CAN clock 30 s off printed a lag of +2.2 s beside the
+    coverage warning): the best shift of unrelated stretches, or one at the range's edge, is
+    no lag."""
+    wheel = _random_drive(0)
+    estimate = estimate_clock_offset(wheel.shifted(-shift), *_noisy_gnss_speed(wheel))
+    assert estimate.residual_s is None and estimate.difference_mps is None
+    assert re.search(why, estimate.no_lag_reason), estimate.no_lag_reason
+    warning = clock_warning("CAN", estimate, 100.0, "--time-offset-can")
+    assert warning.startswith(
+        "CAN clock: no lag found between the wheel speed and the GNSS Doppler speed within ±5 s"
+    )
+    assert warning.endswith("; --time-offset-can 100.000 s is unchecked")
+    assert "should be about" not in warning
+
+
+def test_too_few_overlapping_epochs_give_no_lag():
+    t_gnss = np.arange(5.0, 55.0, 0.2)
+    estimate = estimate_clock_offset(SPEED.shifted(100.0), t_gnss, np.full_like(t_gnss, 10.0))
+    assert estimate.residual_s is None
+    assert estimate.no_lag_reason == (
+        "only 0 valid GNSS epochs lie inside the wheel speed's span, 20 needed"
+    )
 
 
 def test_origin_far_from_the_approximate_position_is_a_warning():

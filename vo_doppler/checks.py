@@ -12,11 +12,18 @@ summary. Each check states its threshold:
   which the scaled wheel speed agrees best with the horizontal Doppler speed at the valid GNSS
   epochs, by the median absolute difference (robust to the reflected epochs that pass the
   velocity's own tests, up to half of them), is the residual clock offset; beyond 0.2 s it is a
-  warning reporting the estimate next to the manifest's ``time_offset_s``;
+  warning reporting the estimate next to the manifest's ``time_offset_s``. The lag is only a
+  lag when the agreement has a clear interior minimum: aligned, the two speeds differ by their
+  noise alone (≈ 0.05 m/s on comma2k19, a tenth of the median difference over the lags), while
+  misaligned by τ they differ by about |acceleration|·τ. A best difference above half the
+  median over the lags (no shift matches: an offset beyond the range, or a speed too
+  featureless) or a best lag at the edge of the range (the agreement still improves beyond it)
+  is "no lag found", a warning naming why, and no number (comma2k19 with its CAN clock 30 s
+  off: 0.47 m/s at +2.2 s against a median of 0.62 m/s);
 * the wheel-speed times against the GNSS epochs: when more than 10 % of the epochs lie outside
   the wheel speed's time span, it is a warning, since those epochs get no tightly coupled
   heading and a clock offset wrong by more than the ±5 s searched looks like this (comma2k19
-  with its CAN clock 30 s off: half the epochs, and a best lag of +2.2 s that is no offset);
+  with its CAN clock 30 s off: half the epochs);
 * the calibrated wheel scale: beyond 1 ± 0.10 it is a warning, since a tyre's rolling radius
   changes by a few per cent with wear and pressure, and a scale far from 1 means a speed in
   other units (km/h: 0.28, mph: 0.45) or a wheel speed that is not this drive's;
@@ -46,9 +53,12 @@ MAX_MEDIAN_LATERAL_ACCELERATION = 1.5
 CLOCK_TOLERANCE_S = 0.2
 CLOCK_SEARCH_S = 5.0
 CLOCK_RATE_HZ = 10.0
-MIN_CLOCK_CONTRAST = 0.1
-"""Share of its largest value by which the agreement must vary over the lags: below, the speed
-profile is too featureless (a constant speed) to estimate a lag."""
+MAX_CLOCK_MATCH_RATIO = 0.5
+"""Largest best-to-median ratio of the speed difference over the lags for a lag to count as
+found: a true lag leaves the speeds' noise (a tenth of the median on comma2k19), a chance
+alignment of unrelated stretches of the drive or a featureless speed barely beats the rest."""
+MIN_CLOCK_EPOCHS = 20
+"""Fewest valid GNSS epochs inside the wheel speed's span (less the searched lag) to search."""
 MIN_SPEED_COVERAGE = 0.9
 WHEEL_SCALE_TOLERANCE = 0.10
 STANDSTILL_MAX_MEDIAN_SPEED_MPS = 0.5
@@ -60,11 +70,15 @@ EARTH_SURFACE_M = (6.3e6, 6.4e6)
 @dataclass(frozen=True)
 class ClockOffsetEstimate:
     """Residual offset (s) to add to the sensor's ``time_offset_s``; the median absolute
-    difference (m/s) of the GNSS and the scaled wheel speed at that shift and unshifted."""
+    difference (m/s) of the GNSS and the scaled wheel speed at that shift and unshifted. When
+    the search has no real answer, ``residual_s`` is None and ``no_lag_reason`` says why."""
 
-    residual_s: float
-    difference_mps: float
-    unshifted_difference_mps: float
+    residual_s: float | None
+    difference_mps: float | None = None
+    unshifted_difference_mps: float | None = None
+    search_s: float = CLOCK_SEARCH_S
+    """Half-width of the searched lags (s)."""
+    no_lag_reason: str = ""
 
 
 def moving_yaw_rate_medians(yaw_rate: SensorSeries, speed: SensorSeries) -> tuple[float, float]:
@@ -103,41 +117,66 @@ def check_yaw_rate_unit(yaw_rate: SensorSeries, speed: SensorSeries, dbc_unit: s
 
 def estimate_clock_offset(
     speed: SensorSeries, t_gnss: np.ndarray, speed_gnss: np.ndarray
-) -> ClockOffsetEstimate | None:
+) -> ClockOffsetEstimate:
     """Residual clock offset of ``speed`` (already on GPS time by the manifest's offset) against
     the GNSS speed: the shift s (0.1-s steps within ±5 s or a quarter of the record, refined by
     a parabola through the best step) minimising median |gnss(t) − k·speed(t − s)| over the
     valid GNSS epochs (no interpolation across GNSS gaps), k the median ratio of the two speeds
-    where the wheels turn faster than 2 m/s (the wheel scale error). None with fewer than 20
-    epochs inside the overlap, without moving epochs, or when the agreement hardly depends on
-    the shift (``MIN_CLOCK_CONTRAST``)."""
+    where the wheels turn faster than 2 m/s (the wheel scale error). No lag (``residual_s``
+    None, with the reason) with fewer than ``MIN_CLOCK_EPOCHS`` epochs inside the overlap,
+    without moving epochs, with the best shift at the edge of the range or no clear minimum
+    (``MAX_CLOCK_MATCH_RATIO``; module docstring)."""
     t_gnss, speed_gnss = np.asarray(t_gnss, dtype=float), np.asarray(speed_gnss, dtype=float)
     if len(speed) < 2:
-        return None
+        return ClockOffsetEstimate(None, no_lag_reason="the wheel speed has fewer than 2 samples")
     span = min(CLOCK_SEARCH_S, (speed.t[-1] - speed.t[0]) / 4)
     inside = (
         np.isfinite(speed_gnss) & (t_gnss >= speed.t[0] + span) & (t_gnss <= speed.t[-1] - span)
     )
-    if np.count_nonzero(inside) < 20:
-        return None
+    if np.count_nonzero(inside) < MIN_CLOCK_EPOCHS:
+        return ClockOffsetEstimate(
+            None,
+            search_s=span,
+            no_lag_reason=f"only {np.count_nonzero(inside)} valid GNSS epochs lie inside the "
+            f"wheel speed's span, {MIN_CLOCK_EPOCHS} needed",
+        )
     t, reference = t_gnss[inside], speed_gnss[inside]
     step = 1.0 / CLOCK_RATE_HZ
     lags = np.arange(-span, span + step / 2, step)
     costs = np.array([_speed_difference(speed, t, reference, lag) for lag in lags])
-    if not np.isfinite(costs).all() or np.ptp(costs) <= MIN_CLOCK_CONTRAST * costs.max():
-        return None
+    if not np.isfinite(costs).all():
+        return ClockOffsetEstimate(
+            None,
+            search_s=span,
+            no_lag_reason="the vehicle hardly moves: at some shifts the wheel speed exceeds "
+            f"{MOVING_SPEED_MPS:g} m/s at no valid GNSS epoch",
+        )
     best = int(np.argmin(costs))
-    offset = 0.0
-    if 0 < best < len(lags) - 1:
-        left, mid, right = costs[best - 1 : best + 2]
-        curvature = left - 2 * mid + right
-        if curvature > 0:
-            offset = 0.5 * (left - right) / curvature
+    typical = float(np.median(costs))
+    if not costs[best] < MAX_CLOCK_MATCH_RATIO * typical:  # a flat 0 is no minimum either
+        return ClockOffsetEstimate(
+            None,
+            search_s=span,
+            no_lag_reason=f"no shift matches, the smallest median difference ({costs[best]:.2f} "
+            f"m/s) is not below half their median ({typical:.2f} m/s): an offset beyond the "
+            "range, or a featureless speed",
+        )
+    if best in (0, len(lags) - 1):
+        return ClockOffsetEstimate(
+            None,
+            search_s=span,
+            no_lag_reason=f"the agreement is best at the edge of the range, {lags[best]:+.1f} s "
+            f"({costs[best]:.2f} m/s): the offset is beyond it",
+        )
+    left, mid, right = costs[best - 1 : best + 2]
+    curvature = left - 2 * mid + right
+    offset = 0.5 * (left - right) / curvature if curvature > 0 else 0.0
     residual = float(lags[best] + offset * step)
     return ClockOffsetEstimate(
         residual,
         _speed_difference(speed, t, reference, residual),
         _speed_difference(speed, t, reference, 0.0),
+        span,
     )
 
 
@@ -154,14 +193,18 @@ def _speed_difference(speed: SensorSeries, t: np.ndarray, reference: np.ndarray,
 
 def clock_warning(
     sensor: str,
-    estimate: ClockOffsetEstimate | None,
+    estimate: ClockOffsetEstimate,
     manifest_offset_s: float,
     offset_name: str = "the manifest's time_offset_s",
 ) -> str | None:
-    """A warning when the estimated residual offset exceeds 0.2 s; ``offset_name`` names the
-    setting to fix."""
-    if estimate is None:
-        return None
+    """A warning when the estimated residual offset exceeds 0.2 s, or when no lag was found
+    (the offset is then unchecked); ``offset_name`` names the setting to fix."""
+    if estimate.residual_s is None:
+        return (
+            f"{sensor} clock: no lag found between the wheel speed and the GNSS Doppler speed "
+            f"within ±{estimate.search_s:.3g} s: {estimate.no_lag_reason}; {offset_name} "
+            f"{manifest_offset_s:.3f} s is unchecked"
+        )
     if abs(estimate.residual_s) <= CLOCK_TOLERANCE_S:
         return None
     return (
@@ -211,7 +254,7 @@ def calibration_warnings(
     sensor: str,
     offset_s: float,
     offset_name: str = "the manifest's time_offset_s",
-) -> tuple[ClockOffsetEstimate | None, list[str]]:
+) -> tuple[ClockOffsetEstimate, list[str]]:
     """The checks of a heading calibration, for ``run`` and ``heading`` alike: the wheel-speed
     times against the GNSS epochs (``coverage_warning``), its clock against the horizontal
     Doppler speed at the valid epochs (``clock_warning``) and the
