@@ -6,6 +6,7 @@ import datetime as dt
 import functools
 import logging
 import operator
+import re
 from pathlib import Path
 
 import numpy as np
@@ -236,6 +237,58 @@ def test_nmea_midnight_roll_over_and_gga_only(tmp_path):
     empty.write_text(_gga(dt.time(1, 2, 3), 1.0, 2.0, quality=0) + "\n")
     with pytest.raises(InputError, match="no GGA or RMC fix"):
         read_nmea(empty)
+
+
+def _rmc_log(tmp_path, knots: list[float]) -> Path:
+    """An RMC sentence a second with these speeds (knots), line k + 1 for speed k."""
+    start = dt.datetime(2024, 6, 24, 8, 20, 0)
+    path = tmp_path / "speeds.nmea"
+    moments = [start + dt.timedelta(seconds=k) for k in range(len(knots))]
+    path.write_text(
+        "".join(f"{_rmc(m, 48.1, -11.5, v)}\n" for m, v in zip(moments, knots, strict=True))
+    )
+    return path
+
+
+def test_nmea_isolated_absurd_speeds_skip_their_sentence_with_a_warning(tmp_path, caplog):
+    """1e9 knots and a negative speed over ground (a magnitude) are no vehicle's: their
+    sentences are skipped and named, the other 198 read."""
+    knots = [10.0] * 200
+    knots[50], knots[60] = 1e9, -3.0
+    path = _rmc_log(tmp_path, knots)
+    with caplog.at_level(logging.WARNING):
+        fixes = read_nmea(path)
+    assert len(fixes.t) == 198 and fixes.n_skipped == 2
+    np.testing.assert_allclose(fixes.speed, 10.0 * 1852 / 3600)
+    assert (
+        f"{path}: skipped 2 RMC sentences with a speed over ground outside [0, 150] m/s "
+        "(first 5.14444e+08 m/s; lines 51, 61)"
+    ) in caplog.text
+
+
+def test_nmea_speeds_out_of_range_beyond_one_percent_are_an_error_naming_the_line(tmp_path):
+    knots = [10.0] * 100
+    knots[40], knots[70] = 400.0, 500.0  # 2 % beyond 150 m/s (291.6 knots)
+    path = _rmc_log(tmp_path, knots)
+    expected = (
+        f"{path}:41: RMC speed over ground 205.778 m/s (400 knots) is outside what a vehicle "
+        "can report, [0, 150] m/s, and so are 2 of the 100 RMC speeds: not isolated bad "
+        "sentences; check the receiver's output"
+    )
+    with pytest.raises(InputError, match=f"^{re.escape(expected)}$"):
+        read_nmea(path)
+
+
+def test_nmea_gga_keeps_its_fix_when_the_rmc_speed_at_its_time_is_skipped(tmp_path):
+    start = dt.datetime(2024, 6, 24, 8, 20, 0)
+    lines = [_rmc(start + dt.timedelta(seconds=k), 48.1, -11.5, 10.0) for k in range(200)]
+    lines[5] = _rmc(start + dt.timedelta(seconds=5), 48.1, -11.5, 1e9)
+    lines.insert(6, _gga((start + dt.timedelta(seconds=5)).time(), 48.2, -11.5))
+    path = tmp_path / "gga.nmea"
+    path.write_text("\n".join(lines) + "\n")
+    fixes = read_nmea(path)
+    assert len(fixes.t) == 200 and np.isnan(fixes.speed[5])
+    assert np.degrees(fixes.lat[5]) == pytest.approx(48.2)
 
 
 @tmp_settings

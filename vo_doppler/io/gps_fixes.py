@@ -3,16 +3,20 @@
 NMEA: GGA and RMC sentences through pynmeagps. Fix times become GPS time in seconds since
 1980-01-06 (UTC + leap seconds) once an RMC sentence has given the date; a GGA-only file has no
 date, so its times stay UTC seconds of day (logged). Sentences with a bad checksum or no fix
-(GGA quality 0, RMC status V) are skipped and counted. When GGA and RMC report the same time,
-one fix is kept (GGA position, RMC speed over ground). Fix times must not go backwards (the
-``"error"`` policy of :mod:`vo_doppler.io.time_order`, naming the sentence's line).
+(GGA quality 0, RMC status V) are skipped and counted. An RMC speed over ground beyond what a
+vehicle can report (:data:`vo_doppler.io.vehicle_limits.GROUND_SPEED`: negative or above
+150 m/s) skips its sentence, warned with its line; more than 1 % of the speeds beyond it is an
+error naming the first such line (the receiver's output is wrong, not a sentence). When GGA and
+RMC report the same time, one fix is kept (GGA position, RMC speed over ground). Fix times must
+not go backwards (the ``"error"`` policy of :mod:`vo_doppler.io.time_order`, naming the
+sentence's line).
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +26,7 @@ from vo_doppler.errors import InputError
 from vo_doppler.io.sensor_csv import read_numeric_csv
 from vo_doppler.io.textfile import read_text, regular_file
 from vo_doppler.io.time_order import order_samples
+from vo_doppler.io.vehicle_limits import GROUND_SPEED, too_many_out_of_range
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.model.gpstime import utc_to_gps_seconds as gpstime_utc_to_gps
 
@@ -97,10 +102,23 @@ def _seconds_of_day(value: dt.time) -> float:
     return value.hour * 3600.0 + value.minute * 60.0 + value.second + value.microsecond * 1e-6
 
 
-def _parse_sentences(path: Path, lines: list[bytes]):
-    """Readable GGA/RMC messages with a fix, and the counts of the skipped ones."""
-    messages = []
-    n_bad = n_nofix = 0
+@dataclass
+class _Sentences:
+    """The readable GGA/RMC messages with a fix (line, message), and what was skipped."""
+
+    messages: list = field(default_factory=list)
+    n_bad: int = 0
+    n_nofix: int = 0
+    n_speeds: int = 0
+    """RMC sentences with a fix and a speed over ground."""
+    out_of_range: list[tuple[int, float]] = field(default_factory=list)
+    """(line, speed in m/s) of the RMC speeds beyond ``GROUND_SPEED`` (sentences skipped)."""
+
+
+def _parse_sentences(path: Path, lines: list[bytes]) -> _Sentences:
+    """Readable GGA/RMC messages with a fix and a speed a vehicle can have, and the counts of
+    the skipped ones."""
+    found = _Sentences()
     for number, raw in enumerate(lines, start=1):
         raw = raw.strip()
         if not raw.startswith(b"$"):
@@ -108,7 +126,7 @@ def _parse_sentences(path: Path, lines: list[bytes]):
         try:
             message = NMEAReader.parse(raw)
         except (NMEAParseError, NMEAMessageError, NMEATypeError, ValueError) as exc:
-            n_bad += 1
+            found.n_bad += 1
             log.debug("%s:%d: %s", path, number, exc)
             continue
         if message is None or message.msgID not in ("GGA", "RMC"):
@@ -116,21 +134,58 @@ def _parse_sentences(path: Path, lines: list[bytes]):
         gga = message.msgID == "GGA"
         no_fix = message.quality in (0, "") if gga else message.status != "A"
         if no_fix or "" in (message.lat, message.lon, message.time):
-            n_nofix += 1
+            found.n_nofix += 1
             continue
-        messages.append((number, message))
-    return messages, n_bad, n_nofix
+        if not gga and message.spd != "":
+            found.n_speeds += 1
+            speed = float(message.spd) * KNOT_MPS
+            if GROUND_SPEED.outside(speed):
+                found.out_of_range.append((number, speed))
+                continue
+        found.messages.append((number, message))
+    return found
+
+
+def _check_speeds(path: Path, found: _Sentences) -> None:
+    """Raise when the speeds beyond ``GROUND_SPEED`` are more than isolated bad sentences;
+    warn with their lines when they are."""
+    if not found.out_of_range:
+        return
+    line, speed = found.out_of_range[0]
+    n_out = len(found.out_of_range)
+    if too_many_out_of_range(n_out, found.n_speeds):
+        raise InputError(
+            f"RMC speed over ground {speed:g} m/s ({speed / KNOT_MPS:g} knots) is outside what a "
+            f"vehicle can report, {GROUND_SPEED}, and so are {n_out} of the {found.n_speeds} "
+            "RMC speeds: not isolated bad sentences; check the receiver's output",
+            path,
+            line,
+        )
+    lines = ", ".join(str(number) for number, _ in found.out_of_range[:10])
+    more = f" and {n_out - 10} more" if n_out > 10 else ""
+    log.warning(
+        "%s: skipped %d RMC sentences with a speed over ground outside %s (first %g m/s; "
+        "lines %s%s)",
+        path,
+        n_out,
+        GROUND_SPEED,
+        speed,
+        lines,
+        more,
+    )
 
 
 def read_nmea(path: str | Path) -> GpsFixes:
     """Read GGA/RMC fixes from an NMEA 0183 log (midnight roll-overs follow the time of day)."""
     path = Path(path)
     lines = [line.encode("ascii", "replace") for line in read_text(path, "NMEA file").split("\n")]
-    messages, n_bad, n_nofix = _parse_sentences(path, lines)
+    found = _parse_sentences(path, lines)
+    messages, n_bad, n_nofix = found.messages, found.n_bad, found.n_nofix
     if n_bad or n_nofix:
         log.warning(
             "%s: skipped %d unreadable sentences and %d without a fix", path, n_bad, n_nofix
         )
+    _check_speeds(path, found)
     if not messages:
         raise InputError("no GGA or RMC fix found in the NMEA file", path)
     date = next((m.date for _, m in messages if m.msgID == "RMC" and m.date != ""), None)
@@ -172,7 +227,7 @@ def read_nmea(path: str | Path) -> GpsFixes:
         np.radians(rows[:, 1]),
         rows[:, 2],
         path,
-        n_bad + n_nofix,
+        n_bad + n_nofix + len(found.out_of_range),
         "gps" if date is not None else "utc-seconds-of-day",
     )
 

@@ -47,6 +47,8 @@ class SignalBounds:
 
 SPEED = SignalBounds(-10.0, 150.0, "m/s")
 """Vehicle (wheel, odometer, GNSS ground) speed, forward positive."""
+GROUND_SPEED = SignalBounds(0.0, SPEED.high, "m/s")
+"""Speed over ground as NMEA reports it: a magnitude, never negative; bounded like SPEED."""
 YAW_RATE = SignalBounds(-5.0, 5.0, "rad/s")
 """Yaw rate, either sign."""
 FORWARD_ACCELERATION = SignalBounds(-50.0, 50.0, "m/s²")
