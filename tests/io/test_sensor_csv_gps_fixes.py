@@ -28,6 +28,7 @@ from vo_doppler.io.sensor_csv import (
     YAW_RATE_COLUMN,
     read_numeric_csv,
     read_sensor_csv,
+    read_sensor_csv_with_report,
     read_speed_csv,
     read_yaw_rate_csv,
     write_sensor_csv,
@@ -172,6 +173,25 @@ def test_gps_csv_out_of_range_fixes_skipped(tmp_path):
     fixes = read_gps_csv(path)
     np.testing.assert_array_equal(fixes.t, [0.0, 4.0])
     assert fixes.n_skipped == 3 and np.all(np.isnan(fixes.speed))
+
+
+def test_a_row_repeated_exactly_is_dropped_with_a_warning_naming_its_line(tmp_path, caplog):
+    path = tmp_path / "speed.csv"
+    path.write_text("t,speed_mps\n0.0,10.0\n0.1,10.5\n0.1,10.5\n# note\n0.1,10.5\n0.2,11.0\n")
+    with caplog.at_level(logging.WARNING):
+        series, report = read_sensor_csv_with_report(path, SPEED_COLUMN)
+    np.testing.assert_array_equal(series.t, [0.0, 0.1, 0.2])
+    np.testing.assert_array_equal(series.value, [10.0, 10.5, 11.0])
+    expected = f"{path}: dropped 2 rows repeating the row before exactly (lines 4, 6)"
+    assert report.problems() == [expected] and expected in caplog.text
+
+
+def test_two_values_at_one_time_are_an_error_naming_the_file_and_both_lines(tmp_path):
+    """Which of the two is the measurement cannot be told: the first one was kept silently."""
+    path = tmp_path / "yaw.csv"
+    path.write_text("t,yaw_rate_rad_s\n0.0,0.01\n0.1,0.02\n0.1,0.05\n0.2,0.03\n")
+    with pytest.raises(InputError, match=r"yaw\.csv:4: lines 3 and 4 of the yaw\.csv rows are "):
+        read_yaw_rate_csv(path)
 
 
 def _sentence(body: str) -> str:

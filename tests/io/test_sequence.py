@@ -212,6 +212,8 @@ def test_vehicle_rows_skipped_by_the_readers_are_warnings_of_the_run(tmp_path):
         tmp_path / "speed.csv", SensorSeries(from_can.wheel_speed.t, speed), SPEED_COLUMN
     )
     write_sensor_csv(tmp_path / "yaw.csv", from_can.yaw_rate, YAW_RATE_COLUMN)
+    yaw_lines = (tmp_path / "yaw.csv").read_text().splitlines(keepends=True)
+    (tmp_path / "yaw.csv").write_text("".join(yaw_lines[:11] + yaw_lines[10:]))  # line 12 = 11
     manifest = yaml.safe_load((tmp_path / "sequence.yaml").read_text())
     del manifest["can"]
     manifest["vehicle"] = {"yaw_rate": "yaw.csv", "wheel_speed": "speed.csv"}
@@ -219,7 +221,9 @@ def test_vehicle_rows_skipped_by_the_readers_are_warnings_of_the_run(tmp_path):
     sequence, report = read_sequence_with_report(tmp_path)
     assert len(sequence.wheel_speed) == len(speed) - 1
     assert np.max(sequence.wheel_speed.value) == np.max(np.delete(speed, 50))
+    np.testing.assert_array_equal(sequence.yaw_rate.value, from_can.yaw_rate.value)
     assert report.warnings() == [
+        f"{tmp_path / 'yaw.csv'}: dropped 1 rows repeating the row before exactly (lines 12)",
         f"{tmp_path / 'speed.csv'}: skipped 0 malformed, 0 non-finite and 1 out-of-range rows "
-        "(speed_mps 1e+09 beyond [-10, 150] m/s) (first lines: 52)"
+        "(speed_mps 1e+09 beyond [-10, 150] m/s) (first lines: 52)",
     ]

@@ -30,9 +30,13 @@ def test_sort_policy_sorts_small_steps_and_refuses_large_ones():
         order_samples([0.0, 6.0, 1.0], [0, 1, 2], None, "can", policy="sort")
 
 
-def test_duplicates_identical_dropped_conflicting_counted_first_kept():
+def test_sorted_duplicates_identical_dropped_conflicting_counted_first_kept():
     t, v, report = order_samples(
-        [0.0, 1.0, 1.0, 2.0, 2.0], [[0, 0], [1, 1], [1, 1], [2, 2], [9, 2]], None, "x"
+        [0.0, 1.0, 1.0, 2.0, 2.0],
+        [[0, 0], [1, 1], [1, 1], [2, 2], [9, 2]],
+        None,
+        "x",
+        policy="sort",
     )
     np.testing.assert_array_equal(t, [0.0, 1.0, 2.0])
     np.testing.assert_array_equal(v, [[0, 0], [1, 1], [2, 2]])
@@ -55,3 +59,27 @@ def test_sorted_output_is_strictly_increasing_or_the_input_was_refused(times):
         assert late.max() > 0.5
         return
     assert np.all(np.diff(t) > 0)
+
+
+def test_error_policy_drops_identical_duplicates_and_keeps_their_lines():
+    t, v, report = order_samples(
+        [0.0, 1.0, 1.0, 1.0, 2.0], [5, 6, 6, 6, 7], "f.csv", "x", np.array([2, 3, 4, 5, 7])
+    )
+    np.testing.assert_array_equal(t, [0.0, 1.0, 2.0])
+    np.testing.assert_array_equal(v, [5, 6, 7])
+    assert report.n_duplicates == 2 and report.duplicate_lines == [4, 5]
+
+
+def test_error_policy_refuses_two_values_at_one_time_naming_both_lines():
+    with pytest.raises(InputError) as info:
+        order_samples(
+            [0.0, 1.0, 1.0, 2.0],
+            [[0.0, 5.0], [1.0, 6.0], [1.0, 6.5], [2.0, 7.0]],
+            "f.csv",
+            "speed rows",
+            np.array([2, 3, 4, 6]),
+        )
+    assert str(info.value) == (
+        "f.csv:4: lines 3 and 4 of the speed rows are both at t = 1.000000 s with different "
+        "values (1, 6; 1, 6.5): which is the measurement cannot be told; keep one of them"
+    )

@@ -9,10 +9,11 @@ appears) is checked against what a car can report (:mod:`vo_doppler.io.vehicle_l
 isolated rows beyond it are skipped, counted and logged like non-finite ones; more than 1 % of
 the rows beyond it is an error naming the first such line (the column's unit or scale is
 wrong). A file with a ``t`` column follows the ``"error"`` time-order policy of
-:mod:`vo_doppler.io.time_order` (a row going back raises naming its line; duplicate times are
-dropped and counted). Times are seconds on the sensor's clock, and a per-sensor offset maps
-them to GPS time. Files are read through :mod:`vo_doppler.io.textfile` (bounded, UTF-8, no
-binary).
+:mod:`vo_doppler.io.time_order`: a row going back raises naming its line; a row repeating the
+one before exactly is dropped, counted and warned with its line; two rows at one time with
+different values raise naming both lines. Times are seconds on the sensor's clock, and a
+per-sensor offset maps them to GPS time. Files are read through
+:mod:`vo_doppler.io.textfile` (bounded, UTF-8, no binary).
 """
 
 from __future__ import annotations
@@ -60,14 +61,24 @@ class CsvReadReport:
         return self.n_malformed + self.n_non_finite + self.n_out_of_range
 
     def problems(self) -> list[str]:
-        """One sentence for the warnings of a run (empty when every row was used)."""
-        if not self.n_skipped:
-            return []
-        return [
-            f"{self.path}: skipped {self.n_malformed} malformed, {self.n_non_finite} non-finite "
-            f"and {self.n_out_of_range} out-of-range rows{self.first_out_of_range} (first "
-            f"lines: {', '.join(map(str, self.skipped_lines[:5]))})"
-        ]
+        """Sentences for the warnings of a run: the rows skipped, the duplicate rows dropped
+        (empty when every row was used)."""
+        found = []
+        if self.n_skipped:
+            found.append(
+                f"{self.path}: skipped {self.n_malformed} malformed, {self.n_non_finite} "
+                f"non-finite and {self.n_out_of_range} out-of-range rows"
+                f"{self.first_out_of_range} (first lines: "
+                f"{', '.join(map(str, self.skipped_lines[:5]))})"
+            )
+        duplicates = [] if self.time_order is None else self.time_order.duplicate_lines
+        if duplicates:
+            more = f" and {len(duplicates) - 10} more" if len(duplicates) > 10 else ""
+            found.append(
+                f"{self.path}: dropped {len(duplicates)} rows repeating the row before exactly "
+                f"(lines {', '.join(map(str, duplicates[:10]))}{more})"
+            )
+        return found
 
     def log_summary(self) -> None:
         for problem in self.problems():
@@ -142,14 +153,14 @@ def read_numeric_csv(
         )
     if not rows:
         raise InputError("CSV file has no usable data rows", path)
-    report.n_rows = len(rows)
-    report.log_summary()
     data = np.asarray(rows, dtype=float)
     if "t" in index:
         j = list(index).index("t")
         _, data, report.time_order = order_samples(
-            data[:, j], data, path, f"{path.name} samples", np.asarray(report.row_lines)
+            data[:, j], data, path, f"{path.name} rows", np.asarray(report.row_lines)
         )
+    report.n_rows = len(data)
+    report.log_summary()
     return {name: data[:, j] for j, name in enumerate(index)}, report
 
 

@@ -9,15 +9,17 @@ Policies (every reader applies one; the counts go into ``vo-doppler run``'s summ
   ``max_back_s`` are sorted into place and counted; a frame later than that (e.g. a block of
   frames 5 s early) is an error naming it.
 
-Under both, a sample at the same time as the one before is a duplicate: identical values are
-dropped and counted; different values keep the first, are counted as conflicting and logged.
-Non-finite times are an error.
+Under both, a sample at the same time as the one before with identical values is a duplicate,
+dropped and counted (its line kept for the reader's warning). One with different values is,
+under ``"error"``, an :class:`InputError` naming both lines (which of two values is the
+measurement cannot be told); under ``"sort"`` the first is kept, counted as conflicting and
+logged (a frame read by two channels). Non-finite times are an error.
 """
 
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +41,8 @@ class TimeOrderReport:
     n_out_of_order: int = 0
     n_duplicates: int = 0
     n_conflicting_duplicates: int = 0
+    duplicate_lines: list[int] = field(default_factory=list)
+    """Lines of the identical duplicates dropped (when the reader gave lines)."""
 
     def as_dict(self) -> dict[str, int]:
         return {
@@ -63,6 +67,11 @@ class TimeOrderReport:
 
 def _line(lines: np.ndarray | None, index: int) -> int | None:
     return None if lines is None else int(lines[index])
+
+
+def _values(row) -> str:
+    """A sample's values for a message: one number, or a comma-separated row."""
+    return ", ".join(f"{value:.10g}" for value in np.atleast_1d(row))
 
 
 def order_samples(
@@ -105,7 +114,19 @@ def order_samples(
         if repeated.size:
             same = values[repeated] == values[repeated - 1]
             same = same.reshape(len(repeated), -1).all(axis=1)
+            if policy == "error" and not same.all():
+                first = repeated[~same][0]
+                which = "two" if lines is None else f"lines {lines[first - 1]} and {lines[first]}"
+                raise InputError(
+                    f"{which} of the {sensor} are both at t = {t[first]:.6f} s with different "
+                    f"values ({_values(values[first - 1])}; {_values(values[first])}): which "
+                    "is the measurement cannot be told; keep one of them",
+                    path,
+                    _line(lines, int(first)),
+                )
             report.n_duplicates = int(same.sum())
+            if lines is not None:
+                report.duplicate_lines = [int(lines[k]) for k in repeated[same]]
             report.n_conflicting_duplicates = int((~same).sum())
             if report.n_conflicting_duplicates:
                 first = repeated[~same][0]
