@@ -155,6 +155,18 @@ def test_dbc_parser_errors_are_wrapped(tmp_path):
         load_dbc(path)
 
 
+def test_a_non_dbc_tried_in_every_format_gives_our_error_and_no_deprecation_warning(
+    tmp_path, recwarn
+):
+    """Without a known suffix cantools tries its CDD parser too, which warned that it is
+    deprecated beside our error."""
+    path = tmp_path / "garbage.obs"
+    path.write_text("t,lat_deg,lon_deg\n0,37.7,-122.4\n")
+    with pytest.raises(InputError, match=r"garbage.obs: cannot load the CAN database: "):
+        load_dbc(path)
+    assert [w for w in recwarn if issubclass(w.category, DeprecationWarning)] == []
+
+
 def test_frames_slightly_late_are_sorted_and_counted(tmp_path, dbc):
     items = messages(10)
     items[4], items[6] = items[6], items[4]  # KIN frames 0.1 s apart swap places

@@ -29,6 +29,7 @@ import datetime
 import logging
 import math
 import re
+import warnings
 from array import array
 from collections import Counter
 from dataclasses import dataclass, field
@@ -373,9 +374,13 @@ def load_dbc(path: str | Path) -> cantools.database.can.Database:
     text = read_text(path, "CAN database", SMALL_MAX_BYTES, DBC_MAX_LINE_CHARS)
     formats = {".dbc": "dbc", ".kcd": "kcd", ".sym": "sym", ".arxml": "arxml", ".cdd": "cdd"}
     try:
-        return cantools.database.load_string(
-            text, database_format=formats.get(path.suffix.lower()), strict=False
-        )
+        with warnings.catch_warnings():
+            # Without a known suffix cantools tries every format, its CDD parser among them,
+            # which warns that it is deprecated: noise beside our error, nothing the user did.
+            warnings.filterwarnings("ignore", category=DeprecationWarning, module=r"cantools\.")
+            return cantools.database.load_string(
+                text, database_format=formats.get(path.suffix.lower()), strict=False
+            )
     except Exception as exc:  # cantools wraps its parsers' errors inconsistently
         raise InputError(
             f"cannot load the CAN database: {type(exc).__name__}: {exc}", path
