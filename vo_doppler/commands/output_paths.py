@@ -66,7 +66,17 @@ def check_output_files(
 
 def _check_writable_file(path: Path) -> None:
     """Raise unless ``path`` can be written as a file: not a folder, its nearest existing
-    ancestor a writable folder, and (when its folder exists) a file can be opened there."""
+    ancestor a writable folder, the file itself writable when it exists, and a name the file
+    system takes. Judged from permissions alone: nothing is created, opened or changed in the
+    user's folders (a probe file would show up, however briefly, to whatever watches them,
+    and change the folder's modification time)."""
+    try:
+        _check_permissions(path)
+    except OSError as exc:  # e.g. a name too long for the file system
+        raise OutputError(f"{path}: cannot write the output ({exc.strerror})") from exc
+
+
+def _check_permissions(path: Path) -> None:
     if path.is_dir():
         raise OutputError(f"{path}: the output is a folder; give a file name")
     ancestor = path.absolute().parent
@@ -76,14 +86,5 @@ def _check_writable_file(path: Path) -> None:
         raise OutputError(f"{path}: {ancestor} is a file, not a folder")
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise OutputError(f"{path}: no permission to write in {ancestor}")
-    if ancestor != path.absolute().parent:
-        return
-    existed = path.exists()
-    try:
-        # Append mode neither truncates an existing file nor changes its contents.
-        with path.open("a"):
-            pass
-    except OSError as exc:
-        raise OutputError(f"{path}: cannot write the output ({exc.strerror})") from exc
-    if not existed:
-        path.unlink(missing_ok=True)
+    if path.exists() and not os.access(path, os.W_OK):
+        raise OutputError(f"{path}: no permission to write the existing file")
