@@ -4,6 +4,8 @@ write."""
 from __future__ import annotations
 
 import json
+import os
+import stat
 from pathlib import Path
 
 import pytest
@@ -15,6 +17,7 @@ from vo_doppler.io.output_folder import (
     check_output_folder,
     mark_output,
     open_output_folder,
+    remove_cut_off_staging,
     staged_output,
     untouched,
     written_by,
@@ -63,6 +66,36 @@ def test_failure_leaves_the_previous_folder_and_no_staging(tmp_path):
     assert sorted(p.name for p in out.iterdir()) == [MARKER, "old.txt"]
     assert untouched(out) == f"nothing written: {out} left as it was"
     assert untouched(tmp_path / "new") == f"nothing written: {tmp_path / 'new'} not created"
+
+
+@pytest.mark.parametrize(
+    ("umask", "mode"), [(0o022, 0o755), (0o027, 0o750), (0o002, 0o775)], ids=oct
+)
+def test_a_staged_folder_has_the_mode_mkdir_gives(tmp_path, umask, mode):
+    """Others may read the results as the umask allows (mkdtemp made every run's folder 0700)."""
+    previous = os.umask(umask)
+    try:
+        with staged_output(tmp_path / "out", RUN) as staging:
+            (staging / "x").write_text("1")
+        earlier_run(tmp_path / "again", "old.txt").chmod(0o700)
+        with staged_output(tmp_path / "again", RUN) as staging:
+            (staging / "x").write_text("1")
+    finally:
+        os.umask(previous)
+    for out in (tmp_path / "out", tmp_path / "again"):
+        assert stat.S_IMODE(out.stat().st_mode) == mode
+
+
+def test_cut_off_staging_folders_of_one_output_are_removed(tmp_path):
+    mine = [tmp_path / ".out.partial-1234abcd", tmp_path / ".out.partial-x"]
+    others = [tmp_path / ".out2.partial-1", tmp_path / ".out.old-1", tmp_path / "out"]
+    for folder in mine + others:
+        folder.mkdir()
+        (folder / "half.png").write_text("half")
+    (tmp_path / ".out.partial-file").write_text("not a folder")
+    remove_cut_off_staging(tmp_path / "out")
+    left = {p.name for p in tmp_path.iterdir()}
+    assert left == {p.name for p in others} | {".out.partial-file"}
 
 
 def test_nested_new_folder_is_created(tmp_path):

@@ -4,9 +4,11 @@ write.
 A command's ``-o`` folder must be new, empty or written by an earlier run of the same command
 (:func:`written_by`), must not be or contain one of the command's inputs, and, when the command
 replaces the whole folder (``run``; ``batch`` for each recording's folder), must not be the
-current directory or hold it. ``vo-doppler run`` fills a temporary folder beside the output and
-swaps it in only when complete (:func:`staged_output`), so a failed run leaves the previous
-results untouched and a rerun leaves no stale files.
+current directory or hold it. ``vo-doppler run`` and each recording of ``vo-doppler batch`` fill
+a temporary folder beside the output and swap it in only when complete (:func:`staged_output`;
+:func:`begin_staging` and :func:`swap_in` for a caller that decides itself), so a failed run
+leaves the previous results untouched and a rerun leaves no stale files. Folders are created
+with the mode the umask gives, as by ``mkdir``.
 
 How a folder is recognised as written by a command: the marker file :data:`MARKER` that every
 command writes into the folders it makes, naming the command and, for a folder that is
@@ -17,11 +19,12 @@ marker existed, the command's own files (:data:`_OWN_FILES`).
 
 from __future__ import annotations
 
+import glob
 import json
 import os
 import re
+import secrets
 import shutil
-import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from fnmatch import fnmatch
@@ -238,19 +241,50 @@ def check_output_folder(
     return path
 
 
-@contextmanager
-def staged_output(
-    path: str | Path, command: str, inputs: Iterable[str | Path | None] = ()
-) -> Iterator[Path]:
-    """A temporary folder beside ``path`` to write into; on normal exit it is marked as
-    ``command``'s and replaces ``path`` (checked again, then the previous folder is removed), on
-    an exception it is removed and ``path`` is unchanged."""
-    inputs = list(inputs)
+def new_folder(parent: Path, prefix: str) -> Path:
+    """A new folder ``parent/prefix<random>``, created as a plain ``mkdir`` would create it:
+    with the mode the umask gives (``tempfile.mkdtemp`` makes it 0700, and a staged output
+    swapped in kept that mode, unreadable to the other users whatever their umask)."""
+    while True:
+        folder = parent / f"{prefix}{secrets.token_hex(4)}"
+        try:
+            folder.mkdir()
+        except FileExistsError:
+            continue
+        return folder
+
+
+def begin_staging(path: str | Path, command: str, inputs: Iterable[str | Path | None] = ()) -> Path:
+    """Check ``path`` as an output ``command`` replaces as a whole and create the temporary
+    folder beside it to write into instead (hidden, ``.NAME.partial-*``); the caller either
+    swaps it in (:func:`swap_in`) or deletes it."""
     path = check_output_folder(path, command, inputs, replace=True).absolute()
     path.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.partial-", dir=path.parent))
+    return new_folder(path.parent, _staging_prefix(path))
+
+
+def _staging_prefix(path: Path) -> str:
+    return f".{path.name}.partial-"
+
+
+def remove_cut_off_staging(path: str | Path) -> None:
+    """Delete the staging folders that runs into ``path`` cut off (killed, power loss) left
+    beside it: no run reads them again. Only for a caller that alone writes ``path`` (a batch's
+    recording): it would delete a concurrent run's staging folder too."""
+    path = Path(os.path.normpath(path)).absolute()
+    for leftover in path.parent.glob(glob.escape(_staging_prefix(path)) + "*"):
+        if leftover.is_dir() and not leftover.is_symlink():
+            shutil.rmtree(leftover, ignore_errors=True)
+
+
+def swap_in(
+    staging: Path, path: str | Path, command: str, inputs: Iterable[str | Path | None] = ()
+) -> None:
+    """Mark ``staging`` as ``command``'s and make it ``path``: ``path`` is checked again (it may
+    have changed since :func:`begin_staging`), then the previous folder is removed. When the
+    check fails, ``staging`` is removed, ``path`` left as it is and the error raised."""
+    path = Path(os.path.normpath(path)).absolute()
     try:
-        yield staging
         mark_output(staging, command)
         check_output_folder(path, command, inputs, replace=True)
     except BaseException:
@@ -258,12 +292,29 @@ def staged_output(
         raise
     previous = None
     if path.exists():
-        previous = Path(tempfile.mkdtemp(prefix=f".{path.name}.old-", dir=path.parent))
+        previous = new_folder(path.parent, f".{path.name}.old-")
         previous.rmdir()
         path.rename(previous)
     staging.rename(path)
     if previous is not None:
         shutil.rmtree(previous, ignore_errors=True)
+
+
+@contextmanager
+def staged_output(
+    path: str | Path, command: str, inputs: Iterable[str | Path | None] = ()
+) -> Iterator[Path]:
+    """A temporary folder beside ``path`` to write into; on normal exit it is marked as
+    ``command``'s and replaces ``path`` (:func:`swap_in`), on an exception it is removed and
+    ``path`` is unchanged."""
+    inputs = list(inputs)
+    staging = begin_staging(path, command, inputs)
+    try:
+        yield staging
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    swap_in(staging, path, command, inputs)
 
 
 def untouched(path: str | Path) -> str:
