@@ -23,8 +23,10 @@ from tests.helpers.batch import (
     wait_while_blocked,
 )
 from vo_doppler.batch import (
+    FAILED_LOG,
     MARKER,
     Failure,
+    Listing,
     Status,
     _pool,
     fingerprint,
@@ -32,6 +34,7 @@ from vo_doppler.batch import (
     opencv_threads,
     output_names,
     plan,
+    process_recording,
     read_list,
     run_batch,
 )
@@ -39,6 +42,7 @@ from vo_doppler.errors import InputError, OutputError
 from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
 from vo_doppler.io.output_folder import RUN, mark_output, open_output_folder, written_by
 from vo_doppler.run import RunConfig
+from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 from vo_doppler.vo.config import VoConfig
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
@@ -56,9 +60,38 @@ def test_read_list_skips_comments_and_resolves_relative_paths(tmp_path):
     listing = tmp_path / "lists" / "drives.txt"
     listing.parent.mkdir()
     listing.write_text("# fleet\nd1\n\n  /abs/d2  # second\n")
-    assert read_list(listing) == [listing.parent / "d1", Path("/abs/d2")]
+    assert read_list(listing) == {
+        listing.parent / "d1": Listing(listing, 2),
+        Path("/abs/d2"): Listing(listing, 4),
+    }
     with pytest.raises(InputError, match=r"missing\.txt"):
         read_list(tmp_path / "missing.txt")
+
+
+def test_read_list_names_repeated_entries_and_keeps_the_first(tmp_path, caplog):
+    listing = tmp_path / "drives.txt"
+    listing.write_text("s1\nd2\n./s1\n# s1\ns1/\n")
+    with caplog.at_level("WARNING", logger="vo_doppler.batch"):
+        listed = read_list(listing)
+    assert listed == {tmp_path / "s1": Listing(listing, 1), tmp_path / "d2": Listing(listing, 2)}
+    assert caplog.messages == [
+        f"{listing}: lines 1, 3, 5 name the same recording (s1, ./s1, s1/); it runs once"
+    ]
+
+
+def test_a_missing_recording_fails_naming_where_it_is_listed(tmp_path):
+    listing = tmp_path / "drives.txt"
+    listing.write_text("# fleet\n\nnot_there\n")
+    out = tmp_path / "out"
+    (listed,) = plan(read_list(listing), out, RunConfig(), listings=read_list(listing))
+    (given,) = plan([tmp_path / "gone"], out, RunConfig())
+    outcomes = [process_recording(job) for job in (listed, given)]
+    assert [(o.status, o.category) for o in outcomes] == [(Status.FAILED, Failure.INPUT)] * 2
+    assert outcomes[0].error == (
+        f"{listing}:3: the recording {tmp_path / 'not_there'} does not exist"
+    )
+    assert outcomes[1].error == f"{tmp_path / 'gone'}: the recording does not exist"
+    assert not out.exists()
 
 
 def test_fingerprint_follows_files_and_config(tmp_path):
@@ -156,6 +189,34 @@ def test_a_batch_never_replaces_a_recording_or_a_folder_it_did_not_write(tmp_pat
     assert sorted(p.name for p in out.iterdir()) == [OUTPUT_MARKER, "drive"]
 
 
+def test_a_rerun_that_fails_before_its_outputs_keeps_the_earlier_results(tmp_path):
+    """A recording that succeeded, then fails (its RINEX cut short): the failure is listed, the
+    earlier results stay as they were with the failed run's log beside them, and no staging
+    folder is left."""
+    drive = tmp_path / "drive"
+    simulate_urban_canyon(drive, UrbanCanyonConfig(duration_s=8.0, seed=1, render=False))
+    out = tmp_path / "out"
+    assert run_batch([drive], out, workers=1).outcomes[0].status is Status.DONE
+    earlier = _mtimes(out / "drive")
+    obs = drive / "gnss" / "rover.obs"
+    obs.write_text(obs.read_text()[:1000])
+    result = run_batch([drive], out, workers=1)
+    (outcome,) = result.outcomes
+    assert (outcome.status, outcome.category) == (Status.FAILED, Failure.INPUT)
+    assert outcome.error == (
+        f"{obs}: no 'END OF HEADER' record: not a RINEX file or truncated header (the earlier "
+        f"results in {out / 'drive'} are kept; this run's log is {FAILED_LOG})"
+    )
+    assert [r["status"] for r in result.rows] == ["failed", "1 failed"]
+    now = _mtimes(out / "drive")
+    assert now.keys() - earlier.keys() == {FAILED_LOG}
+    del now[FAILED_LOG], now[OUTPUT_MARKER], earlier[OUTPUT_MARKER]
+    assert now == earlier
+    assert "END OF HEADER" in (out / "drive" / FAILED_LOG).read_text()
+    assert written_by(out / "drive", RUN) == (True, [])
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [OUTPUT_MARKER]
+
+
 def test_an_output_that_is_a_file_fails_before_any_work(tmp_path):
     out = tmp_path / "out"
     out.write_text("a file")
@@ -216,6 +277,7 @@ def test_killed_batch_resumes_without_recomputing_finished_recordings(
     result = run_batch(drives, out, workers=1, resume=True, prepare=wait_while_blocked)
     assert [o.status for o in result.outcomes] == [Status.SKIPPED, Status.DONE, Status.DONE]
     assert _mtimes(out / drives[0].name) == first
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [OUTPUT_MARKER]
     assert all((out / d.name / MARKER).exists() for d in drives)
     assert result.rows[0]["gnss_epochs"] == result.rows[1]["gnss_epochs"] > 0
 

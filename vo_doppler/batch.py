@@ -7,13 +7,21 @@ completion marker ``OUT/<name>/batch_done.json``: written atomically (a temporar
 over it) only after every output, with the fingerprint of the recording's inputs and of the
 configuration. A batch started again with ``resume=True`` skips every recording whose marker
 holds the current fingerprint and whose listed outputs still exist; a recording that was cut
-off (killed process, crash, power loss) has no marker and runs again from the start.
+off (killed process, crash, power loss) has no marker and runs again from the start (the
+staging folder it left is deleted then).
 
 ``OUT`` must be new, empty or a batch's own, and hold no recording; each ``OUT/<name>/`` is
-emptied before its recording runs, so it must be new, empty or one that ``run`` or ``batch``
-wrote, with nothing added since, and no recording (``vo_doppler.io.output_folder``). All of
-this is checked for every recording before any runs: a refused folder stops the batch with
-nothing touched.
+replaced as a whole, so it must be new, empty or one that ``run`` or ``batch`` wrote, with
+nothing added since, and no recording (``vo_doppler.io.output_folder``). All of this is checked
+for every recording before any runs: a refused folder stops the batch with nothing touched.
+
+A recording is written as ``vo-doppler run`` writes its folder: into a temporary folder beside
+``OUT/<name>/`` (``OUT/.<name>.partial-*``) that replaces it once the run has written its
+outputs, so no output of an earlier run stays beside the new ones. A run that fails before
+its outputs (unreadable input, a crash) leaves earlier results (a ``summary.json``) as they
+were and adds its log beside them as :data:`FAILED_LOG`; a folder without earlier results is
+replaced by the failed run's (its ``run.log``). A recording that does not exist fails without
+any folder, its message naming the list's file and line when it came from a list.
 
 The fingerprint hashes the package version, the configuration, the ``prepare`` step's name
 (or, for a callable object, its ``repr``: e.g. the orbits an importer uses) and, for every file
@@ -23,8 +31,8 @@ check of rsync and make: touching or replacing a file re-runs the recording; fil
 
 ``prepare``: a picklable function ``prepare(source, work_dir) -> sequence_folder`` run in the
 worker before the job, for recordings that need importing first (e.g. a raw comma2k19 segment
-turned into a sequence folder under ``work_dir`` = ``OUT/<name>/prepared``). Without it every
-source is a sequence folder.
+turned into a sequence folder under ``work_dir``: the staging folder's ``prepared``, which
+becomes ``OUT/<name>/prepared``). Without it every source is a sequence folder.
 
 Executors: ``local`` (default), a ``concurrent.futures`` process pool started with ``spawn``
 (no state inherited from the parent; each worker imports the package afresh and gives OpenCV
@@ -45,7 +53,7 @@ import shutil
 import threading
 import time
 import traceback
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
@@ -57,9 +65,12 @@ from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
 from vo_doppler.io.output_folder import (
     RUN,
+    begin_staging,
     check_output_folder,
     mark_output,
     open_output_folder,
+    remove_cut_off_staging,
+    swap_in,
 )
 from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
 from vo_doppler.io.tables import write_csv_and_parquet
@@ -71,6 +82,7 @@ from vo_doppler.report.batch_summary import (
 )
 from vo_doppler.report.json_text import json_text
 from vo_doppler.report.run_outputs import (
+    SUMMARY_FILE,
     input_warnings,
     require_tight_heading,
     result_checks,
@@ -82,6 +94,8 @@ log = logging.getLogger(__name__)
 
 MARKER = "batch_done.json"
 LOG_FILE = "run.log"
+FAILED_LOG = "failed_run.log"
+"""The log of a run that failed before its outputs, beside the earlier results it left."""
 PREPARED = "prepared"
 EXECUTORS = ("local", "ray")
 TABLE_NAME = "batch_summary"
@@ -110,6 +124,14 @@ class Failure(StrEnum):
 
 
 @dataclass(frozen=True)
+class Listing:
+    """Where a list of recordings names one: the list file and the line (from 1)."""
+
+    file: Path
+    line: int
+
+
+@dataclass(frozen=True)
 class RecordingJob:
     """Everything a worker needs for one recording (picklable)."""
 
@@ -118,6 +140,8 @@ class RecordingJob:
     config: RunConfig
     fingerprint: str
     prepare: Prepare | None = None
+    listed: Listing | None = None
+    """Where a list named the recording (for its messages), None when given directly."""
 
     @property
     def name(self) -> str:
@@ -155,16 +179,35 @@ class BatchResult:
         return 1 if self.failed else 0
 
 
-def read_list(path: Path) -> list[Path]:
-    """Recordings listed one per line (blank lines and ``#`` comments skipped); relative paths
-    are relative to the list's folder."""
+def read_list(path: Path) -> dict[Path, Listing]:
+    """The recordings listed one per line (blank lines and ``#`` comments skipped; relative
+    paths are relative to the list's folder), in order, each with where it is listed. Entries
+    naming one recording (``s1``, ``./s1``, ``s1/``, a link to it) count once, at their first
+    line, with a warning naming their lines."""
     try:
         lines = path.read_text().splitlines()
     except OSError as exc:
         reason = exc.strerror or exc
         raise InputError(f"cannot read the list of recordings: {reason}", path) from exc
-    entries = (line.split("#", 1)[0].strip() for line in lines)
-    return [path.parent / entry for entry in entries if entry]
+    spellings: dict[Path, list[tuple[int, str]]] = {}
+    listed: dict[Path, Listing] = {}
+    for number, line in enumerate(lines, start=1):
+        entry = line.split("#", 1)[0].strip()
+        if not entry:
+            continue
+        source = path.parent / entry
+        spelled = spellings.setdefault(source.resolve(), [])
+        if not spelled:
+            listed[source] = Listing(path, number)
+        spelled.append((number, entry))
+    for spelled in spellings.values():
+        if len(spelled) > 1:
+            where = ", ".join(str(number) for number, _ in spelled)
+            names = ", ".join(entry for _, entry in spelled)
+            log.warning(
+                "%s: lines %s name the same recording (%s); it runs once", path, where, names
+            )
+    return listed
 
 
 def output_names(sources: list[Path]) -> list[str]:
@@ -221,8 +264,12 @@ def finished(job: RecordingJob) -> dict | None:
     return marker
 
 
-def _run_job(job: RecordingJob) -> dict:
-    folder = job.source if job.prepare is None else job.prepare(job.source, job.out / PREPARED)
+def _run_job(job: RecordingJob, staging: Path) -> dict:
+    """Run the recording, writing its outputs into ``staging`` (which becomes ``job.out``)."""
+    if job.prepare is None:
+        folder = shown = job.source
+    else:
+        folder, shown = job.prepare(job.source, staging / PREPARED), job.out / PREPARED
     sequence, report = read_sequence_with_report(folder)
     warnings = input_warnings(sequence, report)
     for text in warnings:
@@ -230,53 +277,86 @@ def _run_job(job: RecordingJob) -> dict:
     result = run_sequence(sequence, job.config)
     checks = result_checks(sequence, report, result, warnings)
     summary = write_run_outputs(
-        sequence, result, job.config, job.out, checks, read_manifest(folder)
+        sequence, result, job.config, staging, checks, read_manifest(folder)
     )
-    require_tight_heading(result, folder, job.out)
+    require_tight_heading(result, shown, job.out)
     return summary
 
 
 def process_recording(job: RecordingJob) -> RecordingOutcome:
-    """Run one recording and write its outputs and, last, its marker; never raises for a
-    failure of the recording itself (the outcome says what failed). The recording's folder is
-    emptied first, so no output of an earlier run stays beside the new ones (a failed
-    recording's folder holds its ``run.log``); a folder that a run did not write, or that holds
-    the recording, is refused and left as it is."""
+    """Run one recording into a staging folder and, last, write its marker; never raises for a
+    failure of the recording itself (the outcome says what failed). The staging folder replaces
+    the recording's folder unless the run failed before its outputs and the folder holds
+    earlier results, which then stay, with the failed run's log beside them (module
+    docstring); a folder that a run did not write, or that holds the recording, is refused
+    and left as it is."""
     start = time.perf_counter()
+    if not job.source.exists():
+        if job.listed is None:
+            error = InputError("the recording does not exist", job.source)
+        else:
+            what = f"the recording {job.source} does not exist"
+            error = InputError(what, job.listed.file, job.listed.line)
+        return _failed(job, Failure.INPUT, str(error))
     try:
         check_output_folder(job.out, RUN, [job.source], replace=True)
+        remove_cut_off_staging(job.out)
+        staging = begin_staging(job.out, RUN, [job.source])
     except VoDopplerError as exc:
         return _failed(job, Failure.INPUT, str(exc))
-    shutil.rmtree(job.out, ignore_errors=True)
-    open_output_folder(job.out, RUN)
-    handler = logging.FileHandler(job.out / LOG_FILE, mode="w")
+    try:
+        outcome = _logged_run(job, staging, start)
+        if outcome.status is Status.FAILED and _keeps_earlier_results(job.out, staging):
+            os.replace(staging / LOG_FILE, job.out / FAILED_LOG)
+            mark_output(job.out, RUN)
+            outcome.error += (
+                f" (the earlier results in {job.out} are kept; this run's log is {FAILED_LOG})"
+            )
+        else:
+            swap_in(staging, job.out, RUN, [job.source])
+    except VoDopplerError as exc:
+        return _failed(job, Failure.INPUT, str(exc), time.perf_counter() - start)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return outcome
+
+
+def _keeps_earlier_results(out: Path, staging: Path) -> bool:
+    """Whether a failed run's ``staging`` is dropped for the earlier results in ``out``: they
+    hold a summary and the failed run wrote none (a run that wrote its outputs and then failed,
+    as one without any tightly coupled heading does, replaces them, as with ``run``)."""
+    return (out / SUMMARY_FILE).is_file() and not (staging / SUMMARY_FILE).exists()
+
+
+def _logged_run(job: RecordingJob, staging: Path, start: float) -> RecordingOutcome:
+    """Run the job with the package's log also written to ``staging``'s :data:`LOG_FILE`; a
+    failure becomes the outcome (with the error, or an internal error's traceback, logged)."""
+    handler = logging.FileHandler(staging / LOG_FILE, mode="w")
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     package_log = logging.getLogger("vo_doppler")
     package_log.addHandler(handler)
     if package_log.level == logging.NOTSET:
         package_log.setLevel(logging.INFO)
     try:
-        summary = _run_job(job)
+        summary = _run_job(job, staging)
     except VoDopplerError as exc:
         package_log.error("%s", exc)
-        outcome = _failed(job, Failure.INPUT, str(exc), time.perf_counter() - start)
+        return _failed(job, Failure.INPUT, str(exc), time.perf_counter() - start)
     except Exception as exc:
         package_log.error("%s", traceback.format_exc())
         message = f"{type(exc).__name__}: {exc}"
-        outcome = _failed(job, Failure.INTERNAL, message, time.perf_counter() - start)
-    else:
-        outcome = _done(job, summary, time.perf_counter() - start)
+        return _failed(job, Failure.INTERNAL, message, time.perf_counter() - start)
     finally:
         package_log.removeHandler(handler)
         handler.close()
-    mark_output(job.out, RUN)
-    return outcome
+    return _done(job, staging, summary, time.perf_counter() - start)
 
 
-def _done(job: RecordingJob, summary: dict, seconds: float) -> RecordingOutcome:
-    """A finished recording's outcome, after its completion marker (module docstring)."""
+def _done(job: RecordingJob, staging: Path, summary: dict, seconds: float) -> RecordingOutcome:
+    """A finished recording's outcome, after its completion marker in ``staging`` (module
+    docstring)."""
     outputs = sorted(
-        p.name for p in job.out.iterdir() if p.is_file() and p.name not in (MARKER, OUTPUT_MARKER)
+        p.name for p in staging.iterdir() if p.is_file() and p.name not in (MARKER, OUTPUT_MARKER)
     )
     marker = {
         "fingerprint": job.fingerprint,
@@ -285,7 +365,7 @@ def _done(job: RecordingJob, summary: dict, seconds: float) -> RecordingOutcome:
         "outputs": outputs,
         "summary": summary,
     }
-    _write_atomically(job.out / MARKER, json_text(marker, indent=2))
+    _write_atomically(staging / MARKER, json_text(marker, indent=2))
     return RecordingOutcome(job.name, job.source, Status.DONE, seconds, summary)
 
 
@@ -419,12 +499,22 @@ def plan(
     out: Path,
     config: RunConfig,
     prepare: Prepare | None = None,
+    listings: Mapping[Path, Listing] | None = None,
 ) -> list[RecordingJob]:
-    """One job per distinct recording (repeats dropped), each with its output folder."""
+    """One job per distinct recording (repeats dropped), each with its output folder and, from
+    ``listings`` (:func:`read_list`), where a list named it."""
     unique = list(dict.fromkeys(Path(s).resolve() for s in sources))
+    listed = {Path(s).resolve(): where for s, where in (listings or {}).items()}
     names = output_names(unique)
     return [
-        RecordingJob(source, out / name, config, fingerprint(source, config, prepare), prepare)
+        RecordingJob(
+            source,
+            out / name,
+            config,
+            fingerprint(source, config, prepare),
+            prepare,
+            listed.get(source),
+        )
         for source, name in zip(unique, names, strict=True)
     ]
 
@@ -439,6 +529,7 @@ def run_batch(
     prepare: Prepare | None = None,
     ray_address: str | None = None,
     on_outcome: Callable[[RecordingOutcome], None] | None = None,
+    listings: Mapping[Path, Listing] | None = None,
 ) -> BatchResult:
     """Run the main job on every recording and write the aggregate into ``out``
     (``batch_summary.csv``, ``.parquet``, ``.html``).
@@ -446,7 +537,8 @@ def run_batch(
     ``workers`` defaults to min(CPU cores, recordings to run); with ``resume`` the recordings
     finished by an earlier batch with the same fingerprint are skipped (their summaries still
     enter the aggregate). ``on_outcome`` is called in the calling process as each recording
-    ends (skipped ones first).
+    ends (skipped ones first). ``listings``: where a list named the recordings it named
+    (:func:`read_list`), for their messages.
     """
     if executor not in EXECUTORS:
         raise InputError(f"unknown executor {executor!r} (choose from {', '.join(EXECUTORS)})")
@@ -455,7 +547,7 @@ def run_batch(
     config = config or RunConfig()
     sources = [Path(folder) for folder in folders]
     check_output_folder(out, "batch", sources)
-    jobs = plan(sources, out, config, prepare)
+    jobs = plan(sources, out, config, prepare, listings)
     for job in jobs:
         check_output_folder(job.out, RUN, sources, replace=True)
     open_output_folder(out, "batch")

@@ -22,11 +22,14 @@ def batch_run(tmp_path_factory):
     drives = [tiny_drive(tmp_path_factory, seed) for seed in (1, 2)]
     folder = tmp_path_factory.mktemp("batch_cli")
     listing = folder / "recordings.txt"
-    listing.write_text(f"# two drives and a folder that is not there\n{drives[1]}\nmissing\n")
+    listing.write_text(
+        f"# two drives (one twice) and a folder that is not there\n{drives[1]}\nmissing\n"
+        f"{drives[1]}/\n"
+    )
     out = folder / "out"
     command = ["batch", str(drives[0]), "--list", str(listing), "-o", str(out), "--workers", "2"]
     assert main(command) == 1
-    return drives, out, command
+    return drives, out, command, listing
 
 
 def read_rows(out):
@@ -35,19 +38,20 @@ def read_rows(out):
 
 
 def test_every_recording_is_listed_with_failures_categorised(batch_run):
-    _, out, _ = batch_run
+    _, out, _, listing = batch_run
     rows = read_rows(out)
     assert [r["recording"] for r in rows] == ["drive1", "drive2", "missing", "all recordings"]
     assert [r["status"] for r in rows[:3]] == ["done", "done", "failed"]
     assert rows[2]["exit_category"] == "input-error"
-    assert "missing" in rows[2]["error"] and "sequence manifest" in rows[2]["error"]
+    missing = f"{listing}:3: the recording {listing.parent / 'missing'} does not exist"
+    assert rows[2]["error"] == missing
     assert rows[3]["status"] == "2 done, 1 failed"
     page = (out / "batch_summary.html").read_text()
-    assert "drive1/report.html" in page and "sequence manifest" in page
+    assert "drive1/report.html" in page and "does not exist" in page
 
 
 def test_rows_hold_each_runs_summary_and_the_overall_weights(batch_run):
-    _, out, _ = batch_run
+    _, out, _, _ = batch_run
     rows = read_rows(out)
     for row in rows[:2]:
         summary = json.loads((out / row["recording"] / "summary.json").read_text())
@@ -66,7 +70,7 @@ def test_rows_hold_each_runs_summary_and_the_overall_weights(batch_run):
 
 
 def test_parquet_holds_the_csv_table(batch_run):
-    _, out, _ = batch_run
+    _, out, _, _ = batch_run
     table = pq.read_table(out / "batch_summary.parquet").to_pylist()
     for from_parquet, from_csv in zip(table, read_rows(out), strict=True):
         assert from_parquet["recording"] == from_csv["recording"]
@@ -78,7 +82,7 @@ def test_parquet_holds_the_csv_table(batch_run):
 
 
 def test_outputs_are_those_of_vo_doppler_run(batch_run, tmp_path):
-    drives, out, _ = batch_run
+    drives, out, _, _ = batch_run
     alone = tmp_path / "run"
     assert main(["run", str(drives[0]), "-o", str(alone)]) == 0
     batch_files = {p.name for p in (out / "drive1").iterdir()}
@@ -89,7 +93,7 @@ def test_outputs_are_those_of_vo_doppler_run(batch_run, tmp_path):
 
 
 def test_resume_skips_finished_recordings(batch_run):
-    drives, out, command = batch_run
+    drives, out, command, _ = batch_run
     markers = {d.name: (out / d.name / MARKER).stat().st_mtime_ns for d in drives}
     assert main([*command, "--resume"]) == 1
     rows = read_rows(out)
@@ -97,9 +101,18 @@ def test_resume_skips_finished_recordings(batch_run):
     assert {d.name: (out / d.name / MARKER).stat().st_mtime_ns for d in drives} == markers
 
 
-def test_no_recordings_is_an_error(tmp_path, capsys):
-    assert main(["batch", "-o", str(tmp_path)]) == 1
-    assert "no recordings" in capsys.readouterr().err
+def test_no_recordings_is_a_usage_error_and_an_empty_list_bad_input(tmp_path, capsys):
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as stop:
+        main(["batch", "-o", str(out)])
+    assert stop.value.code == 2
+    assert "error: no recordings: give sequence folders or --list FILE" in capsys.readouterr().err
+    listing = tmp_path / "empty.txt"
+    listing.write_text("# nothing yet\n\n")
+    assert main(["batch", "--list", str(listing), "-o", str(out)]) == 1
+    message = f"{listing}: the list names no recording (only blank lines and comments)"
+    assert message in capsys.readouterr().err
+    assert not out.exists()
 
 
 @pytest.mark.shared_data

@@ -26,14 +26,18 @@ def register(subparsers, summary: str) -> None:
         "outputs into OUT/<name>/, then OUT/batch_summary.csv, .parquet and .html (per "
         "recording and overall: error per 100 m per pipeline when there is ground truth, "
         "heading availability, calibration). A failed recording is listed and the others go "
-        "on; the exit status is 1 when any failed. --resume skips the recordings an earlier "
-        "batch finished with the same inputs and options.",
+        "on (one that fails before its outputs keeps its earlier results in OUT/<name>/); the "
+        "exit status is 1 when any failed. --resume skips the recordings an earlier batch "
+        "finished with the same inputs and options.",
     )
     parser.add_argument(
         "sequences", type=Path, nargs="*", help="sequence folders (or segments: --comma2k19)"
     )
     parser.add_argument(
-        "--list", type=Path, help="file listing sequence folders, one a line ('#' comments)"
+        "--list",
+        type=Path,
+        help="file listing sequence folders, one a line ('#' comments; relative to the file's "
+        "folder); a folder listed twice runs once, with a warning naming the lines",
     )
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     parser.add_argument(
@@ -66,7 +70,7 @@ def register(subparsers, summary: str) -> None:
         "file, or a folder of SP3 files from which each segment takes the one around its time",
     )
     add_run_options(parser)
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, usage_error=parser.error)
 
 
 def _terminate(signum, frame) -> None:
@@ -74,9 +78,12 @@ def _terminate(signum, frame) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    sources = list(args.sequences) + (read_list(args.list) if args.list else [])
+    if not args.sequences and args.list is None:
+        args.usage_error("no recordings: give sequence folders or --list FILE")
+    listed = read_list(args.list) if args.list is not None else {}
+    sources = list(args.sequences) + list(listed)
     if not sources:
-        raise InputError("no recordings: give sequence folders or --list FILE")
+        raise InputError("the list names no recording (only blank lines and comments)", args.list)
     signal.signal(signal.SIGTERM, _terminate)
     console = Console(width=None if sys.stdout.isatty() else 150)
     columns = (
@@ -103,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
             prepare=None if args.comma2k19 is None else Comma2k19Import(args.comma2k19.resolve()),
             ray_address=args.ray_address,
             on_outcome=advance,
+            listings=listed,
         )
     console.print(outcome_table(result.outcomes))
     console.print(f"wrote {result.csv}, {result.parquet.name} and {result.html.name}")
