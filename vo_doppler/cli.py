@@ -106,12 +106,24 @@ def main(argv: list[str] | None = None) -> int:
         print("interrupted", file=sys.stderr)
         return 130
     except Exception as exc:  # the top-level handler: anything else is a bug
+        if isinstance(exc, OSError) and exc.filename is not None:
+            _report(args, f"error: {_refused_file_operation(exc)}")
+            return EXIT_FAILURE
         _report(
             args,
             f"internal error: {type(exc).__name__}: {exc} (a bug; rerun with --debug for the "
             "traceback)",
         )
         return EXIT_INTERNAL
+
+
+def _refused_file_operation(exc: OSError) -> str:
+    """The message of a file operation the system refused (a full disk, permissions, a place
+    that holds no files such as /proc): the environment, not a bug, so exit 1 naming the file.
+    The checks before the work catch most such places; these are the rest."""
+    reason = exc.strerror or type(exc).__name__
+    other = f" → {exc.filename2}" if exc.filename2 is not None else ""
+    return f"{exc.filename}{other}: {reason} (the system refused this file operation)"
 
 
 def _report(args: argparse.Namespace, message: str) -> None:

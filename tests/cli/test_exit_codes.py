@@ -70,6 +70,26 @@ def test_internal_error_is_3_with_one_line_and_traceback_under_debug(tum, monkey
     assert "Traceback" in err and "1 / 0" in err
 
 
+def test_a_file_operation_the_system_refuses_is_1_naming_the_file(tum, monkeypatch, capsys):
+    def disk_full(args):
+        raise OSError(28, "No space left on device", "/data/out/summary.json")
+
+    monkeypatch.setattr(eval_command, "run", disk_full)
+    assert main(["eval", str(tum), str(tum)]) == EXIT_FAILURE
+    err = capsys.readouterr().err
+    assert "/data/out/summary.json: No space left on device" in err
+    assert len(err.strip().splitlines()) == 1 and "internal error" not in err
+
+
+def test_an_os_error_without_a_file_stays_internal(tum, monkeypatch, capsys):
+    def broken(args):
+        raise OSError("bad file descriptor")
+
+    monkeypatch.setattr(eval_command, "run", broken)
+    assert main(["eval", str(tum), str(tum)]) == EXIT_INTERNAL
+    assert "internal error: OSError" in capsys.readouterr().err
+
+
 def test_bad_input_as_a_process_exits_1_and_debug_shows_the_traceback(tmp_path):
     png = tmp_path / "picture.png"
     png.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(64))
