@@ -227,4 +227,6 @@ def test_heading_cli_from_a_can_log(walk, tmp_path):
     difference = np.degrees(np.abs(wrap_angle(table.yaw_tc - walk["yaw_ref"])))[walking]
     assert table.tc_available[walking].mean() >= 0.90 and np.nanmedian(difference) <= 3.0
     assert abs(np.degrees(table.gyro_bias[walking][0] - BIAS)) <= 0.05
-    assert main([*args[:-12], "--can", str(tmp_path / "car.log")]) == 1  # --dbc etc. missing
+    with pytest.raises(SystemExit) as usage:  # --dbc etc. missing: a usage error
+        main([*args[:-12], "--can", str(tmp_path / "car.log")])
+    assert usage.value.code == 2
