@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import struct
 
 import can
 import cantools
@@ -411,3 +412,23 @@ def test_check_dbc_names_the_file_and_the_missing_or_wrong_signal(dbc_path):
         check_dbc(dbc_path, "KIN.YAW_RATE", "WHEELS.WL,WHEELS.NOPE")
     with pytest.raises(InputError, match=r"test.dbc: KIN.YAW_RATE is in rad/s, not m/s"):
         check_dbc(dbc_path, "KIN.YAW_RATE", "KIN.YAW_RATE")
+
+
+def test_a_float_signal_decoded_as_nan_skips_its_frame(tmp_path):
+    """A NaN or infinity from an IEEE float signal is no measurement: its frame is counted as
+    undecodable and left out, since a SensorSeries refuses non-finite values."""
+    dbc = tmp_path / "float.dbc"
+    dbc.write_text(
+        'VERSION ""\n\nBU_:\n\nBO_ 300 IMU: 8 Vector__XXX\n'
+        ' SG_ YAW : 0|32@1- (1,0) [-10|10] "rad/s" Vector__XXX\n\n'
+        "SIG_VALTYPE_ 300 YAW : 1;\n"
+    )
+    db = load_dbc(dbc)
+    payloads = [struct.pack("<f", v) + bytes(4) for v in (0.1, math.nan, 0.3, math.inf)]
+    frames = frames_from_arrays([1.0, 2.0, 3.0, 4.0], [300] * 4, payloads)
+    report = CanDecodeReport()
+    out = decode_signals(frames, db, parse_signal_list("IMU.YAW"), report=report)
+    series = out[SignalRef("IMU", "YAW")]
+    np.testing.assert_array_equal(series.t, [1.0, 3.0])
+    np.testing.assert_allclose(series.value, [0.1, 0.3], rtol=1e-7)
+    assert report.n_undecodable == 2 and report.undecodable_by_id == {300: 2}

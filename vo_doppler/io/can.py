@@ -476,6 +476,9 @@ class _StreamDecoder:
         try:
             decoded = message.decode(payload, decode_choices=False)
             sample = [float(decoded[ref.signal]) for ref in refs]
+            if not all(map(math.isfinite, sample)):
+                # a float signal's NaN or infinity: no measurement (a SensorSeries refuses it)
+                raise ValueError("non-finite signal value")
         except (
             cantools.database.errors.DecodeError,
             KeyError,
