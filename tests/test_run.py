@@ -9,6 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.cli import main
+from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.trajectory import read_tum
@@ -17,6 +18,7 @@ from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.run import (
     AntennaTrack,
+    RunConfig,
     _malloc_trim,
     antenna_track,
     initial_yaw_offset,
@@ -335,3 +337,19 @@ def test_a_trajectory_without_a_gnss_epoch_is_placed_by_the_nearest_one_with_a_w
     untimed = AntennaTrack(np.zeros(0), np.array([[1.0, 2.0, 3.0]]))
     own = Trajectory(t_dr, np.zeros((100, 3)), Rotation.identity(100))
     np.testing.assert_allclose(level_with_yaw(own, 0.0, untimed).positions[0], [1.0, 2.0, 3.0])
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ({"elevation_mask": 10.0}, r"RunConfig.elevation_mask = 10: .*looks like degrees"),
+        ({"elevation_mask": np.pi / 2}, r"RunConfig.elevation_mask = 1.5708"),
+        ({"dead_reckoning_rate_hz": 0.0}, "RunConfig.dead_reckoning_rate_hz = 0.0"),
+    ],
+)
+def test_run_config_refuses_values_out_of_their_domain(arguments, message):
+    """A mask of 10 (degrees for radians) left no tight heading at all, silently (QA round 3,
+    finding 3)."""
+    with pytest.raises(InputError, match=message):
+        RunConfig(**arguments)
+    assert RunConfig(elevation_mask=0.0).elevation_mask == 0.0

@@ -23,6 +23,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import logging
+import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -31,6 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.errors import InputError
 from vo_doppler.fusion.correction import (
     CorrectionConfig,
     conventional_absolute_heading,
@@ -39,7 +41,7 @@ from vo_doppler.fusion.correction import (
     usable_tight_heading,
 )
 from vo_doppler.geo import EnuFrame, wrap_angle
-from vo_doppler.gnss.pipeline import GnssVelocityResult, gnss_velocity
+from vo_doppler.gnss.pipeline import GnssVelocityResult, check_elevation_mask, gnss_velocity
 from vo_doppler.gnss.receiver_track import smoothed_track
 from vo_doppler.gnss.spp import EARTH_SURFACE_M, nearest_time
 from vo_doppler.heading.from_gnss import heading_from_gnss
@@ -84,6 +86,15 @@ class RunConfig:
     vo: VoConfig = field(default_factory=VoConfig)
     correction: CorrectionConfig = field(default_factory=CorrectionConfig)
     dead_reckoning_rate_hz: float = 20.0
+
+    def __post_init__(self) -> None:
+        """Refuse values out of their domain now (an :class:`~vo_doppler.errors.InputError`
+        naming the field), not as an empty result later: a mask of 10 (degrees given for
+        radians) removes every satellite and leaves no heading, silently."""
+        check_elevation_mask(self.elevation_mask, "RunConfig.elevation_mask")
+        rate = self.dead_reckoning_rate_hz
+        if not (isinstance(rate, (int, float, np.number)) and math.isfinite(rate) and rate > 0):
+            raise InputError(f"RunConfig.dead_reckoning_rate_hz = {rate!r}: expected a rate > 0 Hz")
 
 
 @dataclass

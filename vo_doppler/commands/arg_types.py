@@ -6,6 +6,7 @@ import argparse
 import math
 from collections.abc import Callable
 
+from vo_doppler.gnss.signals import bands_problem
 from vo_doppler.io.vehicle_limits import lever_arm_problem
 
 
@@ -98,10 +99,9 @@ def int_in(low: int, high: int | None = None) -> Callable[[str], int]:
 
 def band_digits(text: str) -> str:
     """argparse type: RINEX band digits (1-9), e.g. ``12`` for L1 and L2."""
-    if not text or set(text) - set("123456789"):
-        raise argparse.ArgumentTypeError(
-            f"expected RINEX band digits 1-9, e.g. 1 or 15, got {text!r}"
-        )
+    problem = bands_problem(text)
+    if problem:
+        raise argparse.ArgumentTypeError(problem)
     return text
 
 

@@ -3,12 +3,15 @@ velocities (no file I/O)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from vo_doppler.errors import InputError
 from vo_doppler.gnss.doppler_velocity import (
     DopplerRows,
+    doppler_codes,
     doppler_rows,
     solve_velocity,
     solve_with_fitted_noise,
@@ -17,7 +20,8 @@ from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
 from vo_doppler.gnss.receiver_track import smoothed_track
 from vo_doppler.gnss.satellite_source import StateSource
-from vo_doppler.gnss.spp import receiver_positions, solve_spp
+from vo_doppler.gnss.signals import bands_problem
+from vo_doppler.gnss.spp import EARTH_SURFACE_M, receiver_positions, solve_spp
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.observations import Observations
@@ -39,6 +43,71 @@ class GnssVelocityResult:
 
 
 RANGE_RATE_SOURCES = ("doppler", "phase")
+RECEIVER_RADIUS_M = (EARTH_SURFACE_M, 7.0e6)
+"""Distance from the Earth's centre (m) a receiver position given to :func:`gnss_velocity` must
+have: on or near the Earth, at most about 600 km up."""
+
+
+def check_elevation_mask(value: float, name: str = "elevation_mask_rad") -> float:
+    """``value`` if it is an elevation mask in [0, π/2) rad; else an :class:`InputError` naming
+    the argument ``name``. A value beyond π/2 is almost surely degrees, and the message says so:
+    a mask of 10 rad would otherwise remove every satellite and leave no solution, silently."""
+    if not (isinstance(value, (int, float, np.number)) and math.isfinite(value)):
+        raise InputError(f"{name} = {value!r}: an elevation mask is a finite number of radians")
+    if not 0.0 <= value < math.pi / 2:
+        hint = (
+            f"; {value:g} looks like degrees: {math.radians(value):.4f} rad is {value:g}°"
+            if math.pi / 2 <= value < 90.0
+            else ""
+        )
+        raise InputError(f"{name} = {value:g}: an elevation mask is in [0, π/2) rad{hint}")
+    return float(value)
+
+
+def _check_arguments(
+    obs: Observations,
+    systems: str,
+    elevation_mask_rad: float,
+    bands: str | None,
+    range_rate: str,
+    receiver_ecef: np.ndarray | None,
+) -> np.ndarray | None:
+    """An :class:`InputError` naming the first argument of :func:`gnss_velocity` out of its
+    domain (each would leave no valid epoch, without a word); ``receiver_ecef`` as an array."""
+    if range_rate not in RANGE_RATE_SOURCES:
+        raise InputError(f"range_rate = {range_rate!r}: use one of {', '.join(RANGE_RATE_SOURCES)}")
+    check_elevation_mask(elevation_mask_rad)
+    if bands is not None:
+        problem = bands_problem(bands)
+        if problem:
+            raise InputError(f"bands: {problem}")
+        if not doppler_codes(obs, systems, bands):
+            present = "".join(sorted({c[1] for c in doppler_codes(obs, systems)}))
+            raise InputError(
+                f"bands = {bands!r}: the file has no Doppler of those bands for the systems "
+                f"{systems!r} (it has bands {present or 'none'})",
+                obs.header.path,
+            )
+    if receiver_ecef is None:
+        return None
+    position = np.asarray(receiver_ecef, dtype=float)
+    if position.shape not in ((3,), (obs.epoch_time.size, 3)):
+        raise InputError(
+            f"receiver_ecef has shape {position.shape}: give one ECEF position (3,) or one per "
+            f"epoch ({obs.epoch_time.size}, 3)"
+        )
+    radius = np.linalg.norm(position.reshape(-1, 3), axis=1)
+    bad = np.flatnonzero(
+        ~np.isfinite(radius) | (radius < RECEIVER_RADIUS_M[0]) | (radius > RECEIVER_RADIUS_M[1])
+    )
+    if bad.size:
+        where = f" at epoch {bad[0]}" if position.ndim == 2 else ""
+        raise InputError(
+            f"receiver_ecef{where} is {position.reshape(-1, 3)[bad[0]]}, {radius[bad[0]]:.6g} m "
+            f"from the Earth's centre: an ECEF position (m) is {RECEIVER_RADIUS_M[0]:.3g} to "
+            f"{RECEIVER_RADIUS_M[1]:.3g} m from it"
+        )
+    return position
 
 
 def gnss_velocity(
@@ -59,9 +128,14 @@ def gnss_velocity(
     ``range_rate`` 'phase' replaces the Doppler by the carrier-phase rate (``phase_rate``);
     ``reported_sigma`` the receiver's σ of the range rates (weights where present);
     ``fit_noise`` re-solves with σ fitted to the residuals (``solve_with_fitted_noise``);
-    without it the σ models are still fitted, for the record."""
-    if range_rate not in RANGE_RATE_SOURCES:
-        raise ValueError(f"range_rate must be one of {RANGE_RATE_SOURCES}")
+    without it the σ models are still fitted, for the record.
+
+    Arguments out of their domain (an elevation mask outside [0, π/2) rad, band digits that are
+    not digits or absent from the file, a receiver position off the Earth, an unknown
+    ``range_rate``) are an :class:`InputError` naming the argument."""
+    receiver_ecef = _check_arguments(
+        obs, systems, elevation_mask_rad, bands, range_rate, receiver_ecef
+    )
     spp = solve_spp(obs, source, systems, elevation_mask_rad)
     fallback = receiver_ecef if receiver_ecef is not None else obs.header.approx_position
     position = (

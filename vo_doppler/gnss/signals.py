@@ -77,3 +77,10 @@ def wavelengths(
 def strength_code(doppler_code: str) -> str:
     """The signal-strength observable of the same signal: 'D1C' → 'S1C', 'D1' → 'S1'."""
     return "S" + doppler_code[1:]
+
+
+def bands_problem(bands: str) -> str | None:
+    """Why ``bands`` is not a string of RINEX band digits 1-9 (e.g. "1" or "15"), or None."""
+    if not isinstance(bands, str) or not bands or set(bands) - set("123456789"):
+        return f"expected RINEX band digits 1-9, e.g. 1 or 15, got {bands!r}"
+    return None
