@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from vo_doppler.errors import InputError
 from vo_doppler.model.trajectory import Trajectory
 
 ALIGNMENTS = ("none", "start", "se2", "sim3")
@@ -47,8 +48,16 @@ def se2_about_up(source: np.ndarray, target: np.ndarray, up: np.ndarray) -> tupl
     return rotation, mu_t - rotation @ mu_s, 1.0
 
 
+def check_alignment(method: str) -> str:
+    """``method`` if it names an alignment (:data:`ALIGNMENTS`), else an :class:`InputError`."""
+    if method not in ALIGNMENTS:
+        raise InputError(f"unknown alignment {method!r}; choose from {', '.join(ALIGNMENTS)}")
+    return method
+
+
 def align(estimate: Trajectory, truth: Trajectory, method: str, up: np.ndarray) -> Trajectory:
     """Return ``estimate`` aligned to ``truth`` (same length, matched rows) by ``method``."""
+    check_alignment(method)
     if method == "none":
         return estimate
     if method == "start":
@@ -56,6 +65,4 @@ def align(estimate: Trajectory, truth: Trajectory, method: str, up: np.ndarray) 
         return estimate.transformed(rel[:3, :3], rel[:3, 3])
     if method == "se2":
         return estimate.transformed(*se2_about_up(estimate.positions, truth.positions, up))
-    if method == "sim3":
-        return estimate.transformed(*umeyama(estimate.positions, truth.positions, True))
-    raise ValueError(f"unknown alignment {method!r}; choose from {', '.join(ALIGNMENTS)}")
+    return estimate.transformed(*umeyama(estimate.positions, truth.positions, True))

@@ -14,7 +14,8 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.eval.alignment import align
+from vo_doppler.errors import InputError
+from vo_doppler.eval.alignment import align, check_alignment
 from vo_doppler.eval.per_distance import too_short_for_distance_figures
 from vo_doppler.model.trajectory import Trajectory
 
@@ -173,11 +174,21 @@ def evaluate(
     alignment: str = "start",
     up: np.ndarray | None = None,
 ) -> TrajectoryErrors:
-    """All error figures of ``estimate`` against ``truth`` (rows must already correspond)."""
+    """All error figures of ``estimate`` against ``truth`` (rows must already correspond).
+
+    An :class:`InputError` names the argument when the two differ in length, hold fewer than
+    two poses, a non-finite position or orientation (it would turn every figure into NaN or
+    stop the alignment's SVD), or ``alignment`` is not one of
+    :data:`~vo_doppler.eval.alignment.ALIGNMENTS`."""
     if len(estimate) != len(truth):
-        raise ValueError(f"estimate has {len(estimate)} poses, ground truth {len(truth)}")
+        raise InputError(
+            f"estimate has {len(estimate)} poses, truth {len(truth)}: the rows must correspond "
+            "(evaluate_by_time matches them by time)"
+        )
     if len(truth) < 2:
-        raise ValueError("need at least two poses to evaluate")
+        raise InputError(f"need at least two poses to evaluate, got {len(truth)}")
+    _check_finite(estimate, "estimate")
+    _check_finite(truth, "truth")
     up = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, dtype=float)
     aligned = align(estimate, truth, alignment, up)
     path_length = truth.path_length
@@ -205,6 +216,36 @@ def evaluate(
     return result
 
 
+def _check_finite(trajectory: Trajectory, name: str) -> None:
+    """An :class:`InputError` naming ``name`` and the first pose with a non-finite position or
+    orientation."""
+    finite = np.isfinite(trajectory.positions).all(axis=1)
+    if len(trajectory):
+        finite &= np.isfinite(trajectory.orientations.as_quat()).all(axis=1)
+    bad = np.flatnonzero(~finite)
+    if bad.size:
+        k = int(bad[0])
+        raise InputError(
+            f"{name}: pose {k} (t = {trajectory.t[k]:.6f} s) has a non-finite position or "
+            f"orientation ({bad.size} such poses)"
+        )
+
+
+def _check_time_order(trajectory: Trajectory, name: str) -> None:
+    """An :class:`InputError` naming ``name`` unless its times are finite and sorted: matching
+    by time searches them."""
+    bad = np.flatnonzero(~np.isfinite(trajectory.t))
+    if bad.size:
+        raise InputError(f"{name}: t[{bad[0]}] is {trajectory.t[bad[0]]}")
+    back = np.flatnonzero(np.diff(trajectory.t) < 0)
+    if back.size:
+        k = int(back[0]) + 1
+        raise InputError(
+            f"{name}: times must be sorted to match poses by time, but t[{k}] = "
+            f"{trajectory.t[k]:.6f} s comes after t[{k - 1}] = {trajectory.t[k - 1]:.6f} s"
+        )
+
+
 def associate(estimate: Trajectory, truth: Trajectory, max_dt: float = MATCH_MAX_DT_S) -> tuple:
     """Match rows by nearest timestamp within ``max_dt``; returns the matched pair."""
     index = np.clip(np.searchsorted(truth.t, estimate.t), 1, max(len(truth) - 1, 1))
@@ -229,7 +270,12 @@ def evaluate_by_time(
 ) -> TrajectoryErrors | None:
     """:func:`evaluate` on the poses whose times match the ground truth's (:func:`associate`),
     with the share of the estimate they cover (``coverage``, and a note when part is left out);
-    None when fewer than two match (:data:`NO_MATCH` says so)."""
+    None when fewer than two match (:data:`NO_MATCH` says so). Times must be finite and
+    sorted (an :class:`InputError` naming the argument otherwise: unsorted times would match
+    wrongly or not at all, and read as :data:`NO_MATCH`)."""
+    _check_time_order(estimate, "estimate")
+    _check_time_order(truth, "truth")
+    check_alignment(alignment)
     matched, matched_truth = associate(estimate, truth, max_dt)
     if len(matched) < 2:
         return None
