@@ -1,5 +1,6 @@
 """The pipelines' evaluation over the time the ground truth covers: a truth that starts late,
-one from another time, and a path that does not move."""
+one from another time, and a path that does not move; the positions as written against the
+truth (not moved to it)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,11 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from tests.helpers.heading_table import plain_heading_table
-from vo_doppler.eval.pipelines import evaluate_pipelines, evaluation_warnings
+from vo_doppler.eval.pipelines import (
+    absolute_position_errors,
+    evaluate_pipelines,
+    evaluation_warnings,
+)
 from vo_doppler.model.trajectory import Trajectory
 
 T0 = 1000.0
@@ -102,3 +107,29 @@ def test_a_static_path_has_no_figure_per_distance():
         "(error per 100 m, KITTI segment errors, drift in % of the path) need: they are not "
         "available"
     ]
+
+
+def test_absolute_errors_are_of_the_track_as_written_inside_the_truths_span():
+    """A track 3 m east, 4 m north and 5 m up of the truth at its start, drifting 0.1 m/s
+    north and sinking 0.05 m/s; the truth covers only its first 20 s."""
+    truth = drive(T[T <= T0 + 20.0])
+    elapsed = T - T0
+    offset = np.column_stack([np.full_like(T, 3.0), 4.0 + 0.1 * elapsed, 5.0 - 0.05 * elapsed])
+    written = Trajectory(T, drive(T).positions + offset, drive(T).orientations)
+    found = absolute_position_errors(written, truth)
+    inside = elapsed[elapsed <= 20.0]
+    horizontal = np.hypot(3.0, 4.0 + 0.1 * inside)
+    assert found.poses == inside.size
+    assert found.start_horizontal_m == pytest.approx(5.0, abs=1e-9)
+    assert found.start_vertical_m == pytest.approx(5.0, abs=1e-9)
+    assert found.end_horizontal_m == pytest.approx(np.hypot(3.0, 6.0), abs=1e-9)
+    assert found.end_vertical_m == pytest.approx(4.0, abs=1e-9)
+    assert found.median_horizontal_m == pytest.approx(np.median(horizontal), abs=1e-9)
+    assert found.median_vertical_m == pytest.approx(4.5, abs=1e-9)
+    # The evaluation moves the track onto the truth: it cannot see the 5 m.
+    _, _, shown = evaluate_pipelines({"dr_gps_tc": written}, TABLE, USABLE, truth)
+    assert np.linalg.norm(shown["dr_gps_tc"].positions[0] - truth.positions[0]) < 1e-9
+
+
+def test_no_absolute_error_without_a_pose_inside_the_truths_span():
+    assert absolute_position_errors(drive(T), drive(T + 1000.0)) is None

@@ -1,7 +1,8 @@
 """Releasing a written figure: its reference cycles are collected, and when the caller froze
 what was alive, what survives the collection is frozen too (later passes skip it). The
 evaluation against a ground truth that covers part of the drive, none of it, or a path that
-does not move: every other output is written, and the summary says what was not evaluated."""
+does not move: every other output is written, and the summary says what was not evaluated. The
+map and the GeoJSON show the trajectories as written, and the summary their absolute errors."""
 
 from __future__ import annotations
 
@@ -15,7 +16,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from vo_doppler.geo import ecef_to_geodetic, geodetic_to_ecef
 from vo_doppler.io.sequence import read_sequence
+from vo_doppler.io.trajectory import read_tum
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report import run_outputs
 from vo_doppler.report.figure import new_figure
@@ -125,3 +128,48 @@ def test_a_failing_evaluation_becomes_a_warning(drive_run, tmp_path, monkeypatch
         "evaluation against the ground truth failed (RuntimeError: boom" in w
         for w in summary["warnings"]
     )
+
+
+def test_geojson_and_map_show_the_trajectories_as_written(drive_run, tmp_path):
+    sequence, _ = drive_run
+    summary = _write(drive_run, tmp_path, sequence.truth)
+    features = json.loads((tmp_path / "trajectories.geojson").read_text())["features"]
+    by_name = {f["properties"]["name"]: f["geometry"]["coordinates"] for f in features}
+    assert set(by_name) == {"truth", "dr", "dr_gps_conv", "dr_gps_tc"}
+    for name in ("dr", "dr_gps_conv", "dr_gps_tc"):
+        written = read_tum(tmp_path / f"trajectory_{name}.tum")
+        lon, lat = np.radians(np.array(by_name[name])).T
+        assert len(lon) == len(written)
+        # GeoJSON has no height: back to ENU at the written position's ellipsoidal height.
+        _, _, height = ecef_to_geodetic(sequence.enu.enu_to_ecef(written.positions))
+        east_north = sequence.enu.ecef_to_enu(geodetic_to_ecef(lat, lon, height))[:, :2]
+        # 1e-8 degrees of the written coordinates is 1.1 mm.
+        np.testing.assert_allclose(east_north, written.positions[:, :2], atol=2e-3)
+    # The absolute errors: the written track against the truth interpolated at its times.
+    truth = sequence.truth
+    for name, found in summary["absolute_position_error"].items():
+        written = read_tum(tmp_path / f"trajectory_{name}.tum")
+        inside = (written.t >= truth.t[0]) & (written.t <= truth.t[-1])
+        reference = np.column_stack(
+            [np.interp(written.t[inside], truth.t, truth.positions[:, k]) for k in range(3)]
+        )
+        difference = written.positions[inside] - reference
+        horizontal = np.linalg.norm(difference[:, :2], axis=1)
+        vertical = np.abs(difference[:, 2])
+        expected = {
+            "start_horizontal_m": horizontal[0],
+            "start_vertical_m": vertical[0],
+            "end_horizontal_m": horizontal[-1],
+            "end_vertical_m": vertical[-1],
+            "median_horizontal_m": np.median(horizontal),
+            "median_vertical_m": np.median(vertical),
+            "poses": inside.sum(),
+        }
+        # The TUM file keeps positions to 0.1 mm.
+        assert found == pytest.approx(expected, abs=2e-4), name
+    # Placed by SPP, not on the truth (evaluated, it would start at 0 m).
+    assert summary["absolute_position_error"]["dr"]["start_horizontal_m"] > 0.1
+    page = (tmp_path / "report.html").read_text()
+    assert "Positions against ground truth, as written" in page
+    assert "<g id='evaluated-tracks' display='none'>" in page
+    assert "trajectories.png" in page

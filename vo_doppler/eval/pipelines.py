@@ -201,3 +201,49 @@ def evaluation_warnings(
     short = {too_short_for_distance_figures(length) for length in lengths} - {None}
     found += sorted(short)
     return found
+
+
+@dataclass
+class AbsolutePositionErrors:
+    """Where a trajectory is, as written (georeferenced as the run placed it), against the
+    ground truth at the same times: horizontal distances and absolute height differences (m)
+    at its first and last pose inside the truth's time span, and their medians over every pose
+    inside it. The evaluation of :func:`evaluate_pipelines` moves each trajectory onto the
+    truth at its start and so cannot see this offset."""
+
+    start_horizontal_m: float
+    start_vertical_m: float
+    end_horizontal_m: float
+    end_vertical_m: float
+    median_horizontal_m: float
+    median_vertical_m: float
+    poses: int
+    """Poses inside the ground truth's time span (the ones compared)."""
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def absolute_position_errors(
+    estimate: Trajectory, truth: Trajectory
+) -> AbsolutePositionErrors | None:
+    """The position errors of ``estimate`` as it is (not moved to the truth) at its poses
+    inside the ground truth's time span, the truth's positions interpolated linearly; ``None``
+    when no pose is inside."""
+    inside = overlap(estimate, truth)
+    if inside.size == 0:
+        return None
+    t = estimate.t[inside]
+    reference = np.column_stack([np.interp(t, truth.t, truth.positions[:, k]) for k in range(3)])
+    difference = estimate.positions[inside] - reference
+    horizontal = np.hypot(difference[:, 0], difference[:, 1])
+    vertical = np.abs(difference[:, 2])
+    return AbsolutePositionErrors(
+        start_horizontal_m=float(horizontal[0]),
+        start_vertical_m=float(vertical[0]),
+        end_horizontal_m=float(horizontal[-1]),
+        end_vertical_m=float(vertical[-1]),
+        median_horizontal_m=float(np.median(horizontal)),
+        median_vertical_m=float(np.median(vertical)),
+        poses=int(inside.size),
+    )

@@ -13,14 +13,17 @@ import numpy as np
 from vo_doppler.checks import calibration_warnings, check_yaw_rate_unit, origin_warning
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
-from vo_doppler.eval.pipelines import evaluate_pipelines, evaluation_warnings
+from vo_doppler.eval.pipelines import (
+    absolute_position_errors,
+    evaluate_pipelines,
+    evaluation_warnings,
+)
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.io.sequence import InputReport
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import travelled_distance
-from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.heading_figure import build_heading_figure
 from vo_doppler.report.json_text import json_text
 from vo_doppler.report.provenance import (
@@ -73,6 +76,10 @@ FACT_FORMATS = {
     "heading_correction": ("heading correction", "{}"),
 }
 """Summary key → (label with the same words as the terminal, format with the unit)."""
+
+NOT_FACTS = ("evaluation", "absolute_position_error", "time_order", "warnings", "doppler_noise")
+"""Summary keys that are not scalars: the report shows them as tables or a list of their own,
+or (``time_order``, ``doppler_noise``) leaves them to summary.json."""
 
 
 def correction_label(config: RunConfig) -> str:
@@ -127,7 +134,7 @@ def readable_facts(summary: dict) -> dict[str, str]:
     """The summary's scalars with labels and units for people (the report's list)."""
     facts = {}
     for key, value in summary.items():
-        if key in ("evaluation", "time_order", "warnings", "doppler_noise"):
+        if key in NOT_FACTS:
             continue
         label, fmt = FACT_FORMATS.get(key, (key, "{}"))
         facts[label] = fmt.format(value)
@@ -247,10 +254,12 @@ def write_run_outputs(
         warnings=list(summary.get("warnings", [])),
     )
     truth_yaw = truth.yaw_at(table.t) if truth is not None else None
-    shown = result.trajectories
     if truth is not None:
-        shown = evaluate_into(summary, report, sequence, result, out)
-    trajectories_figure(out / "trajectories.png", shown, truth, sequence.name)
+        report.tracks = {TRUTH: truth, **result.trajectories}
+        evaluate_into(summary, report, sequence, result, out)
+    trajectories_figure(
+        out / "trajectories.png", result.trajectories, truth, f"{sequence.name}: as written"
+    )
     release_figures()
     write_geojson(out / "trajectories.geojson", report.tracks, TRACK_LABELS, sequence.enu)
     report.heading_figure = png_data_uri(
@@ -269,16 +278,22 @@ def write_run_outputs(
 
 def evaluate_into(
     summary: dict, report: RunReport, sequence: Sequence, result: RunResult, out: Path
-) -> dict[str, Trajectory]:
+) -> None:
     """Evaluate the trajectories against the sequence's ground truth into ``summary``
-    (``evaluation``, and ``warnings`` for what it could not evaluate) and ``report`` (table,
-    figures written to ``out``); return the trajectories as evaluated (moved to the truth).
+    (``absolute_position_error`` of the trajectories as written, ``evaluation`` of them moved
+    to the truth, and ``warnings`` for what it could not evaluate) and ``report`` (tables, the
+    map's layer of the trajectories as evaluated, figures written to ``out``).
 
     The evaluation never costs the run its other outputs: when it fails, the failure becomes a
-    warning and the trajectories are shown as computed."""
+    warning and the rest is written without it."""
     truth, table = sequence.truth, result.heading
     warnings = summary.setdefault("warnings", [])
     try:
+        absolute = {
+            name: found
+            for name, trajectory in result.trajectories.items()
+            if (found := absolute_position_errors(trajectory, truth)) is not None
+        }
         errors, per_100m, shown = evaluate_pipelines(
             result.trajectories, table, result.tc_usable, truth
         )
@@ -289,16 +304,19 @@ def evaluate_into(
             f"the evaluation against the ground truth failed ({type(exc).__name__}: {exc}; a "
             "bug, please report it): the trajectories and figures are written without it"
         ]
-        errors, per_100m, shown = {}, {}, dict(result.trajectories)
+        absolute, errors, per_100m, shown = {}, {}, {}, {}
     for text in found:
         log.warning("%s", text)
     warnings += found
     report.warnings += found
-    report.tracks = {TRUTH: truth, **shown}
+    if absolute:
+        summary["absolute_position_error"] = {name: e.to_dict() for name, e in absolute.items()}
+        report.absolute = absolute
     if not errors:
-        return shown
+        return
     summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
     report.errors = errors
+    report.evaluated_tracks = shown
     report.error_figure = png_data_uri(
         build_error_per_100m_figure(per_100m, sequence.name), out / "error_per_100m.png"
     )
@@ -316,7 +334,6 @@ def evaluate_into(
         + segment_lengths_note(segment_lengths_that_fit(path_length), path_length)
         + "."
     )
-    return shown
 
 
 def require_tight_heading(result: RunResult, folder: Path, out: Path) -> None:

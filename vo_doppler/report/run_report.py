@@ -19,7 +19,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from vo_doppler.eval.per_distance import MIN_PATH_M, ErrorPerDistance
-from vo_doppler.eval.pipelines import PIPELINE_LABELS, UNCORRECTED, PipelineErrors
+from vo_doppler.eval.pipelines import (
+    PIPELINE_LABELS,
+    UNCORRECTED,
+    AbsolutePositionErrors,
+    PipelineErrors,
+)
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
@@ -41,6 +46,17 @@ TABLE_COLUMNS = (
 )
 """(key of :class:`PipelineErrors`, column title with unit, format): the report's table and
 the terminal's share it (see :func:`table_cell`)."""
+
+ABSOLUTE_COLUMNS = (
+    ("start_horizontal_m", "start, horizontal [m]"),
+    ("start_vertical_m", "start, vertical [m]"),
+    ("median_horizontal_m", "median, horizontal [m]"),
+    ("median_vertical_m", "median, vertical [m]"),
+    ("end_horizontal_m", "end, horizontal [m]"),
+    ("end_vertical_m", "end, vertical [m]"),
+)
+"""(key of :class:`AbsolutePositionErrors`, column title with unit) of the report's table of
+the trajectories' positions as written against the ground truth."""
 
 GLOSSARY = (
     (
@@ -91,7 +107,9 @@ GLOSSARY = (
     ),
     (
         "final horizontal error",
-        "Horizontal distance between the last pose and the ground truth at that time.",
+        "Horizontal distance between the last pose and the ground truth at that time, the "
+        "trajectory moved to the truth at its start as for every figure of that table (the "
+        "positions as written are in the next table).",
     ),
     (
         "VO alone / + GPS",
@@ -334,11 +352,16 @@ class RunReport:
     config_rows: list[tuple[str, str]]
     facts: dict[str, str]
     tracks: dict[str, Trajectory]
-    """Trajectories as evaluated (and the ground truth under ``"truth"``), ENU metres."""
+    """Trajectories as written (and the ground truth under ``"truth"``), ENU metres."""
     enu: EnuFrame
     heading_figure: str
     """Data URI of the GNSS heading figure."""
     errors: dict[str, PipelineErrors] = field(default_factory=dict)
+    absolute: dict[str, AbsolutePositionErrors] = field(default_factory=dict)
+    """Per pipeline, its position as written against the ground truth."""
+    evaluated_tracks: dict[str, Trajectory] = field(default_factory=dict)
+    """The trajectories as evaluated (moved to the truth at their start): the map's optional
+    layer."""
     segment_note: str = ""
     error_figure: str | None = None
     heading_error_figure: str | None = None
@@ -385,6 +408,18 @@ def _errors_table(report: RunReport) -> str:
         values = row.to_dict()
         cells = "".join(
             f"<td>{table_cell(name, key, values[key], fmt)}</td>" for key, _, fmt in TABLE_COLUMNS
+        )
+        rows.append(f"<tr><td>{html.escape(label(name))}</td>{cells}</tr>")
+    return f"<table><tr><th>pipeline</th>{head}</tr>{''.join(rows)}</table>"
+
+
+def _absolute_table(absolute: dict[str, AbsolutePositionErrors]) -> str:
+    head = "".join(f"<th>{html.escape(title)}</th>" for _, title in ABSOLUTE_COLUMNS)
+    rows = []
+    for name, row in absolute.items():
+        values = row.to_dict()
+        cells = "".join(
+            f"<td>{number_or_dash(values[key], '{:.2f}')}</td>" for key, _ in ABSOLUTE_COLUMNS
         )
         rows.append(f"<tr><td>{html.escape(label(name))}</td>{cells}</tr>")
     return f"<table><tr><th>pipeline</th>{head}</tr>{''.join(rows)}</table>"
@@ -457,7 +492,20 @@ def render(report: RunReport) -> str:
             f"figures. {html.escape(report.segment_note)}</p>",
             _errors_table(report),
         ]
-    parts += ["<h2>Map</h2>", map_html(report.tracks, TRACK_LABELS, report.enu)]
+    if report.absolute:
+        parts += [
+            "<h2>Positions against ground truth, as written</h2>",
+            "<p class='note'>Where each trajectory is, as in its TUM file and on the map (placed "
+            "by the GNSS single-point positions), against the ground truth at the same time: "
+            "horizontal distance and height difference (absolute) at its first and last pose "
+            "inside the truth's time span, and the medians over all of them. The table above "
+            "moves each trajectory to the truth first and so leaves this offset out.</p>",
+            _absolute_table(report.absolute),
+        ]
+    parts += [
+        "<h2>Map</h2>",
+        map_html(report.tracks, TRACK_LABELS, report.enu, report.evaluated_tracks),
+    ]
     if report.error_figure is not None:
         parts += [
             "<h2>Error over distance</h2>",

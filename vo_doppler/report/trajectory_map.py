@@ -1,5 +1,6 @@
 """The run report's map: the trajectories as inline SVG over the local ENU plane (metres) with
-pan and zoom, an opt-in OpenStreetMap background, and the same tracks as GeoJSON (lon/lat).
+pan and zoom, an opt-in OpenStreetMap background, an opt-in layer of the trajectories as
+evaluated (moved to the ground truth at their start), and the same tracks as GeoJSON (lon/lat).
 
 Nothing is fetched unless the reader ticks the background box, so the page works offline and
 raises no console errors there.
@@ -156,18 +157,44 @@ MAP_SCRIPT = """
   };
   document.getElementById('reset').onclick = () => { view = home.slice(); update(); };
   osm.onchange = drawTiles;
+  const evaluated = document.getElementById('evaluated');
+  if (evaluated) {
+    evaluated.onchange = () => document.getElementById('evaluated-tracks')
+      .setAttribute('display', evaluated.checked ? 'inline' : 'none');
+  }
   update();
 })();
 """
 
 
-def map_html(tracks: dict[str, Trajectory], labels: dict[str, str], enu: EnuFrame) -> str:
+def _polyline(positions: np.ndarray, colour: str, width: int, dash: str, title: str) -> str:
+    dashes = f" stroke-dasharray='{dash}'" if dash else ""
+    return (
+        f"<polyline points='{_points(positions)}' fill='none' stroke='{colour}' "
+        f"stroke-width='{width}' vector-effect='non-scaling-stroke'{dashes}>"
+        f"<title>{html.escape(title)}</title></polyline>"
+    )
+
+
+def map_html(
+    tracks: dict[str, Trajectory],
+    labels: dict[str, str],
+    enu: EnuFrame,
+    evaluated: dict[str, Trajectory] | None = None,
+) -> str:
     """The map section: SVG tracks (east right, north up, metres), a legend, zoom buttons, a
-    scale bar and the opt-in OpenStreetMap background, with its script."""
+    scale bar and the opt-in OpenStreetMap background, with its script. ``tracks`` are drawn as
+    written; ``evaluated`` (the same pipelines moved to the ground truth for the evaluation),
+    when given, is a hidden layer of dotted lines that a box shows, so that the two are never
+    mistaken for each other."""
     shown = {name: t for name, t in tracks.items() if len(t) > 1}
     if not shown:
         return "<p>No trajectory to draw.</p>"
-    every = np.vstack([t.positions[:, :2] for t in shown.values()])
+    moved = {name: t for name, t in (evaluated or {}).items() if len(t) > 1}
+    every = np.vstack([t.positions[:, :2] for t in (*shown.values(), *moved.values())])
+    every = every[np.isfinite(every).all(axis=1)]
+    if not every.size:
+        return "<p>No trajectory to draw (no finite position).</p>"
     low, high = every.min(axis=0), every.max(axis=0)
     margin = 0.05 * max(float(np.max(high - low)), 10.0)
     x, y = low[0] - margin, -high[1] - margin
@@ -176,30 +203,52 @@ def map_html(tracks: dict[str, Trajectory], labels: dict[str, str], enu: EnuFram
     lines, legend = [], []
     for name, trajectory in shown.items():
         colour = COLOURS.get(name, "#9467bd")
-        dash = " stroke-dasharray='6 4'" if name == TRUTH else ""
-        wide = 4 if name == TRUTH else 2
         lines.append(
-            f"<polyline points='{_points(trajectory.positions)}' fill='none' "
-            f"stroke='{colour}' stroke-width='{wide}' vector-effect='non-scaling-stroke'"
-            f"{dash}><title>{html.escape(labels.get(name, name))}</title></polyline>"
+            _polyline(
+                trajectory.positions,
+                colour,
+                4 if name == TRUTH else 2,
+                "6 4" if name == TRUTH else "",
+                labels.get(name, name),
+            )
         )
         legend.append(
             f"<span class='key'><span class='swatch' style='background:{colour}'></span>"
             f"{html.escape(labels.get(name, name))}</span>"
         )
+    if moved:
+        lines.append("<g id='evaluated-tracks' display='none'>")
+        lines += [
+            _polyline(
+                trajectory.positions,
+                COLOURS.get(name, "#9467bd"),
+                2,
+                "1 3",
+                f"{labels.get(name, name)}, as evaluated (moved to the ground truth at its start)",
+            )
+            for name, trajectory in moved.items()
+        ]
+        lines.append("</g>")
     start = next(iter(shown.values())).positions[0]
     lines.append(
         f"<circle cx='{start[0]:.2f}' cy='{-start[1]:.2f}' r='{0.012 * width:.2f}' "
         "fill='black'><title>start</title></circle>"
     )
     legend.append("<span class='key'>● start</span>")
+    evaluated_box = (
+        " <label><input type='checkbox' id='evaluated'> also the trajectories as evaluated "
+        "(dotted: each moved to the ground truth at its start, VO and DR alone also turned to "
+        "its heading, as the error table compares them)</label>"
+        if moved
+        else ""
+    )
     return (
         "<div class='map-tools'><button id='zoom-in' type='button'>zoom in</button> "
         "<button id='zoom-out' type='button'>zoom out</button> "
         "<button id='reset' type='button'>reset view</button> "
         "<label><input type='checkbox' id='osm'> OpenStreetMap background "
         "(loads map tiles from tile.openstreetmap.org when ticked; © OpenStreetMap "
-        "contributors)</label></div>"
+        f"contributors)</label>{evaluated_box}</div>"
         f"<svg id='map' viewBox='{x:.2f} {y:.2f} {width:.2f} {height:.2f}' "
         f"data-lat='{float(np.degrees(lat[0])):.8f}' data-lon='{float(np.degrees(lon[0])):.8f}' "
         "preserveAspectRatio='xMidYMid meet' role='img' "
@@ -208,7 +257,9 @@ def map_html(tracks: dict[str, Trajectory], labels: dict[str, str], enu: EnuFram
         + "".join(legend)
         + "<span class='key'>scale: <span id='scale' class='scalebar'></span></span></div>"
         "<p class='note'>East to the right, north up, in metres from the recording's local "
-        "origin. Drag to pan, scroll or use the buttons to zoom. The tracks are also in "
-        "<code>trajectories.geojson</code> (longitude/latitude).</p>"
+        "origin. Drag to pan, scroll or use the buttons to zoom. The trajectories are drawn as "
+        "written (their TUM files, placed by the GNSS positions); the same tracks are in "
+        "<code>trajectories.geojson</code> (longitude/latitude) and, as a static picture, in "
+        "<code>trajectories.png</code>.</p>"
         f"<script>{MAP_SCRIPT}</script>"
     )
