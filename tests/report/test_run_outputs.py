@@ -2,7 +2,8 @@
 what was alive, what survives the collection is frozen too (later passes skip it). The
 evaluation against a ground truth that covers part of the drive, none of it, or a path that
 does not move: every other output is written, and the summary says what was not evaluated. The
-map and the GeoJSON show the trajectories as written, and the summary their absolute errors."""
+map and the GeoJSON show the trajectories as written, and the summary their absolute errors.
+Every scalar of the summary has a label for the report."""
 
 from __future__ import annotations
 
@@ -12,19 +13,30 @@ import html
 import json
 import weakref
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from vo_doppler.geo import ecef_to_geodetic, geodetic_to_ecef
-from vo_doppler.io.sequence import read_sequence
+from vo_doppler.io.sequence import InputReport, read_sequence
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report import run_outputs
 from vo_doppler.report.figure import new_figure
-from vo_doppler.report.run_outputs import SUMMARY_FILE, release_figures, write_run_outputs
+from vo_doppler.report.run_outputs import (
+    FACT_FORMATS,
+    NOT_FACTS,
+    SUMMARY_FILE,
+    readable_facts,
+    release_figures,
+    result_checks,
+    summarise,
+    write_run_outputs,
+)
 from vo_doppler.run import RunConfig, run_sequence
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+from vo_doppler.vo.odometry import VoStats
 
 
 def _tracked(value: object) -> bool:
@@ -173,3 +185,37 @@ def test_geojson_and_map_show_the_trajectories_as_written(drive_run, tmp_path):
     assert "Positions against ground truth, as written" in page
     assert "<g id='evaluated-tracks' display='none'>" in page
     assert "trajectories.png" in page
+
+
+def test_every_summary_key_has_a_label_and_units(drive_run, tmp_path):
+    """Every key a run's summary can hold, with and without a camera: a new key without a
+    label in ``FACT_FORMATS`` would show in the report as its raw name."""
+    sequence, result = drive_run
+    checks = result_checks(sequence, InputReport(), result, [])
+    summary = write_run_outputs(sequence, result, RunConfig(), tmp_path, checks)
+    with_camera = dataclasses.replace(
+        result, vo=SimpleNamespace(stats=VoStats(frames=10, wall_seconds=2.0))
+    )
+    keys = set(summary) | set(summarise(with_camera))
+    assert {"camera", "vo_frames", "can_clock_residual_offset_s", "evaluation"} <= keys
+    assert not keys - set(FACT_FORMATS) - set(NOT_FACTS)
+    assert not [label for label, _ in FACT_FORMATS.values() if "_" in label]
+
+
+def test_facts_read_not_available_for_missing_figures_and_round_the_rest():
+    facts = readable_facts(
+        {
+            "can_clock_residual_offset_s": -0.007521175152330629,
+            "grade_prior_sigma_median": 0.05,
+            "vo_fps": float("nan"),
+            "final_wheel_scale": None,
+        }
+    )
+    assert facts == {
+        "wheel-speed clock offset left (CAN/vehicle signals against the GNSS Doppler speed)": (
+            "-0.008 s"
+        ),
+        "road-grade prior σ, median (rise over run)": "5.0%",
+        "VO speed": "not available",
+        "wheel scale at the end": "not available",
+    }

@@ -68,14 +68,23 @@ FACT_FORMATS = {
         "road-grade prior from the forward accelerometer",
         "{:.1%}",
     ),
+    "grade_prior_sigma_median": ("road-grade prior σ, median (rise over run)", "{:.1%}"),
     "final_wheel_scale": ("wheel scale at the end", "{:.4f}"),
     "final_gyro_bias_dps": ("gyro bias at the end", "{:+.3f} deg/s"),
     "vo_frames": ("VO frames", "{:d}"),
     "vo_flagged_frames": ("VO frames flagged", "{:d}"),
     "vo_fps": ("VO speed", "{:.1f} frames/s"),
+    "camera": ("camera", "{}"),
     "heading_correction": ("heading correction", "{}"),
+    "can_clock_residual_offset_s": (
+        "wheel-speed clock offset left (CAN/vehicle signals against the GNSS Doppler speed)",
+        "{:+.3f} s",
+    ),
 }
-"""Summary key → (label with the same words as the terminal, format with the unit)."""
+"""Summary key → (label with the same words as the terminal, format with the unit). Every
+scalar key of the summary has one (a test checks), so that the report shows no raw key."""
+
+NOT_AVAILABLE = "not available"
 
 NOT_FACTS = ("evaluation", "absolute_position_error", "time_order", "warnings", "doppler_noise")
 """Summary keys that are not scalars: the report shows them as tables or a list of their own,
@@ -131,13 +140,15 @@ def doppler_noise_summary(result: RunResult) -> dict:
 
 
 def readable_facts(summary: dict) -> dict[str, str]:
-    """The summary's scalars with labels and units for people (the report's list)."""
+    """The summary's scalars with labels and units for people (the report's list); a figure
+    the run could not compute (None, NaN) reads "not available"."""
     facts = {}
     for key, value in summary.items():
         if key in NOT_FACTS:
             continue
         label, fmt = FACT_FORMATS.get(key, (key, "{}"))
-        facts[label] = fmt.format(value)
+        missing = value is None or (isinstance(value, float) and not np.isfinite(value))
+        facts[label] = NOT_AVAILABLE if missing else fmt.format(value)
     return facts
 
 
