@@ -1,5 +1,5 @@
 """The run report's pieces on exact cases: headline, table cells, worst epochs, the map and
-GeoJSON, the configuration in degrees, synthetic vs recorded."""
+GeoJSON, the configuration in degrees, synthetic vs recorded, the definitions."""
 
 from __future__ import annotations
 
@@ -12,12 +12,14 @@ from tests.conftest import REPO_ROOT
 from tests.helpers.heading_table import plain_heading_table
 from vo_doppler.eval.pipelines import PipelineErrors
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
+from vo_doppler.gnss.doppler_velocity import MIN_SATELLITES
 from vo_doppler.io.sequence import read_manifest, read_sequence
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.heading_figure import build_heading_figure, continuous_course_deg
 from vo_doppler.report.provenance import config_rows, describe_data, is_synthetic, main_settings
 from vo_doppler.report.run_report import (
+    GLOSSARY,
     build_heading_error_figure,
     heading_error_over_time,
     headline,
@@ -137,6 +139,23 @@ def test_map_is_inline_svg_and_loads_no_tile_until_asked():
     assert page.count("<polyline") == 2 and "<svg id='map'" in page
     assert "tile.openstreetmap.org" in page and "<image" not in page
     assert "if (!osm.checked) return;" in page
+
+
+def test_the_evaluated_tracks_are_a_hidden_layer_of_their_own():
+    moved = _track()
+    moved.positions += 5.0
+    page = map_html({"truth": _track(), "vo": _track()}, {"vo": "VO alone"}, ENU, {"vo": moved})
+    layer = page[page.index("<g id='evaluated-tracks' display='none'>") :]
+    assert layer.count("<polyline") == 1 and "VO alone, as evaluated" in layer
+    assert page.count("<polyline") == 3 and "id='evaluated'" in page
+    plain = map_html({"vo": _track()}, {"vo": "VO alone"}, ENU)
+    assert "<g id='evaluated-tracks'" not in plain and "id='evaluated'" not in plain
+
+
+def test_the_definition_of_available_needs_the_satellites_the_velocity_test_needs():
+    """A conventional velocity is verified with more than ``MIN_SATELLITES`` satellites."""
+    available = dict(GLOSSARY)["available"]
+    assert MIN_SATELLITES == 4 and "(5 or more satellites" in available
 
 
 def test_long_tracks_are_thinned_keeping_the_last_pose():

@@ -26,6 +26,7 @@ from vo_doppler.eval.pipelines import (
     PipelineErrors,
 )
 from vo_doppler.geo import EnuFrame, wrap_angle
+from vo_doppler.gnss.doppler_velocity import MIN_SATELLITES
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.figure import new_figure, tight_layout
@@ -87,7 +88,9 @@ GLOSSARY = (
     (
         "available",
         "The estimator produced a heading at the epoch. Conventional: a Doppler velocity "
-        "solution (4 or more satellites) while moving. Tightly coupled: the [TK18] window "
+        f"solution that passed its tests ({MIN_SATELLITES + 1} or more satellites after fault "
+        "exclusion, one more than the unknowns so that the χ² test can check them) while "
+        "moving. Tightly coupled: the [TK18] window "
         "solver (Doppler of any number of satellites + gyro + wheel speed over a 2 s window) "
         "returned a heading.",
     ),
