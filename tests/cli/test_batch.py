@@ -1,6 +1,6 @@
 """``vo-doppler batch`` end to end on tiny generated drives: each recording's outputs as
 ``vo-doppler run`` writes them, a failure listed with its category, the aggregate as CSV,
-Parquet and HTML, the exit status, and ``--resume``."""
+Parquet and HTML with each run's warnings, the exit status, and ``--resume``."""
 
 from __future__ import annotations
 
@@ -10,11 +10,13 @@ import json
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+from rich.console import Console
 
 from tests.conftest import require_shared
 from tests.helpers.batch import tiny_drive
-from vo_doppler.batch import MARKER
+from vo_doppler.batch import MARKER, RecordingOutcome, Status
 from vo_doppler.cli import main
+from vo_doppler.commands.batch_command import outcome_table
 
 
 @pytest.fixture(scope="module")
@@ -67,6 +69,22 @@ def test_rows_hold_each_runs_summary_and_the_overall_weights(batch_run):
     available = np.array([float(r["tight_heading_availability"]) for r in rows[:2]])
     expected = np.sum(available * epochs) / np.sum(epochs)
     assert float(rows[3]["tight_heading_availability"]) == pytest.approx(expected, rel=1e-12)
+
+
+def test_rows_and_the_terminal_table_carry_each_runs_warnings(batch_run):
+    _, out, _, _ = batch_run
+    rows = read_rows(out)
+    for row in rows[:2]:
+        warnings = json.loads((out / row["recording"] / "summary.json").read_text())["warnings"]
+        assert int(row["warnings"]) == len(warnings)
+        assert row["warning_texts"] == " | ".join(warnings)
+    assert int(rows[3]["warnings"]) == sum(int(r["warnings"]) for r in rows[:2])
+    warned = RecordingOutcome("kmh", out, Status.DONE, 1.0, {"warnings": ["wheel scale: 0.275"]})
+    clean = RecordingOutcome("clean", out, Status.DONE, 1.0, {"warnings": []})
+    console = Console(width=200, record=True)
+    console.print(outcome_table([warned, clean]))
+    text = console.export_text()
+    assert "│ kmh       │ done, 1 warning │" in text and "│ clean     │ done            │" in text
 
 
 def test_parquet_holds_the_csv_table(batch_run):

@@ -16,6 +16,7 @@ from vo_doppler.commands.arg_types import positive_int
 from vo_doppler.commands.run_command import add_run_options, run_config
 from vo_doppler.errors import InputError
 from vo_doppler.io.comma2k19_import import Comma2k19Import
+from vo_doppler.report.batch_summary import summary_warnings, warnings_status
 
 
 def register(subparsers, summary: str) -> None:
@@ -25,10 +26,10 @@ def register(subparsers, summary: str) -> None:
         description="Run what 'vo-doppler run' runs on every recording, writing each one's "
         "outputs into OUT/<name>/, then OUT/batch_summary.csv, .parquet and .html (per "
         "recording and overall: error per 100 m per pipeline when there is ground truth, "
-        "heading availability, calibration). A failed recording is listed and the others go "
-        "on (one that fails before its outputs keeps its earlier results in OUT/<name>/); the "
-        "exit status is 1 when any failed. --resume skips the recordings an earlier batch "
-        "finished with the same inputs and options.",
+        "heading availability, calibration, the run's warnings). A failed recording is listed "
+        "and the others go on (one that fails before its outputs keeps its earlier results in "
+        "OUT/<name>/); the exit status is 1 when any failed. --resume skips the recordings an "
+        "earlier batch finished with the same inputs and options.",
     )
     parser.add_argument(
         "sequences", type=Path, nargs="*", help="sequence folders (or segments: --comma2k19)"
@@ -123,8 +124,8 @@ def outcome_table(outcomes: list[RecordingOutcome]) -> Table:
         table.add_column(column, justify="right" if column == "time [s]" else "left")
     for o in outcomes:
         category = "" if o.category is None else o.category.value
-        style = "red" if o.status is Status.FAILED else None
-        table.add_row(
-            o.name, o.status.value, f"{o.seconds:.1f}", category, o.error or "", style=style
-        )
+        warnings = len(summary_warnings(o.summary))
+        style = "red" if o.status is Status.FAILED else "yellow" if warnings else None
+        status = warnings_status(o.status.value, warnings)
+        table.add_row(o.name, status, f"{o.seconds:.1f}", category, o.error or "", style=style)
     return table
