@@ -350,10 +350,44 @@ def evaluate_into(
 def require_tight_heading(result: RunResult, folder: Path, out: Path) -> None:
     """A run whose tightly coupled heading was unavailable at every epoch failed: raise the
     project's error naming the recording (after its outputs were written to ``out``, to show
-    why)."""
-    if not result.heading.tc_available.any():
-        raise InputError(
-            "the tightly coupled heading was unavailable at every epoch (the other results are "
-            f"in {out})",
-            folder,
+    why). A heading is a direction of travel: when the vehicle never moved (:func:`standstill`)
+    the message says so rather than blame the heading."""
+    if result.heading.tc_available.any():
+        return
+    kept = f"(the other results are in {out})"
+    still = standstill(result)
+    if still is not None:
+        raise InputError(f"{still}, so no Doppler heading exists {kept}", folder)
+    raise InputError(
+        f"the tightly coupled heading was unavailable at every epoch {kept}",
+        folder,
+    )
+
+
+def standstill(result: RunResult, config: RunConfig | None = None) -> str | None:
+    """Why the drive has no heading when the wheel speed never reaches the tightly coupled
+    heading's minimum speed (``config.heading.tight.min_speed_mps``; the default config when
+    None), in words: the vehicle never moved, with both speeds' maxima, or the GNSS Doppler
+    speed contradicting the wheels (above the conventional heading's minimum at valid epochs);
+    None when the wheels did move."""
+    heading = (config or RunConfig()).heading
+    wheel_limit, gnss_limit = heading.tight.min_speed_mps, heading.conventional_min_speed_mps
+    wheel = np.abs(result.calibrated_speed.value)
+    wheel_max = float(np.max(wheel)) if wheel.size else 0.0
+    if wheel_max >= wheel_limit:
+        return None
+    velocity = result.gnss.velocity
+    gnss = np.hypot(velocity.velocity_enu[:, 0], velocity.velocity_enu[:, 1])[velocity.valid]
+    gnss_max = float(np.max(gnss)) if gnss.size else None
+    wheels = f"the wheel speed stays below {wheel_limit:g} m/s throughout (at most {wheel_max:.2f})"
+    if gnss_max is None:
+        return f"the vehicle never moved by its wheels: {wheels}; no GNSS Doppler speed is valid"
+    if gnss_max < gnss_limit:
+        return (
+            f"the vehicle never moved: {wheels} and the GNSS Doppler speed below {gnss_limit:g} "
+            f"m/s at every valid epoch (at most {gnss_max:.2f})"
         )
+    return (
+        f"the wheels never moved: {wheels}, while the GNSS Doppler speed reaches "
+        f"{gnss_max:.2f} m/s (is the wheel-speed signal, or its unit, right?)"
+    )
