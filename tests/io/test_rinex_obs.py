@@ -192,6 +192,45 @@ def test_glonass_time_system_is_converted_to_gps(tmp_path):
     assert read_obs(path).epoch_time[0] == T0 + 18.0
 
 
+@pytest.mark.parametrize(
+    ("version", "time_system", "allowed"),
+    [("2.10", "UTC", "GPS, GLO"), ("2.10", "GAL", "GPS, GLO"), ("2.11", "BDT", "GPS, GLO, GAL")],
+)
+def test_a_time_system_the_rinex2_version_lacks_is_read_as_gps_and_named(
+    tmp_path, version, time_system, allowed
+):
+    header = rinex2_header(["C1"]).replace("     2.11 ", f"     {version} ", 1)
+    header = header.replace("3.0000000     GPS", f"3.0000000     {time_system}")
+    path = tmp_path / "utc.10o"
+    path.write_text(header + rinex2_epoch(" 10  1  6  5 57  3.0000000", [("G05", [field(2e7)])]))
+    obs = read_obs(path)
+    assert obs.header.time_system == "GPS"
+    assert obs.epoch_time[0] == calendar_to_gps_seconds(2010, 1, 6, 5, 57, 3.0)
+    assert obs.problems == (
+        f"{path}:3: TIME OF FIRST OBS time system {time_system!r} is not one of RINEX "
+        f"{version}'s ({allowed}): the epochs are read as GPS time (UTC epochs would be the "
+        "leap seconds behind)",
+    )
+
+
+def test_the_time_systems_each_version_defines_raise_no_problem(tmp_path):
+    header = rinex2_header(["C1"], system="M").replace("3.0000000     GPS", "3.0000000     GAL")
+    path = tmp_path / "gal.10o"
+    path.write_text(header + rinex2_epoch(" 10  1  6  5 57  3.0000000", [("E05", [field(2e7)])]))
+    assert read_obs(path).problems == ()
+    text = rinex3_header({"C": ["C2I"]}, time_system="BDT")
+    path = tmp_path / "bdt.24o"
+    path.write_text(text + rinex3_epoch("2024 06 24 08 20  0.0000000", [("C11", [field(1.0)])]))
+    obs = read_obs(path)
+    assert obs.problems == () and obs.epoch_time[0] == T0 + 14.0
+    path.write_text(
+        rinex3_header({"G": ["C1C"]}, time_system="UTC")
+        + rinex3_epoch("2024 06 24 08 20  0.0000000", [("G01", [field(1.0)])])
+    )
+    (problem,) = read_obs(path).problems
+    assert "time system 'UTC' is not one of RINEX 3.04's (GPS, GLO, GAL, QZS, BDT, IRN)" in problem
+
+
 def test_rinex2_mixed_file_events_and_blank_system_letter(tmp_path):
     types = ["C1", "D1"]
     g = [("  5", [field(2.0e7), field(-100.0)]), ("R 3", [field(2.1e7), field(200.0)])]

@@ -136,9 +136,7 @@ def _parse_header(path: Path, lines: list[str], problems: list[str]) -> ObsHeade
     if leap is not None and not (leap == int(leap) and 0 <= leap < 100):
         add_problem(problems, path, values["LEAP SECONDS"][0], f"LEAP SECONDS {leap:g} ignored")
         leap = None
-    time_system = values.get("TIME OF FIRST OBS", (0, " " * 60))[1][48:51].strip()
-    if not time_system:
-        time_system = {"R": "GLO", "E": "GAL", "C": "BDT", "J": "QZS"}.get(system, "GPS")
+    time_system = _time_system(path, values, version, system, problems)
     return ObsHeader(
         path=path,
         version=version,
@@ -154,6 +152,38 @@ def _parse_header(path: Path, lines: list[str], problems: list[str]) -> ObsHeade
         signal_strength_unit=values.get("SIGNAL STRENGTH UNIT", (0, ""))[1].strip(),
         n_lines=len(lines),
     )
+
+
+def time_systems(version: float) -> tuple[str, ...]:
+    """The time systems TIME OF FIRST OBS may name in a file of ``version``: RINEX 2.10 GPS and
+    GLO, 2.11 also GAL, RINEX 3 and 4 also QZS, BDT and IRN."""
+    if version < 2.11:
+        return ("GPS", "GLO")
+    if version < 3:
+        return ("GPS", "GLO", "GAL")
+    return ("GPS", "GLO", "GAL", "QZS", "BDT", "IRN")
+
+
+def _time_system(path: Path, values, version: float, system: str, problems) -> str:
+    """The epochs' time system from TIME OF FIRST OBS (blank: the file's satellite system's);
+    one the version does not define (``UTC`` in a 2.10 file) is read as GPS, with a problem
+    naming the line."""
+    number, line = values.get("TIME OF FIRST OBS", (0, " " * 60))
+    time_system = line[48:51].strip()
+    if not time_system:
+        return {"R": "GLO", "E": "GAL", "C": "BDT", "J": "QZS"}.get(system, "GPS")
+    allowed = time_systems(version)
+    if time_system not in allowed:
+        add_problem(
+            problems,
+            path,
+            number,
+            f"TIME OF FIRST OBS time system {time_system!r} is not one of RINEX {version:.2f}'s "
+            f"({', '.join(allowed)}): the epochs are read as GPS time (UTC epochs would be the "
+            "leap seconds behind)",
+        )
+        return "GPS"
+    return time_system
 
 
 def _glonass_slots(path: Path, number: int, line: str, glonass: dict[int, int], problems) -> None:
