@@ -180,7 +180,7 @@ def result_checks(
         log.warning("%s", warning)
     return {
         "warnings": warnings + file_problems(inputs) + found,
-        "can_clock_residual_offset_s": None if estimate is None else estimate.residual_s,
+        "can_clock_residual_offset_s": estimate.residual_s,
         "time_order": {r.sensor: r.as_dict() for r in report.time_order},
     }
 
