@@ -13,6 +13,7 @@ from vo_doppler.commands.help_format import (
     joined_dash_choices,
     shown_default,
 )
+from vo_doppler.io.trajectory import AUTO_FORMAT_RULE
 
 
 def _parsers(parser: argparse.ArgumentParser, name: str = "vo-doppler"):
@@ -69,6 +70,14 @@ def test_the_walk_covers_the_options_the_issue_names():
         "vo-doppler correct"
     ]
     assert "--format" in options["vo-doppler eval"]
+
+
+@pytest.mark.parametrize("name", ["vo-doppler correct", "vo-doppler eval"])
+def test_trajectory_format_help_states_the_rule_auto_follows(name):
+    """The help said "from the extension and the number of columns"; only the columns count."""
+    (action,) = [a for a in _options(PARSERS[name]) if "--format" in a.option_strings]
+    assert f"auto: {AUTO_FORMAT_RULE}; the extension is not used" in action.help
+    assert "from the extension" not in action.help
 
 
 def test_defaults_are_shown_as_typed():

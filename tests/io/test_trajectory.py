@@ -9,7 +9,15 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
-from vo_doppler.io.trajectory import read_kitti, read_trajectory, read_tum, write_kitti, write_tum
+from vo_doppler.io.trajectory import (
+    AUTO_FORMAT_RULE,
+    read_kitti,
+    read_trajectory,
+    read_tum,
+    trajectory_format,
+    write_kitti,
+    write_tum,
+)
 from vo_doppler.model.trajectory import Trajectory
 
 finite = st.floats(-1e4, 1e4, allow_nan=False)
@@ -60,3 +68,18 @@ def test_format_sniffing_rejects_unknown(tmp_path):
     path.write_text("1 2 3\n")
     with pytest.raises(InputError, match="first row has 3 fields"):
         read_trajectory(path)
+
+
+@pytest.mark.parametrize("name", ["poses.kitti", "poses.tum", "poses.txt", "poses"])
+def test_auto_format_goes_by_the_columns_whatever_the_extension(tmp_path, name):
+    """TUM and KITTI files are both commonly .txt: the column count (8 or 12) decides, as
+    ``--format auto``'s help says (AUTO_FORMAT_RULE)."""
+    tum, kitti = tmp_path / "tum", tmp_path / "kitti"
+    tum.mkdir(), kitti.mkdir()
+    (tum / name).write_text("5.0 1 2 3 0 0 0 1\n6.0 4 5 6 0 0 0 1\n")
+    (kitti / name).write_text("1 0 0 7 0 1 0 8 0 0 1 9\n")
+    assert trajectory_format(tum / name) == "tum"
+    assert trajectory_format(kitti / name) == "kitti"
+    np.testing.assert_array_equal(read_trajectory(tum / name).t, [5.0, 6.0])
+    np.testing.assert_array_equal(read_trajectory(kitti / name).positions, [[7.0, 8.0, 9.0]])
+    assert "columns" in AUTO_FORMAT_RULE and "extension" not in AUTO_FORMAT_RULE

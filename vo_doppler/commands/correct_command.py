@@ -21,6 +21,8 @@ from vo_doppler.fusion.correction import (
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.trajectory import (
+    AUTO_FORMAT_RULE,
+    TRAJECTORY_FORMATS,
     read_trajectory,
     trajectory_format,
     write_kitti,
@@ -57,9 +59,9 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--calib", help="camera calibration (YAML with T_vehicle_camera)")
     parser.add_argument(
         "--format",
-        choices=("auto", "tum", "kitti"),
+        choices=TRAJECTORY_FORMATS,
         default="auto",
-        help="trajectory file format (auto: from the extension and the number of columns)",
+        help=f"trajectory file format (auto: {AUTO_FORMAT_RULE}; the extension is not used)",
     )
     parser.add_argument("--times", help="timestamps file for a KITTI trajectory (one per line)")
     parser.add_argument(

@@ -20,7 +20,7 @@ from vo_doppler.eval.metrics import (
     evaluate_by_time,
     segment_lengths_note,
 )
-from vo_doppler.io.trajectory import read_trajectory
+from vo_doppler.io.trajectory import AUTO_FORMAT_RULE, TRAJECTORY_FORMATS, read_trajectory
 from vo_doppler.report.json_text import json_text
 from vo_doppler.report.run_report import number_or_dash
 
@@ -42,9 +42,9 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("ground_truth", help="ground-truth trajectory (TUM or KITTI)")
     parser.add_argument(
         "--format",
-        choices=("auto", "tum", "kitti"),
+        choices=TRAJECTORY_FORMATS,
         default="auto",
-        help="trajectory file format (auto: from the extension and the number of columns)",
+        help=f"trajectory file format (auto: {AUTO_FORMAT_RULE}; the extension is not used)",
     )
     parser.add_argument(
         "--align",

@@ -94,8 +94,16 @@ def write_kitti(path: str | Path, trajectory: Trajectory) -> None:
     np.savetxt(path, rows, fmt="%.9e")
 
 
+TRAJECTORY_FORMATS = ("auto", "tum", "kitti")
+"""The ``fmt`` values of :func:`read_trajectory` (and of the commands' ``--format``)."""
+AUTO_FORMAT_RULE = "by the number of columns of the first data row, TUM 8, KITTI 12"
+"""How ``auto`` tells the format. Not by the extension: TUM and KITTI files are both commonly
+``.txt`` (KITTI's ``00.txt``, TUM's ``groundtruth.txt``), while the column counts never
+overlap."""
+
+
 def read_trajectory(path: str | Path, fmt: str = "auto", times=None) -> Trajectory:
-    """Read TUM or KITTI; ``auto`` picks by the number of columns of the first data row."""
+    """Read TUM or KITTI; ``auto`` picks :data:`AUTO_FORMAT_RULE`."""
     path = Path(path)
     fmt = trajectory_format(path, fmt)
     if fmt == "tum":
