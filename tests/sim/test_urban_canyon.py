@@ -13,7 +13,13 @@ from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.trajectory import read_tum
-from vo_doppler.sim.urban_canyon import CityConfig, UrbanCanyonConfig, simulate_urban_canyon
+from vo_doppler.sim.urban_canyon import (
+    CityConfig,
+    UrbanCanyonConfig,
+    camera_frame_count,
+    simulate_urban_canyon,
+    too_few_frames,
+)
 
 SMALL = {"duration_s": 6.0, "fps": 5.0, "image_size": (160, 90)}
 
@@ -133,6 +139,40 @@ def test_cli_rejects_unknown_system_as_a_usage_error(tmp_path, capsys):
         main(["simulate", "--duration", "3", "--systems", "GR", "-o", str(tmp_path / "x")])
     assert stop.value.code == 2
     assert "systems are letters of GE, got 'GR'" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize(
+    ("fps", "duration", "message"),
+    [
+        (
+            "0.01",
+            "8",
+            "--fps 0.01 with --duration 8 gives 1 camera frame (the first 0.02 s into the "
+            "drive), and visual odometry needs at least 2: give --duration ≥ 100.02 s or "
+            "--fps ≥ 0.12532 Hz",
+        ),
+        ("15", "0.01", "--fps 15 with --duration 0.01 gives 0 camera frames"),
+    ],
+)
+def test_cli_refuses_a_drive_of_fewer_than_two_frames(fps, duration, message, tmp_path, capsys):
+    """The QA case: --fps 0.01 --duration 8 wrote a one-frame sequence no VO can use."""
+    argv = ["simulate", "--fps", fps, "--duration", duration, "--no-images"]
+    with pytest.raises(SystemExit) as stop:
+        main([*argv, "-o", str(tmp_path / "x")])
+    assert stop.value.code == 2
+    assert f"vo-doppler simulate: error: {message}" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
+
+def test_the_least_fps_and_duration_named_give_two_frames(tmp_path):
+    problem = too_few_frames(8.0, 0.01)
+    assert problem.endswith("give duration_s ≥ 100.02 s or fps ≥ 0.12532 Hz")
+    assert camera_frame_count(100.02, 0.01) == 2 and camera_frame_count(8.0, 0.12532) == 2
+    assert camera_frame_count(100.01, 0.01) == 1 and camera_frame_count(8.0, 0.1253) == 1
+    assert too_few_frames(8.0, 0.12532) is None
+    with pytest.raises(ValueError, match=r"fps 0\.01 with duration_s 8 gives 1 camera frame"):
+        simulate_urban_canyon(tmp_path / "x", UrbanCanyonConfig(duration_s=8.0, fps=0.01))
     assert not (tmp_path / "x").exists()
 
 

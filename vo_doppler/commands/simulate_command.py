@@ -33,7 +33,9 @@ from vo_doppler.sim.urban_canyon import (
     CityConfig,
     UrbanCanyonConfig,
     simulate_urban_canyon,
+    too_few_frames,
 )
+from vo_doppler.vo.batch import MIN_VO_FRAMES
 
 
 def _numbers(text: str, count: int, kind: Callable[[str], Any] = finite_float) -> tuple:
@@ -155,7 +157,12 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("--seed", type=int, default=0, help="random seed (same seed, same data)")
     parser.add_argument("-o", "--output", required=True, help="sequence folder to write")
-    parser.add_argument("--fps", type=frame_rate, default=defaults.fps, help="camera rate (Hz)")
+    parser.add_argument(
+        "--fps",
+        type=frame_rate,
+        default=defaults.fps,
+        help=f"camera rate (Hz); over --duration at least {MIN_VO_FRAMES} frames (VO needs them)",
+    )
     parser.add_argument("--size", type=_int_pair, default=defaults.image_size, help="W,H px")
     parser.add_argument("--image-format", choices=("png", "jpg"), default="png", help="images")
     parser.add_argument(
@@ -282,7 +289,13 @@ def register(subparsers, summary: str) -> None:
         help="GNSS antenna X,Y,Z m in the vehicle frame (x forward, y left, z up) from the "
         "rear-axle centre on the ground",
     )
+    parser.add_check(too_few_camera_frames)
     parser.set_defaults(func=run)
+
+
+def too_few_camera_frames(args: argparse.Namespace) -> str | None:
+    """The problem when ``--fps`` × ``--duration`` gives fewer frames than VO needs."""
+    return too_few_frames(args.duration, args.fps, ("--duration", "--fps"))
 
 
 def _iso_time(text: str) -> str:

@@ -27,7 +27,7 @@ from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
 from vo_doppler.report.json_text import json_text
 from vo_doppler.report.plots import plot_top_view
 from vo_doppler.report.run_report import number_or_dash
-from vo_doppler.vo.batch import run_visual_odometry
+from vo_doppler.vo.batch import MIN_VO_FRAMES, run_visual_odometry
 from vo_doppler.vo.config import VoConfig
 
 log = logging.getLogger(__name__)
@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
             speed,
             on_frame=lambda _: progress.advance(task),
         )
-    if decoded[0] < 2:
+    if decoded[0] < MIN_VO_FRAMES:
         raise InputError(
             f"only {decoded[0]} of the {len(files)} images could be decoded", args.images
         )

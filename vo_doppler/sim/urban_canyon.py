@@ -105,6 +105,7 @@ from vo_doppler.sim.vo_sequence import (
     render_frames,
     synthetic_camera,
 )
+from vo_doppler.vo.batch import MIN_VO_FRAMES
 
 log = logging.getLogger(__name__)
 
@@ -117,6 +118,41 @@ GROUND_TRUTH_RATE_HZ = 100.0
 TRAFFIC_STREAM = 0x7AFF1C
 """Second seed word of the traffic's random stream (GNSS and CAN streams stay as they were)."""
 CAMERA_START_DELAY_S = 0.02
+"""The camera's first frame comes this long after the drive starts (s)."""
+
+
+def camera_frame_count(duration_s: float, fps: float) -> int:
+    """Frames the camera takes in a drive of ``duration_s`` at ``fps`` (its first frame
+    ``CAMERA_START_DELAY_S`` into the drive, its last at or before the end)."""
+    return int(np.floor((duration_s - CAMERA_START_DELAY_S) * fps + 1e-9)) + 1
+
+
+def too_few_frames(
+    duration_s: float, fps: float, names: tuple[str, str] = ("duration_s", "fps")
+) -> str | None:
+    """The problem when a drive of ``duration_s`` at ``fps`` gives fewer camera frames than a
+    VO trajectory needs (:data:`~vo_doppler.vo.batch.MIN_VO_FRAMES`), naming the two settings
+    by ``names`` and the least of each that would do, else None."""
+    frames = camera_frame_count(duration_s, fps)
+    if frames >= MIN_VO_FRAMES:
+        return None
+    duration_name, fps_name = names
+    needed = [f"{duration_name} ≥ {_round_up((MIN_VO_FRAMES - 1) / fps + CAMERA_START_DELAY_S)} s"]
+    if duration_s > CAMERA_START_DELAY_S:
+        least_fps = (MIN_VO_FRAMES - 1) / (duration_s - CAMERA_START_DELAY_S)
+        needed.append(f"{fps_name} ≥ {_round_up(least_fps)} Hz")
+    return (
+        f"{fps_name} {fps:g} with {duration_name} {duration_s:g} gives {max(frames, 0)} camera "
+        f"frame{'' if frames == 1 else 's'} (the first {CAMERA_START_DELAY_S:g} s into the "
+        f"drive), and visual odometry needs at least {MIN_VO_FRAMES}: give "
+        f"{' or '.join(needed)}"
+    )
+
+
+def _round_up(value: float, digits: int = 5) -> str:
+    """``value`` rounded up to ``digits`` significant digits (a bound that still holds)."""
+    quantum = 10.0 ** (np.floor(np.log10(value)) - digits + 1)
+    return f"{np.ceil(value / quantum - 1e-9) * quantum:.{digits}g}"
 
 
 MAX_DURATION_S = 3600.0
@@ -260,7 +296,11 @@ def build_city(config: UrbanCanyonConfig):
 def simulate_urban_canyon(
     out_dir: str | Path, config: UrbanCanyonConfig, command: str = "", progress: bool = False
 ) -> UrbanCanyonSimulation:
-    """Generate a complete sequence folder (layout in the module docstring)."""
+    """Generate a complete sequence folder (layout in the module docstring); a ValueError,
+    before anything is written, when the drive gives too few camera frames for VO."""
+    problem = too_few_frames(config.duration_s, config.fps)
+    if problem:
+        raise ValueError(problem)
     out = open_output_folder(out_dir, "simulate")
     for sub in ("gnss", "can"):
         (out / sub).mkdir(parents=True, exist_ok=True)
@@ -325,7 +365,7 @@ def simulate_urban_canyon(
     truth = vehicle(t_truth)
     write_tum(out / "ground_truth.tum", Trajectory.from_matrices(t_truth, truth.T_world_vehicle))
     camera = synthetic_camera(*config.image_size)
-    n_frames = int(np.floor((config.duration_s - CAMERA_START_DELAY_S) * config.fps + 1e-9)) + 1
+    n_frames = camera_frame_count(config.duration_s, config.fps)
     camera_clock = np.arange(n_frames) / config.fps
     camera_offset = t0 + CAMERA_START_DELAY_S
     np.savetxt(out / "times.txt", camera_clock, fmt="%.6f")

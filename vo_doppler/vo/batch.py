@@ -13,6 +13,9 @@ from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.odometry import VisualOdometry, VoStats
 from vo_doppler.vo.scale import metric_positions
 
+MIN_VO_FRAMES = 2
+"""Fewest decoded images a VO trajectory needs: a motion takes two views."""
+
 
 @dataclass
 class VoOutput:
