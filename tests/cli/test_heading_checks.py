@@ -59,6 +59,7 @@ def test_a_can_clock_2_s_off_is_a_warning_with_the_right_offset(
 
 HEADING = ["heading", "r.obs", "--nav", "r.nav", "-o", "h.csv"]
 CAN_SOURCE = ["--can", "c.log", "--dbc", "c.dbc", "--yaw-rate", "M.Y", "--wheel-speed", "M.W"]
+CSV_SOURCE = ["--yaw-rate-csv", "y.csv", "--speed-csv", "s.csv"]
 
 
 @pytest.mark.parametrize(
@@ -74,12 +75,27 @@ CAN_SOURCE = ["--can", "c.log", "--dbc", "c.dbc", "--yaw-rate", "M.Y", "--wheel-
             "give the CAN log or the CSV files, not both (--can, --dbc, --yaw-rate, "
             "--wheel-speed and --speed-csv)",
         ),
+        # CAN-only options with the CSV files were silently ignored (the same heading):
+        ([*CSV_SOURCE, "--can-channel", "can1"], "--can-channel applies to a CAN log (--can) only"),
+        ([*CSV_SOURCE, "--yaw-rate-sign", "-1"], "--yaw-rate-sign applies to a CAN log (--can)"),
+        ([*CSV_SOURCE, "--can-short-frames", "pad"], "--can-short-frames applies to a CAN log"),
+        (
+            [*CSV_SOURCE, "--time-offset-can", "-315964782"],
+            "--time-offset-can applies to a CAN log (--can) only, and the sensors are the CSV "
+            "files (drop it); the CSV times take --time-offset-yaw and --time-offset-speed",
+        ),
+        (
+            [*CSV_SOURCE, "--time-offset-can", "5", "--can-channel", "x", "--yaw-rate-sign", "-1"],
+            "--yaw-rate-sign, --can-channel and --time-offset-can apply to a CAN log (--can) "
+            "only, and the sensors are the CSV files (drop them);",
+        ),
     ],
 )
 def test_sensor_options_that_name_no_one_source_are_exit_2(
     sensors, message, capsys, tmp_path, monkeypatch
 ):
-    """Checked before anything is read: none of the named files exists."""
+    """Checked before anything is read: none of the named files exists. An option of the
+    other source is refused too, as it would be ignored."""
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as stop:
         main([*HEADING, *sensors])
@@ -89,10 +105,19 @@ def test_sensor_options_that_name_no_one_source_are_exit_2(
 
 
 @pytest.mark.parametrize(
-    "sensors", [CAN_SOURCE, ["--yaw-rate-csv", "y.csv", "--speed-csv", "s.csv"]]
+    "sensors",
+    [
+        CAN_SOURCE,
+        CSV_SOURCE,
+        [*CSV_SOURCE, "--time-offset-can", "0", "--yaw-rate-sign", "1"],  # the defaults
+        [*CSV_SOURCE, "--time-offset-yaw", "0.5", "--time-offset-speed", "0.2"],
+        [*CAN_SOURCE, "--can-channel", "can1", "--time-offset-can", "5", "--yaw-rate-sign", "-1"],
+        [*CAN_SOURCE, "--time-offset-yaw", "0.5", "--time-offset-speed", "0.2"],  # add to CAN's
+    ],
 )
 def test_one_whole_sensor_source_passes_the_check(sensors, capsys, tmp_path, monkeypatch):
-    """Past the check, the missing input is the failure (exit 1, naming it)."""
+    """Past the check, the missing input is the failure (exit 1, naming it). The yaw and speed
+    offsets apply to the CAN signals as well as to the CSV files."""
     monkeypatch.chdir(tmp_path)
     assert main([*HEADING, *sensors]) == 1
     err = capsys.readouterr().err

@@ -131,7 +131,38 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("-o", "--output", type=Path, required=True, help="heading CSV")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
     parser.add_check(sensor_options_problem)
+    defaults = {option: parser.get_default(_dest(option)) for option in CAN_ONLY_OPTIONS}
+    parser.add_check(lambda args: can_only_options_problem(args, defaults))
     parser.set_defaults(func=run)
+
+
+CAN_ONLY_OPTIONS = ("--yaw-rate-sign", "--can-channel", "--can-short-frames", "--time-offset-can")
+"""Options that only reading a CAN log uses (``--time-offset-yaw`` and ``--time-offset-speed``
+apply to the CAN signals as well as to the CSV files)."""
+
+
+def _dest(option: str) -> str:
+    return option.removeprefix("--").replace("-", "_")
+
+
+def can_only_options_problem(args: argparse.Namespace, defaults: dict[str, object]) -> str | None:
+    """The problem when the sensors are the CSV files and a :data:`CAN_ONLY_OPTIONS` option is
+    set to other than its default (``defaults``, by option): it would be ignored."""
+    if args.can is not None or args.yaw_rate_csv is None:
+        return None
+    given = [o for o in CAN_ONLY_OPTIONS if getattr(args, _dest(o)) != defaults[o]]
+    if not given:
+        return None
+    hint = (
+        "; the CSV times take --time-offset-yaw and --time-offset-speed"
+        if "--time-offset-can" in given
+        else ""
+    )
+    named = " and ".join([", ".join(given[:-1]), given[-1]] if len(given) > 1 else given)
+    return (
+        f"{named} appl{'ies' if len(given) == 1 else 'y'} to a CAN log (--can) only, "
+        f"and the sensors are the CSV files (drop {'it' if len(given) == 1 else 'them'}){hint}"
+    )
 
 
 def sensor_options_problem(args: argparse.Namespace) -> str | None:
