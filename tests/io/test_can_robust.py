@@ -5,8 +5,11 @@ the stated time-order policy."""
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import subprocess
 import sys
+import warnings
 
 import can
 import numpy as np
@@ -112,6 +115,35 @@ def test_prefixed_blf_is_an_input_error(tmp_path):
     path.write_bytes(b"prefix" + good.read_bytes())
     with pytest.raises(InputError, match=r"bus.blf: cannot read the CAN log"):
         read_can_log(path)
+
+
+def _files_left_open(read) -> list[str]:
+    """The ResourceWarnings (files garbage-collected while open) of calling ``read``, whose
+    InputError is let go first (its traceback would keep the reader alive)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ResourceWarning)
+        with contextlib.suppress(InputError):
+            read()
+        gc.collect()
+    return [str(w.message) for w in caught if issubclass(w.category, ResourceWarning)]
+
+
+@pytest.mark.parametrize("suffix", [".blf", ".asc"])
+@pytest.mark.parametrize("damage", ["none", "empty", "header", "truncated"])
+def test_binary_and_asc_logs_are_closed_however_the_reading_ends(tmp_path, suffix, damage):
+    """python-can's readers left the file open when the header was corrupt (ResourceWarning
+    in the tests above); a log read through, or stopped by a truncated record, is closed too."""
+    path = tmp_path / f"bus{suffix}"
+    write_log(path, messages(200))
+    whole = path.read_bytes()
+    content = {
+        "none": whole,
+        "empty": b"",
+        "header": b"garbage" + bytes(200),
+        "truncated": whole[: len(whole) * 2 // 3],
+    }[damage]
+    path.write_bytes(content)
+    assert _files_left_open(lambda: read_can_log(path)) == []
 
 
 READ_ASC = (

@@ -257,30 +257,35 @@ def _record_messages(path: Path, report: CanDecodeReport):
     """ASC and BLF: python-can cannot resume after a corrupt record, so keep what came first.
 
     ASC times are made absolute from the ``Begin Triggerblock`` date (as UTC), like BLF times.
-    A file python-can cannot open at all is an :class:`InputError`.
+    A file python-can cannot open at all is an :class:`InputError`. The file is opened here and
+    handed to python-can, so it is closed however the reading ends (python-can's readers leave
+    a file they opened open when their header is corrupt or the reading stops early).
     """
     n = 0
-    try:
-        if path.suffix.lower() == ".asc":
-            with path.open("rb") as handle:
-                kind = binary_kind(handle.read(8192))
-            if kind is not None:
-                raise InputError(f"ASC log is a {kind}, not a text log", path)
-            reader = _UtcAscReader(path, relative_timestamp=False, encoding="utf-8")
-        else:
-            reader = can.BLFReader(path)
-        for message in reader:
-            n += 1
-            yield message, None
-        if n == 0 and path.suffix.lower() == ".asc":
-            raise InputError(_not_asc(path), path)
-    except InputError:
-        raise
-    except Exception as exc:  # python-can raises many types on corrupt files
-        if n == 0:
-            raise InputError(f"cannot read the CAN log: {type(exc).__name__}: {exc}", path) from exc
-        log.warning("%s: reading stopped after %d frames: %s", path, n, exc)
-        report.n_unreadable_lines += 1
+    asc = path.suffix.lower() == ".asc"
+    if asc:
+        with path.open("rb") as handle:
+            kind = binary_kind(handle.read(8192))
+        if kind is not None:
+            raise InputError(f"ASC log is a {kind}, not a text log", path)
+    with path.open("r", encoding="utf-8") if asc else path.open("rb") as handle:
+        try:
+            if asc:
+                reader = _UtcAscReader(handle, relative_timestamp=False)
+            else:
+                reader = can.BLFReader(handle)
+            for message in reader:
+                n += 1
+                yield message, None
+        except Exception as exc:  # python-can raises many types on corrupt files
+            if n == 0:
+                raise InputError(
+                    f"cannot read the CAN log: {type(exc).__name__}: {exc}", path
+                ) from exc
+            log.warning("%s: reading stopped after %d frames: %s", path, n, exc)
+            report.n_unreadable_lines += 1
+    if n == 0 and asc:
+        raise InputError(_not_asc(path), path)
 
 
 _CANDUMP_LINE = re.compile(r"^\(\s*[-+0-9.eE]+\)\s+\S+\s+[0-9A-Fa-f]+#")
