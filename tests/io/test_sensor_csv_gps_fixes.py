@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
-import functools
 import logging
-import operator
 import re
 from pathlib import Path
 
@@ -14,6 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tests.helpers.nmea import gga, rmc
 from vo_doppler.errors import InputError
 from vo_doppler.io.gps_fixes import (
     read_gps_csv,
@@ -194,43 +193,15 @@ def test_two_values_at_one_time_are_an_error_naming_the_file_and_both_lines(tmp_
         read_yaw_rate_csv(path)
 
 
-def _sentence(body: str) -> str:
-    checksum = functools.reduce(operator.xor, body.encode(), 0)
-    return f"${body}*{checksum:02X}"
-
-
-def _ddmm(value: float, positive: str, negative: str, width: int) -> tuple[str, str]:
-    hemisphere = positive if value >= 0 else negative
-    value = abs(value)
-    degrees = int(value)
-    minutes = (value - degrees) * 60.0
-    return f"{degrees:0{width}d}{minutes:010.7f}", hemisphere
-
-
-def _gga(time: dt.time, lat: float, lon: float, quality: int = 1) -> str:
-    la, ns = _ddmm(lat, "N", "S", 2)
-    lo, ew = _ddmm(lon, "E", "W", 3)
-    stamp = time.strftime("%H%M%S.%f")[:9]
-    return _sentence(f"GPGGA,{stamp},{la},{ns},{lo},{ew},{quality},08,0.9,10.0,M,30.0,M,,")
-
-
-def _rmc(moment: dt.datetime, lat: float, lon: float, knots: float, status="A") -> str:
-    la, ns = _ddmm(lat, "N", "S", 2)
-    lo, ew = _ddmm(lon, "E", "W", 3)
-    stamp = moment.strftime("%H%M%S.%f")[:9]
-    day = moment.strftime("%d%m%y")
-    return _sentence(f"GPRMC,{stamp},{status},{la},{ns},{lo},{ew},{knots:.2f},45.0,{day},,,A")
-
-
 def test_nmea_gga_rmc_pairs_give_gps_time_and_speed(tmp_path):
     start = dt.datetime(2024, 6, 24, 8, 20, 0)
     lines = []
     for i in range(5):
         moment = start + dt.timedelta(seconds=0.5 * i)
-        lines += [_gga(moment.time(), 48.1 + i * 1e-5, -11.5, 1), _rmc(moment, 48.1, -11.5, 10.0)]
-    lines.insert(3, _gga(start.time(), 1.0, 1.0).replace("*", "0*"))  # bad checksum
-    lines.append(_gga((start + dt.timedelta(seconds=9)).time(), 48.2, -11.5, quality=0))
-    lines.append(_rmc(start + dt.timedelta(seconds=9), 48.2, -11.5, 0.0, status="V"))
+        lines += [gga(moment.time(), 48.1 + i * 1e-5, -11.5, 1), rmc(moment, 48.1, -11.5, 10.0)]
+    lines.insert(3, gga(start.time(), 1.0, 1.0).replace("*", "0*"))  # bad checksum
+    lines.append(gga((start + dt.timedelta(seconds=9)).time(), 48.2, -11.5, quality=0))
+    lines.append(rmc(start + dt.timedelta(seconds=9), 48.2, -11.5, 0.0, status="V"))
     path = tmp_path / "log.nmea"
     path.write_text("\n".join(["garbage line", *lines]) + "\n")
     fixes = read_gps_fixes(path)
@@ -246,15 +217,15 @@ def test_nmea_midnight_roll_over_and_gga_only(tmp_path):
     before = dt.datetime(2020, 12, 31, 23, 59, 59)
     after = before + dt.timedelta(seconds=2)
     path = tmp_path / "midnight.nmea"
-    path.write_text("\n".join([_rmc(before, 1.0, 2.0, 1.0), _gga(after.time(), 1.0, 2.0)]) + "\n")
+    path.write_text("\n".join([rmc(before, 1.0, 2.0, 1.0), gga(after.time(), 1.0, 2.0)]) + "\n")
     fixes = read_nmea(path)
     assert fixes.t[1] - fixes.t[0] == pytest.approx(2.0)
     gga_only = tmp_path / "gga.nmea"
-    gga_only.write_text(_gga(dt.time(1, 2, 3, 500000), 1.0, 2.0) + "\n")
+    gga_only.write_text(gga(dt.time(1, 2, 3, 500000), 1.0, 2.0) + "\n")
     fixes = read_nmea(gga_only)
     assert fixes.time_system == "utc-seconds-of-day" and fixes.t[0] == pytest.approx(3723.5)
     empty = tmp_path / "empty.nmea"
-    empty.write_text(_gga(dt.time(1, 2, 3), 1.0, 2.0, quality=0) + "\n")
+    empty.write_text(gga(dt.time(1, 2, 3), 1.0, 2.0, quality=0) + "\n")
     with pytest.raises(InputError, match="no GGA or RMC fix"):
         read_nmea(empty)
 
@@ -265,7 +236,7 @@ def _rmc_log(tmp_path, knots: list[float]) -> Path:
     path = tmp_path / "speeds.nmea"
     moments = [start + dt.timedelta(seconds=k) for k in range(len(knots))]
     path.write_text(
-        "".join(f"{_rmc(m, 48.1, -11.5, v)}\n" for m, v in zip(moments, knots, strict=True))
+        "".join(f"{rmc(m, 48.1, -11.5, v)}\n" for m, v in zip(moments, knots, strict=True))
     )
     return path
 
@@ -301,9 +272,9 @@ def test_nmea_speeds_out_of_range_beyond_one_percent_are_an_error_naming_the_lin
 
 def test_nmea_gga_keeps_its_fix_when_the_rmc_speed_at_its_time_is_skipped(tmp_path):
     start = dt.datetime(2024, 6, 24, 8, 20, 0)
-    lines = [_rmc(start + dt.timedelta(seconds=k), 48.1, -11.5, 10.0) for k in range(200)]
-    lines[5] = _rmc(start + dt.timedelta(seconds=5), 48.1, -11.5, 1e9)
-    lines.insert(6, _gga((start + dt.timedelta(seconds=5)).time(), 48.2, -11.5))
+    lines = [rmc(start + dt.timedelta(seconds=k), 48.1, -11.5, 10.0) for k in range(200)]
+    lines[5] = rmc(start + dt.timedelta(seconds=5), 48.1, -11.5, 1e9)
+    lines.insert(6, gga((start + dt.timedelta(seconds=5)).time(), 48.2, -11.5))
     path = tmp_path / "gga.nmea"
     path.write_text("\n".join(lines) + "\n")
     fixes = read_nmea(path)
@@ -316,7 +287,7 @@ def test_nmea_gga_keeps_its_fix_when_the_rmc_speed_at_its_time_is_skipped(tmp_pa
 def test_nmea_coordinates_round_trip(tmp_path, lat, lon, second):
     moment = dt.datetime(2023, 3, 1) + dt.timedelta(seconds=second)
     path = Path(tmp_path) / "one.nmea"
-    path.write_text(_rmc(moment, lat, lon, 3.0) + "\n")
+    path.write_text(rmc(moment, lat, lon, 3.0) + "\n")
     fixes = read_nmea(path)
     assert np.degrees(fixes.lat[0]) == pytest.approx(lat, abs=1e-8)
     assert np.degrees(fixes.lon[0]) == pytest.approx(lon, abs=1e-8)
