@@ -19,7 +19,15 @@ summary. Each check states its threshold:
   median over the lags (no shift matches: an offset beyond the range, or a speed too
   featureless) or a best lag at the edge of the range (the agreement still improves beyond it)
   is "no lag found", a warning naming why, and no number (comma2k19 with its CAN clock 30 s
-  off: 0.47 m/s at +2.2 s against a median of 0.62 m/s);
+  off: 0.47 m/s at +2.2 s against a median of 0.62 m/s). A drive steady more than half the time
+  (a highway cruise) matches at every shift to the noise; without a clear minimum, the search
+  is made again over the epochs where the wheel speed changes, |dv/dt| over ±0.5 s above five
+  times its noise (at least 0.05 m/s²), with stricter guards: a best difference below a quarter
+  of the median over the shifts and below twice the GNSS speed's noise, changes spread over
+  more than twice the searched range (a single change can match another). A drive without
+  speed changes then gets "no lag found" (the speed hardly changes); 120-s cruises with three
+  speed changes get their lag (117 of 120 within 0.1 s; the second search gave none of the 160
+  shifted by 6-60 s a lag, the first one gave 7 of them one, as before it);
 * the wheel-speed times against the GNSS epochs: when more than 10 % of the epochs lie outside
   the wheel speed's time span, it is a warning, since those epochs get no tightly coupled
   heading and a clock offset wrong by more than the ±5 s searched looks like this (comma2k19
@@ -58,7 +66,27 @@ MAX_CLOCK_MATCH_RATIO = 0.5
 found: a true lag leaves the speeds' noise (a tenth of the median on comma2k19), a chance
 alignment of unrelated stretches of the drive or a featureless speed barely beats the rest."""
 MIN_CLOCK_EPOCHS = 20
-"""Fewest valid GNSS epochs inside the wheel speed's span (less the searched lag) to search."""
+"""Fewest valid GNSS epochs inside the wheel speed's span (less the searched lag) to search,
+and fewest of them where the wheel speed changes, at every searched lag."""
+MAX_CHANGE_MATCH_RATIO = 0.25
+"""``MAX_CLOCK_MATCH_RATIO`` of the search over the epochs where the speed changes: there a
+true lag leaves a twentieth to an eighth of the median (comma2k19: 0.07-0.12), a chance
+match of a few changes a quarter or more."""
+MAX_CLOCK_NOISE_MULTIPLE = 2.0
+"""Largest best median difference for a lag, in units of the GNSS speed's sample noise σ: at
+the true shift the two speeds differ by their noise (median 0.67 σ); a chance match of two
+speed changes differs by more (4-10 σ on 120-s cruises shifted by 6-60 s)."""
+MIN_CLOCK_NOISE_MPS = 0.02
+"""Least GNSS speed noise assumed (m/s): a noise-free speed still differs from the wheel
+speed by interpolation and the sampling of the shifts."""
+CLOCK_SLOPE_HALF_WINDOW_S = 0.5
+"""The wheel speed's rate of change is its difference over ±0.5 s (s)."""
+CLOCK_SLOPE_NOISE_FACTOR = 5.0
+"""A speed change counts where |dv/dt| exceeds this many times the noise of the rate of change
+(the wheel speed's sample noise, from its second differences, through the ±0.5-s difference)."""
+MIN_CLOCK_ACCELERATION = 0.05
+"""m/s²: the least |dv/dt| that counts as a speed change, however quiet the wheel speed (a
+cruise control holds the speed within a few cm/s over seconds: 0.01-0.02 m/s²)."""
 MIN_SPEED_COVERAGE = 0.9
 WHEEL_SCALE_TOLERANCE = 0.10
 STANDSTILL_MAX_MEDIAN_SPEED_MPS = 0.5
@@ -125,7 +153,14 @@ def estimate_clock_offset(
     where the wheels turn faster than 2 m/s (the wheel scale error). No lag (``residual_s``
     None, with the reason) with fewer than ``MIN_CLOCK_EPOCHS`` epochs inside the overlap,
     without moving epochs, with the best shift at the edge of the range or no clear minimum
-    (``MAX_CLOCK_MATCH_RATIO``; module docstring)."""
+    (``MAX_CLOCK_MATCH_RATIO``; module docstring).
+
+    Without a clear minimum over all epochs, the search is made again over the epochs where the
+    wheel speed changes (:func:`speed_change_threshold`): at a steady speed every shift matches,
+    so a drive steady more than half the time has the median at the noise at every shift. That
+    second search has stricter guards against a chance match of a few speed changes
+    (``MAX_CHANGE_MATCH_RATIO``, ``MAX_CLOCK_NOISE_MULTIPLE``, changes spread over twice the
+    searched range)."""
     t_gnss, speed_gnss = np.asarray(t_gnss, dtype=float), np.asarray(speed_gnss, dtype=float)
     if len(speed) < 2:
         return ClockOffsetEstimate(None, no_lag_reason="the wheel speed has fewer than 2 samples")
@@ -141,54 +176,161 @@ def estimate_clock_offset(
             f"wheel speed's span, {MIN_CLOCK_EPOCHS} needed",
         )
     t, reference = t_gnss[inside], speed_gnss[inside]
+    estimate, unclear = _lag_search(speed, t, reference, span, None)
+    if not unclear:
+        return estimate
+    changes, unclear = _lag_search(speed, t, reference, span, speed_change_threshold(speed))
+    return estimate if unclear else changes
+
+
+def _lag_search(
+    speed: SensorSeries, t: np.ndarray, reference: np.ndarray, span: float, threshold: float | None
+) -> tuple[ClockOffsetEstimate, bool]:
+    """The lag search of :func:`estimate_clock_offset` over all epochs (``threshold`` None) or
+    over those where the wheel speed changes faster than ``threshold``; True beside a no-lag
+    estimate when the agreement had no clear minimum (both searches without one: the reason
+    given is the first's)."""
     step = 1.0 / CLOCK_RATE_HZ
     lags = np.arange(-span, span + step / 2, step)
-    costs = np.array([_speed_difference(speed, t, reference, lag) for lag in lags])
+    costs = np.array([_speed_difference(speed, t, reference, lag, threshold) for lag in lags])
     if not np.isfinite(costs).all():
-        return ClockOffsetEstimate(
-            None,
-            search_s=span,
-            no_lag_reason="the vehicle hardly moves: at some shifts the wheel speed exceeds "
-            f"{MOVING_SPEED_MPS:g} m/s at no valid GNSS epoch",
-        )
+        lag = lags[np.flatnonzero(~np.isfinite(costs))[0]]
+        return _no_lag(span, _featureless(speed, t, lag, threshold)), False
     best = int(np.argmin(costs))
     typical = float(np.median(costs))
-    if not costs[best] < MAX_CLOCK_MATCH_RATIO * typical:  # a flat 0 is no minimum either
-        return ClockOffsetEstimate(
-            None,
-            search_s=span,
-            no_lag_reason=f"no shift matches, the smallest median difference ({costs[best]:.2f} "
-            f"m/s) is not below half their median ({typical:.2f} m/s): an offset beyond the "
-            "range, or a featureless speed",
-        )
+    ratio = MAX_CLOCK_MATCH_RATIO if threshold is None else MAX_CHANGE_MATCH_RATIO
+    if not costs[best] < ratio * typical:  # a flat 0 is no minimum either
+        return _no_lag(
+            span,
+            f"no shift matches, the smallest median difference ({costs[best]:.2f} m/s) "
+            f"is not below {ratio:g} times their median ({typical:.2f} m/s): an offset beyond "
+            "the range, or a featureless speed",
+        ), True
     if best in (0, len(lags) - 1):
-        return ClockOffsetEstimate(
-            None,
-            search_s=span,
-            no_lag_reason=f"the agreement is best at the edge of the range, {lags[best]:+.1f} s "
+        return _no_lag(
+            span,
+            f"the agreement is best at the edge of the range, {lags[best]:+.1f} s "
             f"({costs[best]:.2f} m/s): the offset is beyond it",
-        )
-    left, mid, right = costs[best - 1 : best + 2]
+        ), False
+    if threshold is not None:
+        problem = _chance_match(speed, t, reference, lags[best], costs[best], threshold, span)
+        if problem:
+            return _no_lag(span, problem), False
+    # The refinement compares the three shifts on one set of epochs, the best shift's changing
+    # ones: on each shift's own set the parabola would lean by the sets' difference.
+    left, mid, right = (
+        _speed_difference(speed, t, reference, lag, threshold, lags[best])
+        for lag in lags[best - 1 : best + 2]
+    )
     curvature = left - 2 * mid + right
     offset = 0.5 * (left - right) / curvature if curvature > 0 else 0.0
     residual = float(lags[best] + offset * step)
     return ClockOffsetEstimate(
         residual,
-        _speed_difference(speed, t, reference, residual),
-        _speed_difference(speed, t, reference, 0.0),
+        _speed_difference(speed, t, reference, residual, threshold),
+        _speed_difference(speed, t, reference, 0.0, threshold),
         span,
+    ), False
+
+
+def _no_lag(span: float, reason: str) -> ClockOffsetEstimate:
+    return ClockOffsetEstimate(None, search_s=span, no_lag_reason=reason)
+
+
+def _chance_match(
+    speed: SensorSeries,
+    t: np.ndarray,
+    reference: np.ndarray,
+    lag: float,
+    cost: float,
+    threshold: float,
+    span: float,
+) -> str | None:
+    """Why the best ``lag`` of the speed changes may be a chance match, or None: its median
+    difference ``cost`` above ``MAX_CLOCK_NOISE_MULTIPLE`` times the GNSS speed's noise, or
+    changes spread over less than twice the searched range (one change matching another)."""
+    noise = max(_sample_noise(reference), MIN_CLOCK_NOISE_MPS)
+    if cost > MAX_CLOCK_NOISE_MULTIPLE * noise:
+        return (
+            f"no shift matches to the noise: the smallest median difference where the speed "
+            f"changes ({cost:.2f} m/s, at {lag:+.1f} s) is above {MAX_CLOCK_NOISE_MULTIPLE:g} "
+            f"times the GNSS speed's noise ({noise:.2f} m/s): an offset beyond the range"
+        )
+    changing = t[np.abs(_slope(speed, t - lag)) > threshold]
+    spread = float(changing[-1] - changing[0])
+    if spread < 2 * span:
+        return (
+            f"at the best shift, {lag:+.1f} s ({cost:.2f} m/s), the wheel speed changes within "
+            f"{spread:.1f} s only, less than the {2 * span:.3g} s searched: one change can match "
+            "another at a wrong shift"
+        )
+    return None
+
+
+def _sample_noise(values: np.ndarray) -> float:
+    """Robust σ of a smooth signal's sample noise: the median absolute second difference
+    (1.4826 MAD / √6), which the signal's own changes hardly touch."""
+    second = np.diff(values, 2)
+    return float(1.4826 * np.median(np.abs(second)) / np.sqrt(6.0)) if second.size else 0.0
+
+
+def speed_change_threshold(speed: SensorSeries) -> float:
+    """The |dv/dt| (m/s²) above which the wheel speed changes: ``CLOCK_SLOPE_NOISE_FACTOR``
+    times the noise of its ±``CLOCK_SLOPE_HALF_WINDOW_S`` difference (the sample noise from
+    the median absolute second difference, which a drive's own accelerations hardly touch),
+    at least ``MIN_CLOCK_ACCELERATION``."""
+    slope_noise = _sample_noise(speed.value) * np.sqrt(2.0) / (2.0 * CLOCK_SLOPE_HALF_WINDOW_S)
+    return float(max(CLOCK_SLOPE_NOISE_FACTOR * slope_noise, MIN_CLOCK_ACCELERATION))
+
+
+def _slope(speed: SensorSeries, t: np.ndarray) -> np.ndarray:
+    """The wheel speed's rate of change (m/s²) at ``t``, over ±``CLOCK_SLOPE_HALF_WINDOW_S``."""
+    h = CLOCK_SLOPE_HALF_WINDOW_S
+    return (np.interp(t + h, speed.t, speed.value) - np.interp(t - h, speed.t, speed.value)) / (
+        2.0 * h
     )
 
 
-def _speed_difference(speed: SensorSeries, t: np.ndarray, reference: np.ndarray, lag: float):
-    """median |reference − k·speed(t − lag)| with k the median ratio over moving epochs; NaN
-    without a moving epoch."""
+def _speed_difference(
+    speed: SensorSeries,
+    t: np.ndarray,
+    reference: np.ndarray,
+    lag: float,
+    threshold: float | None,
+    selection_lag: float | None = None,
+) -> float:
+    """median |reference − k·speed(t − lag)| over the epochs ``t`` (with a ``threshold``: those
+    where the wheel speed shifted by ``selection_lag``, default ``lag``, changes faster), k the
+    median ratio over the moving epochs; NaN without a moving epoch or with fewer than
+    ``MIN_CLOCK_EPOCHS`` epochs selected.
+    """
     shifted = np.interp(t - lag, speed.t, speed.value)
     moving = shifted > MOVING_SPEED_MPS
-    if not moving.any():
+    if threshold is None:
+        changing = np.ones(t.size, dtype=bool)
+    else:
+        selected = lag if selection_lag is None else selection_lag
+        changing = np.abs(_slope(speed, t - selected)) > threshold
+    if not moving.any() or np.count_nonzero(changing) < MIN_CLOCK_EPOCHS:
         return float("nan")
     scale = np.median(reference[moving] / shifted[moving])
-    return float(np.median(np.abs(reference - scale * shifted)))
+    return float(np.median(np.abs(reference - scale * shifted)[changing]))
+
+
+def _featureless(speed: SensorSeries, t: np.ndarray, lag: float, threshold: float | None) -> str:
+    """Why the wheel speed shifted by ``lag`` gives nothing to align (``_speed_difference``
+    NaN)."""
+    if threshold is None or not (np.interp(t - lag, speed.t, speed.value) > MOVING_SPEED_MPS).any():
+        return (
+            f"the vehicle hardly moves: shifted by {lag:+.1f} s the wheel speed exceeds "
+            f"{MOVING_SPEED_MPS:g} m/s at no valid GNSS epoch"
+        )
+    changing = np.count_nonzero(np.abs(_slope(speed, t - lag)) > threshold)
+    return (
+        f"the speed hardly changes: shifted by {lag:+.1f} s, only {changing} valid GNSS epochs "
+        f"see the wheel speed change faster than {threshold:.2g} m/s², {MIN_CLOCK_EPOCHS} "
+        "needed (at a steady speed every shift matches)"
+    )
 
 
 def clock_warning(
