@@ -89,6 +89,17 @@ def test_featureless_speed_gives_no_lag_and_says_why():
     assert estimate.no_lag_reason.startswith("the speed hardly changes: shifted by -5.0 s, only 0")
 
 
+def test_a_parked_vehicle_gives_no_lag_saying_it_does_not_move():
+    parked = SensorSeries(T, np.full_like(T, 0.01), "speed", "m/s")
+    t_gnss = np.arange(5.0, 55.0, 0.2)
+    estimate = estimate_clock_offset(parked, t_gnss, np.zeros_like(t_gnss))
+    assert estimate.residual_s is None
+    assert estimate.no_lag_reason == (
+        "the vehicle does not move: the wheel speed never exceeds 2 m/s (at most 0.01 m/s), "
+        "so its clock cannot be checked against the GNSS"
+    )
+
+
 def _random_drive(seed: int) -> SensorSeries:
     """120 s of a wheel speed at 100 Hz around 12 m/s (σ 3 m/s) with smooth random
     accelerations: no two stretches of it alike, unlike a sum of sines."""

@@ -320,6 +320,12 @@ def _speed_difference(
 def _featureless(speed: SensorSeries, t: np.ndarray, lag: float, threshold: float | None) -> str:
     """Why the wheel speed shifted by ``lag`` gives nothing to align (``_speed_difference``
     NaN)."""
+    fastest = float(np.max(speed.value, initial=0.0))
+    if fastest <= MOVING_SPEED_MPS:
+        return (
+            f"the vehicle does not move: the wheel speed never exceeds {MOVING_SPEED_MPS:g} m/s "
+            f"(at most {fastest:.2f} m/s), so its clock cannot be checked against the GNSS"
+        )
     if threshold is None or not (np.interp(t - lag, speed.t, speed.value) > MOVING_SPEED_MPS).any():
         return (
             f"the vehicle hardly moves: shifted by {lag:+.1f} s the wheel speed exceeds "
