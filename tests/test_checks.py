@@ -3,48 +3,63 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+from tests.helpers.heading_table import plain_heading_table
 from tests.helpers.velocity import velocity_solution
 from vo_doppler.checks import (
     calibration_warnings,
     check_standstill_is_still,
+    check_yaw_rate_sign,
     check_yaw_rate_unit,
     clock_warning,
     coverage_warning,
     estimate_clock_offset,
+    gyro_bias_warning,
+    heading_warnings,
     moving_yaw_rate_medians,
     origin_warning,
     wheel_scale_warning,
+    yaw_rate_sign_agreement,
 )
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.timeseries import integral_at
+from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 T = np.arange(0.0, 60.0, 0.01)
 SPEED = SensorSeries(T, 10.0 + 3.0 * np.sin(0.4 * T) + 2.0 * np.sin(1.3 * T), "speed", "m/s")
 
 
+DBC = VehicleSignalSource(yaw_rate="v.dbc: signal Y", yaw_rate_unit_fix="fix the DBC")
+
+
 def test_ordinary_yaw_rate_passes_and_deg_read_as_rad_is_named():
     deg_per_s = 0.3 + 2.0 * np.sin(0.2 * T)  # a drive's yaw rate in °/s
     ordinary = SensorSeries(T, np.radians(deg_per_s), "yaw", "rad/s")
-    check_yaw_rate_unit(ordinary, SPEED, "deg/s")
+    check_yaw_rate_unit(ordinary, SPEED, replace(DBC, yaw_rate_unit="deg/s"))
     rate, lateral = moving_yaw_rate_medians(ordinary, SPEED)
     assert rate == pytest.approx(np.radians(np.median(np.abs(deg_per_s))))
     assert lateral < 1.5
     wrong = SensorSeries(T, deg_per_s, "yaw", "rad/s")
-    with pytest.raises(InputError, match="rad/s but the values look like deg/s"):
-        check_yaw_rate_unit(wrong, SPEED, "rad/s")
+    with pytest.raises(
+        InputError, match=r"^v.dbc: signal Y: implausibly large .* look like deg/s: fix the DBC$"
+    ):
+        check_yaw_rate_unit(wrong, SPEED, DBC)
     with pytest.raises(InputError, match="implausibly large") as info:
-        check_yaw_rate_unit(wrong, SPEED, "deg/s")
+        check_yaw_rate_unit(wrong, SPEED, replace(DBC, yaw_rate_unit="deg/s"))
     assert "look like deg/s" not in str(info.value)
+    with pytest.raises(InputError, match=r"^the yaw rate: .*look like deg/s: convert it to rad/s$"):
+        check_yaw_rate_unit(wrong, SPEED)  # no source: generic words
 
 
 def test_standstill_only_yaw_rate_is_not_judged():
     still = SensorSeries(T, np.zeros_like(T), "speed", "m/s")
-    check_yaw_rate_unit(SensorSeries(T, np.full_like(T, 5.0), "yaw", "rad/s"), still, "rad/s")
+    check_yaw_rate_unit(SensorSeries(T, np.full_like(T, 5.0), "yaw", "rad/s"), still)
 
 
 @pytest.mark.parametrize("shift", [0.0, 0.35, -1.2, 4.0])
@@ -258,3 +273,115 @@ def test_calibration_warnings_gather_the_clock_and_the_scale():
     )
     assert found[1].startswith("wheel scale: the calibration gives 0.278")
     assert calibration_warnings(late, velocity, None, "speed CSV", 2.0, "--x")[1] == found[:1]
+
+
+# A drive at 8 m/s: straight, a left turn of 90° (10–13 s, 30 °/s), straight, a right turn of
+# 90° (25–28 s), straight; GNSS course at 10 Hz with 0.5° of noise, gyro at 100 Hz with a bias
+# of 0.3 °/s.
+T_GNSS = np.arange(0.0, 40.0, 0.1)
+T_GYRO = np.arange(-1.0, 41.0, 0.01)
+TURN_RATE = np.radians(30.0)
+
+
+def _true_rate(t: np.ndarray) -> np.ndarray:
+    return TURN_RATE * (((t >= 10) & (t < 13)).astype(float) - ((t >= 25) & (t < 28)))
+
+
+def _true_yaw(t: np.ndarray) -> np.ndarray:
+    return TURN_RATE * (np.clip(t - 10, 0, 3) - np.clip(t - 25, 0, 3))
+
+
+def _drive(course_error=None, gnss_speed=8.0, valid=None):
+    """Heading table, conventional velocity, wheel speed and yaw rate of the drive above."""
+    noise = np.random.default_rng(3).normal(0.0, np.radians(0.5), T_GNSS.size)
+    course = _true_yaw(T_GNSS) + noise + (0.0 if course_error is None else course_error)
+    speed = np.broadcast_to(gnss_speed, T_GNSS.shape)
+    enu = np.column_stack([speed * np.cos(course), speed * np.sin(course), np.zeros_like(speed)])
+    valid = np.ones(T_GNSS.size, bool) if valid is None else valid
+    table = plain_heading_table(
+        T_GNSS,
+        yaw_conv=np.where(valid, course, np.nan),
+        conv_valid=valid,
+        conv_gnss_valid=valid,
+        sigma_conv_gnss=np.where(valid, np.radians(0.5), np.nan),
+    )
+    wheel = SensorSeries(T_GYRO, np.full_like(T_GYRO, 8.0), "speed", "m/s")
+    gyro = SensorSeries(T_GYRO, _true_rate(T_GYRO) + np.radians(0.3), "yaw", "rad/s")
+    return table, velocity_solution(T_GNSS, enu, valid), wheel, gyro
+
+
+def _negated(series: SensorSeries) -> SensorSeries:
+    return SensorSeries(series.t, -series.value, series.name, series.unit)
+
+
+SIGN_SOURCE = VehicleSignalSource(yaw_rate="yaw.csv", yaw_rate_sign_fix="negate the column")
+
+
+def test_a_yaw_rate_of_the_right_sign_agrees_with_the_doppler_course_over_both_turns():
+    table, velocity, wheel, gyro = _drive()
+    found = check_yaw_rate_sign(table, velocity, wheel, gyro, SIGN_SOURCE)
+    assert found.agreement == 1.0 and found.turns == 2
+    assert np.degrees(found.turn_rad) == pytest.approx(180.0, abs=3.0)
+
+
+def test_a_yaw_rate_of_the_wrong_sign_is_an_error_naming_the_fix():
+    table, velocity, wheel, gyro = _drive()
+    assert yaw_rate_sign_agreement(table, velocity, wheel, _negated(gyro)).agreement == -1.0
+    with pytest.raises(InputError) as info:
+        check_yaw_rate_sign(table, velocity, wheel, _negated(gyro), SIGN_SOURCE)
+    message = str(info.value)
+    assert message.startswith("yaw.csv: wrong sign: over 2 turn(s) totalling 18")
+    assert "sign agreement -1.00" in message and message.endswith("; negate the column")
+
+
+def test_without_enough_turning_there_is_no_verdict():
+    table, velocity, wheel, gyro = _drive()
+    straight = SensorSeries(gyro.t, np.full_like(gyro.t, np.radians(0.3)))
+    flat = plain_heading_table(T_GNSS, conv_gnss_valid=np.ones(T_GNSS.size, bool))
+    found = check_yaw_rate_sign(flat, velocity, wheel, straight)  # no turn: no error
+    assert found.turns == 0 and np.isnan(found.agreement)
+    # one gentle turn of 20° (below the 30° needed) with the wrong sign: no verdict either
+    gentle = SensorSeries(gyro.t, _true_rate(gyro.t) * (gyro.t >= 20) / 4.5)  # 25–28 s
+    table = plain_heading_table(
+        T_GNSS,
+        yaw_conv=integral_at(gentle.t, gentle.value, T_GNSS),
+        conv_gnss_valid=np.ones(T_GNSS.size, bool),
+    )
+    found = check_yaw_rate_sign(table, velocity, wheel, _negated(gentle))
+    assert found.agreement == -1.0 and np.degrees(found.turn_rad) == pytest.approx(20.0, abs=1)
+
+
+def test_reflected_courses_in_the_turns_and_at_a_wrong_speed_do_not_count():
+    # in both turns the course is mirrored (a reflection): ends inside a turn would see the
+    # course turn against the gyro; only the straights before and after a turn count
+    in_turn = ((T_GNSS >= 10) & (T_GNSS < 13)) | ((T_GNSS >= 25) & (T_GNSS < 28))
+    error = np.where(in_turn, -2.0 * _true_yaw(T_GNSS), 0.0)
+    table, velocity, wheel, gyro = _drive(course_error=error)
+    assert yaw_rate_sign_agreement(table, velocity, wheel, gyro).agreement == 1.0
+    # a course turned by 120° on a straight at half the wheel speed is no turn at all
+    wrong = (T_GNSS >= 30) & (T_GNSS < 31)
+    table, velocity, wheel, gyro = _drive(
+        course_error=np.where(wrong, np.radians(120.0), 0.0),
+        gnss_speed=np.where(wrong, 4.0, 8.0),
+    )
+    found = yaw_rate_sign_agreement(table, velocity, wheel, gyro)
+    assert found.agreement == 1.0 and found.turns == 2
+
+
+def test_a_gyro_bias_beyond_a_car_sensor_is_a_warning():
+    assert gyro_bias_warning(np.radians(3.9)) is None
+    assert gyro_bias_warning(float("nan")) is None
+    warning = gyro_bias_warning(np.radians(-5.9))
+    assert warning.startswith("gyro bias: the calibration gives -5.90 °/s, beyond the ±4 °/s")
+    assert "counter-clockwise positive" in warning
+
+
+def test_heading_warnings_gather_the_bias_and_raise_for_the_sign():
+    table, velocity, wheel, gyro = _drive()
+    table.gyro_bias[:] = np.radians(6.0)
+    _, found = heading_warnings(table, velocity, wheel, gyro, SIGN_SOURCE)
+    assert [w for w in found if w.startswith("gyro bias: the calibration gives +6.00 °/s")]
+    _, fixed = heading_warnings(table, velocity, wheel, gyro, SIGN_SOURCE, bias_calibrated=False)
+    assert not [w for w in fixed if w.startswith("gyro bias")]
+    with pytest.raises(InputError, match="wrong sign"):
+        heading_warnings(table, velocity, wheel, _negated(gyro), SIGN_SOURCE)

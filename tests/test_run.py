@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -12,9 +13,11 @@ from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.io.heading_csv import read_heading_csv
+from vo_doppler.io.sequence import read_sequence
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.run import (
     AntennaTrack,
@@ -24,6 +27,7 @@ from vo_doppler.run import (
     initial_yaw_offset,
     level_with_yaw,
     release_free_heap,
+    run_sequence,
 )
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
@@ -353,3 +357,41 @@ def test_run_config_refuses_values_out_of_their_domain(arguments, message):
     with pytest.raises(InputError, match=message):
         RunConfig(**arguments)
     assert RunConfig(elevation_mask=0.0).elevation_mask == 0.0
+
+
+@pytest.fixture(scope="module")
+def turning_drive(tmp_path_factory):
+    """The 20-s simulated canyon drive with one left turn of 90° (13–16 s), without images:
+    gyro bias 0.3 °/s, wheel scale 1/1.02, the yaw rate counter-clockwise positive."""
+    folder = tmp_path_factory.mktemp("turn") / "seq"
+    argv = ["-q", "simulate", "--duration", "20", "--seed", "1", "--no-images", "-o", str(folder)]
+    assert main(argv) == 0
+    return read_sequence(folder)
+
+
+def test_the_library_run_checks_the_inputs_and_returns_its_warnings(turning_drive):
+    result = run_sequence(turning_drive)
+    assert result.warnings == [] and result.heading.warnings == []
+    assert result.heading.clock_residual_offset_s == pytest.approx(0.0, abs=0.15)
+    # a gyro 5 °/s off (beyond a car's sensor; the true bias is 0.3 °/s)
+    offset = SensorSeries(turning_drive.yaw_rate.t, turning_drive.yaw_rate.value + np.radians(5))
+    (warning,) = run_sequence(replace(turning_drive, yaw_rate=offset)).warnings
+    assert warning.startswith("gyro bias: the calibration gives +5.3")
+
+
+def test_the_library_run_refuses_a_yaw_rate_of_the_wrong_sign_or_in_deg_per_s(turning_drive):
+    negated = replace(turning_drive, yaw_rate=_scaled(turning_drive.yaw_rate, -1.0))
+    with pytest.raises(InputError, match=r"wrong sign: over 1 turn\(s\) totalling 9") as info:
+        run_sequence(negated)
+    assert "CAN signal VEHICLE_DYNAMICS.YAW_RATE (can.yaw_rate)" in str(info.value)
+    assert str(info.value).endswith(
+        "set can.yaw_rate_sign in "
+        + str(turning_drive.vehicle_source.yaw_rate_sign_fix.split(" in ", 1)[1])
+    )
+    degrees = replace(turning_drive, yaw_rate=_scaled(turning_drive.yaw_rate, np.degrees(1.0)))
+    with pytest.raises(InputError, match=r"can.yaw_rate\): implausibly large for a moving car"):
+        run_sequence(degrees)
+
+
+def _scaled(series: SensorSeries, factor: float) -> SensorSeries:
+    return SensorSeries(series.t, series.value * factor, series.name, series.unit)

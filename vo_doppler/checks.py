@@ -1,13 +1,23 @@
 """Plausibility checks that turn silent input errors into named warnings or errors.
 
-Pure functions over model types and numpy (no file I/O, no stage): the callers
-(``vo-doppler run``) raise the errors before the long work and put the warnings in the run's
-summary. Each check states its threshold:
+Pure functions over model types and numpy (no file I/O, no stage): the library's entry points
+call them (``run_sequence`` and ``heading_from_gnss``: errors raised before the work they
+would spoil, warnings logged and returned), and so every command. The messages name the
+signals as a :class:`~vo_doppler.model.vehicle_source.VehicleSignalSource` says (a file, a
+CAN signal and its DBC, an option). Each check states its threshold:
 
 * yaw rate against its DBC unit: while the wheels turn faster than 2 m/s, a median |yaw rate|
   above 0.2 rad/s (11.5 °/s) or a median lateral acceleration |yaw rate × speed| above
   1.5 m/s² is no car's road driving (a skid pad would be); when the DBC says rad/s and the
   values read as deg/s would be ordinary, the hint says so;
+* the yaw rate's sign against the GNSS Doppler course (:func:`yaw_rate_sign_agreement`): over
+  the turns between two straights, the course change of the conventional heading (GNSS tests
+  alone, at the wheel speed) and the integrated raw yaw rate must agree in sign; a summed
+  course change of 30° or more at an agreement of −0.5 or less is an error (simulated canyon
+  drives: +1.00 right, −1.00 with the sign flipped, on every one of 15 with a turn), less
+  turning is no verdict;
+* the calibrated gyro bias: beyond ±4 °/s (a car yaw-rate sensor's specified offset) it is a
+  warning;
 * the CAN clock against the GNSS speed: the lag (±5 s, or a quarter of a shorter record) at
   which the scaled wheel speed agrees best with the horizontal Doppler speed at the valid GNSS
   epochs, by the median absolute difference (robust to the reflected epochs that pass the
@@ -48,9 +58,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.errors import InputError
-from vo_doppler.geo import EnuFrame
+from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.model.gnss_solutions import VelocitySolution
+from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.timeseries import integral_at
+from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 MOVING_SPEED_MPS = 2.0
 MAX_MEDIAN_YAW_RATE = 0.2
@@ -93,6 +106,47 @@ STANDSTILL_MAX_MEDIAN_SPEED_MPS = 0.5
 ORIGIN_TOLERANCE_M = 10_000.0
 EARTH_SURFACE_M = (6.3e6, 6.4e6)
 """Norm of an ECEF position on the ground (m): outside, the approximate position is no place."""
+SIGN_SPAN_S = (1.0, 8.0)
+"""Shortest and longest time (s) between the two conventional headings of a compared span:
+the longest bridges a turn (a right angle at 30 °/s: 3 s) and a gap of the heading in a
+street canyon around it."""
+SIGN_STRAIGHT_RATE = np.radians(3.0)
+"""rad/s: a span's ends are where the vehicle drives straight, the gyro's |mean rate| over the
+surrounding second below this (sign aside), since in a canyon's turn the conventional course
+is often reflected for seconds (a simulated canyon: 40–175° off with six or seven
+satellites, at the wheel speed) while on the straights before and after it is not."""
+SIGN_MIN_TURN_RATE = np.radians(2.0)
+"""rad/s: a span is a turn when the Doppler course and the integrated yaw rate both turn
+faster than this on average, beyond a raw car gyro's bias (well under 1 °/s on the drives
+here) and slower than the curves of a highway (a few °/s)."""
+SIGN_SPEED_TOLERANCE = (0.5, 0.10)
+"""m/s and fraction: a conventional heading counts only where its horizontal speed lies within
+max(these) of the calibrated wheel speed, as the calibration's own gate. In a street canyon a
+velocity from four or five satellites can pass the GNSS tests and point the other way (a
+simulated canyon: 175° off for seconds after a turn, at half the wheel speed)."""
+SIGN_CONFIRM = (0.5, np.radians(5.0))
+"""s and rad: a conventional course counts only when the next or previous one, at most 0.5 s
+away, turned from it by the amount the gyro turned, within 5° (sign aside): a lone reflected
+course (a simulated canyon: 62° off, seven satellites) has no such neighbour."""
+SIGN_NOISE_FACTOR = 5.0
+"""A turn's course change also exceeds this many σ of the two conventional headings."""
+SIGN_MAX_TURN_RATIO = 1.5
+"""The course and the gyro must turn by amounts within this factor of each other, sign aside
+(a wrong sign leaves the amounts alike): a span across a reflected course (a simulated
+canyon: 61° off at the wheel speed) turns by another amount than the gyro."""
+SIGN_MAX_TURN = np.radians(150.0)
+"""Spans turning more (by the gyro or the course) are left out: the wrap at 180° blurs them."""
+SIGN_MIN_TOTAL_TURN = np.radians(30.0)
+"""Least course change summed over the turns for a verdict: below it, no verdict."""
+SIGN_MAX_AGREEMENT = -0.5
+"""At or below this agreement (+1: every turn agrees in sign, −1: every turn disagrees) the
+yaw rate has the wrong sign."""
+MAX_GYRO_BIAS = np.radians(4.0)
+"""rad/s (4 °/s): beyond the offset a car's yaw-rate sensor is specified for over its life
+and temperature range (3.75 °/s, a Hyundai ESP yaw-rate/lateral-G sensor's shop-manual
+specification; ESP units zero it at standstill, the drives here show 0.03–0.4 °/s). A
+calibrated bias beyond it is the calibration absorbing a yaw rate that is wrong (its sign,
+its axis), not a sensor's offset: 5.9 °/s on a 20 s simulated drive with the sign flipped."""
 
 
 @dataclass(frozen=True)
@@ -122,24 +176,26 @@ def moving_yaw_rate_medians(yaw_rate: SensorSeries, speed: SensorSeries) -> tupl
     return float(np.median(rate)), float(np.median(rate * v[moving]))
 
 
-def check_yaw_rate_unit(yaw_rate: SensorSeries, speed: SensorSeries, dbc_unit: str) -> None:
-    """Raise when the yaw rate is implausibly large for a moving car (module docstring)."""
+def check_yaw_rate_unit(
+    yaw_rate: SensorSeries, speed: SensorSeries, source: VehicleSignalSource | None = None
+) -> None:
+    """Raise when the yaw rate is implausibly large for a moving car (module docstring),
+    naming the yaw rate's origin and, when its values read as deg/s would be ordinary and it
+    declares rad/s, what to fix (``source``; generic words without one)."""
+    source = source or VehicleSignalSource()
     rate, lateral = moving_yaw_rate_medians(yaw_rate, speed)
     if not (rate > MAX_MEDIAN_YAW_RATE or lateral > MAX_MEDIAN_LATERAL_ACCELERATION):
         return
     hint = ""
     as_degrees = np.radians([rate, lateral])
-    if dbc_unit.strip().lower().replace(" ", "") == "rad/s" and (
+    if source.yaw_rate_unit.strip().lower().replace(" ", "") == "rad/s" and (
         as_degrees[0] <= MAX_MEDIAN_YAW_RATE and as_degrees[1] <= MAX_MEDIAN_LATERAL_ACCELERATION
     ):
-        hint = (
-            "; the DBC declares the signal in rad/s but the values look like deg/s: fix the "
-            "unit in the DBC"
-        )
+        hint = f"; the values look like deg/s: {source.yaw_rate_unit_fix}"
     raise InputError(
-        f"yaw rate implausibly large for a moving car: median |yaw rate| {rate:.3g} rad/s "
-        f"({np.degrees(rate):.3g} °/s), median |yaw rate × speed| {lateral:.3g} m/s² while "
-        f"moving (DBC unit {dbc_unit!r}){hint}"
+        f"{source.yaw_rate}: implausibly large for a moving car: median |yaw rate| "
+        f"{rate:.3g} rad/s ({np.degrees(rate):.3g} °/s), median |yaw rate × speed| "
+        f"{lateral:.3g} m/s² while moving (declared unit {source.yaw_rate_unit!r}){hint}"
     )
 
 
@@ -418,6 +474,149 @@ def calibration_warnings(
         None if wheel_scale is None else wheel_scale_warning(wheel_scale),
     ]
     return estimate, [warning for warning in found if warning]
+
+
+@dataclass(frozen=True)
+class YawRateSignAgreement:
+    """How the raw yaw rate agrees in sign with the GNSS Doppler course over the turns:
+    ``agreement`` the turns' sign agreement weighted by their course change (+1 all agree, −1
+    all disagree; NaN without a turn), ``turns`` their number, ``turn_rad`` their summed
+    |course change|."""
+
+    agreement: float
+    turns: int
+    turn_rad: float
+
+
+def yaw_rate_sign_agreement(
+    table: HeadingTable,
+    velocity: VelocitySolution,
+    wheel_speed: SensorSeries,
+    yaw_rate: SensorSeries,
+) -> YawRateSignAgreement:
+    """Compare the integrated yaw rate with the change of the conventional Doppler course.
+
+    The course is the conventional heading that passed the GNSS tests alone
+    (:attr:`~vo_doppler.model.heading.HeadingTable.published_conventional`): the tightly
+    coupled heading and the gyro-tested conventional one use the yaw rate themselves and would
+    follow a wrong sign. A course counts where the conventional ``velocity`` (one row per
+    table epoch) agrees with the calibrated ``wheel_speed`` (``SIGN_SPEED_TOLERANCE``), a
+    neighbour confirms it (``SIGN_CONFIRM``) and the vehicle drives straight
+    (``SIGN_STRAIGHT_RATE``): the GNSS tests alone pass reflected velocities in a canyon, most
+    of all in its turns. From each such course, the first one ``SIGN_SPAN_S`` later (1 to 8 s)
+    closes a span; spans do not overlap. A span is a turn when the course and the integrated
+    raw yaw rate (uncalibrated: the calibration absorbs a wrong sign into the bias) both
+    change by more than ``SIGN_MIN_TURN_RATE`` × its duration and less than
+    ``SIGN_MAX_TURN``, by amounts within ``SIGN_MAX_TURN_RATIO`` of each other, the course by
+    more than ``SIGN_NOISE_FACTOR`` σ."""
+    valid, sigma = table.published_conventional
+    t, course = table.t, table.yaw_conv
+    if len(yaw_rate) < 2 or len(wheel_speed) < 2 or len(velocity.t) != len(t):
+        return YawRateSignAgreement(float("nan"), 0, 0.0)
+    wheel = table.wheel_scale * np.interp(t, wheel_speed.t, wheel_speed.value)
+    gnss_speed = np.hypot(velocity.velocity_enu[:, 0], velocity.velocity_enu[:, 1])
+    tolerance = np.maximum(SIGN_SPEED_TOLERANCE[0], SIGN_SPEED_TOLERANCE[1] * np.abs(wheel))
+    agrees = np.abs(np.nan_to_num(gnss_speed - wheel, nan=np.inf)) <= tolerance
+    rows = np.flatnonzero(
+        valid & agrees & np.isfinite(course) & (t >= yaw_rate.t[0]) & (t <= yaw_rate.t[-1])
+    )
+    turned = integral_at(yaw_rate.t, yaw_rate.value, t[rows])
+    around = integral_at(yaw_rate.t, yaw_rate.value, t[rows] + 0.5, "extend") - integral_at(
+        yaw_rate.t, yaw_rate.value, t[rows] - 0.5, "extend"
+    )
+    alike = (np.diff(t[rows]) <= SIGN_CONFIRM[0]) & (
+        np.abs(np.abs(wrap_angle(np.diff(course[rows]))) - np.abs(np.diff(turned)))
+        <= SIGN_CONFIRM[1]
+    )
+    confirmed = np.concatenate([[False], alike]) | np.concatenate([alike, [False]])
+    ends = confirmed & (np.abs(around) <= SIGN_STRAIGHT_RATE * 1.0)
+    rows, turned = rows[ends], turned[ends]
+    signs, weights = [], []
+    start = 0
+    while start < len(rows):
+        end = int(np.searchsorted(t[rows], t[rows[start]] + SIGN_SPAN_S[0]))
+        if end >= len(rows):
+            break
+        a, b = rows[start], rows[end]
+        duration = t[b] - t[a]
+        course_change = float(wrap_angle(course[b] - course[a]))
+        gyro_change = float(turned[end] - turned[start])
+        noise = SIGN_NOISE_FACTOR * float(np.hypot(*np.nan_to_num(sigma[[a, b]])))
+        least = SIGN_MIN_TURN_RATE * duration
+        if (
+            duration <= SIGN_SPAN_S[1]
+            and max(least, noise) < abs(course_change) < SIGN_MAX_TURN
+            and least < abs(gyro_change) < SIGN_MAX_TURN
+            and abs(course_change) <= SIGN_MAX_TURN_RATIO * abs(gyro_change)
+            and abs(gyro_change) <= SIGN_MAX_TURN_RATIO * abs(course_change)
+        ):
+            signs.append(np.sign(course_change * gyro_change))
+            weights.append(abs(course_change))
+        start = end
+    if not weights:
+        return YawRateSignAgreement(float("nan"), 0, 0.0)
+    total = float(np.sum(weights))
+    return YawRateSignAgreement(float(np.dot(signs, weights)) / total, len(weights), total)
+
+
+def check_yaw_rate_sign(
+    table: HeadingTable,
+    velocity: VelocitySolution,
+    wheel_speed: SensorSeries,
+    yaw_rate: SensorSeries,
+    source: VehicleSignalSource | None = None,
+) -> YawRateSignAgreement:
+    """Raise when the yaw rate turns against the GNSS Doppler course (agreement at or below
+    ``SIGN_MAX_AGREEMENT`` over at least ``SIGN_MIN_TOTAL_TURN`` of turns), naming the setting
+    to change (``source``); too few turns give no verdict. Returns the agreement."""
+    source = source or VehicleSignalSource()
+    found = yaw_rate_sign_agreement(table, velocity, wheel_speed, yaw_rate)
+    if found.turn_rad >= SIGN_MIN_TOTAL_TURN and found.agreement <= SIGN_MAX_AGREEMENT:
+        raise InputError(
+            f"{source.yaw_rate}: wrong sign: over {found.turns} turn(s) "
+            f"totalling {np.degrees(found.turn_rad):.0f}° of GNSS Doppler course change, it "
+            f"turns the other way (sign agreement {found.agreement:+.2f}, +1 when right); "
+            f"{source.yaw_rate_sign_fix}"
+        )
+    return found
+
+
+def gyro_bias_warning(bias: float) -> str | None:
+    """A warning when the calibrated gyro bias (rad/s) exceeds ``MAX_GYRO_BIAS``."""
+    if not np.isfinite(bias) or abs(bias) <= MAX_GYRO_BIAS:
+        return None
+    return (
+        f"gyro bias: the calibration gives {np.degrees(bias):+.2f} °/s, beyond the ±"
+        f"{np.degrees(MAX_GYRO_BIAS):g} °/s of a car's yaw-rate sensor: is the yaw rate "
+        "counter-clockwise positive, in rad/s, about the vertical axis, and its clock right?"
+    )
+
+
+def heading_warnings(
+    table: HeadingTable,
+    velocity: VelocitySolution,
+    wheel_speed: SensorSeries,
+    yaw_rate: SensorSeries,
+    source: VehicleSignalSource | None = None,
+    scale_calibrated: bool = True,
+    bias_calibrated: bool = True,
+) -> tuple[ClockOffsetEstimate, list[str]]:
+    """Every check of a heading stage's result, for the library and so for every command:
+    raises for a yaw rate of the wrong sign (:func:`check_yaw_rate_sign`); returns the clock
+    estimate and the warnings of :func:`calibration_warnings` and :func:`gyro_bias_warning`
+    (the wheel scale and gyro bias only when calibrated, not fixed)."""
+    source = source or VehicleSignalSource()
+    check_yaw_rate_sign(table, velocity, wheel_speed, yaw_rate, source)
+    estimate, found = calibration_warnings(
+        wheel_speed,
+        velocity,
+        float(table.wheel_scale[-1]) if scale_calibrated and len(table) else None,
+        source.sensor,
+        source.offset_s,
+        source.offset_name,
+    )
+    bias = gyro_bias_warning(float(table.gyro_bias[-1])) if bias_calibrated and len(table) else None
+    return estimate, found + ([bias] if bias else [])
 
 
 def origin_warning(enu: EnuFrame, approx_position_ecef: np.ndarray | None) -> str | None:

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.checks import check_yaw_rate_unit, origin_warning
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.correction import (
     CorrectionConfig,
@@ -110,6 +111,10 @@ class RunResult:
     """The antenna positions that placed the trajectories."""
     tc_usable: np.ndarray
     """Epochs whose tightly coupled heading was allowed to correct."""
+    warnings: list[str] = field(default_factory=list)
+    """What the checks found doubtful in the inputs and the calibration (each also logged):
+    the origin against the RINEX approximate position, then the heading stage's
+    (``heading.warnings``)."""
 
 
 @dataclass(frozen=True)
@@ -334,6 +339,7 @@ def sequence_heading(
         config,
         sequence.antenna_lever_arm_m,
         sequence.forward_acceleration,
+        sequence.vehicle_source,
     )
 
 
@@ -379,9 +385,18 @@ def run_sequence(
     images: Iterable[np.ndarray] | None = None,
 ) -> RunResult:
     """Run every stage on a recording. ``images`` replaces reading ``sequence.image_paths``
-    (e.g. frames already in memory); ``on_frame`` is called after each VO frame."""
+    (e.g. frames already in memory); ``on_frame`` is called after each VO frame.
+
+    The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`): a
+    yaw rate too large for a car (before the GNSS stage) or turning against the GNSS Doppler
+    course (after the heading stage, before the VO) raises :class:`InputError`; the rest are
+    warnings, logged and returned in ``RunResult.warnings``."""
     config = config or RunConfig()
     obs = sequence.observations
+    check_yaw_rate_unit(sequence.yaw_rate, sequence.wheel_speed, sequence.vehicle_source)
+    origin = origin_warning(sequence.enu, obs.header.approx_position)
+    if origin:
+        log.warning("%s", origin)
     gnss = sequence_gnss(sequence, config)
     release_free_heap()
     table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
@@ -399,4 +414,5 @@ def run_sequence(
     trajectories = correct_all(sequence, table, vo_vehicle, speed, antenna, config)
     release_free_heap()
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
-    return RunResult(gnss, table, vo, speed, trajectories, antenna, usable)
+    warnings = ([origin] if origin else []) + table.warnings
+    return RunResult(gnss, table, vo, speed, trajectories, antenna, usable, warnings)

@@ -257,8 +257,10 @@ def test_dbc_declaring_rad_s_for_deg_s_data_is_an_error_with_a_hint(clean, tmp_p
     dbc = folder / "can" / "vehicle.dbc"
     dbc.write_text(dbc.read_text().replace('[-327.68|327.67] "deg/s"', '[-327.68|327.67] "rad/s"'))
     err = failing_run(folder, tmp_path, capsys)
-    assert "yaw rate implausibly large for a moving car" in err
-    assert "the DBC declares the signal in rad/s but the values look like deg/s" in err
+    assert (
+        "CAN signal VEHICLE_DYNAMICS.YAW_RATE (can.yaw_rate): implausibly large for a moving" in err
+    )
+    assert "the values look like deg/s: the DBC declares the signal in rad/s: fix the unit" in err
 
 
 def test_block_of_can_frames_five_seconds_early_is_an_error(clean, tmp_path, capsys):
@@ -496,3 +498,22 @@ def test_can_clock_off_by_most_of_a_second_is_warned_with_the_fix(tmp_path, capl
     assert summary["can_clock_residual_offset_s"] == pytest.approx(-0.8, abs=0.1)
     warning = next(w for w in summary["warnings"] if w.startswith("CAN clock"))
     assert f"should be about {offset:.1f}" in warning
+
+
+@pytest.fixture(scope="module")
+def turning(tmp_path_factory) -> Path:
+    """20 s without images, with one left turn of 90° (the QA report's ``s1``)."""
+    folder = tmp_path_factory.mktemp("turning") / "s1"
+    argv = ["-q", "simulate", "--duration", "20", "--seed", "1", "--no-images", "-o", str(folder)]
+    assert main(argv) == 0
+    return folder
+
+
+def test_a_yaw_rate_sign_flipped_in_the_manifest_is_an_error_naming_the_setting(
+    turning, tmp_path, capsys
+):
+    folder = damaged_copy(turning, tmp_path)
+    edit_manifest(folder, "can", "yaw_rate_sign", -1)
+    err = failing_run(folder, tmp_path, capsys)
+    assert "CAN signal VEHICLE_DYNAMICS.YAW_RATE (can.yaw_rate): wrong sign: over 1 turn(s)" in err
+    assert f"set can.yaw_rate_sign in {folder / 'sequence.yaml'} to 1 (it is -1)" in err

@@ -185,6 +185,16 @@ def test_vehicle_signals_from_sensor_csvs_instead_of_a_can_log(tmp_path):
     assert report.can is None and report.vehicle_time_offset_s == offset
     assert sequence.clock_offsets_s["vehicle"] == offset
     assert sequence.forward_acceleration is None
+    names = sequence.vehicle_source  # what the checks' messages say: the CSV and its fix
+    assert names.yaw_rate == f"{tmp_path / 'vehicle' / 'yaw.csv'} (the yaw rate, vehicle.yaw_rate)"
+    assert names.yaw_rate_unit_fix.startswith("the yaw_rate_rad_s column must be in rad/s")
+    assert "yaw_rate_rad_s column must be counter-clockwise positive" in names.yaw_rate_sign_fix
+    assert (names.sensor, names.offset_s) == ("vehicle signals", offset)
+    assert "DBC" not in names.yaw_rate_unit_fix
+    assert from_can.vehicle_source.yaw_rate.endswith(
+        "vehicle.dbc: the yaw rate, CAN signal VEHICLE_DYNAMICS.YAW_RATE (can.yaw_rate)"
+    )
+    assert from_can.vehicle_source.yaw_rate_sign_fix.startswith("set can.yaw_rate_sign in ")
     manifest["can"] = can
     write_manifest(tmp_path, manifest)
     with pytest.raises(InputError, match="given twice"):

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.checks import calibration_warnings
 from vo_doppler.commands.arg_types import (
     finite_float,
     lever_arm,
@@ -36,7 +35,9 @@ from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
+from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import sample
+from vo_doppler.model.vehicle_source import VehicleSignalSource
 from vo_doppler.report.heading_figure import heading_figure
 from vo_doppler.report.json_text import json_text
 
@@ -197,7 +198,8 @@ def sensor_options_problem(args: argparse.Namespace) -> str | None:
     return None
 
 
-def _sensors(args):
+def _sensors(args) -> tuple[SensorSeries, SensorSeries, str]:
+    """Wheel speed, yaw rate and the yaw rate's declared unit (the DBC's, rad/s for a CSV)."""
     if args.can is not None:
         motion = read_can_motion(
             args.can,
@@ -210,10 +212,36 @@ def _sensors(args):
             args.can_channel,
             args.can_short_frames,
         )
-        return motion.speed, motion.yaw_rate
+        return motion.speed, motion.yaw_rate, motion.report.dbc_units.get(args.yaw_rate.strip(), "")
     return (
         read_speed_csv(args.speed_csv, args.time_offset_speed),
         read_yaw_rate_csv(args.yaw_rate_csv, args.time_offset_yaw),
+        "rad/s",
+    )
+
+
+def _signal_source(args: argparse.Namespace, yaw_rate_unit: str) -> VehicleSignalSource:
+    """The vehicle signals in the words of this command's options, for the checks' messages
+    (``yaw_rate_unit``: the DBC's unit of the yaw-rate signal)."""
+    if args.can is not None:
+        return VehicleSignalSource(
+            sensor="CAN",
+            offset_s=args.time_offset_can,
+            offset_name="--time-offset-can",
+            yaw_rate=f"{args.dbc}: the yaw rate, CAN signal {args.yaw_rate} (--yaw-rate)",
+            yaw_rate_unit=yaw_rate_unit,
+            yaw_rate_unit_fix="the DBC declares the signal in rad/s: fix the unit (or factor) "
+            "in the DBC",
+            yaw_rate_sign_fix=f"give --yaw-rate-sign {-args.yaw_rate_sign:g}",
+        )
+    return VehicleSignalSource(
+        sensor="speed CSV",
+        offset_s=args.time_offset_speed,
+        offset_name="--time-offset-speed",
+        yaw_rate=f"{args.yaw_rate_csv} (the yaw rate, --yaw-rate-csv)",
+        yaw_rate_unit_fix="its yaw_rate_rad_s column must be in rad/s: convert it (× π/180)",
+        yaw_rate_sign_fix="its yaw_rate_rad_s column must be counter-clockwise positive (a left "
+        "turn > 0): negate it",
     )
 
 
@@ -236,7 +264,7 @@ def run(args: argparse.Namespace) -> int:
         {"output": args.output, "figure": figure},
         [args.obs, *satellite_inputs(args), *sensor_files],
     )
-    speed, yaw_rate = _sensors(args)
+    speed, yaw_rate, yaw_rate_unit = _sensors(args)
     obs = read_obs(args.obs)
     nav = satellite_states(args)
     systems, mask = args.systems, np.radians(args.elev_mask)
@@ -268,17 +296,9 @@ def run(args: argparse.Namespace) -> int:
         _local_frame(rows.receiver_ecef, obs),
         config,
         args.antenna_lever_arm,
+        source=_signal_source(args, yaw_rate_unit),
     )
-    _, warnings = calibration_warnings(
-        speed,
-        conventional,
-        float(table.wheel_scale[-1]) if args.wheel_scale is None else None,
-        "CAN" if args.can else "speed CSV",
-        args.time_offset_can if args.can else args.time_offset_speed,
-        "--time-offset-can" if args.can else "--time-offset-speed",
-    )
-    for warning in warnings:
-        log.warning("%s", warning)
+    warnings = table.warnings
     for path in (args.output, figure):
         path.parent.mkdir(parents=True, exist_ok=True)
     write_heading_csv(args.output, table)

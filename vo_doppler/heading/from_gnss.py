@@ -5,11 +5,13 @@ recordings."""
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
 
+from vo_doppler.checks import check_yaw_rate_unit, heading_warnings
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.doppler_velocity import doppler_rows, solve_velocity
 from vo_doppler.gnss.satellite_source import StateSource
@@ -22,6 +24,9 @@ from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_source import VehicleSignalSource
+
+log = logging.getLogger(__name__)
 
 
 def keep_highest_satellites(
@@ -85,13 +90,22 @@ def heading_from_gnss(
     config: HeadingPipelineConfig,
     antenna_lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0),
     forward_acceleration: SensorSeries | None = None,
+    source: VehicleSignalSource | None = None,
 ) -> HeadingTable:
     """The heading stage ([TK18] sec. 3.3–3.5) from the GNSS stage's Doppler rows and
     conventional velocities: what ``run``, ``heading`` and the benchmarks all call. The table
     carries the conventional solution's speed σ (scaled as the heading's, design (I1)) and
     HDOP on its valid epochs.
     ``forward_acceleration``: the road grade prior's accelerometer, if the recording has one
-    (:func:`~vo_doppler.heading.pipeline.heading_pipeline`)."""
+    (:func:`~vo_doppler.heading.pipeline.heading_pipeline`).
+
+    The vehicle signals are checked (:mod:`vo_doppler.checks`; ``source`` names them in the
+    messages): a yaw rate too large for a car (deg/s read as rad/s) before the work, and one
+    turning against the GNSS Doppler course after it, raise :class:`InputError`; the clock,
+    the coverage of the GNSS epochs, the calibrated wheel scale and gyro bias give warnings,
+    logged and kept in the table's ``warnings`` (the residual clock offset in
+    ``clock_residual_offset_s``)."""
+    check_yaw_rate_unit(yaw_rate, wheel_speed, source)
     table = heading_pipeline(
         epoch_time,
         rows.in_enu(),
@@ -109,4 +123,17 @@ def heading_from_gnss(
         conventional_vertical_sigma_mps=velocity.vertical_sigma_mps,
     )
     table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)
+    estimate, warnings = heading_warnings(
+        table,
+        velocity,
+        wheel_speed,
+        yaw_rate,
+        source,
+        scale_calibrated=config.fixed_wheel_scale is None,
+        bias_calibrated=config.fixed_gyro_bias is None,
+    )
+    for warning in warnings:
+        log.warning("%s", warning)
+    table.warnings = warnings
+    table.clock_residual_offset_s = estimate.residual_s
     return table

@@ -39,12 +39,15 @@ from vo_doppler.io.vehicle_limits import lever_arm_problem
 from vo_doppler.io.yaml_file import load_yaml
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 log = logging.getLogger(__name__)
 
 MANIFEST = "sequence.yaml"
 FORMAT = "vo-doppler-sequence/1"
 MANIFEST_MAX_BYTES = 1 << 20
+MANIFEST_OFFSET = "the manifest's time_offset_s"
+"""The vehicle signals' clock setting, as the clock checks name it."""
 _REQUIRED = object()
 
 
@@ -277,6 +280,7 @@ def read_sequence_with_report(
         truth=truth,
         antenna_lever_arm_m=lever_arm,
         clock_offsets_s={"camera": camera_offset, motion.source: motion.offset_s, "gnss": 0.0},
+        vehicle_source=motion.names,
     )
     return sequence, report
 
@@ -288,6 +292,7 @@ class _VehicleMotion:
     forward_acceleration: SensorSeries | None
     source: str
     offset_s: float
+    names: VehicleSignalSource
 
 
 def _vehicle_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
@@ -311,7 +316,17 @@ def _vehicle_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
     speed = _sensor_csv(m, "vehicle", "wheel_speed", SPEED_COLUMN, report)
     report.yaw_rate_dbc_unit = "rad/s"
     report.vehicle_time_offset_s = offset
-    return _VehicleMotion(yaw_rate, speed, None, "vehicle", offset)
+    yaw_file = m.file("vehicle", "yaw_rate")
+    names = VehicleSignalSource(
+        sensor="vehicle signals",
+        offset_s=offset,
+        offset_name=MANIFEST_OFFSET,
+        yaw_rate=f"{yaw_file} (the yaw rate, vehicle.yaw_rate)",
+        yaw_rate_unit_fix=f"the {YAW_RATE_COLUMN} column must be in rad/s: convert it (× π/180)",
+        yaw_rate_sign_fix=f"the {YAW_RATE_COLUMN} column must be counter-clockwise positive (a "
+        "left turn > 0): negate it",
+    )
+    return _VehicleMotion(yaw_rate, speed, None, "vehicle", offset, names)
 
 
 def _sensor_csv(
@@ -371,8 +386,18 @@ def _can_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
     report.time_order.extend(motion.report.time_order.values())
     report.yaw_rate_dbc_unit = motion.report.dbc_units.get(yaw_name.strip(), "")
     report.vehicle_time_offset_s = can_offset
+    names = VehicleSignalSource(
+        sensor="CAN",
+        offset_s=can_offset,
+        offset_name=MANIFEST_OFFSET,
+        yaw_rate=f"{dbc_path}: the yaw rate, CAN signal {yaw_name.strip()} (can.yaw_rate)",
+        yaw_rate_unit=report.yaw_rate_dbc_unit,
+        yaw_rate_unit_fix="the DBC declares the signal in rad/s: fix the unit (or factor) in the "
+        "DBC",
+        yaw_rate_sign_fix=f"set can.yaw_rate_sign in {m.path} to {-sign:g} (it is {sign:g})",
+    )
     return _VehicleMotion(
-        motion.yaw_rate, motion.speed, motion.forward_acceleration, "can", can_offset
+        motion.yaw_rate, motion.speed, motion.forward_acceleration, "can", can_offset, names
     )
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -55,6 +55,12 @@ class HeadingTable:
     grade_from_accelerometer: np.ndarray | None = None
     """Whether that prior came from a calibrated forward accelerometer (else the zero-mean
     default)."""
+    warnings: list[str] = field(default_factory=list)
+    """What the checks of the heading stage found doubtful in its inputs and calibration
+    (:func:`vo_doppler.heading.from_gnss.heading_from_gnss`); not written to a heading CSV."""
+    clock_residual_offset_s: float | None = None
+    """The wheel speed's residual clock offset (s) against the GNSS Doppler speed, None when
+    no lag was found or not checked (:func:`vo_doppler.checks.estimate_clock_offset`)."""
 
     def __post_init__(self) -> None:
         n = len(self.t)

@@ -15,6 +15,7 @@ from vo_doppler.model.observations import Observations
 from vo_doppler.model.precise_orbits import PreciseOrbits
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 
 @dataclass
@@ -49,6 +50,8 @@ class Sequence:
     forward_acceleration: SensorSeries | None = None
     """Specific force along the vehicle's forward axis (m/s², an accelerometer's), if recorded:
     the tight heading's road grade prior."""
+    vehicle_source: VehicleSignalSource = field(default_factory=VehicleSignalSource)
+    """Where the yaw rate and wheel speed came from, for the checks' messages."""
 
     @property
     def has_camera(self) -> bool:

@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.checks import calibration_warnings, check_yaw_rate_unit, origin_warning
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
 from vo_doppler.eval.pipelines import (
@@ -153,34 +152,21 @@ def readable_facts(summary: dict) -> dict[str, str]:
 
 
 def input_warnings(inputs: Sequence, report: InputReport) -> list[str]:
-    """Errors raised and warnings listed before the long work: the yaw rate against its DBC
-    unit, the origin against the RINEX approximate position, each sensor's time order."""
-    check_yaw_rate_unit(inputs.yaw_rate, inputs.wheel_speed, report.yaw_rate_dbc_unit)
-    found = report.warnings()
-    origin = origin_warning(inputs.enu, inputs.observations.header.approx_position)
-    return found + ([origin] if origin else [])
+    """What reading the sequence found: the samples the readers skipped and each sensor's time
+    order (the checks of the data themselves are the library's, in ``run_sequence``)."""
+    return report.warnings()
 
 
 def result_checks(
     inputs: Sequence, report: InputReport, result: RunResult, warnings: list[str]
 ) -> dict:
     """The summary's ``checks``: the input ``warnings``, what the GNSS readers skipped
-    (:func:`file_problems`, already logged by them), the CAN clock against the GNSS Doppler
-    speed (the estimate, and a warning beyond 0.2 s, logged) and the calibrated wheel scale
-    (:func:`~vo_doppler.checks.calibration_warnings`), the time order per sensor."""
-    sensor = "CAN" if report.can is not None else "vehicle signals"
-    estimate, found = calibration_warnings(
-        inputs.wheel_speed,
-        result.gnss.velocity,
-        float(result.heading.wheel_scale[-1]),
-        sensor,
-        report.vehicle_time_offset_s,
-    )
-    for warning in found:
-        log.warning("%s", warning)
+    (:func:`file_problems`, already logged by them), the library's warnings
+    (``result.warnings``, already logged: the origin, the CAN clock against the GNSS Doppler
+    speed, the calibration), the residual clock offset, the time order per sensor."""
     return {
-        "warnings": warnings + file_problems(inputs) + found,
-        "can_clock_residual_offset_s": estimate.residual_s,
+        "warnings": warnings + file_problems(inputs) + result.warnings,
+        "can_clock_residual_offset_s": result.heading.clock_residual_offset_s,
         "time_order": {r.sensor: r.as_dict() for r in report.time_order},
     }
 

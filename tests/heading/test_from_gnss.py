@@ -1,0 +1,54 @@
+"""``heading_from_gnss`` checks its vehicle signals as ``run`` does, on a simulated drive."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vo_doppler.cli import main
+from vo_doppler.errors import InputError
+from vo_doppler.gnss.pipeline import gnss_velocity
+from vo_doppler.heading.from_gnss import heading_from_gnss
+from vo_doppler.heading.pipeline import HeadingPipelineConfig
+from vo_doppler.io.sequence import read_sequence
+from vo_doppler.model.series import SensorSeries
+
+
+@pytest.fixture(scope="module")
+def drive(tmp_path_factory):
+    """A 20-s simulated canyon drive with one left turn of 90°, its GNSS stage run."""
+    folder = tmp_path_factory.mktemp("turn") / "seq"
+    argv = ["-q", "simulate", "--duration", "20", "--seed", "1", "--no-images", "-o", str(folder)]
+    assert main(argv) == 0
+    sequence = read_sequence(folder)
+    return sequence, gnss_velocity(sequence.observations, sequence.navigation, "GE")
+
+
+def _heading(drive, yaw_rate: SensorSeries, **config):
+    sequence, gnss = drive
+    return heading_from_gnss(
+        sequence.observations.epoch_time,
+        gnss.rows,
+        gnss.velocity,
+        sequence.wheel_speed,
+        yaw_rate,
+        sequence.enu,
+        HeadingPipelineConfig(**config),
+    )
+
+
+def test_a_yaw_rate_of_the_wrong_sign_is_refused_in_generic_words_without_a_source(drive):
+    sequence, _ = drive
+    assert _heading(drive, sequence.yaw_rate).warnings == []
+    negated = SensorSeries(sequence.yaw_rate.t, -sequence.yaw_rate.value)
+    with pytest.raises(InputError, match=r"^the yaw rate: wrong sign: .*; negate it: it must be"):
+        _heading(drive, negated)
+
+
+def test_a_calibrated_gyro_bias_beyond_a_car_sensor_is_in_the_table_warnings(drive, caplog):
+    sequence, _ = drive
+    off = SensorSeries(sequence.yaw_rate.t, sequence.yaw_rate.value + np.radians(5.0))
+    table = _heading(drive, off)
+    (warning,) = table.warnings
+    assert warning.startswith("gyro bias: the calibration gives +5.3") and warning in caplog.text
+    assert _heading(drive, off, fixed_gyro_bias=np.radians(5.0)).warnings == []  # chosen: no check
