@@ -22,6 +22,7 @@ from vo_doppler.checks import (
     heading_warnings,
     moving_yaw_rate_medians,
     origin_warning,
+    speed_ratio_warning,
     wheel_scale_warning,
     yaw_rate_sign_agreement,
 )
@@ -253,7 +254,9 @@ def test_wheel_scales_beyond_ten_percent_are_a_warning(scale):
     assert f"the calibration gives {scale:.3f}, beyond 1 ± 0.1" in wheel_scale_warning(scale)
 
 
-def test_calibration_warnings_gather_the_clock_and_the_scale():
+def _gnss_of_speed():
+    """GNSS epochs at 5 Hz over 5–55 s with SPEED's exact value northwards, every 4th
+    invalid: the times, the speeds (NaN where invalid) and the velocity solution."""
     t_gnss = np.arange(5.0, 55.0, 0.2)
     gnss = np.interp(t_gnss, SPEED.t, SPEED.value)
     gnss[::4] = np.nan
@@ -262,6 +265,11 @@ def test_calibration_warnings_gather_the_clock_and_the_scale():
         np.column_stack([np.zeros_like(gnss), np.nan_to_num(gnss), np.zeros_like(gnss)]),
         np.isfinite(gnss),
     )
+    return t_gnss, gnss, velocity
+
+
+def test_calibration_warnings_gather_the_clock_and_the_scale():
+    velocity = _gnss_of_speed()[2]
     estimate, found = calibration_warnings(SPEED, velocity, 1.0, "CAN", 0.0)
     assert estimate.residual_s == pytest.approx(0.0, abs=0.01) and found == []
     late = SensorSeries(T, SPEED.value * 3.6).shifted(-1.0)  # km/h, 1 s late
@@ -273,6 +281,22 @@ def test_calibration_warnings_gather_the_clock_and_the_scale():
     )
     assert found[1].startswith("wheel scale: the calibration gives 0.278")
     assert calibration_warnings(late, velocity, None, "speed CSV", 2.0, "--x")[1] == found[:1]
+
+
+def test_a_wheel_speed_the_calibration_never_saw_is_judged_by_its_ratio_to_the_doppler_speed():
+    """A 20-s drive with its speed in km/h kept the scale of 1: the calibration takes only
+    Doppler speeds within 10 % of the wheel speed, so it never estimated one (QA round 3)."""
+    t_gnss, gnss, velocity = _gnss_of_speed()
+    kmh = SensorSeries(T, SPEED.value * 3.6)
+    (warning,) = calibration_warnings(kmh, velocity, 1.0, "CAN", 0.0)[1]
+    assert warning.startswith(
+        "wheel scale: the calibration gives 1.000 from the Doppler speeds within 10 % of the "
+        "wheel speed, but over 187 valid GNSS epochs the Doppler speed is the wheel speed times "
+        "0.278, beyond 1 ± 0.1"
+    )
+    assert calibration_warnings(kmh, velocity, None, "CAN", 0.0)[1] == []  # a fixed scale
+    assert speed_ratio_warning(SPEED, t_gnss, gnss, 1.0) is None
+    assert speed_ratio_warning(kmh, t_gnss[:19], gnss[:19], 1.0) is None  # too few epochs
 
 
 # A drive at 8 m/s: straight, a left turn of 90° (10–13 s, 30 °/s), straight, a right turn of

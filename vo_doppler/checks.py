@@ -44,7 +44,9 @@ CAN signal and its DBC, an option). Each check states its threshold:
   with its CAN clock 30 s off: half the epochs);
 * the calibrated wheel scale: beyond 1 ± 0.10 it is a warning, since a tyre's rolling radius
   changes by a few per cent with wear and pressure, and a scale far from 1 means a speed in
-  other units (km/h: 0.28, mph: 0.45) or a wheel speed that is not this drive's;
+  other units (km/h: 0.28, mph: 0.45) or a wheel speed that is not this drive's; so is the
+  median ratio of the Doppler to the wheel speed at the valid moving epochs, which the
+  calibration may never have seen (it takes only speeds within 10 % of each other);
 * the ENU origin against the RINEX approximate position: more than 10 km apart is a warning;
 * a standstill interval given by hand against the measured speed: a median speed above
   0.5 m/s inside it (GNSS speed noise at rest is a few cm/s to 0.2 m/s) is an error, since the
@@ -440,12 +442,12 @@ def coverage_warning(
     )
 
 
-def wheel_scale_warning(scale: float) -> str | None:
-    """A warning when the calibrated wheel scale lies beyond 1 ± 0.10 (module docstring)."""
+def wheel_scale_warning(scale: float, found: str = "the calibration gives") -> str | None:
+    """A warning when the wheel scale ``found`` lies beyond 1 ± 0.10 (module docstring)."""
     if not np.isfinite(scale) or abs(scale - 1.0) <= WHEEL_SCALE_TOLERANCE:
         return None
     return (
-        f"wheel scale: the calibration gives {scale:.3f}, beyond 1 ± {WHEEL_SCALE_TOLERANCE:g} "
+        f"wheel scale: {found} {scale:.3f}, beyond 1 ± {WHEEL_SCALE_TOLERANCE:g} "
         "(a tyre's radius changes by a few per cent): is the wheel speed in m/s (km/h reads "
         "0.278, mph 0.447) and its clock offset right?"
     )
@@ -468,12 +470,39 @@ def calibration_warnings(
         velocity.valid, np.linalg.norm(velocity.velocity_enu[:, :2], axis=1), np.nan
     )
     estimate = estimate_clock_offset(wheel_speed, velocity.t, horizontal)
+    scale = None if wheel_scale is None else wheel_scale_warning(wheel_scale)
+    if wheel_scale is not None and scale is None:
+        scale = speed_ratio_warning(wheel_speed, velocity.t, horizontal, wheel_scale)
     found = [
         coverage_warning(sensor, wheel_speed, velocity.t, offset_s, offset_name),
         clock_warning(sensor, estimate, offset_s, offset_name),
-        None if wheel_scale is None else wheel_scale_warning(wheel_scale),
+        scale,
     ]
     return estimate, [warning for warning in found if warning]
+
+
+def speed_ratio_warning(
+    wheel_speed: SensorSeries, t_gnss: np.ndarray, gnss_speed: np.ndarray, wheel_scale: float
+) -> str | None:
+    """The median ratio of the GNSS speed ``gnss_speed`` (NaN where invalid) to the wheel speed
+    at the GNSS epochs where the wheels turn faster than 2 m/s, judged as a calibrated wheel
+    scale is (:func:`wheel_scale_warning`), from ``MIN_CLOCK_EPOCHS`` epochs on. The
+    calibration takes only the Doppler speeds within 10 % of the wheel speed, so a wheel speed
+    in other units is never calibrated on a short drive, and the scale of 1 it keeps would pass
+    the check of a calibrated one (a simulated 20-s drive with its speed in km/h)."""
+    if len(wheel_speed) < 2:
+        return None
+    wheel = np.interp(t_gnss, wheel_speed.t, wheel_speed.value, left=np.nan, right=np.nan)
+    moving = np.isfinite(gnss_speed) & (np.nan_to_num(wheel) > MOVING_SPEED_MPS)
+    if np.count_nonzero(moving) < MIN_CLOCK_EPOCHS:
+        return None
+    ratio = float(np.median(gnss_speed[moving] / wheel[moving]))
+    return wheel_scale_warning(
+        ratio,
+        f"the calibration gives {wheel_scale:.3f} from the Doppler speeds within 10 % of the "
+        f"wheel speed, but over {np.count_nonzero(moving)} valid GNSS epochs the Doppler speed "
+        "is the wheel speed times",
+    )
 
 
 @dataclass(frozen=True)
