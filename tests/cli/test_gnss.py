@@ -44,6 +44,23 @@ def test_velocity_and_spp_commands(tmp_path):
     assert np.array(rows, dtype=float)[:, -1].all()
 
 
+@pytest.mark.shared_data
+def test_the_summary_line_counts_the_input_problems_the_reader_warned(tmp_path, caplog):
+    """A time system the RINEX version lacks is read as GPS and warned: a problem, not a
+    skipped record."""
+    text = require_shared("yamatogawa_ublox_walk/yamatogawa_rover.obs").read_text()
+    obs = tmp_path / "utc.obs"
+    obs.write_text(
+        text.replace("     GPS         TIME OF FIRST OBS", "     UTC         TIME OF FIRST OBS")
+    )
+    nav = require_shared("yamatogawa_ublox_walk/brdc0060.10n")
+    out = tmp_path / "vel.csv"
+    assert main(["gnss", "velocity", str(obs), "--nav", str(nav), "-o", str(out)]) == 0
+    assert "TIME OF FIRST OBS time system 'UTC'" in caplog.text
+    assert "; 1 input problems (warned above)" in caplog.text
+    assert "skipped" not in caplog.records[-1].getMessage()
+
+
 def test_unknown_system_letter_is_a_usage_error(tmp_path):
     with pytest.raises(SystemExit) as stop:
         main(["gnss", "velocity", "x.obs", "--nav", "x.nav", "--systems", "GX", "-o", "v.csv"])

@@ -133,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
                 np.median(speed),
                 np.percentile(speed, 95),
             )
-    skipped = len(obs.problems) + len(state_problems(nav))
+    problems = len(obs.problems) + len(state_problems(nav))
     log.log(
         logging.INFO if valid.all() else logging.WARNING,
         "%d of %d epochs valid (the others: too few satellites or failing the residual test); "
@@ -142,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
         valid.size,
         args.output,
         figure,
-        f"; {skipped} bad records skipped" if skipped else "",
+        f"; {problems} input problems (warned above)" if problems else "",
     )
     if not valid.any():
         raise VoDopplerError("no epoch could be solved (too few satellites with ephemerides)")

@@ -38,7 +38,8 @@ class Observations:
     ``time`` GPS seconds; ``system`` one letter; ``prn`` satellite number; ``code`` an index into
     ``codes`` (RINEX 3 three-character codes such as ``D1C``, RINEX 2 two-character codes such as
     ``D1`` kept as written); ``lli`` and ``ssi`` −1 where blank. ``epoch_time``/``epoch_flag``
-    list the data epochs. ``problems`` holds one message per skipped record.
+    list the data epochs. ``problems`` holds one message per problem the reader met: a skipped
+    record, or a header value read otherwise than written (e.g. an unknown time system).
     """
 
     header: ObsHeader
