@@ -79,6 +79,17 @@ def test_read_list_names_repeated_entries_and_keeps_the_first(tmp_path, caplog):
     ]
 
 
+def test_plan_names_the_spellings_of_one_recording_and_runs_it_once(tmp_path, caplog):
+    (tmp_path / "s1").mkdir()
+    given = [tmp_path / "s1", tmp_path / "s1" / ".." / "s1", tmp_path / "d2"]
+    with caplog.at_level("WARNING", logger="vo_doppler.batch"):
+        jobs = plan(given, tmp_path / "out", RunConfig())
+    assert [job.source for job in jobs] == [tmp_path / "s1", tmp_path / "d2"]
+    assert caplog.messages == [
+        f"{tmp_path / 's1'}, {tmp_path / 's1' / '..' / 's1'} name the same recording; it runs once"
+    ]
+
+
 def test_a_missing_recording_fails_naming_where_it_is_listed(tmp_path):
     listing = tmp_path / "drives.txt"
     listing.write_text("# fleet\n\nnot_there\n")

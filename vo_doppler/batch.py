@@ -501,9 +501,16 @@ def plan(
     prepare: Prepare | None = None,
     listings: Mapping[Path, Listing] | None = None,
 ) -> list[RecordingJob]:
-    """One job per distinct recording (repeats dropped), each with its output folder and, from
-    ``listings`` (:func:`read_list`), where a list named it."""
-    unique = list(dict.fromkeys(Path(s).resolve() for s in sources))
+    """One job per distinct recording (repeats dropped with a warning naming their spellings),
+    each with its output folder and, from ``listings`` (:func:`read_list`), where a list named
+    it."""
+    spellings: dict[Path, list[str]] = {}
+    for source in sources:
+        spellings.setdefault(Path(source).resolve(), []).append(str(source))
+    for given in spellings.values():
+        if len(given) > 1:
+            log.warning("%s name the same recording; it runs once", ", ".join(given))
+    unique = list(spellings)
     listed = {Path(s).resolve(): where for s, where in (listings or {}).items()}
     names = output_names(unique)
     return [

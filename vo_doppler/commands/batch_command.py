@@ -32,7 +32,11 @@ def register(subparsers, summary: str) -> None:
         "earlier batch finished with the same inputs and options.",
     )
     parser.add_argument(
-        "sequences", type=Path, nargs="*", help="sequence folders (or segments: --comma2k19)"
+        "sequences",
+        type=Path,
+        nargs="*",
+        help="sequence folders (or segments: --comma2k19); one named twice (s1 s1/) runs once, "
+        "with a warning",
     )
     parser.add_argument(
         "--list",
