@@ -171,6 +171,20 @@ def test_satellites_without_ephemeris_are_skipped_and_counted(nav):
     np.testing.assert_allclose(solution.velocity_ecef, np.tile(VELOCITY, (2, 1)), atol=1e-6)
 
 
+def test_a_mask_above_every_satellite_says_so(nav, caplog):
+    obs = _synthetic_obs(nav, n_epochs=2)
+    highest = np.degrees(
+        np.max(doppler_rows(obs, nav, RECEIVER, elevation_mask_rad=-1.0).elevation)
+    )
+    with caplog.at_level("WARNING"):
+        rows = doppler_rows(obs, nav, RECEIVER, elevation_mask_rad=np.radians(89.0))
+    assert len(rows.t) == 0 and rows.n_below_mask > 0
+    assert (
+        f"every Doppler row lies below the elevation mask of 89.0° (the highest satellite at "
+        f"{highest:.1f}°): no row is left"
+    ) in caplog.text
+
+
 @pytest.fixture(scope="module")
 def septentrio():
     obs = read_obs(require_shared("septentrio_static/rover.obs"))

@@ -138,6 +138,13 @@ def doppler_rows(
     elevation, azimuth = elevation_azimuth(position[usable], los)
     good = states.valid & (elevation >= elevation_mask_rad)
     n_below = int((states.valid & ~good).sum())
+    if log_missing and n_below and not good.any():
+        log.warning(
+            "every Doppler row lies below the elevation mask of %.1f° (the highest satellite "
+            "at %.1f°): no row is left",
+            np.degrees(elevation_mask_rad),
+            np.degrees(np.max(elevation[states.valid])),
+        )
     idx = np.flatnonzero(usable)[good]
     return DopplerRows(
         t=sel.time[idx],
