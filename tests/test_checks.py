@@ -13,6 +13,7 @@ from tests.helpers.velocity import velocity_solution
 from vo_doppler.checks import (
     calibration_warnings,
     check_standstill_is_still,
+    check_vehicle_overlap,
     check_yaw_rate_sign,
     check_yaw_rate_unit,
     clock_warning,
@@ -114,6 +115,26 @@ def test_a_parked_vehicle_gives_no_lag_saying_it_does_not_move():
         "the vehicle does not move: the wheel speed never exceeds 2 m/s (at most 0.01 m/s), "
         "so its clock cannot be checked against the GNSS"
     )
+
+
+def test_vehicle_signals_that_miss_the_gnss_epochs_are_an_error_naming_their_offset():
+    t_gnss = np.arange(1.4e9, 1.4e9 + 60.0, 0.2)
+    on_gps = SensorSeries(T + 1.4e9, SPEED.value)
+    on_log_clock = SensorSeries(T, SPEED.value)
+    source = VehicleSignalSource(
+        sensor="speed CSV",
+        offset_name="--time-offset-speed",
+        yaw_rate_offset_name="--time-offset-yaw",
+    )
+    check_vehicle_overlap(on_gps, on_gps, t_gnss, source)
+    with pytest.raises(InputError) as yaw:
+        check_vehicle_overlap(on_gps, on_log_clock, t_gnss, source)
+    assert str(yaw.value).startswith("the speed CSV yaw-rate times (0.000..59.990 s)")
+    assert "pass --time-offset-yaw with the GPS time of that start" in str(yaw.value)
+    with pytest.raises(InputError) as wheel:
+        check_vehicle_overlap(on_log_clock, on_gps, t_gnss, source)
+    assert str(wheel.value).startswith("the speed CSV wheel-speed times (0.000..59.990 s)")
+    assert "pass --time-offset-speed with the GPS time of that start" in str(wheel.value)
 
 
 def _random_drive(seed: int) -> SensorSeries:

@@ -66,6 +66,7 @@ from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at
 from vo_doppler.model.vehicle_source import VehicleSignalSource
+from vo_doppler.time_hints import overlap_error, overlaps
 
 MOVING_SPEED_MPS = 2.0
 MAX_MEDIAN_YAW_RATE = 0.2
@@ -646,6 +647,24 @@ def heading_warnings(
     )
     bias = gyro_bias_warning(float(table.gyro_bias[-1])) if bias_calibrated and len(table) else None
     return estimate, found + ([bias] if bias else [])
+
+
+def check_vehicle_overlap(
+    wheel_speed: SensorSeries,
+    yaw_rate: SensorSeries,
+    epoch_time: np.ndarray,
+    source: VehicleSignalSource | None = None,
+) -> None:
+    """Raise when the wheel speed's or the yaw rate's times (GPS time after their offsets) do
+    not meet the span of the GNSS epochs: no epoch would have them, so no heading could exist,
+    and the cause is a clock offset (the message guesses which, :func:`offset_hint`)."""
+    source = source or VehicleSignalSource()
+    for what, series, option in (
+        ("wheel-speed", wheel_speed, source.offset_name),
+        ("yaw-rate", yaw_rate, source.yaw_rate_offset_name or source.offset_name),
+    ):
+        if not overlaps(series.t, epoch_time):
+            raise overlap_error(f"{source.sensor} {what}", series.t, epoch_time, option)
 
 
 def origin_warning(enu: EnuFrame, approx_position_ecef: np.ndarray | None) -> str | None:

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.checks import check_yaw_rate_unit, origin_warning
+from vo_doppler.checks import check_vehicle_overlap, check_yaw_rate_unit, origin_warning
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.correction import (
     CorrectionConfig,
@@ -387,12 +387,16 @@ def run_sequence(
     """Run every stage on a recording. ``images`` replaces reading ``sequence.image_paths``
     (e.g. frames already in memory); ``on_frame`` is called after each VO frame.
 
-    The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`): a
-    yaw rate too large for a car (before the GNSS stage) or turning against the GNSS Doppler
+    The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`):
+    vehicle signals whose times miss the GNSS epochs, a yaw rate too large for a car (before
+    the GNSS stage) or turning against the GNSS Doppler
     course (after the heading stage, before the VO) raises :class:`InputError`; the rest are
     warnings, logged and returned in ``RunResult.warnings``."""
     config = config or RunConfig()
     obs = sequence.observations
+    check_vehicle_overlap(
+        sequence.wheel_speed, sequence.yaw_rate, obs.epoch_time, sequence.vehicle_source
+    )
     check_yaw_rate_unit(sequence.yaw_rate, sequence.wheel_speed, sequence.vehicle_source)
     origin = origin_warning(sequence.enu, obs.header.approx_position)
     if origin:

@@ -486,6 +486,14 @@ def test_gzip_bomb_as_the_observation_file_is_exit_1_without_filling_memory(
     assert (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024 < 500
 
 
+def test_can_times_missing_the_gnss_epochs_are_an_error_before_any_work(clean, tmp_path, capsys):
+    folder = damaged_copy(clean, tmp_path)
+    edit_manifest(folder, "can", "time_offset_s", 0.0)  # the log's own clock
+    err = failing_run(folder, tmp_path, capsys)
+    assert "error: the CAN wheel-speed times (" in err
+    assert "do not overlap the GNSS epochs" in err and "the manifest's time_offset_s" in err
+
+
 def test_can_clock_off_by_most_of_a_second_is_warned_with_the_fix(tmp_path, caplog):
     folder = tmp_path / "drive"
     simulate = ["simulate", "--duration", "30", "--seed", "1", "--no-images", "-o", str(folder)]

@@ -11,7 +11,6 @@ import numpy as np
 from vo_doppler.commands.arg_types import finite_float, positive_float
 from vo_doppler.commands.correction_options import add_correction_options, correction_config
 from vo_doppler.commands.output_paths import check_output_files
-from vo_doppler.commands.time_hints import frame_index_hint, offset_hint, span
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.fusion.correction import (
     HEADING_SOURCES,
@@ -31,6 +30,7 @@ from vo_doppler.io.trajectory import (
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.json_text import json_text
+from vo_doppler.time_hints import frame_index_hint, offset_hint, span
 from vo_doppler.vo.frames import (
     MAX_ROAD_CLIMB,
     WORLDS,

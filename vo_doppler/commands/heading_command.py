@@ -23,7 +23,6 @@ from vo_doppler.commands.satellite_options import (
     satellite_inputs,
     satellite_states,
 )
-from vo_doppler.commands.time_hints import overlap_error
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
@@ -36,7 +35,6 @@ from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
 from vo_doppler.model.series import SensorSeries
-from vo_doppler.model.timeseries import sample
 from vo_doppler.model.vehicle_source import VehicleSignalSource
 from vo_doppler.report.heading_figure import heading_figure
 from vo_doppler.report.json_text import json_text
@@ -238,6 +236,7 @@ def _signal_source(args: argparse.Namespace, yaw_rate_unit: str) -> VehicleSigna
         sensor="speed CSV",
         offset_s=args.time_offset_speed,
         offset_name="--time-offset-speed",
+        yaw_rate_offset_name="--time-offset-yaw",
         yaw_rate=f"{args.yaw_rate_csv} (the yaw rate, --yaw-rate-csv)",
         yaw_rate_unit_fix="its yaw_rate_rad_s column must be in rad/s: convert it (× π/180)",
         yaw_rate_sign_fix="its yaw_rate_rad_s column must be counter-clockwise positive (a left "
@@ -274,10 +273,6 @@ def run(args: argparse.Namespace) -> int:
     else:
         start = obs.epoch_time[0] + args.max_sats_after
         rows, conventional = emulated_canyon(obs, nav, args.max_sats, start, systems, mask)
-    overlap = sample(speed.t, speed.value, obs.epoch_time)
-    if not np.isfinite(overlap).any():
-        option = "--time-offset-can" if args.can else "--time-offset-speed"
-        raise overlap_error("wheel-speed", speed.t, obs.epoch_time, option)
     tight = TightHeadingConfig(window_s=args.window_s)
     if args.no_nlos_rejection:
         tight = replace(tight, outlier_passes=0)

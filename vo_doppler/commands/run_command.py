@@ -17,7 +17,6 @@ from rich.table import Table
 from vo_doppler.commands.arg_types import window_size
 from vo_doppler.commands.correction_options import add_correction_options, correction_config
 from vo_doppler.commands.satellite_options import add_selection_options
-from vo_doppler.commands.time_hints import overlap_error, overlaps
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.io.output_folder import RUN, check_output_folder, staged_output, untouched
@@ -102,11 +101,6 @@ def sequence_inputs(sequence: Path) -> list[Path]:
 def run_and_write(args: argparse.Namespace) -> RunResult:
     """Read, check, run and write the outputs in place (all or nothing)."""
     inputs, report = read_sequence_with_report(args.sequence, args.allow_outside_paths)
-    if not overlaps(inputs.wheel_speed.t, inputs.observations.epoch_time):
-        option = "can: time_offset_s in sequence.yaml"
-        raise overlap_error(
-            "CAN", inputs.wheel_speed.t, inputs.observations.epoch_time, option, args.sequence
-        )
     warnings = input_warnings(inputs, report)
     for text in warnings:
         log.warning("%s", text)

@@ -10,7 +10,6 @@ import numpy as np
 from rich.progress import Progress
 
 from vo_doppler.commands.arg_types import frame_rate, window_size
-from vo_doppler.commands.time_hints import span
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import NO_MATCH, evaluate_by_time
 from vo_doppler.io.calibration import read_camera
@@ -27,6 +26,7 @@ from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
 from vo_doppler.report.json_text import json_text
 from vo_doppler.report.plots import plot_top_view
 from vo_doppler.report.run_report import number_or_dash
+from vo_doppler.time_hints import span
 from vo_doppler.vo.batch import MIN_VO_FRAMES, run_visual_odometry
 from vo_doppler.vo.config import VoConfig
 

@@ -11,7 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from vo_doppler.checks import check_yaw_rate_unit, heading_warnings
+from vo_doppler.checks import check_vehicle_overlap, check_yaw_rate_unit, heading_warnings
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.doppler_velocity import doppler_rows, solve_velocity
 from vo_doppler.gnss.satellite_source import StateSource
@@ -104,7 +104,9 @@ def heading_from_gnss(
     turning against the GNSS Doppler course after it, raise :class:`InputError`; the clock,
     the coverage of the GNSS epochs, the calibrated wheel scale and gyro bias give warnings,
     logged and kept in the table's ``warnings`` (the residual clock offset in
-    ``clock_residual_offset_s``)."""
+    ``clock_residual_offset_s``). Vehicle signals whose times miss the GNSS epochs raise
+    before the work too (:func:`~vo_doppler.checks.check_vehicle_overlap`)."""
+    check_vehicle_overlap(wheel_speed, yaw_rate, epoch_time, source)
     check_yaw_rate_unit(yaw_rate, wheel_speed, source)
     table = heading_pipeline(
         epoch_time,

@@ -18,6 +18,9 @@ class VehicleSignalSource:
     """The clock offset (s) that put the signals on GPS time."""
     offset_name: str = "the vehicle signals' clock offset"
     """The setting that holds ``offset_s``, e.g. ``the manifest's time_offset_s``."""
+    yaw_rate_offset_name: str | None = None
+    """The setting that puts the yaw rate on GPS time where it is not ``offset_name`` (a yaw-rate
+    CSV with its own offset option)."""
     yaw_rate: str = "the yaw rate"
     """The yaw rate's origin, e.g. a CSV file or a CAN signal with its DBC."""
     yaw_rate_unit: str = "rad/s"
