@@ -45,10 +45,7 @@ def run(args: argparse.Namespace) -> int:
             "a KITTI poses file has no times: pass --times with the sequence's times.txt",
             args.poses,
         )
-    try:
-        speed = speed_from_poses(truth)
-    except ValueError as exc:
-        raise InputError(str(exc), args.poses) from exc
+    speed = speed_from_poses(truth, args.poses)
     args.output.parent.mkdir(parents=True, exist_ok=True)
     write_sensor_csv(args.output, speed, SPEED_COLUMN)
     print(

@@ -4,22 +4,31 @@ wheel speed."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from vo_doppler.errors import InputError
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
 
 
-def speed_from_poses(truth: Trajectory) -> SensorSeries:
+def speed_from_poses(truth: Trajectory, source: str | Path | None = None) -> SensorSeries:
     """Speed (m/s) at every pose whose trapezoidal integral between consecutive poses is the
     true step length: v₀ = s₀/Δt₀, vᵢ = 2 sᵢ₋₁/Δtᵢ₋₁ − vᵢ₋₁ (what the VO's scale integrates,
     :mod:`vo_doppler.vo.scale`). Where that recursion would turn negative, the plain step rate
-    sᵢ/Δtᵢ is used instead (first sample repeated)."""
+    sᵢ/Δtᵢ is used instead (first sample repeated). Fewer than two poses, or times that do
+    not increase, are an :class:`InputError` naming ``source`` (the poses' file) and the pose."""
     if len(truth) < 2:
-        raise ValueError("need at least two poses for a speed")
+        raise InputError(f"need at least two poses for a speed, got {len(truth)}", source)
     dt = np.diff(truth.t)
     if np.any(dt <= 0):
-        raise ValueError("pose times must increase")
+        i = int(np.argmax(dt <= 0)) + 1
+        raise InputError(
+            f"pose times must increase, but pose {i} (t = {truth.t[i]:.6f} s) follows "
+            f"t = {truth.t[i - 1]:.6f} s",
+            source,
+        )
     steps = np.linalg.norm(np.diff(truth.positions, axis=0), axis=1)
     speed = np.empty(len(truth))
     speed[0] = steps[0] / dt[0]
