@@ -223,6 +223,29 @@ def test_a_featureless_cruise_or_an_offset_beyond_the_range_gives_no_lag(changes
     assert estimate.residual_s is None and re.search(why, estimate.no_lag_reason)
 
 
+def _random_cruise(seed: int) -> SensorSeries:
+    """120 s at 25 m/s with three smooth speed changes at random times (±5 m/s over 2-8 s)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 120.0, 0.01)
+    v = np.full_like(t, 25.0) + rng.normal(0.0, 0.01, t.size)
+    for _ in range(3):
+        start, change, duration = rng.uniform(5, 110), rng.uniform(-5, 5), rng.uniform(2, 8)
+        v += change * (1 - np.cos(np.pi * np.clip((t - start) / duration, 0.0, 1.0))) / 2
+    return SensorSeries(t, v, "speed", "m/s")
+
+
+@pytest.mark.parametrize(
+    ("seed", "shift"), [(9, 60.0), (22, 60.0), (31, -30.0), (36, -30.0), (48, 30.0), (57, 60.0)]
+)
+def test_a_cruise_far_off_gets_no_lag_from_a_match_above_the_noise(seed, shift):
+    """Over all epochs these shifted cruises matched best at a wrong lag inside the range, at
+    a median difference 2.3 to 12 times the GNSS speed's noise (a true lag leaves 0.65 times
+    it): that is no match, and neither is one over the speed changes."""
+    wheel = _random_cruise(seed)
+    estimate = estimate_clock_offset(wheel.shifted(-shift), *_noisy_gnss_speed(wheel))
+    assert estimate.residual_s is None, estimate
+
+
 def test_too_few_overlapping_epochs_give_no_lag():
     t_gnss = np.arange(5.0, 55.0, 0.2)
     estimate = estimate_clock_offset(SPEED.shifted(100.0), t_gnss, np.full_like(t_gnss, 10.0))
