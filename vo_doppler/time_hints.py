@@ -6,12 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.model.gpstime import GPS_MINUS_UTC_LATEST_S, UNIX_TIME_AT_GPS_EPOCH_S
 
-GPS_MINUS_UNIX_S = -315964800.0
-"""GPS time − Unix time at the GPS epoch (1980-01-06); add the leap seconds since then."""
-LEAP_SECONDS = 18
-"""GPS − UTC since 2017-01-01."""
-UNIX_OFFSET_S = GPS_MINUS_UNIX_S + LEAP_SECONDS
+UNIX_OFFSET_S = GPS_MINUS_UTC_LATEST_S - UNIX_TIME_AT_GPS_EPOCH_S
+"""GPS time − Unix time today, the offset that puts a Unix-time log on GPS time."""
 
 
 def span(t) -> str:
@@ -27,7 +25,8 @@ def offset_hint(sensor_t0: float, gnss_t0: float, option: str) -> str:
     if abs(gap - UNIX_OFFSET_S) < 3600.0:
         return (
             f"the sensor times look like Unix time: pass {option} {UNIX_OFFSET_S:.0f} "
-            f"(GPS - Unix = {GPS_MINUS_UNIX_S:.0f} s + {LEAP_SECONDS} leap seconds)"
+            f"(GPS - Unix = {-UNIX_TIME_AT_GPS_EPOCH_S:.0f} s "
+            f"+ {GPS_MINUS_UTC_LATEST_S:.0f} leap seconds)"
         )
     if abs(sensor_t0) < 1.0e5:
         return (

@@ -14,8 +14,8 @@ STAGES = {"vo", "gnss", "heading", "fusion", "lowcost", "eval"}
 ALLOWED: dict[str, set[str]] = {
     "errors": set(),
     "geo": {"errors"},
-    "time_hints": {"errors"},
-    "model": BASE,
+    "time_hints": {"errors", "model"},
+    "model": {"errors", "geo", "model"},
     "vo": BASE | {"vo"},
     "gnss": BASE | {"gnss"},
     "lowcost": BASE | {"lowcost"},

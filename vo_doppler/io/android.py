@@ -30,12 +30,11 @@ import numpy as np
 from vo_doppler.errors import InputError
 from vo_doppler.io.android_raw import RawColumns, raw_observations
 from vo_doppler.io.textfile import read_text
-from vo_doppler.model.gpstime import gps_minus_utc
+from vo_doppler.model.gpstime import unix_to_gps_seconds
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.row_sigma import RowSigma
 from vo_doppler.model.series import SensorSeries
 
-UNIX_TO_GPS_EPOCH_S = 315964800.0
 DOMINANCE_RATIO = 3.0
 RAW_INTEGERS = ("ConstellationType", "Svid", "TimeNanos", "FullBiasNanos", "ReceivedSvTimeNanos")
 GYRO_RECORDS = ("UncalGyro", "Gyro")
@@ -240,8 +239,7 @@ def sensor_gps_time(sensor: Records, raw: Records, path: Path) -> np.ndarray:
         ]
         offset = np.median(gps_ns.astype(float) - chipset[tied])
         return (elapsed + offset) * 1e-9
-    utc = sensor.numbers("utcTimeMillis", path) * 1e-3 - UNIX_TO_GPS_EPOCH_S
-    return utc + gps_minus_utc(utc)
+    return unix_to_gps_seconds(sensor.numbers("utcTimeMillis", path) * 1e-3)
 
 
 def _check_sensor(path: Path, rows: Records, t: np.ndarray, values: np.ndarray) -> None:

@@ -20,9 +20,7 @@ from vo_doppler.errors import InputError
 from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.gps_fixes import GpsFixes
-from vo_doppler.model.gpstime import SECONDS_PER_WEEK, utc_to_gps_seconds
-
-UNIX_TO_GPS_EPOCH_S = 315964800.0
+from vo_doppler.model.gpstime import SECONDS_PER_WEEK, unix_to_gps_seconds
 
 
 def load_array(base: str | Path, *parts: str) -> np.ndarray:
@@ -112,8 +110,7 @@ def read_live_fixes(
     if gps_minus_mono_s is None:
         t = load_array(base, *folder, "t")
     else:
-        utc_as_gps = value[:, 3] / 1000.0 - UNIX_TO_GPS_EPOCH_S
-        t = np.mod(utc_to_gps_seconds(utc_as_gps), SECONDS_PER_WEEK) - gps_minus_mono_s
+        t = np.mod(unix_to_gps_seconds(value[:, 3] / 1000.0), SECONDS_PER_WEEK) - gps_minus_mono_s
     return GpsFixes(
         t, np.radians(value[:, 0]), np.radians(value[:, 1]), value[:, 2], Path(base, *folder)
     )

@@ -11,6 +11,8 @@ import numpy as np
 SECONDS_PER_DAY = 86400.0
 SECONDS_PER_WEEK = 604800.0
 BDT_MINUS_GPST_S = -14.0
+UNIX_TIME_AT_GPS_EPOCH_S = 315964800.0
+"""Unix time of the GPS epoch, 1980-01-06 00:00:00 UTC (GPS − UTC was 0 then)."""
 _LEAP_SECOND_DATES = (  # UTC dates from which GPS − UTC grew by one second (IERS Bulletin C)
     (1981, 7),
     (1982, 7),
@@ -31,6 +33,8 @@ _LEAP_SECOND_DATES = (  # UTC dates from which GPS − UTC grew by one second (I
     (2015, 7),
     (2017, 1),
 )
+GPS_MINUS_UTC_LATEST_S = float(len(_LEAP_SECOND_DATES))
+"""GPS − UTC after the table's last leap second (18 s since 2017-01-01)."""
 
 
 def days_from_civil(year, month, day) -> np.ndarray:
@@ -77,6 +81,11 @@ def utc_to_gps_seconds(utc_as_gps_seconds, leap_seconds: float | None = None) ->
         return t + leap_seconds
     starts_utc, counts = _leap_table()
     return t + np.concatenate(([0.0], counts))[np.searchsorted(starts_utc, t, side="right")]
+
+
+def unix_to_gps_seconds(unix_seconds) -> np.ndarray:
+    """Unix time (UTC, as logs and phones write it) to GPS seconds, leap seconds added."""
+    return utc_to_gps_seconds(np.asarray(unix_seconds, dtype=float) - UNIX_TIME_AT_GPS_EPOCH_S)
 
 
 def time_of_week(gps_seconds) -> tuple[np.ndarray, np.ndarray]:

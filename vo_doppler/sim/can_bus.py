@@ -26,10 +26,10 @@ from pathlib import Path
 import cantools
 import numpy as np
 
+from vo_doppler.model.gpstime import UNIX_TIME_AT_GPS_EPOCH_S
 from vo_doppler.sim.vo_sequence import VehicleMotion
 
 DBC_PATH = Path(__file__).with_name("vehicle.dbc")
-GPS_UNIX_EPOCH_DIFFERENCE_S = 315_964_800.0
 WHEEL_MESSAGE = "WHEEL_SPEEDS"
 DYNAMICS_MESSAGE = "VEHICLE_DYNAMICS"
 WHEELS = ("FL", "FR", "RL", "RR")
@@ -40,7 +40,7 @@ WHEEL_SPEED_SIGNALS = f"{WHEEL_MESSAGE}.WHEEL_SPEED_RL,{WHEEL_MESSAGE}.WHEEL_SPE
 
 def gps_to_unix_offset(leap_seconds: int) -> float:
     """t_unix − t_gps (s)."""
-    return GPS_UNIX_EPOCH_DIFFERENCE_S - leap_seconds
+    return UNIX_TIME_AT_GPS_EPOCH_S - leap_seconds
 
 
 @dataclass(frozen=True)
