@@ -8,7 +8,7 @@ over it) only after every output, with the fingerprint of the recording's inputs
 configuration. A batch started again with ``resume=True`` skips every recording whose marker
 holds the current fingerprint and whose listed outputs still exist; a recording that was cut
 off (killed process, crash, power loss) has no marker and runs again from the start (the
-staging folder it left is deleted then).
+staging folder it left is deleted then, whichever host's worker left it).
 
 ``OUT`` must be new, empty or a batch's own, and hold no recording; each ``OUT/<name>/`` is
 replaced as a whole, so it must be new, empty or one that ``run`` or ``batch`` wrote, with
@@ -65,6 +65,7 @@ from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
 from vo_doppler.io.output_folder import (
     RUN,
+    STAGING_OWNER,
     begin_staging,
     check_output_folder,
     mark_output,
@@ -300,7 +301,7 @@ def process_recording(job: RecordingJob) -> RecordingOutcome:
         return _failed(job, Failure.INPUT, str(error))
     try:
         check_output_folder(job.out, RUN, [job.source], replace=True)
-        remove_cut_off_staging(job.out)
+        remove_cut_off_staging(job.out, alone=True)
         staging = begin_staging(job.out, RUN, [job.source])
     except VoDopplerError as exc:
         return _failed(job, Failure.INPUT, str(exc))
@@ -356,7 +357,9 @@ def _done(job: RecordingJob, staging: Path, summary: dict, seconds: float) -> Re
     """A finished recording's outcome, after its completion marker in ``staging`` (module
     docstring)."""
     outputs = sorted(
-        p.name for p in staging.iterdir() if p.is_file() and p.name not in (MARKER, OUTPUT_MARKER)
+        p.name
+        for p in staging.iterdir()
+        if p.is_file() and p.name not in (MARKER, OUTPUT_MARKER, STAGING_OWNER)
     )
     marker = {
         "fingerprint": job.fingerprint,

@@ -18,10 +18,11 @@ import numpy as np
 import pytest
 import yaml
 
+from tests.helpers.staging import cut_off_staging
 from vo_doppler.cli import main
 from vo_doppler.errors import EXIT_FAILURE, EXIT_OK
 from vo_doppler.io.heading_csv import read_heading_csv
-from vo_doppler.io.output_folder import RUN, mark_output
+from vo_doppler.io.output_folder import RUN, begin_staging, mark_output
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
@@ -372,6 +373,8 @@ def test_failed_run_keeps_the_previous_results_and_says_so(clean, clean_run, tmp
 def test_duplicated_can_frames_and_a_distant_origin_are_warned_and_stale_files_go(
     clean, clean_run, tmp_path, caplog
 ):
+    """Stale files go: an earlier run's figure in the output, and the staging folder of a run
+    into it that was killed (while that of a run still writing stays)."""
     folder = damaged_copy(clean, tmp_path)
     log_path = folder / "can" / "vehicle.log"
     lines = log_path.read_text().splitlines(keepends=True)
@@ -386,9 +389,11 @@ def test_duplicated_can_frames_and_a_distant_origin_are_warned_and_stale_files_g
     shutil.copytree(clean_run, out)
     (out / "stale_figure.png").write_bytes(b"old")
     mark_output(out, RUN)  # an earlier run wrote it
+    killed, writing = cut_off_staging(out), begin_staging(out, RUN)
     with caplog.at_level(logging.INFO):
         assert main(["run", str(folder), "-o", str(out)]) == EXIT_OK
     assert not (out / "stale_figure.png").exists()
+    assert not killed.exists() and writing.is_dir()
     assert_full_outputs(out, n_images(folder))
     summary = json.loads((out / "summary.json").read_text())
     counts = summary["time_order"]["CAN message WHEEL_SPEEDS"]

@@ -5,15 +5,24 @@ from __future__ import annotations
 
 import json
 import os
+import socket
 import stat
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
 
+from tests.helpers.staging import cut_off_staging
 from vo_doppler.errors import OutputError
 from vo_doppler.io.output_folder import (
     MARKER,
     RUN,
+    STAGING_OWNER,
+    _boot_id,
+    _this_process,
+    begin_staging,
     check_output_folder,
     mark_output,
     open_output_folder,
@@ -87,6 +96,8 @@ def test_a_staged_folder_has_the_mode_mkdir_gives(tmp_path, umask, mode):
 
 
 def test_cut_off_staging_folders_of_one_output_are_removed(tmp_path):
+    """A caller writing the output alone (a batch's recording) removes every staging folder of
+    that output, owned or not; others only those whose owner has ended (none here)."""
     mine = [tmp_path / ".out.partial-1234abcd", tmp_path / ".out.partial-x"]
     others = [tmp_path / ".out2.partial-1", tmp_path / ".out.old-1", tmp_path / "out"]
     for folder in mine + others:
@@ -94,8 +105,76 @@ def test_cut_off_staging_folders_of_one_output_are_removed(tmp_path):
         (folder / "half.png").write_text("half")
     (tmp_path / ".out.partial-file").write_text("not a folder")
     remove_cut_off_staging(tmp_path / "out")
+    assert all(folder.is_dir() for folder in mine)
+    remove_cut_off_staging(tmp_path / "out", alone=True)
     left = {p.name for p in tmp_path.iterdir()}
     assert left == {p.name for p in others} | {".out.partial-file"}
+
+
+def owned_staging(tmp_path: Path, name: str, **owner) -> Path:
+    """A staging folder of ``tmp_path/out`` whose owner file says ``owner`` over this
+    process's own record."""
+    folder = tmp_path / f".out.partial-{name}"
+    folder.mkdir()
+    record = {**_this_process(), **owner}
+    (folder / STAGING_OWNER).write_text(json.dumps(record))
+    return folder
+
+
+def test_only_staging_folders_whose_owner_has_ended_are_removed(tmp_path):
+    """A run killed before its swap left its staging folder: the next run into the same output
+    removes it, and leaves the one of a run still writing, of another host, of a process that
+    cannot be checked, or without an owner file (older versions, or created a moment ago)."""
+    dead = cut_off_staging(tmp_path / "out")
+    assert json.loads((dead / STAGING_OWNER).read_text())["host"] == socket.gethostname()
+    live = begin_staging(tmp_path / "out", RUN)
+    kept = [
+        live,
+        owned_staging(tmp_path, "host", host="another-host", pid=1 << 22),
+        owned_staging(tmp_path, "pid", pid="12"),
+        owned_staging(tmp_path, "unknown"),
+    ]
+    (kept[-1] / STAGING_OWNER).unlink()
+    gone = [dead]
+    if _boot_id() is not None:
+        gone += [
+            owned_staging(tmp_path, "boot", boot_id="an earlier boot"),
+            owned_staging(tmp_path, "reused", start="1"),  # this PID, another process
+        ]
+    remove_cut_off_staging(tmp_path / "out")
+    assert [folder.is_dir() for folder in kept] == [True] * len(kept)
+    assert [folder.exists() for folder in gone] == [False] * len(gone)
+    assert (live / STAGING_OWNER).is_file()
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
+def test_a_zombie_owner_has_ended(tmp_path):
+    """A killed run its parent has not reaped yet still has its PID: it counts as ended."""
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    try:
+        deadline = time.monotonic() + 60
+        while Path(f"/proc/{child.pid}/stat").read_text().rpartition(")")[2].split()[0] != "Z":
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        zombie = owned_staging(tmp_path, "zombie", pid=child.pid, start=None)
+        remove_cut_off_staging(tmp_path / "out")
+        assert not zombie.exists()
+    finally:
+        child.wait()
+
+
+def test_a_run_removes_a_killed_runs_staging_and_swaps_in_without_its_owner_file(tmp_path):
+    """What ``run`` does (staged_output): the killed run's staging folder goes, a concurrent
+    live run's stays, and the owner file is not among the results."""
+    out = earlier_run(tmp_path / "out", "old.txt")
+    dead = cut_off_staging(out)
+    live = begin_staging(out, RUN)
+    with staged_output(out, RUN) as staging:
+        assert (staging / STAGING_OWNER).is_file()
+        assert not dead.exists()
+        (staging / "new.txt").write_text("new")
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "new.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([live.name, "out"])
 
 
 def test_nested_new_folder_is_created(tmp_path):

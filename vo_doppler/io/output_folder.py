@@ -10,6 +10,11 @@ a temporary folder beside the output and swap it in only when complete (:func:`s
 leaves the previous results untouched and a rerun leaves no stale files. Folders are created
 with the mode the umask gives, as by ``mkdir``.
 
+A temporary folder names its owner (:data:`STAGING_OWNER`: host, process ID, and on Linux the
+boot and the process's start), so that one a killed run left is recognised and deleted when the
+output is written again (:func:`remove_cut_off_staging`), while that of a run still writing the
+same output, or of one whose owner cannot be checked (another host, no owner file), is left.
+
 How a folder is recognised as written by a command: the marker file :data:`MARKER` that every
 command writes into the folders it makes, naming the command and, for a folder that is
 replaced as a whole, every entry it wrote (an entry added later by someone else would be
@@ -25,6 +30,7 @@ import os
 import re
 import secrets
 import shutil
+import socket
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from fnmatch import fnmatch
@@ -36,6 +42,8 @@ from vo_doppler.io.yaml_file import load_yaml
 MARKER = ".vo-doppler-output.json"
 MARKER_FORMAT = "vo-doppler-output/1"
 MARKER_MAX_BYTES = 1 << 20
+STAGING_OWNER = ".vo-doppler-staging.json"
+"""The file in a temporary folder naming the process writing it (removed before the swap)."""
 RUN = "run"
 """The kind of folder ``run`` writes and ``batch`` writes per recording (one replaces the other)."""
 
@@ -255,25 +263,92 @@ def new_folder(parent: Path, prefix: str) -> Path:
 
 
 def begin_staging(path: str | Path, command: str, inputs: Iterable[str | Path | None] = ()) -> Path:
-    """Check ``path`` as an output ``command`` replaces as a whole and create the temporary
-    folder beside it to write into instead (hidden, ``.NAME.partial-*``); the caller either
-    swaps it in (:func:`swap_in`) or deletes it."""
+    """Check ``path`` as an output ``command`` replaces as a whole, delete the temporary folders
+    that killed runs into it left (:func:`remove_cut_off_staging`) and create the one beside it
+    to write into instead (hidden, ``.NAME.partial-*``, holding :data:`STAGING_OWNER`); the
+    caller either swaps it in (:func:`swap_in`) or deletes it."""
     path = check_output_folder(path, command, inputs, replace=True).absolute()
     path.parent.mkdir(parents=True, exist_ok=True)
-    return new_folder(path.parent, _staging_prefix(path))
+    remove_cut_off_staging(path)
+    staging = new_folder(path.parent, _staging_prefix(path))
+    (staging / STAGING_OWNER).write_text(json.dumps(_this_process()) + "\n")
+    return staging
 
 
 def _staging_prefix(path: Path) -> str:
     return f".{path.name}.partial-"
 
 
-def remove_cut_off_staging(path: str | Path) -> None:
-    """Delete the staging folders that runs into ``path`` cut off (killed, power loss) left
-    beside it: no run reads them again. Only for a caller that alone writes ``path`` (a batch's
-    recording): it would delete a concurrent run's staging folder too."""
+def _read_text(path: str) -> str | None:
+    try:
+        with open(path) as stream:
+            return stream.read()
+    except OSError:
+        return None
+
+
+def _boot_id() -> str | None:
+    """This boot of the machine (Linux), None where unknown."""
+    text = _read_text("/proc/sys/kernel/random/boot_id")
+    return None if text is None else text.strip()
+
+
+def _process_start(pid: int) -> tuple[str, str] | None:
+    """The state and start time (clock ticks after boot) of process ``pid`` (Linux), None where
+    unknown or when there is no such process."""
+    text = _read_text(f"/proc/{pid}/stat")
+    if text is None:
+        return None
+    fields = text.rpartition(")")[2].split()
+    return (fields[0], fields[19]) if len(fields) > 19 else None
+
+
+def _this_process() -> dict:
+    """What :data:`STAGING_OWNER` records: this process on this host, in this boot."""
+    start = _process_start(os.getpid())
+    return {
+        "host": socket.gethostname(),
+        "pid": os.getpid(),
+        "boot_id": _boot_id(),
+        "start": None if start is None else start[1],
+    }
+
+
+def _owner_gone(staging: Path) -> bool:
+    """Whether the process that created ``staging`` has certainly ended: it ran on this host and
+    either in an earlier boot, or its process ID names no process, a zombie, or a process
+    started at another time (the ID reused). False whenever that cannot be known (no or an
+    unreadable owner file, another host, no process table to ask)."""
+    owner = _read_json(staging / STAGING_OWNER)
+    if not isinstance(owner, dict) or owner.get("host") != socket.gethostname():
+        return False
+    pid = owner.get("pid")
+    if not isinstance(pid, int) or isinstance(pid, bool) or pid <= 0 or os.name != "posix":
+        return False
+    boot = _boot_id()
+    if owner.get("boot_id") is not None and boot is not None and owner["boot_id"] != boot:
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OSError:  # another user's process (PermissionError): alive
+        return False
+    now = _process_start(pid)
+    if now is None:
+        return False
+    state, start = now
+    return state == "Z" or (owner.get("start") is not None and owner["start"] != start)
+
+
+def remove_cut_off_staging(path: str | Path, alone: bool = False) -> None:
+    """Delete the temporary folders beside ``path`` whose run was cut off (killed, power loss):
+    no run reads them again. Without ``alone`` only those whose owner has certainly ended
+    (:func:`_owner_gone`), so that a run still writing into ``path`` keeps its own; ``alone``:
+    the caller alone writes ``path`` (a batch's recording), so every one is cut off."""
     path = Path(os.path.normpath(path)).absolute()
     for leftover in path.parent.glob(glob.escape(_staging_prefix(path)) + "*"):
-        if leftover.is_dir() and not leftover.is_symlink():
+        if leftover.is_dir() and not leftover.is_symlink() and (alone or _owner_gone(leftover)):
             shutil.rmtree(leftover, ignore_errors=True)
 
 
@@ -285,6 +360,7 @@ def swap_in(
     check fails, ``staging`` is removed, ``path`` left as it is and the error raised."""
     path = Path(os.path.normpath(path)).absolute()
     try:
+        (staging / STAGING_OWNER).unlink(missing_ok=True)
         mark_output(staging, command)
         check_output_folder(path, command, inputs, replace=True)
     except BaseException:
