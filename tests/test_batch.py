@@ -128,6 +128,10 @@ def test_a_marker_counts_only_with_its_fingerprint_and_outputs(tmp_path):
     (job.out / MARKER).write_text(json.dumps({**marker, "fingerprint": "other"}))
     assert finished(job) is None
     (job.out / MARKER).write_text(json.dumps(marker))
+    assert finished(job) == marker
+    (job.out / FAILED_LOG).write_text("the last run failed")
+    assert finished(job) is None
+    (job.out / FAILED_LOG).unlink()
     (job.out / "summary.json").unlink()
     assert finished(job) is None
 
@@ -203,14 +207,17 @@ def test_a_batch_never_replaces_a_recording_or_a_folder_it_did_not_write(tmp_pat
 def test_a_rerun_that_fails_before_its_outputs_keeps_the_earlier_results(tmp_path):
     """A recording that succeeded, then fails (its RINEX cut short): the failure is listed, the
     earlier results stay as they were with the failed run's log beside them, and no staging
-    folder is left."""
+    folder is left. With the RINEX restored as it was (the first run's fingerprint again),
+    ``resume`` runs the recording again instead of listing as skipped the results beside the
+    failed run's log, and the log goes."""
     drive = tmp_path / "drive"
     simulate_urban_canyon(drive, UrbanCanyonConfig(duration_s=8.0, seed=1, render=False))
     out = tmp_path / "out"
     assert run_batch([drive], out, workers=1).outcomes[0].status is Status.DONE
     earlier = _mtimes(out / "drive")
     obs = drive / "gnss" / "rover.obs"
-    obs.write_text(obs.read_text()[:1000])
+    original, original_stat = obs.read_text(), obs.stat()
+    obs.write_text(original[:1000])
     result = run_batch([drive], out, workers=1)
     (outcome,) = result.outcomes
     assert (outcome.status, outcome.category) == (Status.FAILED, Failure.INPUT)
@@ -226,6 +233,14 @@ def test_a_rerun_that_fails_before_its_outputs_keeps_the_earlier_results(tmp_pat
     assert "END OF HEADER" in (out / "drive" / FAILED_LOG).read_text()
     assert written_by(out / "drive", RUN) == (True, [])
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [OUTPUT_MARKER]
+    obs.write_text(original)
+    os.utime(obs, ns=(original_stat.st_atime_ns, original_stat.st_mtime_ns))
+    (job,) = plan([drive], out, RunConfig())
+    assert json.loads((out / "drive" / MARKER).read_text())["fingerprint"] == job.fingerprint
+    resumed = run_batch([drive], out, workers=1, resume=True)
+    assert [r["status"] for r in resumed.rows] == ["done", "1 done"]
+    assert not (out / "drive" / FAILED_LOG).exists()
+    assert finished(job) is not None
 
 
 def test_an_output_that_is_a_file_fails_before_any_work(tmp_path):

@@ -6,8 +6,10 @@ Each recording ``SOURCE`` writes what ``vo-doppler run`` writes into ``OUT/<name
 completion marker ``OUT/<name>/batch_done.json``: written atomically (a temporary file renamed
 over it) only after every output, with the fingerprint of the recording's inputs and of the
 configuration. A batch started again with ``resume=True`` skips every recording whose marker
-holds the current fingerprint and whose listed outputs still exist; a recording that was cut
-off (killed process, crash, power loss) has no marker and runs again from the start (the
+holds the current fingerprint and whose listed outputs still exist, unless its last run failed
+(its :data:`FAILED_LOG` beside the earlier results: the failure may have been fixed, and the
+aggregate would otherwise list as fine a recording whose last run failed); a recording that was
+cut off (killed process, crash, power loss) has no marker and runs again from the start (the
 staging folder it left is deleted then, whichever host's worker left it).
 
 ``OUT`` must be new, empty or a batch's own, and hold no recording; each ``OUT/<name>/`` is
@@ -253,7 +255,11 @@ def _write_atomically(path: Path, text: str) -> None:
 
 def finished(job: RecordingJob) -> dict | None:
     """The marker of a recording finished with the job's fingerprint whose outputs are all still
-    there, else None."""
+    there and whose last run did not fail, else None. A :data:`FAILED_LOG` says the last run
+    failed: a run that succeeds replaces the whole folder, so the log cannot be older than the
+    results beside it."""
+    if (job.out / FAILED_LOG).exists():
+        return None
     try:
         marker = json.loads((job.out / MARKER).read_text())
     except (OSError, ValueError):

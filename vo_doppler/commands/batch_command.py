@@ -29,7 +29,8 @@ def register(subparsers, summary: str) -> None:
         "heading availability, calibration, the run's warnings). A failed recording is listed "
         "and the others go on (one that fails before its outputs keeps its earlier results in "
         "OUT/<name>/); the exit status is 1 when any failed. --resume skips the recordings an "
-        "earlier batch finished with the same inputs and options.",
+        "earlier batch finished with the same inputs and options, unless their last run "
+        "failed (a failed_run.log beside earlier results): those run again.",
     )
     parser.add_argument(
         "sequences",
@@ -59,7 +60,9 @@ def register(subparsers, summary: str) -> None:
         "its CPUs)",
     )
     parser.add_argument(
-        "--resume", action="store_true", help="skip recordings already finished in OUT"
+        "--resume",
+        action="store_true",
+        help="skip recordings already finished in OUT (not those whose last run failed)",
     )
     parser.add_argument(
         "--ray-address",
