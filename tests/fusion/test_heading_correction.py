@@ -117,7 +117,7 @@ def test_pitch_and_roll_are_untouched_and_drift_is_removed():
     assert heading_error.max() < 0.02 * 3.0 < 0.3 < uncorrected.max()
     truth_end = gt.positions[-1] - gt.positions[0]
     end_error = np.linalg.norm(result.vehicle.positions[-1] - truth_end)
-    start_yaw_only = Rotation.from_euler("Z", 2.5).apply(drifted_vehicle.positions[-1])
+    start_yaw_only = Rotation.from_euler("Z", 2.5).apply(positions[-1])
     assert end_error < 0.02 * gt.path_length
     assert end_error < np.linalg.norm(start_yaw_only - truth_end) / 5
 

@@ -69,3 +69,14 @@ def test_malformed_arrays_are_refused(t, value, message):
 
 def test_an_empty_series_is_allowed():
     assert len(SensorSeries(np.zeros(0), np.zeros(0))) == 0
+
+
+def test_the_series_keeps_its_own_copy_of_the_checked_arrays():
+    t, value = np.array([0.0, 1.0, 2.0]), np.array([1.0, 2.0, 3.0])
+    series = SensorSeries(t, value, "speed")
+    t[2], value[0] = 0.5, np.nan  # would fail the checks, but after construction
+    np.testing.assert_array_equal(series.t, [0.0, 1.0, 2.0])
+    np.testing.assert_array_equal(series.value, [1.0, 2.0, 3.0])
+    shifted = series.shifted(1.0)
+    shifted.value[0] = 7.0
+    assert series.value[0] == 1.0

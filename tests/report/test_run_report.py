@@ -123,8 +123,7 @@ def test_heading_error_axis_turns_logarithmic_only_beside_much_larger_errors():
 
 
 def test_geojson_is_lon_lat_and_starts_at_the_origin(tmp_path):
-    track = _track()
-    track.positions -= track.positions[0]
+    track = _track()  # its first position is the origin
     write_geojson(tmp_path / "t.geojson", {"vo": track}, {"vo": "VO alone"}, ENU)
     data = json.loads((tmp_path / "t.geojson").read_text())
     (feature,) = data["features"]
@@ -142,8 +141,7 @@ def test_map_is_inline_svg_and_loads_no_tile_until_asked():
 
 
 def test_the_evaluated_tracks_are_a_hidden_layer_of_their_own():
-    moved = _track()
-    moved.positions += 5.0
+    moved = _track().transformed(np.eye(3), np.full(3, 5.0))
     page = map_html({"truth": _track(), "vo": _track()}, {"vo": "VO alone"}, ENU, {"vo": moved})
     layer = page[page.index("<g id='evaluated-tracks' display='none'>") :]
     assert layer.count("<polyline") == 1 and "VO alone, as evaluated" in layer

@@ -34,6 +34,9 @@ class DopplerRows:
     origin (``epoch`` index into the observation epochs, ``system``, ``prn``, ``code`` such as
     'D1C', ``wavelength_m``, ``cn0`` dB-Hz, ``elevation``/``azimuth`` rad, ``sat_position`` m,
     ``receiver_ecef`` the position used) and counts of rows it could not form.
+
+    Every per-row array is a copy of the one given, so the rows stay sorted and shaped as
+    checked on construction whatever the caller does to its arrays later.
     """
 
     t: np.ndarray
@@ -68,14 +71,13 @@ class DopplerRows:
         n = len(self.t)
         self.los = np.asarray(self.los, dtype=float).reshape(n, 3)
         self.sat_velocity = np.asarray(self.sat_velocity, dtype=float).reshape(n, 3)
-        self.sat_clock_drift = _per_row(self.sat_clock_drift, n)
+        self.sat_clock_drift = np.broadcast_to(np.asarray(self.sat_clock_drift, dtype=float), n)
         self.range_rate = np.asarray(self.range_rate, dtype=float).reshape(n)
-        self.weight = _per_row(self.weight, n)
+        self.weight = np.broadcast_to(np.asarray(self.weight, dtype=float), n)
         self.sat_id = np.asarray(self.sat_id).reshape(n)
-        if n and np.any(np.diff(self.t) < 0):
-            order = np.argsort(self.t, kind="stable")
-            for name, value in self._row_arrays().items():
-                setattr(self, name, value[order])
+        order = np.argsort(self.t, kind="stable") if np.any(np.diff(self.t) < 0) else slice(None)
+        for name, value in self._row_arrays().items():
+            setattr(self, name, np.array(value[order]))
 
     def __len__(self) -> int:
         return len(self.t)
@@ -130,7 +132,3 @@ class DopplerRows:
             sat_position=None,
             frame="enu",
         )
-
-
-def _per_row(value, n: int) -> np.ndarray:
-    return np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy()

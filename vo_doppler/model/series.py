@@ -19,8 +19,10 @@ class SensorSeries:
     value spreads through the integral from its sample on, and unsorted times make the
     interpolation meaningless, both giving silently empty or wrong results far from the cause.
     No stage reads NaN as "missing": a sample without a value is left out, as the readers do
-    (``n_skipped`` counts them). The arrays are not copied, so the check does not see a change
-    made to them in place later.
+    (``n_skipped`` counts them). ``t`` and ``value`` are float64 copies of the arrays given,
+    so that a later change to the caller's arrays cannot bypass the check, and the series
+    cannot change its caller's data. (Writeable, not read-only: SciPy 1.17's ``Rotation``
+    refuses read-only arrays, and a series' arrays go wherever the user takes them.)
     """
 
     t: np.ndarray
@@ -31,8 +33,8 @@ class SensorSeries:
     """Input rows the reader could not use (unreadable or non-finite)."""
 
     def __post_init__(self) -> None:
-        self.t = np.asarray(self.t, dtype=float)
-        self.value = np.asarray(self.value, dtype=float)
+        self.t = np.array(self.t, dtype=float)
+        self.value = np.array(self.value, dtype=float)
         self._check()
 
     def _check(self) -> None:
@@ -71,6 +73,4 @@ class SensorSeries:
 
     def shifted(self, offset_s: float) -> SensorSeries:
         """The same samples with ``offset_s`` added to every time (sensor clock → GPS time)."""
-        return SensorSeries(
-            self.t + offset_s, self.value.copy(), self.name, self.unit, self.n_skipped
-        )
+        return SensorSeries(self.t + offset_s, self.value, self.name, self.unit, self.n_skipped)

@@ -16,15 +16,19 @@ from vo_doppler.model.timeseries import sample
 
 @dataclass
 class Trajectory:
-    """Poses at times ``t`` (N,), positions (N, 3) and orientations as scipy Rotations (N)."""
+    """Poses at times ``t`` (N,), positions (N, 3) and orientations as scipy Rotations (N).
+
+    ``t`` and ``positions`` are copies of the arrays given (as :class:`SensorSeries` keeps
+    its own): a later change to the caller's arrays does not reach the trajectory.
+    """
 
     t: np.ndarray
     positions: np.ndarray
     orientations: Rotation
 
     def __post_init__(self) -> None:
-        self.t = np.asarray(self.t, dtype=float).reshape(-1)
-        self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 3)
+        self.t = np.array(self.t, dtype=float).reshape(-1)
+        self.positions = np.array(self.positions, dtype=float).reshape(-1, 3)
         n = len(self.t)
         if len(self.positions) != n or len(self.orientations) != n:
             raise ValueError(
@@ -62,7 +66,7 @@ class Trajectory:
         """Apply the similarity x ↦ s·R·x + t to every pose (orientations are rotated by R)."""
         rot = Rotation.from_matrix(np.asarray(rotation, dtype=float))
         positions = scale * self.positions @ np.asarray(rotation).T + np.asarray(translation)
-        return Trajectory(self.t.copy(), positions, rot * self.orientations)
+        return Trajectory(self.t, positions, rot * self.orientations)
 
     def subset(self, index) -> Trajectory:
         return Trajectory(self.t[index], self.positions[index], self.orientations[index])
