@@ -11,6 +11,7 @@ import pytest
 from tests.helpers.heading_table import plain_heading_table
 from tests.helpers.velocity import velocity_solution
 from vo_doppler.checks import (
+    ClockOffsetEstimate,
     calibration_warnings,
     check_standstill_is_still,
     check_vehicle_overlap,
@@ -96,6 +97,29 @@ def test_clock_offset_holds_with_a_third_of_the_epochs_reflected_and_a_scale_err
     estimate = estimate_clock_offset(wheel, t_gnss, gnss_speed)
     assert estimate.residual_s == pytest.approx(shift, abs=0.03)
     assert (estimate.unshifted_difference_mps > 2 * estimate.difference_mps) == (shift > 0)
+
+
+@pytest.mark.parametrize(
+    ("residual", "speed", "warned"),
+    [(0.1, 25.0, True), (-0.05, 25.0, True), (0.1, 5.0, False), (0.03, 25.0, False)],
+)
+def test_a_clock_offset_warns_by_the_distance_it_shifts_the_track(residual, speed, warned):
+    """0.1 s is 2.5 m at 25 m/s (comma2k19: 0.1 s nearly doubled DR + GPS) but 0.5 m at 5 m/s;
+    beyond 1 m, or 0.2 s at any speed, it is a warning that says how far."""
+    estimate = ClockOffsetEstimate(residual, 0.05, 0.3, moving_speed_mps=speed)
+    warning = clock_warning("CAN", estimate, 100.0)
+    assert (warning is not None) == warned
+    if warned:
+        along = f"{abs(residual) * speed:.1f} m along the track at {speed:.1f} m/s"
+        assert f"shifted by {residual:+.2f} s, {along} (median" in warning
+
+
+def test_the_clock_estimate_carries_the_median_moving_speed():
+    wheel = _random_drive(0)
+    t_gnss, gnss_speed = _noisy_gnss_speed(wheel)
+    estimate = estimate_clock_offset(wheel, t_gnss, gnss_speed)
+    inside = (t_gnss >= 5.0) & (t_gnss <= wheel.t[-1] - 5.0)
+    assert estimate.moving_speed_mps == pytest.approx(np.median(gnss_speed[inside]), rel=1e-12)
 
 
 def test_featureless_speed_gives_no_lag_and_says_why():

@@ -21,25 +21,28 @@ CAN signal and its DBC, an option). Each check states its threshold:
 * the CAN clock against the GNSS speed: the lag (±5 s, or a quarter of a shorter record) at
   which the scaled wheel speed agrees best with the horizontal Doppler speed at the valid GNSS
   epochs, by the median absolute difference (robust to the reflected epochs that pass the
-  velocity's own tests, up to half of them), is the residual clock offset; beyond 0.2 s it is a
-  warning reporting the estimate next to the manifest's ``time_offset_s``. The lag is only a
-  lag when the agreement has a clear interior minimum: aligned, the two speeds differ by their
-  noise alone (≈ 0.05 m/s on comma2k19, a tenth of the median difference over the lags), while
-  misaligned by τ they differ by about |acceleration|·τ. A best difference above half the
-  median over the lags (no shift matches: an offset beyond the range, or a speed too
-  featureless), a best lag at the edge of the range (the agreement still improves beyond it)
-  or a best difference above twice the GNSS speed's noise (aligned, the median difference is
-  0.56-0.82 times that noise on comma2k19 and simulated drives; a wrong shift leaves more)
-  is "no lag found", a warning naming why, and no number (comma2k19 with its CAN clock 30 s
-  off: 0.47 m/s at +2.2 s against a median of 0.62 m/s). A drive steady more than half the time
-  (a highway cruise) matches at every shift to the noise; without a clear minimum, the search
-  is made again over the epochs where the wheel speed changes, |dv/dt| over ±0.5 s above five
-  times its noise (at least 0.05 m/s²), with stricter guards: a best difference below a quarter
-  of the median over the shifts and below twice the GNSS speed's noise, changes spread over
-  more than twice the searched range (a single change can match another). A drive without
-  speed changes then gets "no lag found" (the speed hardly changes); 120-s cruises with three
-  speed changes get their lag (117 of 120 within 0.1 s; of 160 shifted by 6-60 s, 2 get a
-  wrong lag, 7 before the first search compared its best difference with the noise);
+  velocity's own tests, up to half of them), is the residual clock offset; beyond 0.2 s, or
+  beyond 1 m along the track at the drive's median moving speed, it is a warning reporting the
+  estimate next to the manifest's ``time_offset_s`` (comma2k19 at 17.7 m/s: DR + GPS 0.15 m per
+  100 m with the offset found, 0.27 m with the vehicle signals shifted by 0.1 s, 0.54 m by
+  0.2 s: ``CLOCK_TOLERANCE_M``). The lag is only a lag when the agreement has a clear interior
+  minimum: aligned, the two speeds differ by their noise alone (≈ 0.05 m/s on comma2k19, a tenth
+  of the median difference over the lags), while misaligned by τ they differ by about
+  |acceleration|·τ. A best difference above half the median over the lags (no shift matches: an
+  offset beyond the range, or a speed too featureless), a best lag at the edge of the range (the
+  agreement still improves beyond it) or a best difference above twice the GNSS speed's noise
+  (aligned, the median difference is 0.56-0.82 times that noise on comma2k19 and simulated
+  drives; a wrong shift leaves more) is "no lag found", a warning naming why, and no number
+  (comma2k19 with its CAN clock 30 s off: 0.47 m/s at +2.2 s against a median of 0.62 m/s). A
+  drive steady more than half the time (a highway cruise) matches at every shift to the noise;
+  without a clear minimum, the search is made again over the epochs where the wheel speed
+  changes, |dv/dt| over ±0.5 s above five times its noise (at least 0.05 m/s²), with stricter
+  guards: a best difference below a quarter of the median over the shifts and below twice the
+  GNSS speed's noise, changes spread over more than twice the searched range (a single change
+  can match another). A drive without speed changes then gets "no lag found" (the speed hardly
+  changes); 120-s cruises with three speed changes get their lag (117 of 120 within 0.1 s; of
+  160 shifted by 6-60 s, 2 get a wrong lag, 7 before the first search compared its best
+  difference with the noise);
 * the wheel-speed times against the GNSS epochs: when more than 10 % of the epochs lie outside
   the wheel speed's time span, it is a warning, since those epochs get no tightly coupled
   heading and a clock offset wrong by more than the ±5 s searched looks like this (comma2k19
@@ -57,7 +60,7 @@ CAN signal and its DBC, an option). Each check states its threshold:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -77,6 +80,12 @@ MAX_MEDIAN_YAW_RATE = 0.2
 MAX_MEDIAN_LATERAL_ACCELERATION = 1.5
 """m/s²: a car's median |yaw rate × speed| while moving (road drives: ≈ 0.3 m/s²)."""
 CLOCK_TOLERANCE_S = 0.2
+CLOCK_TOLERANCE_M = 1.0
+"""Largest residual clock offset times the median moving speed (m) without a warning: on
+comma2k19 (17.7 m/s) the vehicle signals shifted by 0.025 / 0.05 / 0.1 / 0.126 / 0.2 s (0.1 /
+0.4 / 1.6 / 1.7 / 3.3 m by the estimates) gave DR + GPS 0.14 / 0.15 / 0.27 / 0.34 / 0.54 m per
+100 m against 0.15 m unshifted; the estimate's own error there is about 0.02 s (0.6 m at
+30 m/s)."""
 CLOCK_SEARCH_S = 5.0
 CLOCK_RATE_HZ = 10.0
 MAX_CLOCK_MATCH_RATIO = 0.5
@@ -168,6 +177,8 @@ class ClockOffsetEstimate:
     search_s: float = CLOCK_SEARCH_S
     """Half-width of the searched lags (s)."""
     no_lag_reason: str = ""
+    moving_speed_mps: float | None = None
+    """Median GNSS speed over the searched epochs faster than 2 m/s (None without one)."""
 
 
 def moving_yaw_rate_medians(yaw_rate: SensorSeries, speed: SensorSeries) -> tuple[float, float]:
@@ -240,10 +251,11 @@ def estimate_clock_offset(
         )
     t, reference = t_gnss[inside], speed_gnss[inside]
     estimate, unclear = _lag_search(speed, t, reference, span, None)
-    if not unclear:
-        return estimate
-    changes, unclear = _lag_search(speed, t, reference, span, speed_change_threshold(speed))
-    return estimate if unclear else changes
+    if unclear:
+        changes, unclear = _lag_search(speed, t, reference, span, speed_change_threshold(speed))
+        estimate = estimate if unclear else changes
+    moving = reference[reference > MOVING_SPEED_MPS]
+    return replace(estimate, moving_speed_mps=float(np.median(moving)) if moving.size else None)
 
 
 def _lag_search(
@@ -414,19 +426,27 @@ def clock_warning(
     manifest_offset_s: float,
     offset_name: str = "the manifest's time_offset_s",
 ) -> str | None:
-    """A warning when the estimated residual offset exceeds 0.2 s, or when no lag was found
-    (the offset is then unchecked); ``offset_name`` names the setting to fix."""
+    """A warning when the estimated residual offset exceeds 0.2 s or 1 m along the track at
+    the median moving speed, or when no lag was found (the offset is then unchecked);
+    ``offset_name`` names the setting to fix."""
     if estimate.residual_s is None:
         return (
             f"{sensor} clock: no lag found between the wheel speed and the GNSS Doppler speed "
             f"within ±{estimate.search_s:.3g} s: {estimate.no_lag_reason}; {offset_name} "
             f"{manifest_offset_s:.3f} s is unchecked"
         )
-    if abs(estimate.residual_s) <= CLOCK_TOLERANCE_S:
+    along = abs(estimate.residual_s) * (estimate.moving_speed_mps or 0.0)
+    if abs(estimate.residual_s) <= CLOCK_TOLERANCE_S and along <= CLOCK_TOLERANCE_M:
         return None
+    track = (
+        f", {along:.1f} m along the track at {estimate.moving_speed_mps:.1f} m/s"
+        if estimate.moving_speed_mps
+        else ""
+    )
     return (
         f"{sensor} clock: the wheel speed matches the GNSS Doppler speed best when shifted by "
-        f"{estimate.residual_s:+.2f} s (median difference {estimate.difference_mps:.2f} m/s, "
+        f"{estimate.residual_s:+.2f} s{track} (median difference "
+        f"{estimate.difference_mps:.2f} m/s, "
         f"{estimate.unshifted_difference_mps:.2f} m/s unshifted); {offset_name} "
         f"{manifest_offset_s:.3f} s should be about "
         f"{manifest_offset_s + estimate.residual_s:.3f} s"
