@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import logging
 from pathlib import Path
 
@@ -155,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
         {"output": args.output}, [args.trajectory, args.heading, args.calib, args.times]
     )
     trajectory = read_trajectory(args.trajectory, args.format, _times(args.times))
-    trajectory.t = trajectory.t + args.time_offset
+    trajectory = dataclasses.replace(trajectory, t=trajectory.t + args.time_offset)
     table = read_heading_csv(args.heading)
     extrinsic = (
         read_camera(args.calib).T_vehicle_camera if args.calib else CAMERA_TO_VEHICLE_FORWARD

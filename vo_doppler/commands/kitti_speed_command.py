@@ -5,6 +5,7 @@ from the ground-truth poses."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     check_output_files({"output": args.output}, [args.poses, args.times])
     truth = read_trajectory(args.poses)
     if args.times is not None:
-        truth.t = read_times(args.times, len(truth))
+        truth = dataclasses.replace(truth, t=read_times(args.times, len(truth)))
     elif len(truth) > 1 and np.array_equal(truth.t, np.arange(len(truth))):
         raise InputError(
             "a KITTI poses file has no times: pass --times with the sequence's times.txt",
