@@ -52,6 +52,16 @@ def test_every_option_has_help_and_shows_its_default(name):
 
 
 @pytest.mark.parametrize("name", sorted(PARSERS))
+def test_no_option_states_its_default_twice(name):
+    parser = PARSERS[name]
+    for action in _options(parser):
+        rendered = parser._get_formatter()._expand_help(action)
+        assert rendered.lower().count("(default") <= 1, (
+            f"{name} {action.option_strings}: {rendered!r}"
+        )
+
+
+@pytest.mark.parametrize("name", sorted(PARSERS))
 def test_help_prints_no_escapes_and_names_the_paper(name):
     text = PARSERS[name].format_help()
     assert "%%" not in text

@@ -50,7 +50,7 @@ def register(subparsers, summary: str) -> None:
         "--executor",
         choices=EXECUTORS,
         default="local",
-        help="local: a process pool on this machine (default); ray: Ray tasks "
+        help="local: a process pool on this machine; ray: Ray tasks "
         "(pip install 'vo-doppler[ray]')",
     )
     parser.add_argument(

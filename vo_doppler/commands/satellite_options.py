@@ -40,10 +40,10 @@ def add_selection_options(parser: argparse.ArgumentParser) -> None:
         "--systems",
         type=system_letters(SYSTEMS),
         default="GREJC",
-        help="GNSS systems to use (RINEX letters: G, R, E, J, C; default GREJC)",
+        help="GNSS systems to use (RINEX letters: G, R, E, J, C)",
     )
     parser.add_argument(
-        "--elev-mask", type=elevation_mask_deg, default=10.0, help="degrees in [0, 90) (default 10)"
+        "--elev-mask", type=elevation_mask_deg, default=10.0, help="degrees in [0, 90)"
     )
 
 
