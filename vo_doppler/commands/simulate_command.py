@@ -244,7 +244,7 @@ def register(subparsers, summary: str) -> None:
         "--initial-speed",
         type=number_in(0.0, MAX_ROAD_SPEED_KMH, unit="km/h"),
         default=0.0,
-        help="km/h at the start (default: from rest)",
+        help="km/h at the start (0: from rest)",
     )
     parser.add_argument(
         "--stops-per-lap",
@@ -410,7 +410,12 @@ def run(args: argparse.Namespace) -> int:
         ("path length", f"{stats.path_length_m:.0f} m"),
         ("turns / stops", f"{stats.turns} / {stats.stops}"),
         ("max speed", f"{stats.max_speed_kmh:.1f} km/h"),
-        ("camera frames", str(stats.frames)),
+        (
+            "camera frames",
+            f"none rendered (--no-images; {stats.frames} times written)"
+            if args.no_images
+            else str(stats.frames),
+        ),
         ("GNSS epochs", str(stats.epochs)),
         (
             "satellites min / median / max",
