@@ -81,5 +81,6 @@ def test_error_policy_refuses_two_values_at_one_time_naming_both_lines():
         )
     assert str(info.value) == (
         "f.csv:4: lines 3 and 4 of the speed rows are both at t = 1.000000 s with different "
-        "values (1, 6; 1, 6.5): which is the measurement cannot be told; keep one of them"
+        "values (line 3: 1, 6; line 4: 1, 6.5): which is the measurement cannot be told; keep "
+        "one of them"
     )

@@ -117,10 +117,13 @@ def order_samples(
             if policy == "error" and not same.all():
                 first = repeated[~same][0]
                 which = "two" if lines is None else f"lines {lines[first - 1]} and {lines[first]}"
+                shown = [_values(values[k]) for k in (first - 1, first)]
+                if lines is not None:
+                    shown = [f"line {lines[k]}: {_values(values[k])}" for k in (first - 1, first)]
                 raise InputError(
                     f"{which} of the {sensor} are both at t = {t[first]:.6f} s with different "
-                    f"values ({_values(values[first - 1])}; {_values(values[first])}): which "
-                    "is the measurement cannot be told; keep one of them",
+                    f"values ({'; '.join(shown)}): which is the measurement cannot be told; keep "
+                    "one of them",
                     path,
                     _line(lines, int(first)),
                 )
