@@ -230,12 +230,10 @@ def absolute_position_errors(
     """The position errors of ``estimate`` as it is (not moved to the truth) at its poses
     inside the ground truth's time span, the truth's positions interpolated linearly; ``None``
     when no pose is inside."""
-    inside = overlap(estimate, truth)
-    if inside.size == 0:
+    reference, inside = truth_at(truth, estimate.t)
+    if not inside.any():
         return None
-    t = estimate.t[inside]
-    reference = np.column_stack([np.interp(t, truth.t, truth.positions[:, k]) for k in range(3)])
-    difference = estimate.positions[inside] - reference
+    difference = estimate.positions[inside] - reference.positions
     horizontal = np.hypot(difference[:, 0], difference[:, 1])
     vertical = np.abs(difference[:, 2])
     return AbsolutePositionErrors(
@@ -245,5 +243,5 @@ def absolute_position_errors(
         end_vertical_m=float(vertical[-1]),
         median_horizontal_m=float(np.median(horizontal)),
         median_vertical_m=float(np.median(vertical)),
-        poses=int(inside.size),
+        poses=int(np.count_nonzero(inside)),
     )
