@@ -71,11 +71,17 @@ def clock_text(
     version: str = "3.04",
     newline: str = "\n",
 ) -> str:
-    """A RINEX clock file with AS records (4 values, so a continuation line each) and one AR."""
+    """A RINEX clock file with AS records (4 values, so a continuation line each) and one AR;
+    the header in the layout of ``version``: up to 3.02 ``F9.2,11X,A1,19X,A1`` and labels from
+    column 61, from 3.04 on ``F4.2,17X,A1,20X,A1`` and labels from column 66."""
+    if version >= "3.04":
+        first, width = f"{version:4}{'':17}C{'':20}G", 65
+    else:
+        first, width = f"{version:>9}{'':11}C{'':19}G", 60
     header = [
-        f"{version:>9}           C                   G                   RINEX VERSION / TYPE",
-        f"{'GPS':>6}{'':54}TIME SYSTEM ID",
-        f"{'':60}END OF HEADER",
+        f"{first:{width}}RINEX VERSION / TYPE",
+        f"{'GPS':>6}".ljust(width) + "TIME SYSTEM ID",
+        f"{'':{width}}END OF HEADER",
     ]
     name_width = 9 if version >= "3.04" else 4
     body = []

@@ -147,3 +147,74 @@ def test_real_iac_sp3_crlf():
     assert missing.sum() == 50
     assert missing[:, list(orbits.sat_id).index("C03")].all()
     assert orbits.clock_s[0, list(orbits.sat_id).index("C02")] == pytest.approx(-74.424289e-6)
+
+
+REAL_304_HEADER = "".join(
+    f"{content:65}{label}\n"  # 3.04: content in columns 1-65, the label from column 66
+    for content, label in [
+        ("3.04" + " " * 17 + "C" + " " * 20 + "M", "RINEX VERSION / TYPE"),
+        ("CCLOCK               CODE AIUB            20240316 060412 UTC", "PGM / RUN BY / DATE"),
+        ("     4    AS    AR    CR    DR", "# / TYPES OF DATA"),
+        ("   GPS", "TIME SYSTEM ID"),
+        ("    18", "LEAP SECONDS"),
+        ("COD  CENTER FOR ORBIT DETERMINATION IN EUROPE (CODE), AIUB", "ANALYSIS CENTER"),
+        ("     2", "# OF SOLN SATS"),
+        ("G01 E11", "PRN LIST"),
+        ("", "END OF HEADER"),
+    ]
+)
+
+
+def test_rinex_clock_304_layout_as_distributed(tmp_path):
+    """RINEX clock 3.04 (CODE/IGS products since 2023): the type 'C' in column 22, the labels
+    from column 66 (the 3.04 format document); 3.02's column 21 read it as no clock file."""
+    body = (
+        "AS G01       2018 08 02 14 00  0.000000  2    0.100000000000E-03  0.1E-10\n"
+        "AS E11       2018 08 02 14 00 30.000000  1   -0.200000000000E-04\n"
+    )
+    path = _write(tmp_path, REAL_304_HEADER + body, "COD0OPSFIN.CLK")
+    clocks = read_rinex_clock(path)
+    assert list(clocks.sat_id) == ["E11", "G01"]
+    np.testing.assert_array_equal(clocks.t, [T0, T0 + 30.0])
+    assert clocks.bias_s[0, 1] == pytest.approx(1e-4) and clocks.bias_s[1, 0] == pytest.approx(
+        -2e-5
+    )
+
+
+@pytest.mark.parametrize(
+    ("first", "column"),
+    [
+        ("     3.04           C                   G                   RINEX VERSION / TYPE", 22),
+        ("3.02                 C                    G                   RINEX VERSION / TYPE", 21),
+    ],
+)
+def test_rinex_clock_layout_of_another_version_named(tmp_path, first, column):
+    """A first line in the layout of another version is refused naming the column the version's
+    layout puts the type in, and line 1."""
+    path = _write(tmp_path, first + "\n" + REAL_304_HEADER.split("\n", 1)[1], "p.clk")
+    with pytest.raises(InputError, match=f"type C in column {column}") as info:
+        read_rinex_clock(path)
+    assert info.value.line == 1 and info.value.path == path
+
+
+def test_rinex_clock_unpublished_version_refused(tmp_path):
+    path = _write(tmp_path, "3.05" + REAL_304_HEADER[4:], "p.clk")
+    with pytest.raises(InputError, match=r"version 3\.05 is not one of"):
+        read_rinex_clock(path)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    version=st.sampled_from(["2.00", "3.00", "3.01", "3.02", "3.04"]),
+    n_epochs=st.integers(1, 5),
+    bias=st.floats(-9e-3, 9e-3, allow_nan=False),
+    crlf=st.booleans(),
+)
+def test_rinex_clock_every_version_round_trips(tmp_path_factory, version, n_epochs, bias, crlf):
+    """Every published version, each in its own header layout, reads back its clocks."""
+    t = T0 + 30.0 * np.arange(n_epochs)
+    table = np.full((n_epochs, 1), bias)
+    text = clock_text(t, ["G01"], table, version, "\r\n" if crlf else "\n")
+    clocks = read_rinex_clock(_write(tmp_path_factory.mktemp("clk"), text, "p.clk"))
+    np.testing.assert_array_equal(clocks.t, t)
+    np.testing.assert_allclose(clocks.bias_s, table, rtol=1e-11, atol=1e-22)
