@@ -82,7 +82,7 @@ def _good_text():
     ("edit", "line", "message"),
     [
         (lambda s: s.replace("#dP", "#aP", 1), 1, "SP3-c/d"),
-        (lambda s: s.replace("      2 ORBIT", "      3 ORBIT", 1), 1, "header declares 3"),
+        (lambda s: s.replace("      2 ORBIT", "      1 ORBIT", 1), 1, "header declares 1"),
         (lambda s: s.replace("PG02  20000.000000", "PG02  2000x.000000", 1), 14, "bad position"),
         (lambda s: s.replace("PG02", "PG07", 1), 14, "G07 not in the header"),
         (lambda s: s.replace("*  2018  8  2 14 15", "*  2018  8  2 1x 15", 1), 16, "epoch"),
@@ -218,3 +218,59 @@ def test_rinex_clock_every_version_round_trips(tmp_path_factory, version, n_epoc
     clocks = read_rinex_clock(_write(tmp_path_factory.mktemp("clk"), text, "p.clk"))
     np.testing.assert_array_equal(clocks.t, t)
     np.testing.assert_allclose(clocks.bias_s, table, rtol=1e-11, atol=1e-22)
+
+
+def _trimmed(text: str, keep: int) -> str:
+    """An SP3 text cut after its first ``keep`` epochs (header untouched), ending in EOF."""
+    lines = text.splitlines(keepends=True)
+    starts = [i for i, line in enumerate(lines) if line.startswith("*")]
+    cut = starts[keep] if keep < len(starts) else len(lines) - 1
+    return "".join(lines[:cut]) + "EOF\n"
+
+
+@settings(max_examples=20, deadline=None)
+@given(n_epochs=st.integers(2, 12), data=st.data())
+def test_trimmed_sp3_reads_the_epochs_it_has(tmp_path_factory, n_epochs, data):
+    """A product trimmed to a recording's hours (the header still declaring the whole day) is
+    read with a warning: the epochs it holds, exactly as in the whole file; it was refused as
+    '73 epochs, header declares 289'."""
+    keep = data.draw(st.integers(1, n_epochs - 1))
+    sats = ["G01", "E11"]
+    t = T0 + 900.0 * np.arange(n_epochs)
+    position = np.tile([2.0e7, 1.0e7, 1.0e7], (n_epochs, 2, 1)) + np.arange(n_epochs)[:, None, None]
+    clock = np.full((n_epochs, 2), 1e-4)
+    text = sp3_text(t, sats, position, clock)
+    folder = tmp_path_factory.mktemp("trim")
+    whole = read_sp3(_write(folder, text, "whole.sp3"))
+    trimmed = read_sp3(_write(folder, _trimmed(text, keep), "trim.sp3"))
+    np.testing.assert_array_equal(trimmed.t, whole.t[:keep])
+    np.testing.assert_array_equal(trimmed.position, whole.position[:keep])
+    np.testing.assert_array_equal(trimmed.clock_s, whole.clock_s[:keep])
+
+
+def test_trimmed_sp3_warns_with_its_span(tmp_path, caplog):
+    t = T0 + 900.0 * np.arange(4)
+    text = sp3_text(t, ["G01"], np.full((4, 1, 3), 2e7), np.zeros((4, 1)))
+    path = _write(tmp_path, _trimmed(text, 2))
+    with caplog.at_level("WARNING"):
+        assert read_sp3(path).t.size == 2
+    assert "2 of the 4 epochs the header declares" in caplog.text
+    assert "2018-08-02 14:00:00 to 2018-08-02 14:15:00" in caplog.text and str(path) in caplog.text
+
+
+@pytest.mark.parametrize(
+    ("edit", "reason"),
+    [
+        (lambda s: s.replace("*  2018  8  2 14  0", "*  2018  8  2 13 45", 1), "start time"),
+        (lambda s: s.replace("*  2018  8  2 14 15", "*  2018  8  2 14 20", 1), "interval of 900"),
+    ],
+)
+def test_trimmed_sp3_inconsistent_with_its_header_refused(tmp_path, edit, reason):
+    """Fewer epochs than declared and epochs that do not fit the header's start and interval:
+    a damaged file, refused naming line 1."""
+    t = T0 + 900.0 * np.arange(4)
+    text = sp3_text(t, ["G01"], np.full((4, 1, 3), 2e7), np.zeros((4, 1)))
+    path = _write(tmp_path, edit(_trimmed(text, 3)))
+    with pytest.raises(InputError, match=f"3 epochs, header declares 4, and .*{reason}") as info:
+        read_sp3(path)
+    assert info.value.line == 1

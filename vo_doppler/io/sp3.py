@@ -4,13 +4,18 @@ SP3-c 2007, SP3-d 2016) → :class:`PreciseOrbits`.
 Read: the first line (version ``c``/``d``, position-only or position+velocity flag, number of
 epochs, coordinate system, agency), the ``+`` satellite list (any number of lines, as SP3-d
 allows), the ``%c`` time system, the ``*`` epoch lines and the ``P`` position/clock records
-(km, µs; a position of 0.000000 or a clock of 999999.999999 marks a missing value). Velocity
+(km, µs; a position of 0.000000 or a clock of 999999.999999 marks a missing value). A file
+with fewer epochs than its first line declares (trimmed to a recording's hours, or cut short)
+is read with a warning when its epochs start at the header's start time and keep its
+interval; more epochs than declared, or epochs that do not fit the header, are an error. Velocity
 (``V``) and correlation (``EP``/``EV``) records are skipped: the GNSS stage differentiates the
 interpolated positions. CRLF line endings are accepted. Errors name the file and the line.
 """
 
 from __future__ import annotations
 
+import logging
+import math
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +24,8 @@ from vo_doppler.errors import InputError
 from vo_doppler.io.rinex_common import PRN_RANGE, parse_calendar, prn_in_range
 from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, calendar_to_gps_seconds, utc_to_gps_seconds
 from vo_doppler.model.precise_orbits import PreciseOrbits
+
+log = logging.getLogger(__name__)
 
 BAD_CLOCK_US = 999999.0
 MAX_CLOCK_S = 0.1
@@ -75,12 +82,12 @@ def read_sp3(path: str | Path) -> PreciseOrbits:
     declared_epochs = _int(first[32:39], path, 1, "number of epochs")
     sats, time_system, body = _header(path, lines)
     n_epoch_lines = sum(1 for line in lines[body:] if line[:1] == "*")
-    if n_epoch_lines != declared_epochs:
+    if n_epoch_lines > declared_epochs or n_epoch_lines == 0:
         raise InputError(f"{n_epoch_lines} epochs, header declares {declared_epochs}", path, 1)
     column = {sat: i for i, sat in enumerate(sats)}
     calendar: list[tuple[float, ...]] = []
-    positions = np.full((declared_epochs, len(sats), 3), np.nan)
-    clocks = np.full((declared_epochs, len(sats)), np.nan)
+    positions = np.full((n_epoch_lines, len(sats), 3), np.nan)
+    clocks = np.full((n_epoch_lines, len(sats)), np.nan)
     for number in range(body, len(lines)):
         line = lines[number]
         tag = line[:1]
@@ -96,11 +103,13 @@ def read_sp3(path: str | Path) -> PreciseOrbits:
             clocks[len(calendar) - 1, sat] = _clock(path, number + 1, line)
         elif tag not in ("V", "E", "/", ""):
             raise InputError(f"unexpected record {line[:2]!r}", path, number + 1)
-    if len(calendar) != declared_epochs:  # epoch lines after an 'EOF' line
-        raise InputError(f"{len(calendar)} epochs, header declares {declared_epochs}", path, 1)
+    if len(calendar) != n_epoch_lines:  # epoch lines after an 'EOF' line
+        raise InputError(f"{n_epoch_lines - len(calendar)} epoch lines after 'EOF'", path)
     times = to_gps_seconds(calendar_to_gps_seconds(*np.array(calendar).T), time_system)
     if np.any(np.diff(times) <= 0):
         raise InputError("epochs not strictly increasing", path)
+    if len(calendar) < declared_epochs:
+        _check_trimmed(path, lines, calendar, declared_epochs)
     return PreciseOrbits(
         t=times,
         sat_id=np.array(sats, dtype="U3"),
@@ -111,6 +120,47 @@ def read_sp3(path: str | Path) -> PreciseOrbits:
         agency=first[56:60].strip(),
         path=path,
     )
+
+
+def _check_trimmed(
+    path: Path, lines: list[str], calendar: list[tuple[float, ...]], declared: int
+) -> None:
+    """Accept, with a warning naming the file and the epochs, a file holding fewer epochs than
+    its first line declares (a product trimmed to the hours of a recording, or cut short)
+    when the epochs read are consistent with its header: the first one at the header's start
+    time, all of them spaced by the header's interval. Else an :class:`InputError` naming
+    line 1, as for a damaged file."""
+    read = np.array([calendar_to_gps_seconds(*c) for c in calendar], dtype=float)
+    reason = ""
+    try:
+        start = float(calendar_to_gps_seconds(*parse_calendar(lines[0][3:31].encode())))
+        interval = float(lines[1][24:38])
+    except (ValueError, IndexError) as exc:
+        start, interval, reason = math.nan, math.nan, f"its start or interval unreadable ({exc})"
+    if not reason and read[0] != start:
+        reason = "its first epoch is not the header's start time"
+    elif not reason and not np.allclose(np.diff(read), interval, rtol=0.0, atol=1e-6):
+        reason = f"its epochs are not spaced by the header's interval of {interval:g} s"
+    if reason:
+        raise InputError(
+            f"{len(calendar)} epochs, header declares {declared}, and {reason}", path, 1
+        )
+    log.warning(
+        "%s: %d of the %d epochs the header declares (trimmed or cut short): read the "
+        "epochs from %s to %s (every %g s); observations outside them get no satellite state",
+        path,
+        len(calendar),
+        declared,
+        _stamp(calendar[0]),
+        _stamp(calendar[-1]),
+        interval,
+    )
+
+
+def _stamp(calendar: tuple[float, ...]) -> str:
+    """'2018-08-02 14:00:00' of a calendar epoch."""
+    y, mo, d, h, mi, s = calendar
+    return f"{int(y):04d}-{int(mo):02d}-{int(d):02d} {int(h):02d}:{int(mi):02d}:{s:02.0f}"
 
 
 def _header(path: Path, lines: list[str]) -> tuple[list[str], str, int]:
