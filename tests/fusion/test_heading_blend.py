@@ -8,6 +8,8 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from tests.fusion.test_heading_correction import _ground_truth, _table, _vo_output
@@ -19,6 +21,7 @@ from vo_doppler.fusion.heading_blend import (
     DriftClock,
     OffsetMeasurements,
     blend_heading,
+    decimate,
     fit_process_noise,
     forward_filter,
     robust_start,
@@ -499,3 +502,56 @@ def test_persisting_faults_raise_the_correlation_floor_until_the_innovations_are
     noise = np.radians(1.0) * np.random.default_rng(0).standard_normal(len(t_heading))
     white = wrap_angle(0.5 * (yaw[1:] + yaw[:-1]) + noise)
     assert blend_heading(vo, t_heading, white, np.radians(1.0)).noise.correlation_floor_s == 0.0
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    period_ms=st.sampled_from([10, 50, 100, 200, 1000]),
+    steps=st.lists(st.integers(min_value=1, max_value=4), min_size=1, max_size=60),
+    gaps=st.lists(st.integers(min_value=0, max_value=6), min_size=61, max_size=61),
+    shift=st.one_of(st.just(1e9), st.floats(min_value=0.0, max_value=1e9, allow_nan=False)),
+)
+def test_decimate_keeps_the_same_measurements_whatever_the_time_origin(
+    period_ms, steps, gaps, shift
+):
+    """Times and spacings in whole sampling periods (a receiver's or a camera's), so that a
+    measurement often lies exactly one spacing after the last kept one: the kept indices are
+    those of the rule on whole periods, at the origin 0 and after any shift up to 10⁹ s (GPS
+    time), where a time carries 1.2·10⁻⁷ s of rounding."""
+    periods = np.concatenate([[0], np.cumsum(steps)])
+    t = 1e-3 * period_ms * periods
+    spacing = 1e-3 * period_ms * np.asarray(gaps[: len(t)], dtype=float)
+    kept, last = [], None
+    for j in range(len(t)):
+        if last is None or periods[j] - periods[last] >= gaps[j]:
+            kept.append(j)
+            last = j
+    np.testing.assert_array_equal(decimate(t, spacing), kept)
+    np.testing.assert_array_equal(decimate(t + shift, spacing), kept)
+
+
+def test_a_10_hz_burst_is_kept_whole_at_image_time_and_at_gps_time():
+    """Issue 30: 30 headings 0.1 s apart with a spacing of 0.1 s; at 10⁹ s rounding dropped 5
+    (and at 0 s, 4: 0.1·k is not exact either)."""
+    t = 0.1 * np.arange(30)
+    for origin in (0.0, 1e9, 1.3e9 + 0.05):
+        np.testing.assert_array_equal(decimate(t + origin, np.full(30, 0.1)), np.arange(30))
+
+
+@pytest.mark.parametrize("method", ["kalman", "window"])
+def test_the_correction_does_not_depend_on_the_time_origin(method):
+    """The same drive and headings on image time (0 s) and on GPS time (10⁹ s): the same
+    fitted noise and the same corrected poses."""
+    vo, t_heading, headings, _ = _burst_headings(0, 30.0)
+    heading = AbsoluteHeading(t_heading, headings, np.ones(len(t_heading), bool), 0.02)
+    config = CorrectionConfig(method=method)
+    at_zero = correct(vo, heading, config)
+    shifted = Trajectory(vo.t + 1e9, vo.positions, vo.orientations)
+    at_gps = correct(shifted, replace(heading, t=t_heading + 1e9), config)
+    np.testing.assert_array_equal(at_gps.vehicle.t, shifted.t)
+    np.testing.assert_array_equal(at_gps.has_absolute, at_zero.has_absolute)
+    np.testing.assert_allclose(at_gps.vehicle.matrices, at_zero.vehicle.matrices, atol=1e-6)
+    np.testing.assert_allclose(at_gps.correction, at_zero.correction, atol=1e-7)
+    if method == "kalman":
+        assert at_gps.noise == at_zero.noise
+        assert at_gps.measurements == at_zero.measurements

@@ -3,11 +3,11 @@ the method ([TK18] Eq. 11–13 window, or the Kalman blend (B1)–(B4)), chosen 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading
+from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading, relative_times
 from vo_doppler.fusion.heading_correction import correct_heading
 from vo_doppler.fusion.result import CorrectionResult
 from vo_doppler.model.heading import HeadingTable
@@ -105,7 +105,18 @@ def absolute_heading(table: HeadingTable, source: str, config: CorrectionConfig)
 def correct(
     vehicle: Trajectory, heading: AbsoluteHeading, config: CorrectionConfig
 ) -> CorrectionResult:
-    """Correct vehicle poses (level world) by ``config.method``."""
+    """Correct vehicle poses (level world) by ``config.method``, on times relative to the
+    first pose (:func:`~vo_doppler.fusion.heading_blend.relative_times`): the result does not
+    depend on the time origin (GPS seconds near 10⁹ or seconds from the start of a log)."""
+    origin = float(vehicle.t[0]) if len(vehicle.t) else 0.0
+    relative = replace(vehicle, t=relative_times(vehicle.t, origin))
+    result = _correct(relative, replace(heading, t=relative_times(heading.t, origin)), config)
+    return replace(result, vehicle=replace(result.vehicle, t=vehicle.t.copy()))
+
+
+def _correct(
+    vehicle: Trajectory, heading: AbsoluteHeading, config: CorrectionConfig
+) -> CorrectionResult:
     if config.method == "kalman":
         return blend_heading(
             vehicle,

@@ -399,13 +399,37 @@ def start_indices(t: np.ndarray, correlation_s: np.ndarray, config: BlendConfig)
     return decimate(t, spacing)[: config.start_measurements]
 
 
+TIME_TOLERANCE_S = 1e-6
+"""Two times closer than this are taken as equal when spacings are compared: far above the
+rounding of a GPS time near 10⁹ s (2⁻²³ s ≈ 1.2·10⁻⁷ s per value), far below any sampling
+interval, so that a measurement exactly one spacing after the last kept one is kept whatever
+the time origin (at 10⁹ s, ``t_j >= last + gap`` dropped 5 of 30 samples 0.1 s apart)."""
+TIME_DECIMALS = 6
+"""Times relative to a start are rounded to the microsecond (:func:`relative_times`)."""
+
+
+def relative_times(t, origin: float) -> np.ndarray:
+    """``t − origin`` rounded to the microsecond: the same numbers whatever the time origin.
+
+    A time near 10⁹ s (GPS seconds) carries up to 1.2·10⁻⁷ s of rounding, so ``t − origin``
+    differs from the same time counted from the start of a log by that much, and a comparison
+    on the edge (a window of exactly 2 s over 10-Hz poses) could go either way; rounded to the
+    microsecond (no clock stamps finer), both give the same numbers."""
+    return np.round(np.asarray(t, dtype=float) - origin, TIME_DECIMALS)
+
+
 def decimate(t: np.ndarray, spacing_s: np.ndarray) -> np.ndarray:
     """Indices of measurements kept greedily so that each is at least its own correlation
-    time after the previous kept one."""
+    time after the previous kept one (within :data:`TIME_TOLERANCE_S`).
+
+    Computed on times relative to the first, comparing differences: the indices do not depend
+    on a constant shift of every time (GPS seconds or seconds from the start of a log)."""
+    t = np.asarray(t, dtype=float)
+    relative = t - t[0] if len(t) else t
     keep = []
     last = -np.inf
-    for j, (tj, gap) in enumerate(zip(t, spacing_s, strict=True)):
-        if tj >= last + gap:
+    for j, (tj, gap) in enumerate(zip(relative, spacing_s, strict=True)):
+        if tj - last >= gap - TIME_TOLERANCE_S:
             keep.append(j)
             last = tj
     return np.asarray(keep, dtype=int)
@@ -602,7 +626,10 @@ def blend_heading(
     sigma = np.where(np.isfinite(sigma), sigma, config.default_measurement_sigma)
     correlation = np.broadcast_to(np.asarray(correlation_s, dtype=float), (n_heading,))
     poses = vehicle.matrices
-    t = vehicle.t
+    # Every step on times relative to the first pose: nothing depends on the time origin.
+    origin = float(vehicle.t[0]) if len(vehicle.t) else 0.0
+    t = relative_times(vehicle.t, origin)
+    t_heading = relative_times(t_heading, origin)
     positions = poses[:, :3, 3] - (poses[0, :3, 3] if len(poses) else 0.0)
     rotations = poses[:, :3, :3]
     t_direction, yaw_direction = vo_direction(
@@ -646,7 +673,9 @@ def blend_heading(
     corrected_positions = np.concatenate([positions[:1], positions[:1] + np.cumsum(steps, axis=0)])
     corrected_rotations = Rotation.from_euler("z", delta[:, None]).as_matrix() @ rotations
     corrected_positions += poses[0, :3, 3] if len(poses) else 0.0
-    corrected = Trajectory(t.copy(), corrected_positions, Rotation.from_matrix(corrected_rotations))
+    corrected = Trajectory(
+        vehicle.t.copy(), corrected_positions, Rotation.from_matrix(corrected_rotations)
+    )
     _, has_absolute = headings_at(t, t_heading, yaw, None, config.max_gap_s)
     return CorrectionResult(
         corrected,
