@@ -328,3 +328,76 @@ def test_rinex2_round_trip(tmp_path, written):
     obs = read_obs(path)
     assert observation_rows(obs) == sorted(expected)
     assert obs.problems == ()
+
+
+GLONASS_CHANNELS = {1: 1, 2: -4, 3: 5, 4: 6, 5: 1, 6: -4, 7: 5, 8: 6, 9: -2, 10: -7}
+
+
+def _with_slot_lines(tmp_path, slot_lines: list[str]):
+    """A RINEX 3 file whose header carries these 'GLONASS SLOT / FRQ #' lines (content only,
+    the label appended after column 60 or, for longer content, right after it)."""
+    header = rinex3_header({"R": ["C1C"]})
+    block = "".join(f"{content:<60}GLONASS SLOT / FRQ #\n" for content in slot_lines)
+    path = tmp_path / "slots.24o"
+    path.write_text(
+        header.replace("     1.000", block + "     1.000", 1)
+        + rinex3_epoch("2024 06 24 08 20  0.0000000", [("R01", [field(2.0e7)])])
+    )
+    return read_obs(path)
+
+
+@pytest.mark.parametrize(
+    "slot_lines",
+    [
+        # RINEX 3.05 Table A2: I3,1X,8(A1,I2.2,1X,I2,1X), continuation with the count blank
+        [" 10 R01  1 R02 -4 R03  5 R04  6 R05  1 R06 -4 R07  5 R08  6", "    R09 -2 R10 -7"],
+        # one blank between slot and channel: every fixed 7-column chunk after the first shifts
+        [" 10 R01 1 R02 -4 R03 5 R04 6 R05 1 R06 -4 R07 5 R08 6 R09 -2", "    R10 -7"],
+        # all ten pairs on one line, past column 60 (the label pushed right)
+        [" 10 R01  1 R02 -4 R03  5 R04  6 R05  1 R06 -4 R07  5 R08  6 R09 -2 R10 -7"],
+        # no count, fewer pairs per line, slots without a leading zero, explicit + signs
+        ["R1 +1 R2 -4 R3 +5", "R4 +6 R5 +1 R6 -4 R7 +5", "R8 +6  R9 -2  R10 -7"],
+    ],
+)
+def test_glonass_slot_line_variants_are_read(tmp_path, slot_lines):
+    """The 'GLONASS SLOT / FRQ #' variants real writers produce are read as pairs of tokens; a
+    GSDC Pixel5 file's gave six 'unreadable' warnings and no GLONASS channel."""
+    obs = _with_slot_lines(tmp_path, slot_lines)
+    assert obs.header.glonass_channels == GLONASS_CHANNELS
+    assert obs.problems == ()
+
+
+def test_glonass_slot_line_unreadable_text_named_once_per_line(tmp_path):
+    obs = _with_slot_lines(tmp_path, ["  4 R01  1 R02 -4 R40  1 Rxx  9 R05  1 R06 12"])
+    assert obs.header.glonass_channels == {1: 1, 2: -4, 5: 1}
+    assert len(obs.problems) == 1
+    assert "'R40 1', 'Rxx  9', 'R06 12' ignored" in obs.problems[0]
+    assert obs.problems[0].split(":")[1] == "4"  # the record's line, after three header lines
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    channels=st.dictionaries(st.integers(1, 27), st.integers(-7, 6), min_size=1, max_size=24),
+    per_line=st.integers(1, 12),
+    gap=st.sampled_from([" ", "  ", "   "]),
+    padded=st.booleans(),
+    count=st.booleans(),
+)
+def test_glonass_slot_pairs_read_whatever_the_layout(
+    tmp_path, channels, per_line, gap, padded, count
+):
+    """Any spacing, any number of pairs per line, with or without the count: the same map."""
+    pairs = [
+        f"R{slot:02d}{gap}{channel:2d}" if padded else f"R{slot}{gap}{channel}"
+        for slot, channel in channels.items()
+    ]
+    lines = [" ".join(pairs[k : k + per_line]) for k in range(0, len(pairs), per_line)]
+    lines = [
+        (f"{len(channels):3d} " if count and k == 0 else "    ") + line
+        for k, line in enumerate(lines)
+    ]
+    obs = _with_slot_lines(tmp_path, lines)
+    assert obs.header.glonass_channels == channels
+    assert obs.problems == ()

@@ -45,6 +45,9 @@ _EPOCH2 = re.compile(rb"^ [ \d]\d [ \d]\d [ \d]\d [ \d]\d [ \d]\d [ \d]\d\.\d{7}
 _EVENT2 = re.compile(rb"^ {28}[2-5][ \d]{2}\d")
 _OBS_TYPE_LABELS = ("SYS / # / OBS TYPES", "# / TYPES OF OBSERV")
 MAX_OBS_TYPES = 200
+GLONASS_SLOT_LABEL = "GLONASS SLOT / FRQ #"
+_GLONASS_COUNT = re.compile(r"\s*\d+(?=\s|$)")
+_GLONASS_PAIR = re.compile(r"R ?(\d{1,2})\s+([+-]?\d{1,2})(?!\d)")
 
 
 @dataclass
@@ -123,9 +126,12 @@ def _parse_header(path: Path, lines: list[str], problems: list[str]) -> ObsHeade
     types = _parse_obs_types(path, lines, version, system, 1)
     for number, line in enumerate(lines, start=1):
         key = label(line)
+        if key != GLONASS_SLOT_LABEL and line.rstrip().endswith(GLONASS_SLOT_LABEL):
+            key = GLONASS_SLOT_LABEL  # content past column 60 pushed the label right
         values.setdefault(key, (number, line[:60]))
-        if key == "GLONASS SLOT / FRQ #":
-            _glonass_slots(path, number, line, glonass, problems)
+        if key == GLONASS_SLOT_LABEL:
+            content = line.rstrip()[: -len(GLONASS_SLOT_LABEL)]
+            _glonass_slots(path, number, content, glonass, problems)
     if not types:
         raise InputError("header has no observation types", path)
     interval = _header_number(path, values, "INTERVAL", slice(0, 10), problems)
@@ -186,20 +192,38 @@ def _time_system(path: Path, values, version: float, system: str, problems) -> s
     return time_system
 
 
-def _glonass_slots(path: Path, number: int, line: str, glonass: dict[int, int], problems) -> None:
-    """Slot → frequency channel (−7…+6) pairs of one 'GLONASS SLOT / FRQ #' record."""
-    for k in range(8):
-        chunk = line[4 + 7 * k : 11 + 7 * k]
-        if not chunk.strip():
-            continue
-        slot, channel = chunk[1:3].strip(), chunk[3:].strip()
-        valid = chunk[:1] == "R" and slot.isdigit() and channel.lstrip("+-").isdigit()
-        if valid and prn_in_range("R", int(slot)) and -7 <= int(channel) <= 6:
-            glonass[int(slot)] = int(channel)
+def _glonass_slots(
+    path: Path, number: int, content: str, glonass: dict[int, int], problems
+) -> None:
+    """Slot → frequency channel (−7…+6) pairs of one 'GLONASS SLOT / FRQ #' record.
+
+    RINEX 3.05 Table A2 writes ``I3,1X,8(A1,I2.2,1X,I2,1X)``: the count, then up to eight pairs
+    such as ``R01  1``, continued on lines whose count is blank. Writers vary it (a GSDC Pixel5
+    file among them): another spacing, more or fewer pairs on a line, no count, content past
+    column 60. The pairs are read as tokens (``R``, the slot, blanks, the signed channel)
+    wherever they stand; the text that is no valid pair is named once for the line.
+    """
+    count = _GLONASS_COUNT.match(content)
+    text = content[count.end() :] if count else content
+    unread: list[str] = []
+    end = 0
+    for pair in _GLONASS_PAIR.finditer(text):
+        unread.append(text[end : pair.start()].strip())
+        end = pair.end()
+        slot, channel = int(pair[1]), int(pair[2])
+        if prn_in_range("R", slot) and -7 <= channel <= 6:
+            glonass[slot] = channel
         else:
-            add_problem(
-                problems, path, number, f"unreadable GLONASS slot/channel {chunk.strip()!r} ignored"
-            )
+            unread.append(" ".join(pair[0].split()))
+    unread.append(text[end:].strip())
+    unread = [u for u in unread if u]
+    if unread:
+        add_problem(
+            problems,
+            path,
+            number,
+            f"unreadable GLONASS slot/channel {', '.join(repr(u) for u in unread)} ignored",
+        )
 
 
 def _header_number(path, values, key, columns, problems) -> float | None:
