@@ -130,10 +130,11 @@ def truth_at(truth: GroundTruth, t: np.ndarray, hold_below_mps: float = HOLD_BEL
         return TruthAt(np.zeros(t.size, dtype=bool), nan3, np.full(t.size, np.nan), nan3)
     velocity = truth_velocity(truth)
     course = held_course(velocity, truth.course_rad, hold_below_mps)
-    before = np.clip(np.searchsorted(truth.t, t, side="right") - 1, 0, n - 2)
-    covered = (t >= truth.t[0]) & (t <= truth.t[-1]) & ~_gaps(truth.t)[before]
-    covered &= np.isfinite(velocity[before]).all(axis=1)
-    covered &= np.isfinite(velocity[before + 1]).all(axis=1)
+    stretch = np.r_[0, np.cumsum(_gaps(truth.t))]  # per sample: which stretch without a gap
+    before = np.clip(np.searchsorted(truth.t, t, side="right") - 1, 0, n - 1)
+    after = np.clip(np.searchsorted(truth.t, t, side="left"), 0, n - 1)
+    covered = (t >= truth.t[0]) & (t <= truth.t[-1]) & (stretch[before] == stretch[after])
+    covered &= np.isfinite(velocity[before]).all(axis=1) & np.isfinite(velocity[after]).all(axis=1)
 
     def at(values: np.ndarray) -> np.ndarray:
         return np.where(covered, np.interp(t, truth.t, values), np.nan)
