@@ -270,13 +270,15 @@ def _geodetic_truth(
         bad = ~(np.isfinite(values) & inside)
         if bad.any():
             k = int(np.argmax(bad))
-            raise InputError(f"{name} {values[k]!r} is not usable", path, int(lines[k]))
+            value = float(values[k])
+            problem = "is blank" if np.isnan(value) else f"{value:g} is out of range"
+            raise InputError(f"{name} {problem}", path, int(lines[k]))
     course = None
     if course_deg is not None:
         usable = np.isfinite(course_deg)
         if (np.abs(course_deg[usable]) > 360.0).any():
             k = int(np.argmax(usable & (np.abs(np.nan_to_num(course_deg)) > 360.0)))
-            raise InputError(f"course {course_deg[k]!r} is not in degrees", path, int(lines[k]))
+            raise InputError(f"course {course_deg[k]:g} is not in degrees", path, int(lines[k]))
         course = np.radians(np.mod(course_deg, 360.0)) if usable.any() else None
     lat, lon = np.radians(lat_deg), np.radians(lon_deg)
     frame = origin if origin is not None else EnuFrame(lat[0], lon[0], float(height_m[0]))
