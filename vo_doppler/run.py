@@ -15,7 +15,8 @@ Stages (docs/design.md, "The main job"):
    corrected the same way.
 
 All trajectories are vehicle poses (x forward, y left, z up) in the sequence's ENU frame, on GPS
-time. A recording without a camera runs every pipeline that needs none.
+time. A recording without a camera runs every pipeline that needs none; one without GNSS (an
+imported KITTI raw drive) runs the VO and the dead reckoning alone (:func:`run_without_gnss`).
 """
 
 from __future__ import annotations
@@ -100,8 +101,9 @@ class RunConfig:
 
 @dataclass
 class RunResult:
-    gnss: GnssVelocityResult
-    heading: HeadingTable
+    gnss: GnssVelocityResult | None
+    """None for a recording without GNSS (so is ``heading``)."""
+    heading: HeadingTable | None
     vo: VoOutput | None
     """None for a recording without a camera."""
     calibrated_speed: SensorSeries
@@ -393,6 +395,8 @@ def run_sequence(
     course (after the heading stage, before the VO) raises :class:`InputError`; the rest are
     warnings, logged and returned in ``RunResult.warnings``."""
     config = config or RunConfig()
+    if not sequence.has_gnss:
+        return run_without_gnss(sequence, config, on_frame, images)
     obs = sequence.observations
     check_vehicle_overlap(
         sequence.wheel_speed, sequence.yaw_rate, obs.epoch_time, sequence.vehicle_source
@@ -420,3 +424,45 @@ def run_sequence(
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
     warnings = ([origin] if origin else []) + table.warnings
     return RunResult(gnss, table, vo, speed, trajectories, antenna, usable, warnings)
+
+
+NO_GNSS = (
+    "{name} has no GNSS: only the VO and the wheel + gyro dead reckoning ran (the GNSS "
+    "pipelines, VO + GPS and DR + GPS, were not run), with the wheel speed and yaw rate as "
+    "recorded (no wheel-scale or gyro-bias calibration) and no absolute heading: the "
+    "trajectories start at the ENU origin facing east"
+)
+
+
+def run_without_gnss(
+    sequence: Sequence,
+    config: RunConfig,
+    on_frame: Callable[[int], None] | None = None,
+    images: Iterable[np.ndarray] | None = None,
+) -> RunResult:
+    """:func:`run_sequence` on a recording without GNSS: the VO (scaled by the wheel speed as
+    recorded) and the wheel + gyro dead reckoning, each started at the ENU origin facing east
+    (the only placement without a fix or an absolute heading); ``gnss`` and ``heading`` are
+    None and the warning says which pipelines were not run."""
+    check_yaw_rate_unit(sequence.yaw_rate, sequence.wheel_speed, sequence.vehicle_source)
+    note = NO_GNSS.format(name=sequence.name)
+    log.warning("%s", note)
+    speed, yaw_rate = sequence.wheel_speed, sequence.yaw_rate
+    vo = vo_vehicle = None
+    if sequence.has_camera:
+        vo = sequence_vo(sequence, config.vo, speed, on_frame, images)
+        vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
+    begin, end = max(speed.t[0], yaw_rate.t[0]), min(speed.t[-1], yaw_rate.t[-1])
+    if vo_vehicle is not None:
+        begin, end = max(begin, vo_vehicle.t[0]), min(end, vo_vehicle.t[-1])
+    t_dr = np.arange(begin, end, 1.0 / config.dead_reckoning_rate_hz)
+    origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)))
+    tracks = {Pipeline.VO: vo_vehicle}
+    if len(t_dr) > 1:
+        tracks[Pipeline.DR] = wheel_gyro_track(speed, yaw_rate, t_dr)
+    trajectories = {
+        name: level_with_yaw(track, float(-track.yaw()[0]), origin)
+        for name, track in tracks.items()
+        if track is not None
+    }
+    return RunResult(None, None, vo, speed, trajectories, origin, np.zeros(0, dtype=bool), [note])

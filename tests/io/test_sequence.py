@@ -63,7 +63,7 @@ def test_wrong_format_is_named(tmp_path):
 
 def test_missing_section_and_key_are_named(tmp_path):
     write_manifest(tmp_path, {"format": "vo-doppler-sequence/1", "camera": {"images": "x"}})
-    with pytest.raises(InputError, match="no 'gnss' section"):
+    with pytest.raises(InputError, match="no 'origin' section"):
         read_sequence(tmp_path)
     write_manifest(
         tmp_path,

@@ -1,5 +1,6 @@
-"""``vo-doppler import comma2k19 SEGMENT --orbits SP3 -o SEQ``: a recording in another layout
-→ a standard sequence folder for ``vo-doppler run``."""
+"""``vo-doppler import comma2k19 SEGMENT --orbits SP3 -o SEQ`` and ``vo-doppler import
+kitti-raw DRIVE -o SEQ``: a recording in another layout → a standard sequence folder for
+``vo-doppler run``."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ import logging
 from pathlib import Path
 
 from vo_doppler.io.comma2k19_import import import_comma2k19
+from vo_doppler.io.kitti_raw_import import CAMERAS as KITTI_CAMERAS
+from vo_doppler.io.kitti_raw_import import import_kitti_raw
 
 log = logging.getLogger(__name__)
 
@@ -37,6 +40,26 @@ def register(subparsers, summary: str) -> None:
     )
     comma.add_argument("-o", "--output", type=Path, required=True, help="sequence folder")
     comma.set_defaults(func=run)
+    kitti = kinds.add_parser(
+        "kitti-raw",
+        help="a KITTI raw drive folder (image_0N/, oxts/; the day's calib_*.txt beside it)",
+        description="Write a camera's images with their times on GPS time (the timestamps "
+        "read as UTC), its calibration from calib_cam_to_cam.txt (P_rect for a _sync drive, "
+        "K and D for an _extract one; the extrinsic to the OXTS unit from calib_imu_to_velo "
+        "and calib_velo_to_cam), OXTS wz and vf as the vehicle yaw rate and speed, the OXTS "
+        "fixes as ENU ground truth (origin: the first fix) and sequence.yaml. A subsampled "
+        "drive (timestamps.txt longer than data/) gives the frames that exist, with a "
+        "warning. KITTI raw has no raw GNSS: run runs the VO and dead reckoning.",
+    )
+    kitti.add_argument("drive", type=Path, help="drive folder (YYYY_MM_DD_drive_NNNN_sync)")
+    kitti.add_argument(
+        "--camera",
+        choices=KITTI_CAMERAS,
+        default="image_00",
+        help="the camera folder (image_00/01 grey, image_02/03 colour)",
+    )
+    kitti.add_argument("-o", "--output", type=Path, required=True, help="sequence folder")
+    kitti.set_defaults(func=run_kitti_raw)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -54,5 +77,23 @@ def run(args: argparse.Namespace) -> int:
         if summary.vehicle_signals == "can"
         else "the IMU gyro and processed_log/CAN/wheel_speed",
         "; video decoded into the camera" if summary.has_video else "; no video: no camera",
+    )
+    return 0
+
+
+def run_kitti_raw(args: argparse.Namespace) -> int:
+    summary = import_kitti_raw(args.drive, args.output, args.camera)
+    log.info(
+        "wrote %s: %d images of %s (%d timestamps), %d OXTS rows (%d timestamps) as ENU ground "
+        "truth, yaw rate and speed; %s images; extrinsic from %s; no GNSS: run runs the VO and "
+        "dead reckoning",
+        summary.folder,
+        summary.images,
+        summary.camera,
+        summary.image_timestamps,
+        summary.oxts_rows,
+        summary.oxts_timestamps,
+        "rectified" if summary.rectified else "raw (distorted)",
+        summary.extrinsic_from,
     )
     return 0

@@ -106,10 +106,10 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
         log.warning("%s", text)
     config = run_config(args)
     console = Console(width=None if sys.stdout.isatty() else 150)
+    epochs = len(inputs.observations.epoch_time) if inputs.has_gnss else "no"
     console.print(
-        f"{inputs.name}: {len(inputs.image_paths)} images, "
-        f"{len(inputs.observations.epoch_time)} GNSS epochs, {len(inputs.wheel_speed)} wheel "
-        f"and {len(inputs.yaw_rate)} yaw-rate samples"
+        f"{inputs.name}: {len(inputs.image_paths)} images, {epochs} GNSS epochs, "
+        f"{len(inputs.wheel_speed)} wheel and {len(inputs.yaw_rate)} yaw-rate samples"
     )
     # What is alive now (the imported modules, the inputs; after the stages, their results)
     # stays to the end of the command: the cycle collector's full passes (automatic, and after
@@ -136,19 +136,23 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
 def print_summary(console: Console, summary: dict) -> None:
     """The run's figures with the report's words: "available" (the estimator produced a
     heading) and "used" (it corrected the VO)."""
-    console.print(
-        f"of {summary['gnss_epochs']} GNSS epochs, heading available: conventional "
-        f"{summary['conventional_heading_availability']:.0%}, tightly coupled "
-        f"{summary['tight_heading_availability']:.0%}; tightly coupled used by the correction "
-        f"{summary['tight_heading_used']:.0%} ({summary['tight_heading_rejected_rows']} Doppler "
-        f"rows rejected by the NLOS tests); wheel scale {summary['final_wheel_scale']:.4f}, "
-        f"gyro bias {summary['final_gyro_bias_dps']:+.3f} deg/s; "
-        + (
-            f"VO {summary['vo_frames']} frames ({summary['vo_flagged_frames']} flagged)"
-            if "vo_frames" in summary
-            else "no camera"
-        )
+    vo = (
+        f"VO {summary['vo_frames']} frames ({summary['vo_flagged_frames']} flagged)"
+        if "vo_frames" in summary
+        else "no camera"
     )
+    if "gnss" in summary:  # no GNSS: the heading figures do not exist
+        console.print(f"GNSS {summary['gnss']}; {vo}")
+    else:
+        console.print(
+            f"of {summary['gnss_epochs']} GNSS epochs, heading available: conventional "
+            f"{summary['conventional_heading_availability']:.0%}, tightly coupled "
+            f"{summary['tight_heading_availability']:.0%}; tightly coupled used by the "
+            f"correction {summary['tight_heading_used']:.0%} "
+            f"({summary['tight_heading_rejected_rows']} Doppler rows rejected by the NLOS "
+            f"tests); wheel scale {summary['final_wheel_scale']:.4f}, "
+            f"gyro bias {summary['final_gyro_bias_dps']:+.3f} deg/s; {vo}"
+        )
     errors = summary.get("evaluation")
     if not errors:
         return

@@ -125,8 +125,11 @@ def with_initial_heading(estimate: Trajectory, truth: Trajectory, first: int = 0
     return estimate.transformed(rotation, origin - rotation @ origin)
 
 
-def heading_availability(table: HeadingTable, tc_usable: np.ndarray) -> dict[str, float]:
-    """Fraction of GNSS epochs whose absolute heading each pipeline could use."""
+def heading_availability(table: HeadingTable | None, tc_usable: np.ndarray) -> dict[str, float]:
+    """Fraction of GNSS epochs whose absolute heading each pipeline could use (``table`` None:
+    a recording without GNSS, whose VO and dead reckoning use none)."""
+    if table is None:
+        return {"vo": 0.0, "dr": 0.0}
     tc = float(np.mean(tc_usable))
     conventional = float(np.mean(table.published_conventional[0]))
     return {
@@ -141,7 +144,7 @@ def heading_availability(table: HeadingTable, tc_usable: np.ndarray) -> dict[str
 
 def evaluate_pipelines(
     trajectories: dict[str, Trajectory],
-    table: HeadingTable,
+    table: HeadingTable | None,
     tc_usable: np.ndarray,
     truth: Trajectory,
 ) -> tuple[dict[str, PipelineErrors], dict[str, ErrorPerDistance], dict[str, Trajectory]]:

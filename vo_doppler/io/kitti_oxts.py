@@ -77,6 +77,8 @@ class OxtsRecord:
     frames: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     """Frame number (the data file's NNNNNNNNNN) of each row."""
     warnings: tuple[str, ...] = ()
+    n_timestamps: int = 0
+    """Lines of ``timestamps.txt`` (more than rows in a subsampled drive)."""
 
     def trajectory(self) -> Trajectory:
         """The poses as a trajectory (first pose at the origin, x along its heading)."""
@@ -112,6 +114,7 @@ def read_oxts(folder: str | Path) -> OxtsRecord:
         path=folder,
         frames=frames,
         warnings=(warning,) if warning else (),
+        n_timestamps=int(all_t.size),
     )
 
 

@@ -226,8 +226,7 @@ def read_sequence_with_report(
 ) -> tuple[Sequence, InputReport]:
     """:func:`read_sequence` and what reading found (time order per sensor, CAN decoding)."""
     m = Manifest(read_manifest(folder), allow_outside)
-    for name in ("gnss", "origin"):
-        m.section(name)
+    m.section("origin")
     report = InputReport()
     images, times, camera, camera_offset = [], np.zeros(0), None, 0.0
     if "camera" in m.data:  # a recording without video has no camera section
@@ -235,24 +234,16 @@ def read_sequence_with_report(
         camera_offset = m.number("camera", "time_offset_s", 0.0)
         times = read_times(m.file("camera", "times"), len(images))
         camera = read_camera(m.file("camera", "calib"))
-    obs = read_obs(m.file("gnss", "obs"))
-    if "orbits" in m.section("gnss"):
-        clocks = m.file("gnss", "clocks") if "clocks" in m.section("gnss") else None
-        nav = read_satellite_states(orbits=m.file("gnss", "orbits"), clocks=clocks)
-    else:
-        nav = read_satellite_states(m.files("gnss", "nav"))
-    sigma = None
-    if "doppler_sigma" in m.section("gnss"):
-        sigma = read_doppler_sigma(m.file("gnss", "doppler_sigma"))
-    if m.number("gnss", "time_offset_s", 0.0) != 0.0:
-        raise m.error("gnss.time_offset_s", "GNSS observations must be on GPS time (0)")
+    obs, nav, sigma, lever_arm = None, None, None, (0.0, 0.0, 0.0)
+    if "gnss" in m.data:  # a recording without GNSS (a KITTI raw drive) runs VO and DR only
+        obs, nav, sigma = _gnss(m)
+        lever_arm = _lever_arm(m.value("gnss", "antenna_lever_arm_m", (0.0, 0.0, 0.0)), m.path)
     motion = _vehicle_motion(m, report)
     enu = EnuFrame(
         np.radians(m.number("origin", "lat_deg", low=-90.0, high=90.0)),
         np.radians(m.number("origin", "lon_deg", low=-180.0, high=180.0)),
         m.number("origin", "height_m", 0.0, low=-1.0e3, high=1.0e4),
     )
-    lever_arm = _lever_arm(m.value("gnss", "antenna_lever_arm_m", (0.0, 0.0, 0.0)), m.path)
     truth = None
     if "ground_truth" in m.data:  # optional, but a named file must be there, as every input
         truth = read_tum(m.file("ground_truth", "trajectory"))
@@ -283,6 +274,22 @@ def read_sequence_with_report(
         vehicle_source=motion.names,
     )
     return sequence, report
+
+
+def _gnss(m: Manifest):
+    """The ``gnss`` section: observations, navigation or precise orbits, the Doppler σ."""
+    obs = read_obs(m.file("gnss", "obs"))
+    if "orbits" in m.section("gnss"):
+        clocks = m.file("gnss", "clocks") if "clocks" in m.section("gnss") else None
+        nav = read_satellite_states(orbits=m.file("gnss", "orbits"), clocks=clocks)
+    else:
+        nav = read_satellite_states(m.files("gnss", "nav"))
+    sigma = None
+    if "doppler_sigma" in m.section("gnss"):
+        sigma = read_doppler_sigma(m.file("gnss", "doppler_sigma"))
+    if m.number("gnss", "time_offset_s", 0.0) != 0.0:
+        raise m.error("gnss.time_offset_s", "GNSS observations must be on GPS time (0)")
+    return obs, nav, sigma
 
 
 @dataclass(frozen=True)

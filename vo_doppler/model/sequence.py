@@ -20,7 +20,8 @@ from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 @dataclass
 class Sequence:
-    """Images and camera, GNSS observations and navigation, vehicle signals, the local ENU
+    """Images and camera, GNSS observations and navigation (either may be missing), vehicle
+    signals, the local ENU
     frame, the antenna lever arm and (when known) the ground truth of one recording.
 
     Every time is GPS seconds: the reader applied each sensor's clock offset (kept in
@@ -31,9 +32,11 @@ class Sequence:
     image_paths: list[Path]
     image_times: np.ndarray
     camera: Camera | None
-    observations: Observations
-    navigation: Navigation | PreciseOrbits
-    """Broadcast ephemerides or precise orbits (+ clocks): the GNSS stage takes either."""
+    observations: Observations | None
+    """None for a recording without GNSS (e.g. an imported KITTI raw drive)."""
+    navigation: Navigation | PreciseOrbits | None
+    """Broadcast ephemerides or precise orbits (+ clocks): the GNSS stage takes either; None
+    without GNSS."""
     yaw_rate: SensorSeries
     """Counter-clockwise positive, rad/s."""
     wheel_speed: SensorSeries
@@ -52,6 +55,10 @@ class Sequence:
     the tight heading's road grade prior."""
     vehicle_source: VehicleSignalSource = field(default_factory=VehicleSignalSource)
     """Where the yaw rate and wheel speed came from, for the checks' messages."""
+
+    @property
+    def has_gnss(self) -> bool:
+        return self.observations is not None and self.navigation is not None
 
     @property
     def has_camera(self) -> bool:

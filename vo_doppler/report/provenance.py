@@ -47,9 +47,12 @@ def sensors_present(sequence: Sequence) -> list[str]:
         span = float(sequence.image_times[-1] - sequence.image_times[0]) if n > 1 else 0.0
         rate = f", {(n - 1) / span:.1f} frames/s" if span > 0 else ""
         sensors.append(f"monocular camera ({n} images{rate})")
-    epochs = len(sequence.observations.epoch_time)
-    systems = "".join(sorted(sequence.observations.header.obs_types)) or "?"
-    sensors.append(f"GNSS receiver ({epochs} epochs, systems {systems}, pseudorange and Doppler)")
+    if sequence.has_gnss:
+        epochs = len(sequence.observations.epoch_time)
+        systems = "".join(sorted(sequence.observations.header.obs_types)) or "?"
+        sensors.append(
+            f"GNSS receiver ({epochs} epochs, systems {systems}, pseudorange and Doppler)"
+        )
     sensors.append(f"wheel speed ({len(sequence.wheel_speed)} samples)")
     sensors.append(f"yaw-rate gyro ({len(sequence.yaw_rate)} samples)")
     if sequence.truth is not None:
@@ -62,7 +65,9 @@ def describe_data(
 ) -> DataDescription:
     """The data of a run. ``driven_m`` (e.g. the wheel-speed integral) stands in for the
     distance when the recording has no ground truth."""
-    times = [sequence.observations.epoch_time, sequence.wheel_speed.t, sequence.yaw_rate.t]
+    times = [sequence.wheel_speed.t, sequence.yaw_rate.t]
+    if sequence.has_gnss:
+        times.append(sequence.observations.epoch_time)
     if sequence.has_camera:
         times.append(sequence.image_times)
     begin = max(float(t[0]) for t in times if len(t))

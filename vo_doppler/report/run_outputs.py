@@ -75,6 +75,7 @@ FACT_FORMATS = {
     "vo_fps": ("VO speed", "{:.1f} frames/s"),
     "camera": ("camera", "{}"),
     "heading_correction": ("heading correction", "{}"),
+    "gnss": ("GNSS", "{}"),
     "can_clock_residual_offset_s": (
         "wheel-speed clock offset left (CAN/vehicle signals against the GNSS Doppler speed)",
         "{:+.3f} s",
@@ -97,8 +98,16 @@ def correction_label(config: RunConfig) -> str:
 
 
 def summarise(result: RunResult) -> dict:
-    """Heading availability, calibration and VO figures of a run (JSON-ready scalars)."""
+    """Heading availability, calibration and VO figures of a run (JSON-ready scalars); without
+    GNSS only the VO figures and ``gnss``, saying that the GNSS pipelines were not run."""
     table = result.heading
+    if table is None:
+        summary: dict = {
+            "gnss_epochs": 0,
+            "gnss": "none: the GNSS pipelines were not run (VO and dead reckoning only)",
+        }
+        _vo_summary(summary, result)
+        return summary
     summary = {
         "gnss_epochs": len(table),
         "conventional_heading_availability": float(np.mean(table.published_conventional[0])),
@@ -114,13 +123,17 @@ def summarise(result: RunResult) -> dict:
         "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
         "doppler_noise": doppler_noise_summary(result),
     }
+    _vo_summary(summary, result)
+    return summary
+
+
+def _vo_summary(summary: dict, result: RunResult) -> None:
     if result.vo is not None:
         summary["vo_frames"] = result.vo.stats.frames
         summary["vo_flagged_frames"] = len(result.vo.stats.flagged_frames)
         summary["vo_fps"] = result.vo.stats.fps
     else:
         summary["camera"] = "none: non-visual pipelines only"
-    return summary
 
 
 def _finite_median(values: np.ndarray) -> float | None:
@@ -166,7 +179,9 @@ def result_checks(
     speed, the calibration), the residual clock offset, the time order per sensor."""
     return {
         "warnings": warnings + file_problems(inputs) + result.warnings,
-        "can_clock_residual_offset_s": result.heading.clock_residual_offset_s,
+        "can_clock_residual_offset_s": None
+        if result.heading is None
+        else result.heading.clock_residual_offset_s,
         "time_order": {r.sensor: r.as_dict() for r in report.time_order},
     }
 
@@ -176,6 +191,8 @@ def file_problems(inputs: Sequence) -> list[str]:
     (a damaged epoch, an unreadable header value): the first ``MAX_PROBLEMS_PER_FILE`` of each
     kind, then how many more."""
     found = []
+    if not inputs.has_gnss:
+        return found
     for what, problems in (
         ("observation", inputs.observations.problems),
         ("navigation", state_problems(inputs.navigation)),
@@ -231,7 +248,8 @@ def write_run_outputs(
             "trajectory_corrected.tum" if name == Pipeline.VO_GPS_TC else f"trajectory_{name}.tum"
         )
         write_tum(out / file, trajectory)
-    write_heading_csv(out / "heading.csv", result.heading)
+    if result.heading is not None:
+        write_heading_csv(out / "heading.csv", result.heading)
     summary = summarise(result)
     summary["heading_correction"] = correction_label(config)
     summary.update(checks or {})
@@ -250,7 +268,7 @@ def write_run_outputs(
         heading_figure="",
         warnings=list(summary.get("warnings", [])),
     )
-    truth_yaw = truth.yaw_at(table.t) if truth is not None else None
+    truth_yaw = truth.yaw_at(table.t) if truth is not None and table is not None else None
     if truth is not None:
         report.tracks = {TRUTH: truth, **result.trajectories}
         evaluate_into(summary, report, sequence, result, out)
@@ -259,13 +277,14 @@ def write_run_outputs(
     )
     release_figures()
     write_geojson(out / "trajectories.geojson", report.tracks, TRACK_LABELS, sequence.enu)
-    report.heading_figure = png_data_uri(
-        build_heading_figure(table, truth_yaw, sequence.name, result.tc_usable),
-        out / "heading.png",
-    )
-    release_figures()
+    if table is not None:
+        report.heading_figure = png_data_uri(
+            build_heading_figure(table, truth_yaw, sequence.name, result.tc_usable),
+            out / "heading.png",
+        )
+        release_figures()
     report.headline = headline(
-        report.errors, summary["tight_heading_used"], truth is not None and not report.errors
+        report.errors, summary.get("tight_heading_used"), truth is not None and not report.errors
     )
     report.facts = readable_facts(summary)
     (out / SUMMARY_FILE).write_text(json_text(summary, indent=2))
@@ -318,13 +337,16 @@ def evaluate_into(
         build_error_per_100m_figure(per_100m, sequence.name), out / "error_per_100m.png"
     )
     release_figures()
-    heading_t0 = float(table.t[0]) if len(table) else 0.0
+    heading_t0 = float(table.t[0]) if table is not None and len(table) else 0.0
+    if table is None:  # no GNSS: the time axis starts with the ground truth
+        heading_t0 = float(truth.t[0])
     report.heading_error_figure = png_data_uri(
         build_heading_error_figure(shown, truth, heading_t0, sequence.name),
         out / "heading_error.png",
     )
     release_figures()
-    report.worst = worst_reliable_tight_errors(table, result.tc_usable, truth.yaw_at(table.t))
+    if table is not None:
+        report.worst = worst_reliable_tight_errors(table, result.tc_usable, truth.yaw_at(table.t))
     path_length = max(e.path_length_m for e in errors.values())
     report.segment_note = (
         "KITTI translation error: "
@@ -337,8 +359,9 @@ def require_tight_heading(result: RunResult, folder: Path, out: Path) -> None:
     """A run whose tightly coupled heading was unavailable at every epoch failed: raise the
     project's error naming the recording (after its outputs were written to ``out``, to show
     why). A heading is a direction of travel: when the vehicle never moved (:func:`standstill`)
-    the message says so rather than blame the heading."""
-    if result.heading.tc_available.any():
+    the message says so rather than blame the heading. A recording without GNSS has no heading
+    to require."""
+    if result.heading is None or result.heading.tc_available.any():
         return
     kept = f"(the other results are in {out})"
     still = standstill(result)

@@ -293,14 +293,17 @@ def worst_reliable_tight_errors(
 
 
 def headline(
-    errors: dict[str, PipelineErrors], used_fraction: float, truth_unused: bool = False
+    errors: dict[str, PipelineErrors], used_fraction: float | None, truth_unused: bool = False
 ) -> str:
     """The result in one sentence: how much the tightly coupled heading changed the VO's error
     per 100 m, or the wheel + gyro dead reckoning's without a camera (or, without ground truth
-    or with one that could not be used (``truth_unused``), how often it was used)."""
+    or with one that could not be used (``truth_unused``), how often it was used;
+    ``used_fraction`` None: the recording had no GNSS)."""
     used = (
         f"The tightly coupled heading was used by the correction at {used_fraction:.0%} of the "
         "GNSS epochs."
+        if used_fraction is not None
+        else "No GNSS: only the VO and the dead reckoning ran, the GNSS pipelines were not run."
     )
     if truth_unused:
         return (
@@ -358,7 +361,7 @@ class RunReport:
     """Trajectories as written (and the ground truth under ``"truth"``), ENU metres."""
     enu: EnuFrame
     heading_figure: str
-    """Data URI of the GNSS heading figure."""
+    """Data URI of the GNSS heading figure ("" without GNSS: the section is left out)."""
     errors: dict[str, PipelineErrors] = field(default_factory=dict)
     absolute: dict[str, AbsolutePositionErrors] = field(default_factory=dict)
     """Per pipeline, its position as written against the ground truth."""
@@ -519,15 +522,16 @@ def render(report: RunReport) -> str:
             "<h2>Heading error over time</h2>",
             f"<img alt='heading error of each pipeline' src='{report.heading_error_figure}'>",
         ]
-    parts += [
-        "<h2>GNSS headings</h2>",
-        "<p class='note'>Satellites per epoch; when the conventional and the tightly coupled "
-        "heading were available and when the tightly coupled one was used; the headings as "
-        "course (clockwise from north, unwrapped: no jump at 0/360°) with the tightly coupled "
-        "heading's ±2σ band; with ground truth, their errors.</p>",
-        f"<img alt='GNSS heading figure' src='{report.heading_figure}'>",
-    ]
-    if report.errors:
+    if report.heading_figure:  # empty without GNSS
+        parts += [
+            "<h2>GNSS headings</h2>",
+            "<p class='note'>Satellites per epoch; when the conventional and the tightly coupled "
+            "heading were available and when the tightly coupled one was used; the headings as "
+            "course (clockwise from north, unwrapped: no jump at 0/360°) with the tightly coupled "
+            "heading's ±2σ band; with ground truth, their errors.</p>",
+            f"<img alt='GNSS heading figure' src='{report.heading_figure}'>",
+        ]
+    if report.errors and report.heading_figure:
         parts += [
             "<h2>Largest tightly coupled heading errors on epochs flagged reliable</h2>",
             "<p class='note'>Largest error against ground truth first, at most one epoch per "
