@@ -42,7 +42,12 @@ from vo_doppler.fusion.correction import (
     tight_absolute_heading,
     usable_tight_heading,
 )
-from vo_doppler.geo import EnuFrame, wrap_angle
+from vo_doppler.fusion.placement import (  # noqa: F401 (INITIAL_HEADING_SPAN_S, yaw_offset: API)
+    INITIAL_HEADING_SPAN_S,
+    initial_yaw_offset,
+    yaw_offset,
+)
+from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import GnssVelocityResult, check_elevation_mask, gnss_velocity
 from vo_doppler.gnss.receiver_track import smoothed_track
 from vo_doppler.gnss.spp import EARTH_SURFACE_M, nearest_time
@@ -62,10 +67,6 @@ if TYPE_CHECKING:
     from vo_doppler.vo.batch import VoOutput
 
 log = logging.getLogger(__name__)
-
-INITIAL_HEADING_SPAN_S = 5.0
-"""Seconds of absolute headings, from the first, whose median starts every trajectory."""
-
 
 class Pipeline(StrEnum):
     """The trajectories of a run (their values are the file and summary keys)."""
@@ -222,45 +223,6 @@ def level_with_yaw(
     carried += out[nearest, :3, :3] @ np.asarray(lever_arm_m, dtype=float)
     out[:, :3, 3] += np.median(antenna.position[rows] - carried, axis=0)
     return Trajectory.from_matrices(t, out)
-
-
-def yaw_offset(trajectory: Trajectory, t: np.ndarray, yaw: np.ndarray) -> float:
-    """Circular median of the absolute headings ``yaw`` minus the trajectory's yaw at ``t``:
-    the rotation about z that best turns the trajectory into the absolute headings."""
-    differences = wrap_angle(yaw - trajectory.yaw_at(t))
-    return float(differences[0] + np.median(wrap_angle(differences - differences[0])))
-
-
-def initial_yaw_offset(
-    table: HeadingTable,
-    tc_usable: np.ndarray,
-    trajectory: Trajectory,
-    span_s: float = INITIAL_HEADING_SPAN_S,
-) -> float:
-    """Rotation about z that starts a trajectory with the absolute heading.
-
-    The circular median of (absolute heading − trajectory yaw) over the usable tightly coupled
-    headings of the ``span_s`` seconds from the first one inside the trajectory's time span, so
-    that one heading that is off cannot turn the whole trajectory; without any, the conventional
-    headings the same way; without those, the reliable tightly coupled headings too vague to
-    correct (a canyon from the start: two satellites, an uncalibrated wheel scale); without
-    those, the trajectory starts facing east (with a warning).
-    """
-    inside = (table.t >= trajectory.t[0]) & (table.t <= trajectory.t[-1])
-    for yaw, valid in (
-        (table.yaw_tc, tc_usable),
-        (table.yaw_conv, table.conv_valid),
-        (table.yaw_tc, table.tc_available & table.tc_reliable),
-    ):
-        rows = np.flatnonzero(valid & inside & np.isfinite(yaw))
-        if rows.size:
-            rows = rows[table.t[rows] <= table.t[rows[0]] + span_s]
-            return yaw_offset(trajectory, table.t[rows], yaw[rows])
-    log.warning(
-        "no absolute heading during the %.0f s of a trajectory: it starts facing east",
-        trajectory.t[-1] - trajectory.t[0],
-    )
-    return float(-trajectory.yaw()[0])
 
 
 def correct_all(

@@ -10,9 +10,15 @@ import pytest
 
 from tests.helpers.heading_table import plain_heading_table
 from tests.helpers.level_track import level_turn
+from vo_doppler import run as run_module
 from vo_doppler.cli import main
+from vo_doppler.commands import correct_command
+from vo_doppler.fusion.placement import initial_yaw_offset, turned_about_start
+from vo_doppler.geo import wrap_angle
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.trajectory import read_tum, write_kitti, write_tum
+from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD
+from vo_doppler.vo.frames import camera_trajectory
 
 
 @pytest.fixture
@@ -68,3 +74,43 @@ def test_a_level_track_read_as_first_camera_is_warned_and_kept(
     else:
         assert summary["warnings"] == []
         assert abs(summary["final_correction_deg"]) < 0.1
+
+
+@pytest.mark.parametrize(
+    ("correction", "metres", "degrees"), [("window", 1e-6, 1e-6), ("kalman", 0.02, 0.06)]
+)
+def test_poses_before_the_first_absolute_heading_start_with_it(
+    tmp_path, correction, metres, degrees, capsys
+):
+    """Issue 30: the window method left the poses before the first absolute heading in the
+    VO's own frame (a drive starting east instead of north). `correct` now starts the
+    trajectory as `run` does (:func:`vo_doppler.fusion.placement.initial_yaw_offset`): the
+    VO below (camera poses in a level world), the level track turned 0.7 rad clockwise, with
+    headings from 2 s on only, starts as the track (the window method exactly, the Kalman blend
+    within its smoothing of the corner) and ends heading as it does."""
+    track = level_turn()
+    vo = turned_about_start(track, -0.7)
+    write_tum(tmp_path / "vo.tum", camera_trajectory(vo, CAMERA_TO_VEHICLE_FORWARD))
+    t = np.arange(0.0, track.t[-1] + 0.05, 0.2)
+    yaw = np.interp(t, track.t, np.unwrap(track.yaw()))
+    yaw[t < 2.0] = np.nan
+    table = plain_heading_table(t, yaw_tc=yaw, yaw_conv=yaw, conv_valid=np.isfinite(yaw))
+    write_heading_csv(tmp_path / "heading.csv", table)
+    argv = ["correct", str(tmp_path / "vo.tum"), "--heading", str(tmp_path / "heading.csv")]
+    argv += ["--world", "level", "--correction", correction, "-o", str(tmp_path / "c.tum")]
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["initial_turn_deg"] == pytest.approx(np.degrees(0.7), abs=1e-6)
+    assert summary["final_correction_deg"] == pytest.approx(np.degrees(0.7), abs=degrees)
+    corrected = read_tum(tmp_path / "c.tum")
+    before = track.t < 2.0
+    np.testing.assert_allclose(corrected.positions[before], track.positions[before], atol=metres)
+    yaw_error = np.degrees(wrap_angle(corrected.yaw() - track.yaw()))
+    np.testing.assert_allclose(yaw_error[before], 0.0, atol=degrees)
+    assert abs(yaw_error[-1]) < degrees
+
+
+def test_correct_and_run_start_a_trajectory_by_one_rule():
+    """`run` imports the same function (no second copy to drift apart)."""
+    assert run_module.initial_yaw_offset is initial_yaw_offset
+    assert correct_command.initial_yaw_offset is initial_yaw_offset

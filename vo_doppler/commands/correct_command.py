@@ -17,7 +17,10 @@ from vo_doppler.fusion.correction import (
     HEADING_SOURCES,
     absolute_heading,
     correct,
+    usable_tight_heading,
 )
+from vo_doppler.fusion.placement import initial_yaw_offset, turned_about_start
+from vo_doppler.geo import wrap_angle
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.trajectory import (
@@ -52,8 +55,9 @@ def register(subparsers, summary: str) -> None:
         "absolute headings: by the window method (shift to the window's absolute heading and "
         "rotate the positions about the window's oldest position, [TK18] Eq. 11-13) or by "
         "the Kalman blend (a filter and smoother on the VO heading offset whose noise is fitted "
-        "to the drive). Output: vehicle (or camera) poses in an ENU-aligned frame with its "
-        "origin at the first position.",
+        "to the drive). The trajectory is first turned to the absolute headings of its first "
+        "seconds, as `run` starts every trajectory. Output: vehicle (or camera) poses in an "
+        "ENU-aligned frame with its origin at the first position.",
     )
     parser.add_argument("trajectory", help="VO trajectory, TUM or KITTI (camera poses)")
     parser.add_argument("--heading", required=True, help="heading.csv from `vo-doppler heading`")
@@ -178,6 +182,11 @@ def run(args: argparse.Namespace) -> int:
     warnings = world_warnings(vehicle, args.world)
     for text in warnings:
         log.warning("%s", text)
+    # The starting heading as `run` sets it: before its first absolute heading (and through
+    # the window method's first window) the trajectory would stay in the VO's own frame.
+    usable = usable_tight_heading(table, config.tc_max_sigma)
+    start_turn = initial_yaw_offset(table, usable, vehicle, source=args.source)
+    vehicle = turned_about_start(vehicle, start_turn)
     result = correct(vehicle, absolute_heading(table, args.source, config), config)
     if not result.has_absolute.any():
         raise InputError(
@@ -195,7 +204,8 @@ def run(args: argparse.Namespace) -> int:
     summary = {
         "poses": len(out),
         "poses_with_absolute_heading": int(result.has_absolute.sum()),
-        "final_correction_deg": float(np.degrees(result.correction[-1])),
+        "initial_turn_deg": float(np.degrees(start_turn)),
+        "final_correction_deg": float(np.degrees(wrap_angle(start_turn + result.correction[-1]))),
         "correction": args.correction,
         "output": str(output),
         "warnings": warnings,

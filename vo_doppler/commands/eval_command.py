@@ -68,7 +68,7 @@ class EvalParser(OptionsParser):
     def parse_known_args(self, args: Sequence[str] | None = None, namespace=None):
         words = sys.argv[1:] if args is None else list(args)
         if words and words[0] == GNSS_MODE:
-            return self.gnss_parser.parse_known_args(words[1:], namespace)
+            return self.gnss_parser.parse_args(words[1:], namespace), []  # its own usage
         return super().parse_known_args(words, namespace)
 
 
