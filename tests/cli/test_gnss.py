@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import csv
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tests.conftest import require_shared
+from tests.conftest import REPO_ROOT, require_shared
+from tests.helpers.precise_text import clock_text, sp3_text
 from tests.helpers.rinex_text import field, rinex3_epoch, rinex3_header
 from vo_doppler.cli import main
 from vo_doppler.io.gnss_csv import SPP_COLUMNS, VELOCITY_COLUMNS
+from vo_doppler.model.gpstime import calendar_to_gps_seconds
 
 
 def _read(path):
@@ -89,3 +93,133 @@ def test_systems_or_bands_without_doppler_in_the_file_name_what_it_has(tmp_path,
         err = capsys.readouterr().err
         assert "gps.obs: the file has no Doppler of the systems" in err
         assert err.strip().endswith("its Doppler observables: G D1C")
+
+
+SAMPLE_GNSS = REPO_ROOT / "sample_sequences" / "urban_canyon_small" / "gnss"
+
+
+def _without_doppler(tmp_path):
+    """The u-blox walk (RINEX 2.10, C1 L1 S1 D1) without its Doppler column: C1 L1 S1."""
+    lines = require_shared("yamatogawa_ublox_walk/yamatogawa_rover.obs").read_text().splitlines()
+    end = next(k for k, line in enumerate(lines) if "END OF HEADER" in line)
+    header = [
+        line.replace("     4    C1    L1    S1    D1", "     3    C1    L1    S1      ")
+        for line in lines[: end + 1]
+    ]
+    body = [
+        line if re.match(r"^ \d\d [ \d]\d [ \d]\d [ \d]\d [ \d]\d [ \d]\d\.\d", line) else line[:48]
+        for line in lines[end + 1 :]
+    ]
+    obs = tmp_path / "no_doppler.10o"
+    obs.write_text("\n".join(header + body) + "\n")
+    return obs
+
+
+@pytest.mark.shared_data
+def test_a_file_without_doppler_is_solved_from_its_carrier_phase(tmp_path, capsys):
+    """A RINEX 2 with carrier phase but no Doppler: the refusal names --range-rate phase, and
+    --range-rate phase solves it (it was refused 'no Doppler' in phase mode too)."""
+    obs = _without_doppler(tmp_path)
+    nav = require_shared("yamatogawa_ublox_walk/brdc0060.10n")
+    out = tmp_path / "vel.csv"
+    argv = ["gnss", "velocity", str(obs), "--nav", str(nav), "--systems", "G", "-o", str(out)]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert "no Doppler of the systems 'G'" in err and "--range-rate phase" in err and "L1" in err
+    assert not out.exists()
+    assert main([*argv, "--range-rate", "phase"]) == 0
+    header, rows = _read(out)
+    assert sum(int(row[header.index("valid")]) for row in rows) > 100
+
+
+def _wrong_day_nav(tmp_path):
+    """The sample's navigation file with every record moved from 2025-03-14 to 2021-01-01."""
+    text = (SAMPLE_GNSS / "brdc.nav").read_text()
+    nav = tmp_path / "wrong_day.nav"
+    nav.write_text(re.sub(r"(?m)^([A-Z]\d\d) 2025 03 14", r"\1 2021 01 01", text))
+    return nav
+
+
+@pytest.mark.parametrize("action", ["velocity", "spp"])
+def test_navigation_of_another_day_is_one_error_and_writes_nothing(
+    tmp_path, capsys, caplog, action
+):
+    """One error naming both date spans and the file, not one 'no healthy ephemeris' line per
+    satellite and 'no epoch could be solved'; the CSV and the PNG are not written, and an
+    earlier run's files stay as they were."""
+    nav = _wrong_day_nav(tmp_path)
+    out = tmp_path / "out.csv"
+    out.write_text("earlier run\n")
+    argv = ["gnss", action, str(SAMPLE_GNSS / "rover.obs"), "--nav", str(nav), "-o", str(out)]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert "wrong_day.nav: ephemerides valid 2020-12-31 22:00:00 to 2021-01-01" in err
+    assert "rover.obs run 2025-03-14 02:10:00 to 2025-03-14 02:10:38 GPS time" in err
+    assert "no ephemeris at any observation epoch" in err
+    assert "no healthy ephemeris" not in caplog.text
+    assert out.read_text() == "earlier run\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv", "wrong_day.nav"]
+
+
+def test_a_run_that_solves_no_epoch_leaves_no_output(tmp_path, capsys):
+    """Exit 1 with every epoch invalid (here the elevation mask removes every satellite):
+    neither vel.csv nor vel.png of that run is left (they were written, every row invalid)."""
+    out = tmp_path / "vel.csv"
+    argv = ["gnss", "velocity", str(SAMPLE_GNSS / "rover.obs"), "--nav"]
+    argv += [str(SAMPLE_GNSS / "brdc.nav"), "--elev-mask", "89.9", "-o", str(out)]
+    assert main(argv) == 1
+    assert "nothing written" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def _orbit_file(tmp_path, name: str, start: float, n: int) -> Path:
+    t = start + 900.0 * np.arange(n)
+    path = tmp_path / name
+    path.write_text(sp3_text(t, ["G10", "G29"], np.full((n, 2, 3), 1.5e7), np.zeros((n, 2))))
+    return path
+
+
+SAMPLE_T0 = float(calendar_to_gps_seconds(2025, 3, 14, 2, 10, 0))
+
+
+def test_precise_orbits_or_clocks_of_another_time_are_named(tmp_path, capsys, caplog):
+    """Orbits or a clock file that cover no observation epoch: one error naming both spans
+    and the file; a clock file covering part of them: a warning naming both spans."""
+    obs = str(SAMPLE_GNSS / "rover.obs")
+    out = str(tmp_path / "vel.csv")
+    day_before = _orbit_file(tmp_path, "before.sp3", SAMPLE_T0 - 86400.0, 8)
+    assert main(["gnss", "velocity", obs, "--orbits", str(day_before), "-o", out]) == 1
+    err = capsys.readouterr().err
+    assert "the precise orbits " in err and "before.sp3: epochs 2025-03-13 02:10:00" in err
+    assert "no orbit at any observation epoch" in err
+    orbits = _orbit_file(tmp_path, "around.sp3", SAMPLE_T0 - 1800.0, 5)
+    clocks = tmp_path / "late.clk"
+    late = SAMPLE_T0 + 3600.0 + 30.0 * np.arange(3)
+    clocks.write_text(clock_text(late, ["G10", "G29"], np.zeros((3, 2))))
+    argv = ["gnss", "velocity", obs, "--orbits", str(orbits), "--clocks", str(clocks)]
+    assert main([*argv, "-o", out]) == 1
+    err = capsys.readouterr().err
+    assert "the clock file " in err and "late.clk: epochs 2025-03-14 03:10:00" in err
+    assert "2025-03-14 02:10:38 GPS time: no clock at any observation epoch" in err
+    half = tmp_path / "half.clk"
+    clock_t = SAMPLE_T0 - 60.0 + 30.0 * np.arange(4)  # to 02:10:30, the last 8 s uncovered
+    half.write_text(clock_text(clock_t, ["G10", "G29"], np.zeros((4, 2))))
+    main(["gnss", "velocity", obs, "--orbits", str(orbits), "--clocks", str(half), "-o", out])
+    assert "half.clk: epochs 2025-03-14 02:09:00 to 2025-03-14 02:10:30" in caplog.text
+    assert "of the 761 observation epochs (the first at 2025-03-14 02:10:30) have no clock" in (
+        caplog.text
+    )
+
+
+def test_glonass_rows_without_a_frequency_channel_are_said_once(tmp_path, caplog):
+    """GLONASS Doppler without a channel (no GLONASS SLOT / FRQ # entry, no GLONASS record in
+    the navigation file): one warning with the count and the satellites (they were dropped
+    without a word)."""
+    text = (SAMPLE_GNSS / "rover.obs").read_text()
+    obs = tmp_path / "glonass.obs"
+    obs.write_text(re.sub(r"(?m)^E(\d\d)", r"R\1", text.replace("E    3 C1C", "R    3 C1C")))
+    out = tmp_path / "vel.csv"
+    main(["gnss", "velocity", str(obs), "--nav", str(SAMPLE_GNSS / "brdc.nav"), "-o", str(out)])
+    said = [r.getMessage() for r in caplog.records if r.getMessage().startswith("GLONASS:")]
+    assert len(said) == 1
+    assert said[0].startswith("GLONASS: 1606 Doppler rows of R02, R03, R04, R10, R19, R21 dropped")

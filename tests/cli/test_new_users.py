@@ -137,5 +137,8 @@ def test_gnss_without_a_valid_epoch_is_exit_1(action, tmp_path, capsys):
     fails_naming(
         ["gnss", action, str(OBS), "--nav", str(nav), "-o", str(tmp_path / "g.csv")],
         capsys,
-        "no epoch could be solved",
+        "the navigation file",
+        "empty.nav: no ephemeris of the systems 'GREJC'",
+        "rover.obs run 2025-03-14 02:10:00",
     )
+    assert not (tmp_path / "g.csv").exists()
