@@ -215,3 +215,23 @@ def test_hong_kong_truth_against_its_own_velocity_turned_two_degrees(tmp_path):
     assert course["median"] == pytest.approx(2.0, abs=0.01)
     assert course["max"] == pytest.approx(2.0, abs=0.01)
     assert figures["speed_error_mps"]["max"] < 0.01
+
+
+def test_every_gnss_option_has_help_and_its_default():
+    from tests.cli.test_help import _options
+    from vo_doppler.commands.eval_command import gnss_parser
+    from vo_doppler.commands.help_format import has_default, shown_default
+
+    parser = gnss_parser("vo-doppler eval gnss")
+    for action in _options(parser):
+        assert action.help, action.option_strings
+        rendered = parser._get_formatter()._expand_help(action)
+        if has_default(action):
+            assert rendered.count(f"(default: {shown_default(action.default)})") == 1
+
+
+def test_the_json_may_not_replace_an_input(files, capsys):
+    args = ["eval", "gnss", "--truth", str(files["truth"]), "--vel", str(files["vel"])]
+    assert main([*args, "--json", str(files["vel"])]) == EXIT_FAILURE
+    assert "would destroy the input" in capsys.readouterr().err
+    assert files["vel"].read_text().startswith("gps_time_s,")
