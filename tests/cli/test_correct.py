@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from tests.helpers.heading_table import plain_heading_table
 from tests.helpers.level_track import level_turn
@@ -18,6 +19,7 @@ from vo_doppler.geo import wrap_angle
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.trajectory import read_tum, write_kitti, write_tum
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.vo.frames import camera_trajectory
 
 
@@ -114,3 +116,41 @@ def test_correct_and_run_start_a_trajectory_by_one_rule():
     """`run` imports the same function (no second copy to drift apart)."""
     assert run_module.initial_yaw_offset is initial_yaw_offset
     assert correct_command.initial_yaw_offset is initial_yaw_offset
+
+
+@pytest.fixture
+def kitti_drive(tmp_path):
+    """80 s of a straight drive east, 801 camera poses at 10 Hz as KITTI (no times) with its
+    times.txt, and 10-Hz headings on the same image clock (0..80 s)."""
+    t = 0.1 * np.arange(801)
+    track = Trajectory(t, np.column_stack([t * 10.0, 0 * t, 0 * t]), Rotation.identity(len(t)))
+    write_kitti(tmp_path / "vo.kitti", camera_trajectory(track, CAMERA_TO_VEHICLE_FORWARD))
+    np.savetxt(tmp_path / "times.txt", t)
+    write_heading_csv(tmp_path / "heading.csv", plain_heading_table(t))
+    return tmp_path
+
+
+def test_a_kitti_trajectory_without_its_times_is_refused_naming_times(kitti_drive, capsys):
+    """Issue 30: its frame numbers 0..800 overlap the headings' 0..80 s; it exited 0 with a
+    tenth of the poses corrected. Now exit 1 naming --times, and nothing written."""
+    argv = ["correct", str(kitti_drive / "vo.kitti"), "--heading", str(kitti_drive / "heading.csv")]
+    assert main([*argv, "-o", str(kitti_drive / "c.tum")]) == 1
+    err = capsys.readouterr().err
+    assert "meet over 10% of the trajectory" in err and "they are frame numbers" in err
+    assert "pass --times with the images' times.txt" in err and "vo.kitti" in err
+    assert not (kitti_drive / "c.tum").exists()
+    argv += ["--times", str(kitti_drive / "times.txt"), "-o", str(kitti_drive / "c.tum")]
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["poses_with_absolute_heading"] == 801
+    assert summary["warnings"] == []
+
+
+def test_headings_covering_part_of_the_trajectory_are_warned(kitti_drive, capsys, caplog):
+    times = kitti_drive / "times.txt"
+    argv = ["correct", str(kitti_drive / "vo.kitti"), "--heading", str(kitti_drive / "heading.csv")]
+    argv += ["--times", str(times), "--time-offset", "56", "-o", str(kitti_drive / "c.tum")]
+    assert main(argv) == 0
+    [warning] = json.loads(capsys.readouterr().out.strip().splitlines()[-1])["warnings"]
+    assert "meet over 30% of the trajectory only" in warning and "--time-offset" in warning
+    assert warning in caplog.text

@@ -34,7 +34,7 @@ from vo_doppler.io.trajectory import (
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.json_text import json_text
-from vo_doppler.time_hints import frame_index_hint, offset_hint, span
+from vo_doppler.time_hints import FRAME_NUMBER_FIX, time_base_check
 from vo_doppler.vo.frames import (
     MAX_ROAD_CLIMB,
     WORLDS,
@@ -68,7 +68,11 @@ def register(subparsers, summary: str) -> None:
         default="auto",
         help=f"trajectory file format (auto: {AUTO_FORMAT_RULE}; the extension is not used)",
     )
-    parser.add_argument("--times", help="timestamps file for a KITTI trajectory (one per line)")
+    parser.add_argument(
+        "--times",
+        help="timestamps file for a KITTI trajectory (one per line; without it the poses' times "
+        "are frame numbers 0, 1, 2, ..., refused unless the heading epochs cover them)",
+    )
     parser.add_argument(
         "--time-offset",
         type=finite_float,
@@ -134,6 +138,19 @@ def _times(path: str | None) -> np.ndarray | None:
         raise InputError(f"cannot read times: {exc}", path) from exc
 
 
+def _frame_number_fix(args: argparse.Namespace) -> str:
+    """What gives a trajectory whose times are frame numbers its times, by where they came
+    from: a KITTI file read without ``--times``, a ``--times`` file, or a TUM file's column."""
+    if args.times is not None:
+        return f"{args.times} holds frame numbers, not the images' times: give the times file"
+    if trajectory_format(args.trajectory, args.format) == "kitti":
+        return FRAME_NUMBER_FIX
+    return (
+        "a TUM trajectory keeps its own times: write the images' times in its first column "
+        "(or give the poses as KITTI with --times)"
+    )
+
+
 OTHER_WORLD = {
     "first_camera": "already level, z up (e.g. ENU, as run's trajectory_*.tum): give --world level",
     "level": "camera poses in the first camera's frame (what VO systems write): give --world "
@@ -165,21 +182,21 @@ def run(args: argparse.Namespace) -> int:
     extrinsic = (
         read_camera(args.calib).T_vehicle_camera if args.calib else CAMERA_TO_VEHICLE_FORWARD
     )
-    overlap = (trajectory.t[-1] >= table.t[0]) and (trajectory.t[0] <= table.t[-1])
-    if len(trajectory) == 0 or not overlap:
-        hint = frame_index_hint(trajectory.t - args.time_offset) or (
-            "; " + offset_hint(float(trajectory.t[0]), float(table.t[0]), "--time-offset")
-            if len(trajectory) and len(table)
-            else ""
-        )
-        raise InputError(
-            f"the trajectory's times ({span(trajectory.t)}) do not overlap the heading epochs "
-            f"({span(table.t)}, GPS time){hint}",
-            args.trajectory,
-        )
+    time_base = time_base_check(
+        trajectory.t,
+        table.t,
+        "trajectory",
+        "heading epochs",
+        "--time-offset",
+        _frame_number_fix(args),
+    )
+    if time_base.error:
+        raise InputError(time_base.error, args.trajectory)
     config = correction_config(args, max_gap_s=args.max_gap_s)
     vehicle = vehicle_trajectory(trajectory, extrinsic, args.world)
-    warnings = world_warnings(vehicle, args.world)
+    warnings = ([time_base.warning] if time_base.warning else []) + world_warnings(
+        vehicle, args.world
+    )
     for text in warnings:
         log.warning("%s", text)
     # The starting heading as `run` sets it: before its first absolute heading (and through
