@@ -154,3 +154,88 @@ def test_headings_covering_part_of_the_trajectory_are_warned(kitti_drive, capsys
     [warning] = json.loads(capsys.readouterr().out.strip().splitlines()[-1])["warnings"]
     assert "meet over 30% of the trajectory only" in warning and "--time-offset" in warning
     assert warning in caplog.text
+
+
+def _own_headings(t: np.ndarray, yaw: np.ndarray, seed: int = 3):
+    """Course (deg, 4 decimals as heading.csv writes it), σ (deg) and validity of a heading
+    from elsewhere: 0.5° of noise, σ between 0.3° and 1.5°, every seventh epoch invalid."""
+    rng = np.random.default_rng(seed)
+    course = np.round(np.degrees(np.pi / 2 - yaw) + 0.5 * rng.standard_normal(len(t)), 4) % 360
+    sigma = np.round(rng.uniform(0.3, 1.5, len(t)), 4)
+    valid = np.arange(len(t)) % 7 != 3
+    return course, sigma, valid
+
+
+@pytest.mark.parametrize("correction", ["kalman", "window"])
+@pytest.mark.parametrize("source", ["tc+conv", "conv"])
+def test_a_minimal_heading_csv_gives_what_the_full_heading_csv_gives(
+    drive, correction, source, capsys
+):
+    """Issue 31: your own heading as gps_time_s, course_deg (or heading_deg), sigma_deg and
+    valid gives the very file and summary of a heading.csv holding the same headings as its
+    conventional heading (no tight heading)."""
+    track = level_turn()
+    t = np.arange(0.0, track.t[-1] + 0.05, 0.2)
+    course, sigma, valid = _own_headings(t, np.interp(t, track.t, np.unwrap(track.yaw())))
+    yaw = np.where(valid, np.pi / 2 - np.radians(course), np.nan)
+    sigma_rad = np.where(valid, np.radians(sigma), np.nan)
+    full = plain_heading_table(
+        t,
+        yaw_tc=np.full(len(t), np.nan),
+        sigma_tc=np.full(len(t), np.nan),
+        tc_reliable=np.zeros(len(t), bool),
+        yaw_conv=yaw,
+        conv_valid=valid,
+        sigma_conv=sigma_rad,
+        conv_gnss_valid=valid,
+        sigma_conv_gnss=sigma_rad,
+    )
+    write_heading_csv(drive / "full.csv", full)
+    rows = "".join(
+        f"{ti:.3f},{c:.4f},{s:.4f},{int(v)}\n"
+        for ti, c, s, v in zip(t, course, sigma, valid, strict=True)
+    )
+    (drive / "own.csv").write_text("gps_time_s,course_deg,sigma_deg,valid\n" + rows)
+    (drive / "own_heading.csv").write_text("gps_time_s,heading_deg,sigma_deg,valid\n" + rows)
+    summaries = {}
+    for name in ("full", "own", "own_heading"):
+        argv = ["correct", str(drive / "track.tum"), "--heading", str(drive / f"{name}.csv")]
+        argv += ["--world", "level", "--correction", correction, "--source", source]
+        assert main([*argv, "-o", str(drive / f"{name}.tum")]) == 0
+        summaries[name] = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+        del summaries[name]["output"]
+    assert summaries["own"] == summaries["full"] == summaries["own_heading"]
+    assert summaries["own"]["poses_with_absolute_heading"] > 0.9 * len(track)
+    written = (drive / "full.tum").read_bytes()
+    assert (drive / "own.tum").read_bytes() == written
+    assert (drive / "own_heading.tum").read_bytes() == written
+
+
+def test_a_minimal_heading_csv_has_no_tight_heading_for_source_tc(drive, capsys):
+    (drive / "own.csv").write_text("gps_time_s,course_deg,sigma_deg\n0.0,90,1\n5.0,90,1\n")
+    argv = ["correct", str(drive / "track.tum"), "--heading", str(drive / "own.csv")]
+    assert main([*argv, "--source", "tc", "-o", str(drive / "c.tum")]) == 1
+    err = capsys.readouterr().err
+    assert "own.csv: no usable tc heading within the trajectory's times" in err
+    assert "a minimal heading CSV is read as the conventional heading: give --source conv" in err
+
+
+@pytest.mark.parametrize(
+    ("text", "where", "message"),
+    [
+        ("gps_time_s,course_deg\n0,90\n", ":1:", "lacks column sigma_deg: expected a minimal"),
+        ("gps_time_s,heading\n0,90\n", ":1:", "heading_deg or course_deg"),
+        ("gps_time_s,course_deg,sigma_deg\n0,90,1\n1,east,1\n", ":3:", "course_deg 'east'"),
+        ("gps_time_s,course_deg,sigma_deg\n0,90,1\n1,90,0\n", ":3:", "sigma_deg '0' of a valid"),
+        ("gps_time_s,course_deg,sigma_deg,valid\n0,90,1,yes\n", ":2:", "valid 'yes' is not 0"),
+    ],
+)
+def test_a_bad_minimal_heading_csv_names_its_file_line_and_columns(
+    drive, text, where, message, capsys
+):
+    (drive / "own.csv").write_text(text)
+    argv = ["correct", str(drive / "track.tum"), "--heading", str(drive / "own.csv")]
+    assert main([*argv, "-o", str(drive / "c.tum")]) == 1
+    err = capsys.readouterr().err
+    assert f"own.csv{where}" in err and message in err
+    assert "sigma_deg" in err and "gps_time_s" in err

@@ -1,7 +1,9 @@
 """heading.csv: the conventional velocity's speed σ and HDOP written and read back; files
-without those columns read as NaN."""
+without those columns read as NaN; the minimal heading CSV (your own heading) and its errors."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -92,3 +94,65 @@ def test_a_header_without_rows_is_an_input_error(tmp_path):
     path.write_text(path.read_text().splitlines()[0] + "\n")
     with pytest.raises(InputError, match=r"heading\.csv: heading CSV has its header but no rows"):
         read_heading_csv(path)
+
+
+def test_a_minimal_heading_csv_reads_as_the_conventional_heading(tmp_path):
+    path = tmp_path / "own.csv"
+    path.write_text(
+        "gps_time_s,pitch_deg,course_deg,sigma_deg\n"
+        "1.2e9,1,90,0.5\n"  # east: yaw 0
+        "1200000001.0,1,,\n"  # no heading: not valid, σ may be empty
+        "1200000002.0,1,-90,2\n"  # west
+        "1200000003.0,1,nan,nan\n"
+    )
+    table = read_heading_csv(path)
+    np.testing.assert_array_equal(table.t, 1.2e9 + np.arange(4.0))
+    np.testing.assert_allclose(table.yaw_conv, [0.0, np.nan, -np.pi, np.nan], atol=1e-15)
+    np.testing.assert_array_equal(table.conv_valid, [True, False, True, False])
+    valid, sigma = table.published_conventional
+    np.testing.assert_array_equal(valid, table.conv_valid)
+    np.testing.assert_allclose(sigma, np.radians([0.5, np.nan, 2.0, np.nan]))
+    np.testing.assert_allclose(table.sigma_conv, sigma)
+    assert not table.tc_available.any() and not table.tc_reliable.any()
+    assert np.isnan(table.wheel_scale).all() and np.isnan(table.gyro_bias).all()
+
+
+def test_a_minimal_heading_csv_valid_column_is_honoured(tmp_path):
+    path = tmp_path / "own.csv"
+    path.write_text("gps_time_s,heading_deg,sigma_deg,valid\n0,0,1,1\n1,0,1,0\n2,0,-1,0\n")
+    table = read_heading_csv(path)
+    np.testing.assert_array_equal(table.conv_valid, [True, False, False])
+    np.testing.assert_allclose(table.yaw_conv, [np.pi / 2, np.nan, np.nan])
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "message"),
+    [
+        ("gps_time_s,course_deg,heading_deg,sigma_deg\n0,1,2,3\n", 1, "both heading_deg and"),
+        ("gps_time_s,course_deg,sigma_deg\n0,90,1\n0,90,1\n", 3, "is not after the previous"),
+        ("gps_time_s,course_deg,sigma_deg\n0,90,1\n1,1e9,1\n", 3, "is not a direction"),
+        ("gps_time_s,course_deg,sigma_deg\n0,90,1\n1,90,inf\n", 3, "is not a standard dev"),
+        ("gps_time_s,course_deg,sigma_deg\n0,90,1\n1,90\n", 3, "row has 2 fields, the header 3"),
+        ("gps_time_s,course_deg,sigma_deg\n", None, "header but no rows"),
+        ("t,course_deg,sigma_deg\n0,1,1\n", 1, "or a minimal heading CSV: gps_time_s"),
+    ],
+)
+def test_a_bad_minimal_heading_csv_is_named_by_line(tmp_path, text, line, message):
+    path = tmp_path / "own.csv"
+    path.write_text(text)
+    with pytest.raises(InputError, match=message) as error:
+        read_heading_csv(path)
+    assert error.value.path == path and error.value.line == line
+
+
+def test_the_minimal_heading_csv_of_docs_formats_reads(tmp_path):
+    """The example in docs/formats.md, "Your own absolute heading", is a readable file."""
+    text = (Path(__file__).parents[2] / "docs" / "formats.md").read_text()
+    section = text.split("## Your own absolute heading", 1)[1]
+    example = section.split("```\n", 2)[1]
+    path = tmp_path / "own.csv"
+    path.write_text(example)
+    table = read_heading_csv(path)
+    np.testing.assert_allclose(table.t, [1418912345.0, 1418912345.1])
+    np.testing.assert_allclose(table.yaw_conv, np.radians([90 - 87.25, 90 - 87.31]))
+    np.testing.assert_allclose(table.sigma_conv, np.radians(0.8))

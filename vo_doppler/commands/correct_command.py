@@ -60,7 +60,13 @@ def register(subparsers, summary: str) -> None:
         "ENU-aligned frame with its origin at the first position.",
     )
     parser.add_argument("trajectory", help="VO trajectory, TUM or KITTI (camera poses)")
-    parser.add_argument("--heading", required=True, help="heading.csv from `vo-doppler heading`")
+    parser.add_argument(
+        "--heading",
+        required=True,
+        help="heading.csv from `vo-doppler heading`, or your own absolute heading as a minimal "
+        "CSV: gps_time_s, heading_deg or course_deg, sigma_deg[, valid] (docs/formats.md; read "
+        "as the conventional heading)",
+    )
     parser.add_argument("--calib", help="camera calibration (YAML with T_vehicle_camera)")
     parser.add_argument(
         "--format",
@@ -208,7 +214,13 @@ def run(args: argparse.Namespace) -> int:
     if not result.has_absolute.any():
         raise InputError(
             f"no usable {args.source} heading within the trajectory's times: nothing to correct "
-            "it with (heading.csv's usable epochs, --source, --max-gap-s)",
+            "it with (heading.csv's usable epochs, --source, --max-gap-s"
+            + (
+                "; a minimal heading CSV is read as the conventional heading: give --source "
+                "conv or tc+conv)"
+                if args.source == "tc" and not table.tc_available.any()
+                else ")"
+            ),
             args.heading,
         )
     out = result.vehicle if args.body == "vehicle" else camera_trajectory(result.vehicle, extrinsic)

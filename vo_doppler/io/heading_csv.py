@@ -12,11 +12,21 @@ pipeline's input; ``conv_valid`` adds every integrity test). Unavailable heading
 ``nan``; flags as 0/1. Reading converts back to yaw (rad, counter-clockwise from east); the last
 eight columns are optional (files written before they existed read as zero, or NaN for the
 standard deviations and the DOP; without conv_gnss_valid the GNSS validity is conv_valid's).
+
+A minimal heading CSV, for an absolute heading from elsewhere (a dual-antenna receiver, an INS,
+another GNSS engine), has the columns gps_time_s, heading_deg or course_deg (degrees clockwise
+from north; empty or ``nan`` where unavailable), sigma_deg (its standard deviation, degrees)
+and optionally valid (0/1; without it every row with a heading is valid); other columns are
+ignored. It reads as a table whose conventional heading is that heading (single-epoch, valid
+and σ as given, for the conventional heading by the GNSS tests too) and which has no tightly
+coupled heading and no calibration (gyro bias and wheel scale NaN): ``correct`` uses it as it
+would a ``heading.csv`` with those conventional headings.
 """
 
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 
 import numpy as np
@@ -106,8 +116,15 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
         raise InputError("heading CSV is empty", path)
     header = [name.strip() for name in next(csv.reader([lines[0]]))]
     missing = [c for c in COLUMNS if c not in header]
+    if missing and "gps_time_s" in header and any(c in header for c in MINIMAL_HEADINGS):
+        return _read_minimal(path, lines, header)
     if missing:
-        raise InputError(f"heading CSV lacks columns {missing}", path, 1)
+        raise InputError(
+            f"heading CSV lacks columns {missing}: expected the heading.csv of "
+            f"`vo-doppler heading` ({', '.join(COLUMNS)}, ...) or {MINIMAL_FORMAT}",
+            path,
+            1,
+        )
     index = [header.index(c) for c in COLUMNS + OPTIONAL_COLUMNS if c in header]
     rows = []
     for number, line in enumerate(lines[1:], start=2):
@@ -180,3 +197,106 @@ def _window_s(column: np.ndarray | None, path: Path) -> float:
     if len(values) != 1 or not np.isfinite(values[0]) or values[0] <= 0:
         raise InputError(f"tc_window_s must be one positive value, found {values[:3]}", path)
     return float(values[0])
+
+
+MINIMAL_HEADINGS = ("heading_deg", "course_deg")
+"""The heading column of a minimal heading CSV: one of these (degrees clockwise from north)."""
+MINIMAL_FORMAT = (
+    "a minimal heading CSV: gps_time_s, heading_deg or course_deg (degrees clockwise from "
+    "north), sigma_deg (> 0, degrees) and optionally valid (0 or 1)"
+)
+MAX_HEADING_DEG = 360.0
+"""Headings beyond ±360° are not angles anyone writes (a corrupt row or another unit)."""
+MAX_SIGMA_DEG = 180.0
+"""A standard deviation beyond 180° says nothing about a direction."""
+
+
+def _read_minimal(path: Path, lines: list[str], header: list[str]) -> HeadingTable:
+    """A minimal heading CSV (module docstring) as a table whose conventional heading is the
+    file's; every bad row raises :class:`InputError` naming the line, the column and the
+    columns expected."""
+    names = [c for c in MINIMAL_HEADINGS if c in header]
+    if len(names) > 1:
+        raise InputError(
+            f"heading CSV has both {' and '.join(names)}: give one ({MINIMAL_FORMAT})", path, 1
+        )
+    if "sigma_deg" not in header:
+        raise InputError(f"heading CSV lacks column sigma_deg: expected {MINIMAL_FORMAT}", path, 1)
+    columns = ["gps_time_s", names[0], "sigma_deg"] + (["valid"] if "valid" in header else [])
+    index = [header.index(c) for c in columns]
+    rows: list[tuple[float, float, float, bool]] = []
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        fields = next(csv.reader([line]))
+        if len(fields) < len(header):
+            raise InputError(
+                f"heading CSV row has {len(fields)} fields, the header {len(header)} "
+                f"({', '.join(header)})",
+                path,
+                number,
+            )
+        values = dict(zip(columns, (fields[i].strip() for i in index), strict=True))
+        rows.append(_minimal_row(values, names[0], rows[-1][0] if rows else None, path, number))
+    if not rows:
+        raise InputError("heading CSV has its header but no rows", path)
+    t, degrees, sigma_deg, valid = (np.array(c) for c in zip(*rows, strict=True))
+    n = len(t)
+    yaw = np.where(valid, course_to_yaw(np.radians(np.where(valid, degrees, 0.0))), np.nan)
+    sigma = np.where(valid, np.radians(sigma_deg), np.nan)
+    return HeadingTable(
+        t=t,
+        yaw_tc=np.full(n, np.nan),
+        sigma_tc=np.full(n, np.nan),
+        tc_reliable=np.zeros(n, dtype=bool),
+        n_obs_window=np.zeros(n, dtype=int),
+        n_sat_epoch=np.zeros(n, dtype=int),
+        yaw_conv=yaw,
+        conv_valid=valid.copy(),
+        gyro_bias=np.full(n, np.nan),
+        wheel_scale=np.full(n, np.nan),
+        sigma_conv=sigma,
+        conv_gnss_valid=valid.copy(),
+        sigma_conv_gnss=sigma.copy(),
+    )
+
+
+def _minimal_row(
+    values: dict[str, str], heading: str, previous_t: float | None, path: Path, number: int
+) -> tuple[float, float, float, bool]:
+    """(time, heading in degrees, σ in degrees, valid) of one row of a minimal heading CSV."""
+
+    def number_of(column: str, text: str) -> float:
+        try:
+            return float(text) if text else math.nan
+        except ValueError:
+            raise InputError(
+                f"{column} {text!r} is not a number (expected {MINIMAL_FORMAT})", path, number
+            ) from None
+
+    t = number_of("gps_time_s", values["gps_time_s"])
+    if not math.isfinite(t):
+        raise InputError(f"gps_time_s {values['gps_time_s']!r} is not a time", path, number)
+    if previous_t is not None and t <= previous_t:
+        raise InputError(f"gps_time_s {t} is not after the previous row's", path, number)
+    degrees = number_of(heading, values[heading])
+    sigma = number_of("sigma_deg", values["sigma_deg"])
+    flag = values.get("valid", "1")
+    if flag not in ("0", "1"):
+        raise InputError(f"valid {flag!r} is not 0 or 1 (expected {MINIMAL_FORMAT})", path, number)
+    valid = flag == "1" and not math.isnan(degrees)
+    if math.isinf(degrees) or abs(degrees) > MAX_HEADING_DEG:
+        raise InputError(
+            f"{heading} {values[heading]!r} is not a direction in degrees (|value| <= "
+            f"{MAX_HEADING_DEG:g}; expected {MINIMAL_FORMAT})",
+            path,
+            number,
+        )
+    if valid and not 0.0 < sigma <= MAX_SIGMA_DEG:
+        raise InputError(
+            f"sigma_deg {values['sigma_deg']!r} of a valid heading is not a standard deviation "
+            f"in degrees (0 < sigma_deg <= {MAX_SIGMA_DEG:g}; expected {MINIMAL_FORMAT})",
+            path,
+            number,
+        )
+    return t, degrees, sigma, valid
