@@ -140,10 +140,12 @@ SIGN_SPEED_TOLERANCE = (0.5, 0.10)
 max(these) of the calibrated wheel speed, as the calibration's own gate. In a street canyon a
 velocity from four or five satellites can pass the GNSS tests and point the other way (a
 simulated canyon: 175° off for seconds after a turn, at half the wheel speed)."""
-SIGN_CONFIRM = (0.5, np.radians(5.0))
-"""s and rad: a conventional course counts only when the next or previous one, at most 0.5 s
+SIGN_CONFIRM = (1.5, np.radians(5.0))
+"""s and rad: a conventional course counts only when the next or previous one, at most 1.5 s
 away, turned from it by the amount the gyro turned, within 5° (sign aside): a lone reflected
-course (a simulated canyon: 62° off, seven satellites) has no such neighbour."""
+course (a simulated canyon: 62° off, seven satellites) has no such neighbour. 1.5 s admits the
+neighbour of a 1-Hz receiver (at 0.5 s no course of a 1-Hz recording was ever confirmed, and a
+negated yaw rate ran with exit 0); the gyro, not the time, carries the comparison."""
 SIGN_NOISE_FACTOR = 5.0
 """A turn's course change also exceeds this many σ of the two conventional headings."""
 SIGN_MAX_TURN_RATIO = 1.5
@@ -666,7 +668,7 @@ def heading_warnings(
     estimate and the warnings of :func:`calibration_warnings` and :func:`gyro_bias_warning`
     (the wheel scale and gyro bias only when calibrated, not fixed)."""
     source = source or VehicleSignalSource()
-    check_yaw_rate_sign(table, velocity, wheel_speed, yaw_rate, source)
+    sign = check_yaw_rate_sign(table, velocity, wheel_speed, yaw_rate, source)
     estimate, found = calibration_warnings(
         wheel_speed,
         velocity,
@@ -676,7 +678,24 @@ def heading_warnings(
         source.offset_name,
     )
     bias = gyro_bias_warning(float(table.gyro_bias[-1])) if bias_calibrated and len(table) else None
-    return estimate, found + ([bias] if bias else [])
+    undecided = sign_undecided_warning(sign, source)
+    return estimate, found + [w for w in (bias, undecided) if w]
+
+
+def sign_undecided_warning(
+    sign: YawRateSignAgreement, source: VehicleSignalSource | None = None
+) -> str | None:
+    """A warning when the yaw rate's sign could not be checked: fewer than
+    ``SIGN_MIN_TOTAL_TURN`` of confirmed turns (a straight drive, or conventional courses too
+    few or too scattered to confirm one another)."""
+    if sign.turn_rad >= SIGN_MIN_TOTAL_TURN:
+        return None
+    name = (source or VehicleSignalSource()).yaw_rate
+    return (
+        f"{name}: its sign could not be checked against the GNSS Doppler course "
+        f"({np.degrees(sign.turn_rad):.0f}° of confirmed turns, "
+        f"{np.degrees(SIGN_MIN_TOTAL_TURN):.0f}° needed)"
+    )
 
 
 def check_vehicle_overlap(

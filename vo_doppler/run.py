@@ -68,6 +68,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
+
 class Pipeline(StrEnum):
     """The trajectories of a run (their values are the file and summary keys)."""
 

@@ -14,7 +14,7 @@ import pytest
 from tests.heading.test_tight_heading import AZIMUTH, ELEVATION, T, sharp_turn, straight, turning
 from tests.heading.test_tight_heading import constant_speed as speed
 from vo_doppler.geo import wrap_angle
-from vo_doppler.heading.pipeline import heading_pipeline
+from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.tight_heading import TightHeadingConfig, tight_heading_series
 from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
 from vo_doppler.model.doppler import DopplerRows
@@ -22,6 +22,8 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.sim.doppler_rows import simulate_doppler
 
 NO_REJECTION = TightHeadingConfig(outlier_passes=0)
+SNOOPING = TightHeadingConfig(outlier_passes=4, max_window_s=2.0)
+"""Data snooping (an option since the robust fit became the default), on fixed windows."""
 
 
 def facade_excess_rate(scenario, facade_normal):
@@ -49,7 +51,7 @@ def with_bias(rows: DopplerRows, bias: np.ndarray) -> DopplerRows:
 
 def _solve(scenario, rows=None, config=None):
     rows = scenario.rows if rows is None else rows
-    config = config or TightHeadingConfig()
+    config = config or SNOOPING
     return tight_heading_series(rows, scenario.t_epoch, scenario.speed, scenario.yaw_angle, config)
 
 
@@ -85,7 +87,7 @@ def test_reflection_over_part_of_the_drive_is_rejected_window_by_window(yaw, tol
     reflected = (rows.sat_id == "G03") & (rows.t >= 2.5) & (rows.t < 4.0)
     bias = np.where(reflected, facade_excess_rate(scenario, FACADE_NORMAL), 0.0)
     result = _solve(scenario, with_bias(rows, bias))
-    window = TightHeadingConfig().window_s
+    window = SNOOPING.window_s
     in_window = np.array(
         [np.count_nonzero(reflected & (rows.t > t - window) & (rows.t <= t)) for t in T]
     )
@@ -156,11 +158,18 @@ def test_false_alarm_rate_is_near_the_nominal_level():
     A false alarm is seldom attributed clearly enough to reject a row (odds 100:1)."""
     scenario = _noisy_drive(200.0)
     alpha = 0.05
-    result = _solve(scenario, config=TightHeadingConfig(window_s=0.01, outlier_alpha=alpha))
+    result = _solve(
+        scenario,
+        config=TightHeadingConfig(
+            outlier_passes=4, window_s=0.01, max_window_s=0.01, outlier_alpha=alpha
+        ),
+    )
     alarms = np.mean(result.inconsistent | (result.n_rejected > 0))
     assert 0.6 * alpha / 2 < alarms < 1.4 * alpha / 2  # measured 0.0223 of 4000 windows
     assert np.mean(result.n_rejected > 0) < alpha / 10
-    default = _solve(scenario, config=TightHeadingConfig(window_s=0.01))
+    default = _solve(
+        scenario, config=TightHeadingConfig(outlier_passes=4, window_s=0.01, max_window_s=0.01)
+    )
     assert np.mean(default.inconsistent | (default.n_rejected > 0)) < 0.002  # 0.0005; α 0.001
 
 
@@ -178,6 +187,7 @@ def test_pipeline_reports_rejected_rows_in_the_heading_csv(tmp_path):
         np.zeros(len(t), bool),
         SensorSeries(t, scenario.speed),
         SensorSeries(t, np.gradient(scenario.yaw, t)),
+        HeadingPipelineConfig(tight=SNOOPING),
     )
     assert table.rejected_rows.sum() > 0 and table.rejected_rows[t < 2.5].sum() == 0
     write_heading_csv(tmp_path / "heading.csv", table)
@@ -218,7 +228,7 @@ def test_noise_three_times_the_a_priori_sigma_keeps_the_false_alarm_rate():
     per window; overlapping windows share rows, so alarms would come in runs)."""
     scenario = _noisy_drive(120.0)
     result = _solve(scenario, _with_noise(scenario, 0.15))
-    tested = scenario.t_epoch >= TightHeadingConfig().window_s
+    tested = scenario.t_epoch >= SNOOPING.window_s
     flagged = result.inconsistent | (result.n_rejected > 0)
     assert np.mean(flagged[tested]) <= 0.005  # measured 0.0 (seeds 7 and 8)
     assert result.available[tested].all()
@@ -239,7 +249,7 @@ def test_window_constant_satellite_errors_are_noise_not_reflections(correlated_d
     are not repaired (the a-priori model alone flags nearly every window)."""
     scenario, rows = correlated_drive
     result = _solve(scenario, rows)
-    tested = scenario.t_epoch >= TightHeadingConfig().window_s
+    tested = scenario.t_epoch >= SNOOPING.window_s
     flagged = result.inconsistent | (result.n_rejected > 0)
     assert np.mean(flagged[tested]) < 0.01  # α = 0.001 per window; measured 0.0
     assert result.available[tested].all()
@@ -254,7 +264,7 @@ def test_reflection_is_still_rejected_amid_correlated_noise(correlated_drive):
     assert np.min(np.abs(bias[reflected])) > 1.0
     result = _solve(scenario, with_bias(rows, bias))
     t = scenario.t_epoch
-    window = TightHeadingConfig().window_s
+    window = SNOOPING.window_s
     touched = (t >= 60.0) & (t < 61.5 + window)
     assert np.mean(result.n_rejected[touched] > 0) > 0.95
     assert result.available[touched].mean() > 0.95

@@ -18,6 +18,11 @@ AZIMUTH = [30.0, 110.0, 200.0, 280.0, 330.0, 160.0]
 ELEVATION = [60.0, 30.0, 45.0, 20.0, 70.0, 15.0]
 
 
+def fixed_windows(t) -> np.ndarray:
+    """Every window of the default minimum length (as before windows could grow)."""
+    return np.full(len(t), TightHeadingConfig().window_s)
+
+
 def test_the_threshold_combines_both_sigmas_and_the_propagated_gyro_bias():
     config = TightHeadingConfig(window_s=2.0, reliability_gate_rad=0.01, reliability_n_sigma=3.0)
     t = np.array([0.0, 1.0, 5.0, 5.5])
@@ -30,7 +35,7 @@ def test_the_threshold_combines_both_sigmas_and_the_propagated_gyro_bias():
         yaw = np.array([1.0, 1.0, 1.3 + offset, 1.3])
         every = np.ones(4, bool)
         agree = _independent_agreement(
-            every, every, yaw, sigma, every, t, (yaw_angle, bias_sigma), config
+            every, every, yaw, sigma, every, t, (yaw_angle, bias_sigma), fixed_windows(t), config
         )
         # Epochs 0 and 1 have no window before theirs; epoch 3 refers to epoch 1 as well.
         np.testing.assert_array_equal(agree, [True, True, expected, True])
@@ -43,11 +48,15 @@ def test_unavailable_epochs_are_never_the_reference():
     gyro = (np.zeros(6), np.zeros(6))
     sigma = np.full(6, 0.01)
     available = np.array([True, False, True, True, True, True])
-    agree = _independent_agreement(available, available, yaw, sigma, available, t, gyro, config)
+    agree = _independent_agreement(
+        available, available, yaw, sigma, available, t, gyro, fixed_windows(t), config
+    )
     np.testing.assert_array_equal(agree, available)
     every = np.ones(6, bool)
     # Epoch 1 has no window before it; epoch 3 refers to it and disagrees.
-    agree = _independent_agreement(every, every, yaw, sigma, every, t, gyro, config)
+    agree = _independent_agreement(
+        every, every, yaw, sigma, every, t, gyro, fixed_windows(t), config
+    )
     np.testing.assert_array_equal(agree, [True, True, True, False, True, True])
 
 
@@ -57,7 +66,15 @@ def test_a_wrong_reliable_heading_cannot_lock_the_right_ones_out():
     yaw = np.where(t < 2.0, 1.0, 0.0)  # the first window's headings are wrong
     every = np.ones(20, bool)
     agree = _independent_agreement(
-        every, every, yaw, np.full(20, 0.01), every, t, (np.zeros(20), np.zeros(20)), config
+        every,
+        every,
+        yaw,
+        np.full(20, 0.01),
+        every,
+        t,
+        (np.zeros(20), np.zeros(20)),
+        fixed_windows(t),
+        config,
     )
     # Until the wrong reference at t = 1 is older than 10 s (epoch 12), the right headings
     # disagree with it; then the last available heading a window earlier (right) serves.
@@ -78,7 +95,9 @@ def test_a_vague_reference_confirms_nothing_and_the_window_must_verify_itself():
         (0.19, np.array([True, True]), False),  # informative: it disagrees
     ):
         sigma = np.array([sigma_reference, 0.01])
-        agree = _independent_agreement(every, verifiable, yaw, sigma, every, t, gyro, config)
+        agree = _independent_agreement(
+            every, verifiable, yaw, sigma, every, t, gyro, fixed_windows(t), config
+        )
         np.testing.assert_array_equal(agree, [True, expected])
 
 
@@ -96,7 +115,15 @@ def test_the_first_windows_of_a_drive_verify_themselves_or_a_later_window_confir
         ([0.0, 1.0, 12.5], [0.0, 0.0, 0.0], [False, True, True]),
     ):
         agree = _independent_agreement(
-            every, verifiable, np.array(yaw), sigma, every, np.array(t), gyro, config
+            every,
+            verifiable,
+            np.array(yaw),
+            sigma,
+            every,
+            np.array(t),
+            gyro,
+            fixed_windows(t),
+            config,
         )
         np.testing.assert_array_equal(agree, expected)
 
@@ -113,7 +140,9 @@ def test_the_gyro_drift_since_the_reference_counts_towards_its_vagueness():
     # √(0.06² + (b·5)²) against 0.1: b = 0.0159 gives 0.0996, b = 0.0161 gives 0.1004.
     for bias_sigma, expected in ((0.0159, True), (0.0161, False)):
         gyro = (np.zeros(2), np.full(2, bias_sigma))
-        agree = _independent_agreement(every, first_only, yaw, sigma, every, t, gyro, config)
+        agree = _independent_agreement(
+            every, first_only, yaw, sigma, every, t, gyro, fixed_windows(t), config
+        )
         np.testing.assert_array_equal(agree, [True, expected])
 
 

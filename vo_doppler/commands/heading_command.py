@@ -16,6 +16,7 @@ from vo_doppler.commands.arg_types import (
     positive_float,
     positive_int,
 )
+from vo_doppler.commands.heading_method import add_heading_method_option, heading_method_config
 from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.commands.satellite_options import (
     add_satellite_options,
@@ -27,8 +28,7 @@ from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
-from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConfig
-from vo_doppler.heading.tight_heading import TightHeadingConfig
+from vo_doppler.heading.pipeline import CALIBRATION_METHODS
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.rinex_obs import read_obs
@@ -103,6 +103,7 @@ def register(subparsers, summary: str) -> None:
         "whose heading is wanted; the Doppler is then the antenna's in turns",
     )
     parser.add_argument("--window-s", type=positive_float, default=2.0, help="heading window (s)")
+    add_heading_method_option(parser)
     parser.add_argument(
         "--no-nlos-rejection",
         action="store_true",
@@ -273,10 +274,12 @@ def run(args: argparse.Namespace) -> int:
     else:
         start = obs.epoch_time[0] + args.max_sats_after
         rows, conventional = emulated_canyon(obs, nav, args.max_sats, start, systems, mask)
-    tight = TightHeadingConfig(window_s=args.window_s)
+    method = heading_method_config(args.heading_method)
+    tight = replace(method.tight, window_s=args.window_s)
     if args.no_nlos_rejection:
         tight = replace(tight, outlier_passes=0)
-    config = HeadingPipelineConfig(
+    config = replace(
+        method,
         calibration=args.calibration,
         tight=tight,
         fixed_gyro_bias=None if args.gyro_bias is None else np.radians(args.gyro_bias),

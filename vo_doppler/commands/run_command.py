@@ -16,6 +16,7 @@ from rich.table import Table
 
 from vo_doppler.commands.arg_types import window_size
 from vo_doppler.commands.correction_options import add_correction_options, correction_config
+from vo_doppler.commands.heading_method import add_heading_method_option, heading_method_config
 from vo_doppler.commands.satellite_options import add_selection_options
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
@@ -64,6 +65,7 @@ def add_run_options(parser: argparse.ArgumentParser) -> None:
         help="VO window (frames, >= 3)",
     )
     add_correction_options(parser)
+    add_heading_method_option(parser)
 
 
 def run_config(args: argparse.Namespace) -> RunConfig:
@@ -71,6 +73,7 @@ def run_config(args: argparse.Namespace) -> RunConfig:
     return RunConfig(
         systems=args.systems.upper(),
         elevation_mask=np.radians(args.elev_mask),
+        heading=heading_method_config(args.heading_method),
         vo=VoConfig(window_size=args.window),
         correction=correction_config(args),
     )

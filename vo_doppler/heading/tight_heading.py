@@ -64,6 +64,7 @@ snooping took for the consistent majority.
 from __future__ import annotations
 
 import warnings
+from bisect import bisect_right
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,20 +101,45 @@ class TightHeadingConfig:
     """Solver settings; angles in radians."""
 
     window_s: float = 2.0
+    """The shortest window (s); longer where the rows need it (:func:`window_lengths`)."""
+    max_window_s: float = 2.0
+    """The longest window (s): the gyro's bias error and the straight-road model's grade grow
+    with it."""
+    max_window_m: float = 40.0
+    """… nor longer than this stretch of road (m) at the epoch's speed (one grade per window)."""
+    window_target_sigma_rad: float = np.radians(0.15)
+    """A window grows until its rows hold the information of this heading σ."""
+    noise_correlation_s: float = 1.0
+    """Rows of one satellite closer in time than this count as one (:func:`window_lengths`)."""
     min_obs: int = 3
     min_speed_mps: float = 0.2
     grid_size: int = 72
     gauss_newton_iterations: int = 10
     robust_passes: int = 3
     huber_k: float = 1.345
+    redescending_passes: int = 0
+    """Passes with Student-t weights w·(ν + 1)/(ν + r²) after the Huber ones (r the residual over
+    its σ, scaled by the window's robust spread where that is larger): a redescending
+    M-estimator, whose weight falls to zero for a reflected satellite far off the fit, where
+    Huber's only levels off."""
+    student_dof: float = 4.0
     sigma_floor_mps: float = 0.01
     observability_ratio: float = 1e-6
     ambiguity_chi2: float = 9.0
     ambiguity_min_separation_rad: float = np.radians(5.0)
     max_sigma_rad: float = np.radians(20.0)
     prior_max_age_s: float = 10.0
-    reliability_epochs: int = 10
+    reliability_epochs: int | None = 10
+    """The earlier headings of the last this many epochs check the current one ([TK18] sec.
+    3.5; at least ``reliability_min_epochs`` of them, all agreeing); None: the rule in
+    seconds below (:func:`_reliability`), which means the same at every rate."""
     reliability_min_epochs: int = 5
+    reliability_span_s: float = 5.0
+    """The earlier headings of the last this many seconds check the current one …"""
+    reliability_min_span_s: float = 2.0
+    """… and must reach back at least this far …"""
+    reliability_agreement: float = 0.75
+    """… and this share of them must agree with it."""
     reliability_gate_rad: float = np.radians(3.0)
     reliability_n_sigma: float = 3.0
     reference_max_sigma_rad: float = np.radians(10.0)
@@ -131,6 +157,9 @@ class TightHeadingConfig:
     many as fit (:func:`windows_per_chunk`); the headings do not depend on it."""
     profile_step_rad: float = np.radians(0.25)
     profile_max_rad: float = np.radians(30.0)
+    clock_epoch_interval_s: float = np.inf
+    """From this epoch interval (median, s) on each epoch has its own clock drift
+    (:func:`clock_per_epoch`)."""
     clock_drift_walk_mps: float = 0.01
     """Random walk of the receiver clock drift (m/s per √s) that the linear model leaves out."""
     grade_sigma: float = 0.05
@@ -151,6 +180,23 @@ class TightHeadingConfig:
     """Satellites whose redundancy number (the share of a bias that shows in the residuals) is
     below this are not tested; a window using such a satellite is not verifiable."""
 
+    @classmethod
+    def robust(cls) -> TightHeadingConfig:
+        """The settings for receivers at any rate in deep street canyons (``--heading-method
+        robust``): no data snooping (the Huber fit weighs reflections down instead of
+        naming them), windows that grow with the information they need (up to 8 s,
+        :func:`window_lengths`), one clock drift per epoch from 0.5 s between epochs, and
+        reliability as a consensus of the last 5 s (at least 2 s of earlier headings, three
+        quarters agreeing). Measured on the Hong Kong canyon drive at 1 Hz
+        (``benchmarks/real_heading.py``); not yet the default because the simulated 20-Hz
+        canyon of the sample loses availability with it (docs/design.md)."""
+        return cls(
+            outlier_passes=0,
+            max_window_s=8.0,
+            clock_epoch_interval_s=0.5,
+            reliability_epochs=None,
+        )
+
 
 @dataclass
 class TightHeadingResult:
@@ -168,6 +214,8 @@ class TightHeadingResult:
     clock_drift_rate: np.ndarray
     n_rejected: np.ndarray
     """Rows of the window rejected as biased by data snooping (reflections, blunders)."""
+    window_s: np.ndarray
+    """Length (s) of the window ending at each epoch (:func:`window_lengths`)."""
     verifiable: np.ndarray
     """Every satellite used could have been tested: a bias on any would show in the residuals
     (redundancy number ≥ ``testable_redundancy``); False where it could hide, e.g. as many
@@ -218,12 +266,18 @@ def _fit(X, T, prior, w, config):
     robust weights, both minima of the final profiled cost and the linear parameters at the
     best one."""
     weights = np.array(w)
-    for _ in range(config.robust_passes):
+    passes = config.robust_passes + config.redescending_passes
+    for n in range(passes):
         Q, _, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, weights, prior)
         theta = gauss_newton(Q, grid_minima(Q, config.grid_size)[0], config.gauss_newton_iterations)
         normalised = np.abs(_residual(X, T, XtWT, TtWT_pinv, theta)) * np.sqrt(w)
-        ratio = normalised / _robust_scale(normalised, w, config)[:, None]
-        weights = w * np.minimum(1.0, config.huber_k / np.maximum(ratio, 1e-300))
+        if n < config.robust_passes:
+            ratio = normalised / _robust_scale(normalised, w, config)[:, None]
+            weights = w * np.minimum(1.0, config.huber_k / np.maximum(ratio, 1e-300))
+        else:
+            nu = config.student_dof
+            ratio = normalised / np.maximum(_robust_scale(normalised, w, config), 1.0)[:, None]
+            weights = w * (nu + 1.0) / (nu + ratio**2)
     Q, XtWX, XtWT, TtWT_pinv, rank_t = projected_normal_matrix(X, T, weights, prior)
     first, second = grid_minima(Q, config.grid_size)
     theta = gauss_newton(Q, first, config.gauss_newton_iterations)
@@ -246,19 +300,29 @@ def _fit(X, T, prior, w, config):
     }
 
 
-def linear_design(tau, grade_coefficient, grade_prior):
+def linear_design(tau, grade_coefficient, grade_prior, clock_epoch=None):
     """Design T (K, R, p) of the linear parameters and their prior as pseudo-observations
     (:func:`vo_doppler.heading.profile.projected_normal_matrix`): T = [1, −τ, c] for (ρ₀, α, g)
     with g ~ N(μ, σ²) per window (``grade_prior`` = (μ, σ), each (K,)), the clock drift and its
-    rate free; or T = [1, −τ] and no prior for a level road (no ``grade_coefficient`` c)."""
-    columns = [np.ones_like(tau), -tau]
+    rate free; or T = [1, −τ] and no prior for a level road (no ``grade_coefficient`` c).
+
+    ``clock_epoch`` (K, R): each row's epoch counted back from the window's newest (0): one
+    free clock drift per epoch instead of ρ₀ − α·τ, T = [e₀ … e_E, c] (indicator columns; the
+    first is the newest epoch's drift, so that the first parameter is ρ₀ in both models)."""
+    if clock_epoch is None:
+        columns = [np.ones_like(tau), -tau]
+    else:
+        n_epochs = int(np.max(clock_epoch, initial=0)) + 1
+        indicator = clock_epoch[..., None] == np.arange(n_epochs)
+        columns = list(np.moveaxis(indicator.astype(float), -1, 0))
     if grade_coefficient is None:
         return np.stack(columns, axis=-1), None
     mean, sigma = (np.broadcast_to(np.asarray(v, dtype=float), tau.shape[:1]) for v in grade_prior)
-    zeros, ones = np.zeros_like(mean), np.ones_like(mean)
+    linear = np.zeros((len(mean), len(columns) + 1))
+    linear[:, -1] = 1.0
     prior = (
-        np.stack([zeros, zeros, mean], axis=-1)[:, None, :],
-        np.stack([zeros, zeros, ones], axis=-1)[:, None, :],
+        np.stack([np.zeros_like(mean), np.zeros_like(mean), mean], axis=-1)[:, None, :],
+        linear[:, None, :],
         sigma[:, None] ** -2.0,
     )
     return np.stack([*columns, grade_coefficient], axis=-1), prior
@@ -284,6 +348,7 @@ def solve_windows(
     noise: ReceiverNoise | None = None,
     grade_coefficient=None,
     grade_prior=(0.0, None),
+    clock_epoch=None,
 ):
     """Solve padded windows at once: arrays (K, R) of reduced observations ``y``, coefficients
     ``a``, ``b`` (model a·cos θ₀ + b·sin θ₀ + ρ₀ − α·τ + c·g), row times ``tau`` relative to
@@ -316,7 +381,7 @@ def solve_windows(
         grade_coefficient = None
     grade_mean, grade_sigma = grade_prior
     grade_sigma = config.grade_sigma if grade_sigma is None else grade_sigma
-    T, prior = linear_design(tau, grade_coefficient, (grade_mean, grade_sigma))
+    T, prior = linear_design(tau, grade_coefficient, (grade_mean, grade_sigma), clock_epoch)
     if group is None:
         group = np.broadcast_to(np.arange(R), (K, R))
     n_groups = int(np.max(group, initial=0)) + 1
@@ -404,8 +469,8 @@ def solve_windows(
         variance_factor=variance_factor,
         profile_sigma=_profile_sigma(Q, theta, cost, variance_factor, config),
         rho0=params[:, 0],
-        alpha=params[:, 1],
-        grade=params[:, 2] if prior is not None else np.zeros(K),
+        alpha=params[:, 1] if clock_epoch is None else np.full(K, np.nan),
+        grade=params[:, -1] if prior is not None else np.zeros(K),
         n_obs=n_obs,
         n_rejected=n_obs - n_used,
         inconsistent=inconsistent,
@@ -416,7 +481,7 @@ def solve_windows(
             _fallback_variance(suspects, theta, bias_variance),
             np.where(reflection, bias_variance, 0.0),
         ),
-        **_error_gains(a, b, T, prior, weights, theta),
+        **_error_gains(a, b, tau, T, prior, weights, theta, clock_epoch is None),
     )
 
 
@@ -461,7 +526,7 @@ def _profile_sigma(Q, theta, cost, variance_factor, config):
     return width
 
 
-def _error_gains(a, b, T, prior, weights, theta):
+def _error_gains(a, b, tau, T, prior, weights, theta, clock_walks=True):
     """How errors the noise model leaves out move θ₀, per window (linearised at θ₀).
 
     The weighted least-squares gain g = e₀ᵀ(JᵀWJ + P)⁺JᵀW of θ₀ (J = ∂model/∂(θ₀, ρ₀, α[, g]),
@@ -472,13 +537,13 @@ def _error_gains(a, b, T, prior, weights, theta):
     covariance min(s, t) − t_start, with the constant and linear parts absorbed by ρ₀ and α).
     The prior's pseudo-observations (T_p, w_p) carry their own gain: an error of the prior mean
     of σ = 1/√w_p moves θ₀ by (N⁻¹T_pᵀ)_θ·√w_p, so ``prior_variance`` = Σ_p (N⁻¹T_pᵀ)_θ²·w_p
-    is the part of var θ₀ that the prior's σ, not the Doppler noise, sets.
+    is the part of var θ₀ that the prior's σ, not the Doppler noise, sets. With one clock drift
+    per epoch (``clock_walks`` False) the walk is absorbed and its gain is zero.
     """
     # Windows without a solution (no rows, or no yaw at their end) are unavailable anyway.
     theta, a, b, weights = (np.nan_to_num(x) for x in (theta, a, b, weights))
     cos_t, sin_t = np.cos(theta)[:, None], np.sin(theta)[:, None]
     j_theta = -a * sin_t + b * cos_t
-    tau = -T[..., 1]
     J = np.concatenate([j_theta[..., None], T], axis=-1)
     normal_inv, prior_variance = _normal_inverse(J, weights, prior)
     g = np.einsum("kj,krj,kr->kr", normal_inv[:, 0, :], J, weights)
@@ -487,7 +552,7 @@ def _error_gains(a, b, T, prior, weights, theta):
     return {
         "scale_gain": np.sum(g * (a * cos_t + b * sin_t), axis=1),
         "bias_gain": -np.sum(g * tau * j_theta, axis=1),
-        "clock_walk_gain": np.sum(np.maximum(step, 0.0) * tail**2, axis=1),
+        "clock_walk_gain": np.sum(np.maximum(step, 0.0) * tail**2, axis=1) * clock_walks,
         "prior_variance": prior_variance,
     }
 
@@ -574,19 +639,28 @@ def tight_heading_series(
     if m == 0:
         return _unavailable(t_epoch)
     windows = _WindowRows.build(
-        rows, t_epoch, speed, yaw_angle, lever_velocity, grade_prior, calibration, config
+        rows,
+        t_epoch,
+        speed,
+        yaw_angle,
+        lever_velocity,
+        grade_prior,
+        calibration,
+        config,
+        bias_sigma,
     )
     n_sat_epoch = windows.n_sat_epoch
     if windows.empty:
         return _unavailable(t_epoch, n_sat_epoch)
     width, n_groups, padded = windows.width, windows.n_groups, windows.padded
+    per_epoch_clock = clock_per_epoch(t_epoch, config)
     size = windows_per_chunk(width, n_groups, config)
     chunks = [np.arange(start, min(start + size, m)) for start in range(0, m, size)]
     noise = None
     if len(chunks) > 1 and config.outlier_passes:
         samples = []
         for k in chunks:
-            y, a, b, tau, w, group, _ = padded(k)
+            y, a, b, tau, w, group, _, _ = padded(k)
             samples.append(
                 noise_statistics(
                     a,
@@ -605,7 +679,7 @@ def tight_heading_series(
         noise = receiver_noise(samples)
     solutions = []
     for k in chunks:
-        y, a, b, tau, w, group, grade_coefficient = padded(k)
+        y, a, b, tau, w, group, grade_coefficient, clock_epoch = padded(k)
         solutions.append(
             solve_windows(
                 y,
@@ -620,6 +694,7 @@ def tight_heading_series(
                 noise,
                 grade_coefficient,
                 windows.grade_at(k),
+                clock_epoch if per_epoch_clock else None,
             )
         )
     solution = _concatenate(solutions)
@@ -632,13 +707,23 @@ def tight_heading_series(
         # grade prior's part is set by its own σ: where s² < 1 it is restored to full size
         + np.clip(1.0 - solution.variance_factor, 0.0, None) * solution.prior_variance
     )
-    return _decide(
-        solution, model_variance, t_epoch, speed, (yaw_angle, bias_sigma), n_sat_epoch, config
-    )
+    gyro = (yaw_angle, bias_sigma)
+    return _decide(solution, model_variance, t_epoch, speed, gyro, n_sat_epoch, windows, config)
 
 
 MIN_SCALE_WINDOWS = 10
 """Fewer disjoint windows with a known heading give no speed scale (:func:`speed_scale_ratio`)."""
+
+
+def clock_per_epoch(t_epoch: np.ndarray, config: TightHeadingConfig) -> bool:
+    """One clock drift per epoch (:func:`linear_design`) where the epochs are at least
+    ``config.clock_epoch_interval_s`` apart (median): over a second a receiver clock's drift
+    wanders further than a line in time follows (the Hong Kong M8T's jumps 0.17 m/s from one
+    1-Hz epoch to the next), while at 10–20 Hz the line holds and an unknown per epoch would
+    cost the rows' information on θ₀."""
+    if len(t_epoch) < 2:
+        return False
+    return bool(np.median(np.diff(t_epoch)) >= config.clock_epoch_interval_s)
 
 
 def speed_scale_ratio(
@@ -685,12 +770,15 @@ def speed_scale_ratio(
     if windows.empty or len(chosen) < MIN_SCALE_WINDOWS:
         return None
     chosen = np.asarray(chosen)
-    y, a, b, tau, w, _, grade_coefficient = windows.padded(chosen)
+    y, a, b, tau, w, _, grade_coefficient, clock_epoch = windows.padded(chosen)
     theta = yaw[chosen][:, None]
     X = np.stack([-(a * np.cos(theta) + b * np.sin(theta)), y], axis=-1)
     use_grade = config.grade_sigma > 0
     T, prior = linear_design(
-        tau, grade_coefficient if use_grade else None, windows.grade_at(chosen)
+        tau,
+        grade_coefficient if use_grade else None,
+        windows.grade_at(chosen),
+        clock_epoch if clock_per_epoch(t_epoch, config) else None,
     )
     if prior is not None:
         prior = (prior[0][..., 1:], prior[1], prior[2])
@@ -728,12 +816,23 @@ class _WindowRows:
     per_epoch: tuple
     grade: tuple[np.ndarray, np.ndarray]
     n_sat_epoch: np.ndarray
+    length: np.ndarray
+    """Each window's length (s, :func:`window_lengths`)."""
     width: int
     n_groups: int
 
     @classmethod
     def build(
-        cls, rows, t_epoch, speed, yaw_angle, lever_velocity, grade_prior, calibration, config
+        cls,
+        rows,
+        t_epoch,
+        speed,
+        yaw_angle,
+        lever_velocity,
+        grade_prior,
+        calibration,
+        config,
+        gyro_bias_sigma=0.0,
     ) -> _WindowRows:
         m = len(t_epoch)
         lever = np.broadcast_to(np.asarray(lever_velocity, dtype=float), (m, 2))
@@ -755,7 +854,13 @@ class _WindowRows:
         index = np.flatnonzero(usable)
         row_group = np.unique(rows.sat_id, return_inverse=True)[1].reshape(-1)
         row_epoch = epoch_of_row[index]
-        lo = np.searchsorted(t_epoch[row_epoch], t_epoch - config.window_s, side="right")
+        information = np.bincount(
+            row_epoch,
+            rows.weight[index] * speed[row_epoch] ** 2 * np.sum(rows.los[index, :2] ** 2, axis=1),
+            minlength=m,
+        )[:m]
+        length = window_lengths(t_epoch, information, config, gyro_bias_sigma, speed)
+        lo = np.searchsorted(t_epoch[row_epoch], t_epoch - length, side="right")
         hi = np.searchsorted(t_epoch[row_epoch], t_epoch, side="right")
         if calibration is None:
             calibration = (np.ones(m), np.zeros(m), np.zeros(m))
@@ -769,6 +874,7 @@ class _WindowRows:
             per_epoch,
             grade,
             n_sat_epoch,
+            length,
             max(int(np.max(hi - lo, initial=0)), 1),
             int(np.max(row_group, initial=0)) + 1,
         )
@@ -793,6 +899,58 @@ class _WindowRows:
             self.per_epoch,
             self.width,
         )
+
+
+def window_lengths(
+    t_epoch: np.ndarray,
+    information: np.ndarray,
+    config: TightHeadingConfig,
+    gyro_bias_sigma: np.ndarray | float = 0.0,
+    speed: np.ndarray | float = 0.0,
+) -> np.ndarray:
+    """Length (s) of the window ending at each epoch: ``config.window_s``, or longer, up to
+    ``config.max_window_s``, until the rows inside hold the information of a heading σ of
+    ``config.window_target_sigma_rad``.
+
+    ``information`` per epoch is Σ (s·|g_h|/σ_i)² over its rows (s the speed, g_h the line of
+    sight's horizontal part, σ_i the row's σ): the Fisher information on θ₀ of rows whose
+    lines of sight surround the receiver, an upper bound otherwise. Rows closer in time than
+    ``config.noise_correlation_s`` are not independent (a reflection's Doppler error lasts
+    about that long), so an epoch counts for min(1, Δt / correlation time) of its rows: the
+    same drive at 1, 10 or 20 Hz gets the same windows. At 10–20 Hz under open sky the
+    minimum holds; at 1 Hz in a street canyon (weak signals, σ of metres per second) the
+    window grows to several seconds.
+
+    A window grows only as far as the gyro allows: a bias error of σ_b turns the rows of a
+    window of length W by up to σ_b·W, which moves θ₀ by about σ_b·W/2, so W stays within
+    2·target/σ_b (``gyro_bias_sigma`` per epoch, rad/s). Before the bias is calibrated that
+    is the minimum: on the comma2k19 minute in a two-satellite canyon from its start, 8-s
+    windows with the prior's bias settled on the mirror root (15° median error). Nor does it
+    grow beyond ``config.max_window_m`` of road at the epoch's ``speed``: the model holds one
+    grade per window, and a road's grade changes over a few tens of metres (the same minute
+    with 8-s windows, 160 m at 20 m/s, went to the mirror root with the bias calibrated)."""
+    t_epoch = np.asarray(t_epoch, dtype=float)
+    m = len(t_epoch)
+    if m == 0:
+        return np.zeros(0)
+    interval = np.diff(t_epoch, prepend=t_epoch[0] - (np.median(np.diff(t_epoch)) if m > 1 else 1))
+    counted = np.asarray(information, dtype=float) * np.minimum(
+        1.0, interval / config.noise_correlation_s
+    )
+    total = np.concatenate([[0.0], np.cumsum(counted)])
+    target = config.window_target_sigma_rad**-2.0
+    # the latest first epoch s with Σ_{s..k} ≥ target: total[s] ≤ total[k + 1] − target
+    first = np.searchsorted(total, total[1:] - target, side="right") - 1
+    enough = first >= 0
+    needed = np.where(enough, t_epoch - t_epoch[np.maximum(first, 0)], np.inf)
+    # the window (t_k − W, t_k] must hold epoch s: W just above t_k − t_s
+    needed = needed + 0.5 * np.minimum(interval, config.epoch_match_s * 1e3)
+    with np.errstate(divide="ignore"):
+        gyro_limit = 2.0 * config.window_target_sigma_rad / np.asarray(gyro_bias_sigma, float)
+        road_limit = config.max_window_m / np.abs(np.asarray(speed, dtype=float))
+    longest = np.minimum(max(config.max_window_s, config.window_s), gyro_limit)
+    longest = np.minimum(longest, np.nan_to_num(road_limit, nan=np.inf))
+    return np.clip(np.minimum(needed, longest), config.window_s, None)
 
 
 def windows_per_chunk(width: int, n_groups: int, config: TightHeadingConfig) -> int:
@@ -834,7 +992,8 @@ def _padded_rows(rows, per_row, index, row_epoch, k, bounds, per_epoch, width):
     a, b, tau = np.where(w > 0, a, 0.0), np.where(w > 0, b, 0.0), np.where(w > 0, tau, 0.0)
     group = np.where(w > 0, row_group[row], 0)
     grade_coefficient = np.where(w > 0, -rows.los[row, 2] * window_speed, 0.0)
-    return y, a, b, tau, w, group, grade_coefficient
+    clock_epoch = np.where(w > 0, k[:, None] - epoch, 0)
+    return y, a, b, tau, w, group, grade_coefficient, clock_epoch
 
 
 def antenna_offset_velocity(yaw_rate: np.ndarray, lever_arm_m) -> np.ndarray:
@@ -864,6 +1023,7 @@ def _unavailable(t_epoch, n_sat_epoch=None) -> TightHeadingResult:
         nan,
         nan,
         counts,
+        np.zeros(m),
         flags,
         flags,
         flags,
@@ -877,10 +1037,13 @@ def _concatenate(solutions):
     )
 
 
-def _decide(sol, model_variance, t_epoch, speed, gyro, n_sat_epoch, config) -> TightHeadingResult:
+def _decide(
+    sol, model_variance, t_epoch, speed, gyro, n_sat_epoch, windows, config
+) -> TightHeadingResult:
     """Availability, ambiguity resolution and reliability; σ from the noise (s²/info) plus
     ``model_variance``, the calibration and clock errors the model leaves out. ``gyro``: the
-    integrated calibrated yaw rate Φ and the gyro-bias σ (rad/s) per epoch."""
+    integrated calibrated yaw rate Φ and the gyro-bias σ (rad/s) per epoch; ``windows`` the
+    :class:`_WindowRows` (their lengths)."""
     yaw_angle, bias_sigma = gyro
     m = len(t_epoch)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -917,13 +1080,14 @@ def _decide(sol, model_variance, t_epoch, speed, gyro, n_sat_epoch, config) -> T
             last = k
     verifiable = available & (sol.min_redundancy >= config.testable_redundancy) & ~sol.inconsistent
     reliable = _independent_agreement(
-        _reliability(yaw, sigma, available, yaw_angle, config),
+        _reliability(yaw, sigma, available, yaw_angle, t_epoch, config),
         verifiable,
         yaw,
         sigma,
         available,
         t_epoch,
         (yaw_angle, bias_sigma),
+        windows.length,
         config,
     )
     return TightHeadingResult(
@@ -941,23 +1105,34 @@ def _decide(sol, model_variance, t_epoch, speed, gyro, n_sat_epoch, config) -> T
         verifiable=verifiable,
         inconsistent=sol.inconsistent & (sol.n_obs >= config.min_obs),
         fallback=available & sol.fallback,
+        window_s=windows.length,
     )
 
 
-def _reliability(yaw, sigma, available, yaw_angle, config):
-    """Gyro-consistency over the last ``reliability_epochs`` epochs ([TK18] sec. 3.5).
+def _reliability(yaw, sigma, available, yaw_angle, t_epoch, config):
+    """Gyro-consistency with the earlier headings ([TK18] sec. 3.5): of the last
+    ``reliability_epochs`` epochs (at least ``reliability_min_epochs`` available, all agreeing),
+    or, with ``reliability_epochs`` None, of the last ``reliability_span_s`` seconds.
 
-    Each earlier heading propagated by the gyro must agree with the current one within
+    Each earlier heading propagated by the gyro agrees with the current one when within
     max(gate, n_sigma · √(σ_k² + σ_j²)): a fixed gate for precise headings, the combined
     uncertainty for imprecise ones (so that a wrong solution, not mere noise, is rejected).
+    The heading is consistent when the earlier available ones reach back at least
+    ``reliability_min_span_s`` and at least ``reliability_agreement`` of them agree (a
+    consensus: one earlier window caught by a reflection does not veto the rest). Counted in
+    seconds, the same drive at 1 Hz and 20 Hz is judged over the same stretch of road.
     """
     m = len(yaw)
     count = np.zeros(m, dtype=int)
-    worst = np.zeros(m)
-    for lag in range(1, config.reliability_epochs):
-        if lag >= m:
-            break
-        both = available[lag:] & available[:-lag]
+    agreeing = np.zeros(m, dtype=int)
+    reach = np.zeros(m)
+    by_epochs = config.reliability_epochs is not None
+    span = np.inf if by_epochs else config.reliability_span_s
+    last_lag = config.reliability_epochs - 1 if by_epochs else m
+    lag = 1
+    while lag < min(m, last_lag + 1) and np.any(t_epoch[lag:] - t_epoch[:-lag] <= span):
+        inside = t_epoch[lag:] - t_epoch[:-lag] <= span
+        both = available[lag:] & available[:-lag] & inside
         predicted = yaw[:-lag] + yaw_angle[lag:] - yaw_angle[:-lag]
         error = np.abs(wrap_angle(yaw[lag:] - predicted))
         allowed = np.maximum(
@@ -965,11 +1140,18 @@ def _reliability(yaw, sigma, available, yaw_angle, config):
             config.reliability_n_sigma * np.hypot(sigma[lag:], sigma[:-lag]),
         )
         count[lag:] += both
-        worst[lag:] = np.maximum(worst[lag:], np.where(both, error / allowed, 0.0))
-    return available & (count >= config.reliability_min_epochs) & (worst <= 1.0)
+        agreeing[lag:] += both & (error <= allowed)
+        reach[lag:] = np.where(both, t_epoch[lag:] - t_epoch[:-lag], reach[lag:])
+        lag += 1
+    if by_epochs:
+        return available & (count >= config.reliability_min_epochs) & (agreeing == count)
+    consensus = agreeing >= config.reliability_agreement * np.maximum(count, 1)
+    return available & (reach >= config.reliability_min_span_s) & consensus
 
 
-def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoch, gyro, config):
+def _independent_agreement(
+    consistent, verifiable, yaw, sigma, available, t_epoch, gyro, window_s, config
+):
     """Reliability: the epochs of ``consistent`` (the consecutive-epoch rule,
     :func:`_reliability`) whose heading also agrees with an informative heading from a window
     that shares no row with theirs, or whose own window is ``verifiable``.
@@ -991,14 +1173,16 @@ def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoc
     and only another window can reveal it.
     """
     reliable = np.zeros(len(yaw), dtype=bool)
-    later = _next_available(available, t_epoch, config.window_s)
-    last_reliable = last_available = -1
-    p = 0
+    later = _next_available(available, t_epoch, window_s)
+    available_epochs = np.flatnonzero(available)
+    reliable_epochs: list[int] = []
+    reliable_times: list[float] = []
     for k in np.flatnonzero(consistent):
-        while p < k and t_epoch[p] <= t_epoch[k] - config.window_s:
-            last_available = p if available[p] else last_available
-            last_reliable = p if reliable[p] else last_reliable
-            p += 1
+        bound = t_epoch[k] - window_s[k]
+        before = np.searchsorted(t_epoch[available_epochs], bound, side="right")
+        last_available = available_epochs[before - 1] if before else -1
+        n = bisect_right(reliable_times, bound)
+        last_reliable = reliable_epochs[n - 1] if n else -1
         fresh = last_reliable >= 0 and t_epoch[k] - t_epoch[last_reliable] <= config.prior_max_age_s
         j = last_reliable if fresh else last_available
         agrees = _agrees(k, j, yaw, sigma, t_epoch, gyro, config)
@@ -1008,11 +1192,15 @@ def _independent_agreement(consistent, verifiable, yaw, sigma, available, t_epoc
             agrees = _agrees(k, j, yaw, sigma, t_epoch, gyro, config) if ahead else None
             agrees = bool(verifiable[k] or agrees)
         reliable[k] = agrees
+        if agrees:
+            reliable_epochs.append(k)
+            reliable_times.append(t_epoch[k])
     return reliable
 
 
 def _next_available(available, t_epoch, window_s):
-    """Per epoch k, the first available epoch j with t_j ≥ t_k + ``window_s`` (−1 if none)."""
+    """Per epoch k, the first available epoch j with t_j ≥ t_k + ``window_s`` (the window
+    ending at j then shares no row with k's; per epoch or a scalar; −1 if none)."""
     candidates = np.flatnonzero(available)
     if not candidates.size:
         return np.full(len(t_epoch), -1)

@@ -59,6 +59,9 @@ class HeadingTable:
     """What the checks of the heading stage found doubtful in its inputs and calibration
     (:func:`vo_doppler.heading.from_gnss.heading_from_gnss`); not written to a heading CSV."""
     clock_residual_offset_s: float | None = None
+    doppler_noise: dict | None = None
+    """The moving receiver's Doppler noise model the tight heading weighted its rows with
+    (``heading.row_noise.RowNoiseModel.to_dict``), where it was fitted."""
     """The wheel speed's residual clock offset (s) against the GNSS Doppler speed, None when
     no lag was found or not checked (:func:`vo_doppler.checks.estimate_clock_offset`)."""
 

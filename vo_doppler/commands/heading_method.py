@@ -1,0 +1,36 @@
+"""``--heading-method``: the tight heading's settings as a named choice (``run``, ``batch``,
+``heading``)."""
+
+from __future__ import annotations
+
+import argparse
+from enum import StrEnum
+
+from vo_doppler.heading.pipeline import HeadingPipelineConfig
+
+
+class HeadingMethod(StrEnum):
+    """``snooping``: windows of 2 s, reflections detected and named by data snooping (tuned on
+    10–20 Hz recordings); ``robust``: :meth:`HeadingPipelineConfig.robust`, for any rate and
+    deep street canyons (1-Hz receivers)."""
+
+    SNOOPING = "snooping"
+    ROBUST = "robust"
+
+
+def add_heading_method_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--heading-method",
+        choices=[m.value for m in HeadingMethod],
+        default=HeadingMethod.SNOOPING.value,
+        help="tight heading: snooping (2-s windows, reflected satellites detected and named; "
+        "tuned at 10-20 Hz) or robust (noise model measured from the data, robust fit, "
+        "windows and reliability in seconds; for 1-Hz receivers in street canyons)",
+    )
+
+
+def heading_method_config(method: str) -> HeadingPipelineConfig:
+    """The heading stage's configuration of ``--heading-method``."""
+    if HeadingMethod(method) is HeadingMethod.ROBUST:
+        return HeadingPipelineConfig.robust()
+    return HeadingPipelineConfig()
