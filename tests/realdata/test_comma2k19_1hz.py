@@ -1,0 +1,135 @@
+"""The comma2k19 minute at a receiver's 1 Hz: the decimation (benchmarks/decimate.py) exactly,
+then the emulated 2-satellite canyon after 20 s with the robust heading method against
+global_pose (issue 29's acceptance; ``python benchmarks/real_heading.py --rate 1 /tmp/comma``
+computes the same figures)."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+
+from benchmarks.decimate import decimate, decimated_epochs
+from benchmarks.real_heading import CANYON_AFTER_S, canyon_inputs, tight_figures
+from tests.helpers.comma2k19 import imported_comma2k19
+from vo_doppler.geo import EnuFrame
+from vo_doppler.heading.pipeline import HeadingPipelineConfig
+from vo_doppler.model.doppler_sigma import ReportedSigma
+from vo_doppler.model.observations import Observations, ObsHeader
+from vo_doppler.model.sequence import Sequence
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.run import RunConfig, sequence_heading
+
+T0 = 404100.0
+CODES = ("D1C", "S1C")
+
+
+def _recording(t: np.ndarray) -> Sequence:
+    """Two satellites with a Doppler and a C/N0 row per epoch, a reported σ per Doppler row;
+    values encode (epoch, satellite, code) so that every kept row can be checked."""
+    n = t.size
+    epoch = np.repeat(np.arange(n), 4)
+    prn = np.tile(np.array([3, 3, 17, 17], dtype=np.int16), n)
+    code = np.tile(np.array([0, 1, 0, 1], dtype=np.int16), n)
+    header = ObsHeader(None, 3.04, "G", "", "", None, 0.1, {"G": CODES}, {}, "GPS", 18, "", 0)
+    obs = Observations(
+        header=header,
+        time=t[epoch],
+        system=np.full(4 * n, "G", dtype="U1"),
+        prn=prn,
+        code=code,
+        codes=CODES,
+        value=1000.0 * epoch + 10.0 * prn + code,
+        lli=np.full(4 * n, -1, dtype=np.int8),
+        ssi=np.full(4 * n, 7, dtype=np.int8),
+        epoch_time=t,
+        epoch_flag=np.arange(n, dtype=np.int8) % 2,
+    )
+    sigma = ReportedSigma(
+        t=np.repeat(t, 2),
+        sat_id=np.tile(np.array(["G03", "G17"]), n),
+        code=np.full(2 * n, "D1C"),
+        sigma_mps=np.repeat(np.arange(n), 2) + np.tile([0.1, 0.2], n),
+    )
+    signal = SensorSeries(np.array([t[0], t[-1]]), np.zeros(2))
+    return Sequence(
+        "decimate",
+        [],
+        np.zeros(0),
+        None,
+        obs,
+        None,
+        signal,
+        signal,
+        EnuFrame(0.0, 0.0, 0.0),
+        doppler_sigma=sigma,
+    )
+
+
+def test_decimation_keeps_the_epoch_nearest_each_whole_second():
+    """A 10 Hz receiver 3 ms behind GPS time (epochs at T0 + 0.097 … T0 + 3.897 s) with the
+    epochs from T0 + 1.897 to T0 + 2.097 missing: at 1 Hz the epochs 3 ms before T0 + 1 and
+    T0 + 3 stay (with their rows and σ); T0 (nearest epoch 97 ms off), T0 + 2 (none within
+    half an interval) and T0 + 4 (after the last epoch) stay empty."""
+    t = T0 - 0.003 + 0.1 * np.arange(1, 40)
+    t = t[(t < T0 + 1.85) | (t > T0 + 2.15)]
+    sequence = _recording(t)
+    decimated = decimate(sequence, 1.0)
+    kept = decimated.observations
+    np.testing.assert_array_equal(kept.epoch_time, t[np.isin(np.round(t - T0, 3), [0.997, 2.997])])
+    np.testing.assert_allclose(kept.epoch_time - T0, [0.997, 2.997], atol=1e-6)
+    index = np.flatnonzero(np.isin(t, kept.epoch_time))
+    np.testing.assert_array_equal(kept.epoch_flag, sequence.observations.epoch_flag[index])
+    expected = (1000.0 * np.repeat(index, 4) + np.tile([30.0, 31.0, 170.0, 171.0], 2)).tolist()
+    assert kept.value.tolist() == expected
+    np.testing.assert_array_equal(kept.time, np.repeat(kept.epoch_time, 4))
+    assert kept.header.interval == pytest.approx(2.0)
+    sigma = decimated.doppler_sigma
+    assert sigma.sigma_mps.tolist() == pytest.approx([9.1, 9.2, 26.1, 26.2])
+    assert sigma.sat_id.tolist() == ["G03", "G17", "G03", "G17"]
+    assert decimated.yaw_rate is sequence.yaw_rate and decimated.wheel_speed is sequence.wheel_speed
+    # 5 Hz keeps the epochs at x.197, x.397 … (within 0.05 s of a tick), 3 ms off each
+    five = decimated_epochs(t, 5.0)
+    np.testing.assert_allclose(np.round((t[five] - T0) % 0.2, 3), 0.197)
+    # at or above the recorded rate nothing changes
+    assert decimate(sequence, 10.0) is sequence and decimate(sequence, 20.0) is sequence
+    with pytest.raises(ValueError, match="positive"):
+        decimated_epochs(t, 0.0)
+
+
+def test_a_1_hz_recording_at_1_hz_is_unchanged():
+    t = T0 + np.arange(30.0) - 0.003
+    t[5:] += 0.004  # a receiver clock step of 4 ms
+    sequence = _recording(t)
+    assert decimated_epochs(t, 1.0).all()
+    assert decimate(sequence, 1.0) is sequence
+
+
+@pytest.mark.shared_data
+def test_canyon_at_1_hz_robust_heading(tmp_path_factory):
+    """The minute at 1 Hz, two GPS satellites after 20 s, ``HeadingPipelineConfig.robust()``.
+    Issue 29 asks ≥ 95 % of the moving epochs, median ≤ 0.5°, p95 ≤ 1.5°; only the first is
+    met (see the asserts)."""
+    sequence = decimate(imported_comma2k19(tmp_path_factory), 1.0)
+    obs = sequence.observations
+    assert obs.epoch_time.size == 60
+    np.testing.assert_allclose(np.diff(obs.epoch_time), 1.0, atol=1e-3)
+    config = RunConfig()
+    logging.disable(logging.WARNING)
+    try:
+        rows, velocity = canyon_inputs(sequence, config)
+        table = sequence_heading(sequence, rows, velocity, HeadingPipelineConfig.robust())
+    finally:
+        logging.disable(logging.NOTSET)
+    after = obs.epoch_time >= obs.epoch_time[0] + CANYON_AFTER_S
+    figures = tight_figures(sequence, table, after)
+    assert figures["moving_epochs"] == 40
+    assert figures["conv_valid"] == 0.0  # two satellites give no conventional velocity
+    # measured at 8605381: available on 100 % of the 40 moving epochs, median 1.37°, p95 2.80°
+    # (gyro bias −0.453 °/s for −0.409, wheel scale 1.0042 for 1.0086: 20 one-second epochs
+    # of open sky calibrate; with both fixed to the truth 0.93° / 2.33°). Availability meets
+    # the acceptance, the median and p95 do not: these bounds hold today's figures.
+    assert figures["tc_available"] >= 0.95
+    error = figures["tc_error_deg"]
+    assert error["median"] <= 1.6 and error["p95"] <= 3.2
