@@ -13,9 +13,11 @@ LAT, LON = np.radians(35.69), np.radians(139.70)
 RATE_HZ = 20.0
 
 
-def drive(seconds: float = 60.0, radius_m: float = 60.0, speed_mps: float = 10.0):
+def drive(
+    seconds: float = 60.0, radius_m: float = 60.0, speed_mps: float = 10.0, rate_hz: float = RATE_HZ
+):
     """Times, ECEF positions and velocities of a car circling at constant speed."""
-    t = np.arange(0.0, seconds, 1.0 / RATE_HZ)
+    t = np.arange(0.0, seconds, 1.0 / rate_hz)
     angle = speed_mps * t / radius_m
     enu = radius_m * np.stack([np.sin(angle), 1.0 - np.cos(angle), np.zeros_like(t)], axis=1)
     velocity = speed_mps * np.stack([np.cos(angle), np.sin(angle), np.zeros_like(t)], axis=1)
