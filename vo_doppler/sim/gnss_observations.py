@@ -51,6 +51,12 @@ from vo_doppler.gnss.satellite_source import transmit_states
 from vo_doppler.gnss.signals import FREQUENCIES_HZ
 from vo_doppler.io.rinex_write import ObsEpochs
 from vo_doppler.model.navigation import Navigation
+from vo_doppler.sim.canyon_realism import (
+    CanyonRealism,
+    canyon_rows,
+    scatterers,
+    thermal_sigma_mps,
+)
 from vo_doppler.sim.constellation import GROUP_DELAY_FIELD
 
 CODES = ("C1C", "D1C", "S1C")
@@ -81,6 +87,9 @@ class GnssSimConfig:
     clock_drift0_mps: float | None = None
     clock_drift_walk_mps: float = 0.01
     clock_bias_walk_m: float = 0.1
+    canyon: CanyonRealism | None = None
+    """The real canyon's diffraction, scattering and noise floor
+    (:mod:`vo_doppler.sim.canyon_realism`; None: the geometric canyon)."""
 
 
 @dataclass(frozen=True)
@@ -254,7 +263,10 @@ class GnssSimulation:
     Per epoch (K): ``epoch_time`` tags (GPS s, receiver time), ``t_true`` reception times,
     ``clock``, ``n_direct``/``n_reflected`` received satellites, ``n_above_mask``.
     Per row: ``epoch``, ``system``, ``prn``, ``pseudorange_m``, ``doppler_hz``, ``cn0_dbhz``,
-    ``range_rate_true_mps`` (noise-free −λ·D), ``elevation``/``azimuth`` (rad), ``reflected``.
+    ``range_rate_true_mps`` (noise-free −λ·D), ``elevation``/``azimuth`` (rad), ``reflected``
+    (no line of sight), ``range_rate_direct_mps`` (the noise-free −λ·D of the direct path: the
+    truth a Doppler error is measured against) and, with the real canyon, ``scatter_weight``
+    (the scattered power's share w).
     """
 
     epoch_time: np.ndarray
@@ -274,6 +286,8 @@ class GnssSimulation:
     elevation: np.ndarray
     azimuth: np.ndarray
     reflected: np.ndarray
+    range_rate_direct_mps: np.ndarray | None = None
+    scatter_weight: np.ndarray | None = None
 
     @property
     def n_visible(self) -> np.ndarray:
@@ -327,10 +341,12 @@ def simulate_gnss(
     above = geometry.valid & (elevation > np.radians(config.elevation_mask_deg))
     rows = np.flatnonzero(above)
     origins = position_enu[epoch[rows]]
-    blocked = ray_hits(origins, los_enu[rows], boxes).hit
+    hits = ray_hits(origins, los_enu[rows], boxes)
+    blocked = hits.hit
     reflected = np.zeros(rows.size, dtype=bool)
     excess = np.zeros(rows.size)
     excess_rate = np.zeros(rows.size)
+    bounce = None
     if config.nlos and np.any(blocked):
         b = np.flatnonzero(blocked)
         reflective = rng.uniform(size=(len(boxes.lo), 2)) < config.nlos_reflective_fraction
@@ -339,12 +355,33 @@ def simulate_gnss(
         )
         reflected[b] = bounce.found
         excess[b], excess_rate[b] = bounce.excess_m, bounce.excess_rate_mps
-    cn0_mean = (
-        config.cn0_horizon_dbhz
-        + (config.cn0_zenith_dbhz - config.cn0_horizon_dbhz) * np.sin(elevation[rows])
-        - config.nlos_loss_db * reflected
-    )
-    received = (~blocked | reflected) & (cn0_mean >= config.tracking_threshold_dbhz)
+    weight = None
+    if config.canyon is None:
+        cn0_mean = (
+            config.cn0_horizon_dbhz
+            + (config.cn0_zenith_dbhz - config.cn0_horizon_dbhz) * np.sin(elevation[rows])
+            - config.nlos_loss_db * reflected
+        )
+        received = (~blocked | reflected) & (cn0_mean >= config.tracking_threshold_dbhz)
+    else:
+        scatter = scatterers(position_enu, len(sats), dt, boxes, config.canyon, rng)
+        mixed = canyon_rows(
+            config,
+            los_enu[rows],
+            elevation[rows],
+            origins,
+            velocity_enu[epoch[rows]],
+            hits.distance,
+            hits.box,
+            scatter,
+            scatter.episode.ravel()[rows],
+            SPEED_OF_LIGHT / np.array([FREQUENCIES_HZ[s]["1"] for s in system[rows]]),
+            boxes,
+            rng,
+        )
+        cn0_mean, received, weight = mixed.cn0_dbhz, mixed.received, mixed.weight[mixed.received]
+        reflected = blocked.copy()
+        excess, excess_rate = mixed.excess_m, mixed.excess_rate_mps
     rows, reflected, cn0 = rows[received], reflected[received], cn0_mean[received]
     excess, excess_rate = excess[received], excess_rate[received]
     k = epoch[rows]
@@ -374,7 +411,10 @@ def simulate_gnss(
         cn0 = cn0 + rng.normal(0.0, config.cn0_noise_db, rows.size)
         scale = 10.0 ** ((CN0_NOISE_REFERENCE_DBHZ - cn0) / 20.0)
         pseudorange += rng.normal(0.0, 1.0, rows.size) * config.sigma_pseudorange_m * scale
-        range_rate += rng.normal(0.0, 1.0, rows.size) * config.sigma_range_rate_mps * scale
+        if config.canyon is None:
+            range_rate += rng.normal(0.0, 1.0, rows.size) * config.sigma_range_rate_mps * scale
+        else:
+            range_rate += rng.normal(0.0, 1.0, rows.size) * thermal_sigma_mps(config, cn0)
     count = np.bincount
     return GnssSimulation(
         epoch_time=np.asarray(epoch_time, dtype=float),
@@ -394,4 +434,6 @@ def simulate_gnss(
         elevation=el,
         azimuth=az,
         reflected=reflected,
+        range_rate_direct_mps=true_range_rate - excess_rate,
+        scatter_weight=weight,
     )

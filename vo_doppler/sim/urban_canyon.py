@@ -588,7 +588,7 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
             "yaw_rate_noise_dps": config.can.yaw_rate_noise_dps,
             "long_accel_bias_mps2": config.can.long_accel_bias_mps2,
             "long_accel_noise_mps2": config.can.long_accel_noise_mps2,
-            "gnss": _plain(asdict(config.gnss)),
+            "gnss": _gnss_truth(config.gnss),
         },
         "city": {
             "blocks": list(city.blocks),
@@ -604,6 +604,15 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
     with open(out / "sequence.yaml", "w") as stream:
         yaml.safe_dump(manifest, stream, sort_keys=False)
     return files
+
+
+def _gnss_truth(gnss: GnssSimConfig) -> dict:
+    """The GNSS settings for the manifest's ``truth`` (``canyon`` only for the real canyon, so
+    the geometric canyon's manifest is what it was before the option existed)."""
+    settings = _plain(asdict(gnss))
+    if gnss.canyon is None:
+        del settings["canyon"]
+    return settings
 
 
 def _plain(value):
