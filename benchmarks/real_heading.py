@@ -284,7 +284,7 @@ def evaluate(
         "kind": kind,
         "conventional_gnss": conventional_figures(sequence, gnss.velocity),
         "standstill_gnss": standstill_figures(sequence, gnss.velocity),
-        "truth_wheel_scale": scale_truth,
+        "truth_wheel_scale": scale_truth if np.isfinite(scale_truth) else None,
         "truth_gyro_bias_dps": float(np.degrees(bias_truth)),
         "doppler_noise": [model.to_dict() for model in gnss.noise_models.values()],
         "methods": {},
@@ -436,7 +436,10 @@ def print_heading(console: Console, name: str, figures: dict) -> None:
             "DR alone / + conv / + TC [m/100 m]",
         ),
     )
-    truth = f"({figures['truth_wheel_scale']:.4f})", f"({figures['truth_gyro_bias_dps']:.3f})"
+    truth = (
+        f"({_fmt(figures['truth_wheel_scale'], '.4f')})",
+        f"({figures['truth_gyro_bias_dps']:.3f})",
+    )
     for method, m in figures["methods"].items():
         for case, f in m["cases"].items():
             dr = m["dead_reckoning"][case]
@@ -459,12 +462,32 @@ def _choice(value: str, names: tuple[str, ...]) -> tuple[str, ...]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(add_help=False)
+    parser = argparse.ArgumentParser(
+        prog="real_heading.py", add_help=False, description="This benchmark's own options:"
+    )
     parser.add_argument("--calibration", choices=CALIBRATION_METHODS, default="ls")
-    parser.add_argument("--rate", type=float, default=None)
-    parser.add_argument("--heading-method", choices=(*HEADING_METHODS, "both"), default="both")
-    parser.add_argument("--noise", choices=(*NOISES, "both"), default="both")
+    parser.add_argument(
+        "--rate",
+        type=float,
+        default=None,
+        metavar="HZ",
+        help="decimate every sequence's GNSS to this rate (default: as recorded)",
+    )
+    parser.add_argument(
+        "--heading-method",
+        choices=(*HEADING_METHODS, "both"),
+        default="both",
+        help="the heading stage's method (default: both)",
+    )
+    parser.add_argument(
+        "--noise",
+        choices=(*NOISES, "both"),
+        default="both",
+        help="Doppler σ: the receiver's (else the C/N0 model) or fitted (default: both)",
+    )
     chosen, rest = parser.parse_known_args(argv)
+    if {"-h", "--help"} & set(rest):
+        parser.print_help()
     if chosen.rate is not None and not chosen.rate > 0:
         parser.error(f"--rate {chosen.rate}: give a positive rate in Hz")
     methods = _choice(chosen.heading_method, tuple(HEADING_METHODS))
