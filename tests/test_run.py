@@ -375,8 +375,11 @@ def test_the_library_run_checks_the_inputs_and_returns_its_warnings(turning_driv
     assert result.heading.clock_residual_offset_s == pytest.approx(0.0, abs=0.15)
     # a gyro 5 °/s off (beyond a car's sensor; the true bias is 0.3 °/s)
     offset = SensorSeries(turning_drive.yaw_rate.t, turning_drive.yaw_rate.value + np.radians(5))
-    (warning,) = run_sequence(replace(turning_drive, yaw_rate=offset)).warnings
+    warnings = run_sequence(replace(turning_drive, yaw_rate=offset)).warnings
+    (warning,) = [w for w in warnings if w.startswith("gyro bias")]
     assert warning.startswith("gyro bias: the calibration gives +5.3")
+    # turning 5 °/s more than the course, the gyro confirms no turn: its sign is unchecked
+    assert any("its sign could not be checked" in w for w in warnings)
 
 
 def test_the_library_run_refuses_a_yaw_rate_of_the_wrong_sign_or_in_deg_per_s(turning_drive):

@@ -679,7 +679,26 @@ def heading_warnings(
     )
     bias = gyro_bias_warning(float(table.gyro_bias[-1])) if bias_calibrated and len(table) else None
     undecided = sign_undecided_warning(sign, source)
-    return estimate, found + [w for w in (bias, undecided) if w]
+    untested = continuity_warning(velocity)
+    return estimate, found + [w for w in (bias, undecided, untested) if w]
+
+
+def continuity_warning(velocity: VelocitySolution) -> str | None:
+    """A warning when the course-continuity test (2b) could not judge most valid epochs (its
+    neighbours within ±0.5 s: a 1-Hz receiver has none), so that their validity rests on the
+    epoch's own tests and the heading stage's gyro and wheel test alone."""
+    tested = velocity.continuity_tested
+    if tested is None or not velocity.valid.any():
+        return None
+    share = float(tested.sum() / velocity.valid.sum())
+    if share >= 0.5:
+        return None
+    return (
+        f"GNSS course continuity: judged {share:.0%} of the valid epochs only (it needs "
+        "neighbours within ±0.5 s; the epochs are "
+        f"{float(np.median(np.diff(velocity.t))):.2g} s apart): the others rest on their own "
+        "chi-square and vertical tests and on the gyro and wheel test"
+    )
 
 
 def sign_undecided_warning(

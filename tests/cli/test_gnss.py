@@ -36,7 +36,7 @@ def test_velocity_and_spp_commands(tmp_path):
     table = np.array(rows, dtype=float)
     speed = np.hypot(table[:, 1], table[:, 2])
     course = np.mod(np.rad2deg(np.arctan2(table[:, 1], table[:, 2])), 360.0)
-    np.testing.assert_allclose(np.hypot(speed, table[:, 3]), table[:, 4], atol=2e-4)
+    np.testing.assert_allclose(speed, table[:, 4], atol=2e-4)  # speed_mps is horizontal
     fast = table[:, 4] > 0.5
     np.testing.assert_allclose(course[fast], table[fast, 5], atol=0.05)
     assert (out.with_suffix(".png")).stat().st_size > 10_000

@@ -9,6 +9,7 @@ from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.gnss.doppler_velocity import solve_velocity
 from vo_doppler.gnss.windowed_line import ConsistencyConfig
 from vo_doppler.heading.from_gnss import heading_from_gnss
+from vo_doppler.heading.integrity import conventional_integrity
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.series import SensorSeries
@@ -101,3 +102,27 @@ def test_reflections_that_pass_the_chi_square_fail_the_gyro_test():
     unchecked = heading_from_gnss(t, rows, velocity, wheel, gyro, FRAME, off)
     np.testing.assert_array_equal(unchecked.conv_valid, velocity.valid)
     np.testing.assert_array_equal(unchecked.yaw_tc, table.yaw_tc)  # tight heading untouched
+
+
+def test_a_speed_while_the_wheels_stand_fails_whatever_its_sigma():
+    t = np.arange(20.0)
+    valid = np.ones(20, bool)
+    speed = np.full(20, 0.05)
+    speed[10] = 0.75  # reflected satellites pulled the fix
+    wheel = np.zeros(20)
+    result = conventional_integrity(
+        t, valid, np.zeros(20), None, np.zeros(20), speed, np.full(20, 0.3), wheel, np.zeros(20)
+    )
+    assert not result.valid[10] and result.valid[[9, 11]].all()
+    moving = conventional_integrity(
+        t,
+        valid,
+        np.zeros(20),
+        None,
+        np.zeros(20),
+        speed + 5,
+        np.full(20, 0.3),
+        wheel + 5,
+        np.zeros(20),
+    )
+    assert moving.valid[10]  # 0.75 m/s off at 5 m/s is within the speed test's 3σ here

@@ -27,14 +27,21 @@ def test_window_length_is_the_same_at_every_rate(rate_hz):
     assert np.allclose(length[t > 10.0], 4.0, atol=1.0 / rate_hz + 1e-9)
 
 
-def test_window_stays_short_without_gyro_calibration_or_at_speed():
+def test_window_grows_while_the_gyro_makes_it_worthwhile_and_not_beyond_the_road():
     t = np.arange(0.0, 30.0, 1.0)
-    information = np.full(t.size, 1.0)  # far below the target: would grow to the maximum
-    assert np.all(window_lengths(t, information, ROBUST)[10:] == ROBUST.max_window_s)
-    uncalibrated = window_lengths(t, information, ROBUST, gyro_bias_sigma=np.radians(0.5))
-    assert np.all(uncalibrated == ROBUST.window_s)
-    fast = window_lengths(t, information, ROBUST, speed=20.0)
-    np.testing.assert_allclose(fast[10:], ROBUST.max_window_m / 20.0)
+    sparse = np.full(t.size, 1.0)  # far below the target: grows to the maximum (whole epochs)
+    longest = window_lengths(t, sparse, ROBUST)[10:]
+    assert np.all((longest <= ROBUST.max_window_s) & (longest > ROBUST.max_window_s - 1.0))
+    # an uncalibrated gyro (0.5 °/s) over rows that already give 0.5° in 2 s: 1/I + (σ_b·W/2)²
+    # is least at the shortest window
+    bias = np.radians(0.5)
+    rich = np.full(t.size, 0.5 * np.radians(0.5) ** -2.0)
+    assert np.all(window_lengths(t, rich, ROBUST, gyro_bias_sigma=bias)[10:] == ROBUST.window_s)
+    # the same gyro over rows that hold almost nothing: a longer window is still worth it
+    assert np.all(window_lengths(t, sparse, ROBUST, gyro_bias_sigma=bias)[10:] > 4.0)
+    fast = window_lengths(t, sparse, ROBUST, speed=20.0)
+    assert np.all(fast[10:] <= ROBUST.max_window_m / 20.0)
+    assert np.all(fast[10:] >= ROBUST.max_window_m / 20.0 - 1.0)
 
 
 def test_one_clock_drift_per_epoch_from_half_a_second_between_epochs():
@@ -56,3 +63,14 @@ def test_reliability_in_seconds_judges_the_same_stretch_at_every_rate(rate_hz):
     assert not reliable[(t >= 10.0) & (t < 11.0)].any()  # the majority disagrees
     # once the wrong second is less than a quarter of the last 5 s, consensus returns
     assert reliable[t >= 10.0 + 1.0 + 5.0].all()
+
+
+@pytest.mark.parametrize("rate_hz", [1, 5, 10, 20])
+def test_window_holds_enough_equations_beyond_its_clock_unknowns(rate_hz):
+    t = np.arange(0.0, 30.0, 1.0 / rate_hz)
+    rich = np.full(t.size, 1e12)  # plenty of information: the minimum would do
+    one_each = (np.ones(t.size), 0)  # two satellites, one clock drift per epoch
+    length = window_lengths(t, rich, ROBUST, speed=20.0, equations=one_each)
+    # four equations need four epochs: 3.5 s at 1 Hz, the 2-s minimum from 2 Hz on
+    expected = max(ROBUST.window_s, (ROBUST.min_window_equations - 0.5) / rate_hz)
+    np.testing.assert_allclose(length[t > 10.0], expected)

@@ -38,6 +38,7 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.vehicle_source import VehicleSignalSource
 from vo_doppler.report.heading_figure import heading_figure
 from vo_doppler.report.json_text import json_text
+from vo_doppler.report.run_outputs import final_calibration
 
 log = logging.getLogger(__name__)
 
@@ -302,6 +303,7 @@ def run(args: argparse.Namespace) -> int:
     write_heading_csv(args.output, table)
     truth = read_trajectory(args.gt).yaw_at(table.t) if args.gt else None
     heading_figure(figure, table, truth, args.obs.name)
+    final = final_calibration(table)
     summary = {
         "epochs": len(table),
         "tc_available": float(table.tc_available.mean()),
@@ -310,8 +312,9 @@ def run(args: argparse.Namespace) -> int:
         "rejected_rows": int(table.rejected_rows.sum()),
         "epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "tc_verifiable": float(table.tc_verifiable.mean()),
-        "gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
-        "wheel_scale": float(table.wheel_scale[-1]),
+        "gyro_bias_dps": final["final_gyro_bias_dps"],
+        "wheel_scale": final["final_wheel_scale"],
+        "calibration": None if table.calibration is None else table.calibration.to_dict(),
         "output": str(args.output),
         "figure": str(figure),
         "warnings": warnings,

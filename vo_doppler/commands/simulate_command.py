@@ -271,7 +271,7 @@ def register(subparsers, summary: str) -> None:
         "--canyon-realism",
         choices=REALISM_LEVELS,
         default=REALISM_LEVELS[0],
-        help="geometric (default): direct rays and specular facade reflections; real: the "
+        help="geometric: direct rays and specular facade reflections; real: the "
         "canyon measured on a u-blox M8T in Hong Kong (diffraction over the roofs, diffuse "
         "scattering whose Doppler error grows with speed and weakness, C/N0 22-44 dB-Hz, a "
         "clock drift jumping 0.17 m/s per 1-Hz epoch; replaces --nlos's specular reflections)",

@@ -31,11 +31,13 @@ def continuity_checked(
     solution: VelocitySolution, config: ConsistencyConfig = CONTINUITY
 ) -> VelocitySolution:
     """``solution`` with ``valid`` cleared where the course fails the continuity test (module
-    docstring); ``verified`` (the epoch's own tests) is kept."""
+    docstring) and ``continuity_tested`` set where it could judge; ``verified`` (the epoch's
+    own tests) is kept."""
     if not config.enabled or solution.course_sigma_rad is None:
         return solution
     velocity = solution.velocity_enu
     t, valid = solution.t, solution.valid
     course = np.arctan2(velocity[:, 1], velocity[:, 0])
     test = consistency_test(t, course, solution.course_sigma_rad, valid, config, angular=True)
-    return replace(solution, valid=valid & ~test.failed)
+    tested = valid & np.isfinite(test.z)
+    return replace(solution, valid=valid & ~test.failed, continuity_tested=tested)

@@ -4,7 +4,7 @@ velocities (no file I/O)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -16,6 +16,7 @@ from vo_doppler.gnss.doppler_velocity import (
     solve_velocity,
     solve_with_fitted_noise,
 )
+from vo_doppler.gnss.moving_noise import MovingNoiseModel, moving_noise_weights
 from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
 from vo_doppler.gnss.receiver_track import smoothed_track
@@ -40,6 +41,9 @@ class GnssVelocityResult:
     noise_fitted: bool
     """True when the rows' σ are the fitted ones; else the models are fitted for the record
     (one pass on the residuals of the solution as weighted) and not applied."""
+    moving_noise: MovingNoiseModel = field(default_factory=MovingNoiseModel)
+    """The rest factor and speed share of the rows' σ (``moving_noise``), applied to every row
+    before the final solution."""
 
 
 RANGE_RATE_SOURCES = ("doppler", "phase")
@@ -120,6 +124,7 @@ def gnss_velocity(
     receiver_ecef: np.ndarray | None = None,
     reported_sigma: ReportedSigma | None = None,
     fit_noise: bool = False,
+    moving_noise: bool = True,
 ) -> GnssVelocityResult:
     """Per-epoch Doppler velocity. Line-of-sight vectors use ``receiver_ecef`` where given, else
     the SPP fixes smoothed along the Doppler velocities (``receiver_track``: the velocities
@@ -128,7 +133,10 @@ def gnss_velocity(
     ``range_rate`` 'phase' replaces the Doppler by the carrier-phase rate (``phase_rate``);
     ``reported_sigma`` the receiver's σ of the range rates (weights where present);
     ``fit_noise`` re-solves with σ fitted to the residuals (``solve_with_fitted_noise``);
-    without it the σ models are still fitted, for the record.
+    without it the σ models are still fitted, for the record. Either way, unless
+    ``moving_noise`` is False, the rows' σ are then scaled to the receiver's noise at rest and
+    given their speed share (:mod:`vo_doppler.gnss.moving_noise`) and the velocity solved
+    again.
 
     Arguments out of their domain (an elevation mask outside [0, π/2) rad, band digits that are
     not digits or absent from the file, a receiver position off the Earth, an unknown
@@ -177,4 +185,8 @@ def gnss_velocity(
     else:
         velocity = solve_velocity(rows, obs.epoch_time)
         models = fit_noise_models(rows, velocity)
-    return GnssVelocityResult(velocity, rows, spp, np.asarray(position), models, fit_noise)
+    moving = MovingNoiseModel()
+    if moving_noise:
+        rows, moving = moving_noise_weights(rows, velocity)
+        velocity = solve_velocity(rows, obs.epoch_time)
+    return GnssVelocityResult(velocity, rows, spp, np.asarray(position), models, fit_noise, moving)

@@ -14,19 +14,17 @@ import numpy as np
 from vo_doppler.checks import check_vehicle_overlap, check_yaw_rate_unit, heading_warnings
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.doppler_velocity import doppler_rows, solve_velocity
-from vo_doppler.gnss.noise_model import normalised_residuals
+from vo_doppler.gnss.moving_noise import moving_noise_weights
 from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.heading.conventional import velocity_heading_sigma
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
-from vo_doppler.heading.row_noise import RowNoiseModel, fit_row_noise
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.series import SensorSeries
-from vo_doppler.model.timeseries import sample
 from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 log = logging.getLogger(__name__)
@@ -73,6 +71,7 @@ def emulated_canyon(
         reported_sigma=reported_sigma,
     )
     rows = keep_highest_satellites(rows, n_keep, after_t)
+    rows, _ = moving_noise_weights(rows, solve_velocity(rows, obs.epoch_time))
     return rows, solve_velocity(rows, obs.epoch_time)
 
 
@@ -81,19 +80,6 @@ def conventional_heading_sigma(velocity: VelocitySolution, enu: EnuFrame) -> np.
     covariance turned into the ENU frame ``enu``
     (:func:`~vo_doppler.heading.conventional.velocity_heading_sigma`)."""
     return velocity_heading_sigma(velocity.velocity_enu, velocity.covariance, enu.rotation)
-
-
-def moving_receiver_weights(
-    rows: DopplerRows, velocity: VelocitySolution, wheel_speed: SensorSeries
-) -> tuple[DopplerRows, RowNoiseModel]:
-    """The rows re-weighted by the moving receiver's noise model fitted to the conventional
-    solutions' residuals (:mod:`vo_doppler.heading.row_noise`), and the model."""
-    cn0 = rows.cn0 if rows.cn0 is not None else np.full(len(rows), np.nan)
-    speed = sample(wheel_speed.t, wheel_speed.value, rows.t)
-    prior = rows.sigma()
-    residual = normalised_residuals(rows, velocity) if rows.epoch is not None else prior * np.nan
-    noise = fit_row_noise(residual, prior, cn0, speed)
-    return replace(rows, weight=noise.sigma(prior, cn0, speed) ** -2.0), noise
 
 
 def heading_from_gnss(
@@ -124,9 +110,6 @@ def heading_from_gnss(
     before the work too (:func:`~vo_doppler.checks.check_vehicle_overlap`)."""
     check_vehicle_overlap(wheel_speed, yaw_rate, epoch_time, source)
     check_yaw_rate_unit(yaw_rate, wheel_speed, source)
-    noise = None
-    if config.moving_noise:
-        rows, noise = moving_receiver_weights(rows, velocity, wheel_speed)
     table = heading_pipeline(
         epoch_time,
         rows.in_enu(),
@@ -143,7 +126,6 @@ def heading_from_gnss(
         conventional_untestable=velocity.untestable,
         conventional_vertical_sigma_mps=velocity.vertical_sigma_mps,
     )
-    table.doppler_noise = None if noise is None else noise.to_dict()
     table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)
     estimate, warnings = heading_warnings(
         table,

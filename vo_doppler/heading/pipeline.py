@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.heading.calibration import (
     PRIOR_GYRO_BIAS_SIGMA,
     PRIOR_WHEEL_SCALE_SIGMA,
@@ -53,7 +54,7 @@ from vo_doppler.heading.tight_heading import (
     tight_heading_series,
 )
 from vo_doppler.model.doppler import DopplerRows
-from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.heading import CalibrationSummary, HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
 
@@ -112,20 +113,16 @@ class HeadingPipelineConfig:
     prior."""
     fixed_gyro_bias: float | None = None
     fixed_wheel_scale: float | None = None
-    moving_noise: bool = False
-    """Weight the Doppler rows by the moving receiver's noise model fitted to the data
-    (:mod:`vo_doppler.heading.row_noise`) instead of their a-priori σ alone."""
 
     @classmethod
     def robust(cls) -> HeadingPipelineConfig:
-        """``--heading-method robust``: :meth:`TightHeadingConfig.robust`, the moving
-        receiver's noise model, and calibration fits over the last 600 s (a canyon's Doppler
+        """``--heading-method robust``: :meth:`TightHeadingConfig.robust` and calibration fits
+        over the last 600 s (a canyon's Doppler
         speeds scatter by metres per second; over 60 s the Hong Kong drive's wheel scale was
         1 % off, over 600 s 0.1 %)."""
         return cls(
             tight=TightHeadingConfig.robust(),
             gate=GateConfig(window_s=600.0),
-            moving_noise=True,
         )
 
 
@@ -241,7 +238,9 @@ def causal_calibration(
     return out
 
 
-def backfill_start(cal: CalibrationSeries, max_bias_sigma: float = np.inf) -> CalibrationSeries:
+def backfill_start(
+    cal: CalibrationSeries, max_bias_sigma: float = np.inf, covered: np.ndarray | None = None
+) -> CalibrationSeries:
     """The epochs before the first estimate of the gyro bias (of the wheel scale) take the
     median of the drive's estimates instead of the prior's value, and keep the prior's σ (in
     place; returned). So do the gyro bias's first estimates while their σ exceeds
@@ -260,6 +259,7 @@ def backfill_start(cal: CalibrationSeries, max_bias_sigma: float = np.inf) -> Ca
     the dead reckoning by b_e·T for the rest of the drive, which no later estimate undoes. A
     first fit over 3–5 s of a dozen samples has σ 0.1–0.4 °/s
     (:attr:`HeadingPipelineConfig.backfill_bias_sigma`)."""
+    covered = np.ones(len(cal.bias), dtype=bool) if covered is None else covered
     bias_first = _first_precise(cal.bias_estimated, cal.bias_sigma, max_bias_sigma)
     scale_first = _first_precise(cal.scale_estimated, cal.scale_sigma, np.inf)
     for value, estimated, first in (
@@ -267,9 +267,28 @@ def backfill_start(cal: CalibrationSeries, max_bias_sigma: float = np.inf) -> Ca
         (cal.scale, cal.scale_estimated, scale_first),
     ):
         if first is not None:
-            value[:first] = np.median(value[first:][estimated[first:]])
+            drive = estimated[first:] & covered[first:]
+            value[:first] = np.median(value[first:][drive if drive.any() else estimated[first:]])
             estimated[:first] = True
     return cal
+
+
+def calibration_summary(cal: CalibrationSeries, covered: np.ndarray) -> CalibrationSummary | None:
+    """:class:`~vo_doppler.model.heading.CalibrationSummary` over the ``covered`` epochs (None
+    when the vehicle signals cover none)."""
+    if not covered.any():
+        return None
+    last = int(np.flatnonzero(covered)[-1])
+
+    def stats(value, sigma):
+        v = value[covered]
+        median = float(np.median(v))
+        spread = MAD_TO_SIGMA * float(np.median(np.abs(v - median)))
+        return median, spread, float(np.median(sigma[covered])), float(value[last])
+
+    return CalibrationSummary(
+        *stats(cal.bias, cal.bias_sigma), *stats(cal.scale, cal.scale_sigma), int(covered.sum())
+    )
 
 
 def _first_precise(estimated: np.ndarray, sigma: np.ndarray, max_sigma: float) -> int | None:
@@ -471,9 +490,11 @@ def heading_pipeline(
     )
     calibrating &= np.abs(np.nan_to_num(conv_speed - wheel, nan=np.inf)) <= tolerance
     raw_angle = integral_at(yaw_rate.t, yaw_rate.value, t_epoch)
+    covered = np.isfinite(wheel) & np.isfinite(raw_angle)
     cal = backfill_start(
         causal_calibration(t_epoch, conv_speed, conv_yaw, calibrating, wheel, raw_angle, config),
         config.backfill_bias_sigma,
+        covered,
     )
 
     def solve(cal: CalibrationSeries) -> _Pass:
@@ -569,4 +590,5 @@ def heading_pipeline(
         sigma_conv_gnss=_sigma_where(conventional_yaw_sigma, conv_ok),
         grade_prior_sigma=solved.grade[1],
         grade_from_accelerometer=solved.grade_from_accelerometer,
+        calibration=calibration_summary(cal, covered),
     )

@@ -105,6 +105,8 @@ class TightHeadingConfig:
     max_window_s: float = 2.0
     """The longest window (s): the gyro's bias error and the straight-road model's grade grow
     with it."""
+    min_window_equations: int = 4
+    """… but holds at least this many rows beyond its clock unknowns (:func:`window_lengths`)."""
     max_window_m: float = 40.0
     """… nor longer than this stretch of road (m) at the epoch's speed (one grade per window)."""
     window_target_sigma_rad: float = np.radians(0.15)
@@ -854,12 +856,18 @@ class _WindowRows:
         index = np.flatnonzero(usable)
         row_group = np.unique(rows.sat_id, return_inverse=True)[1].reshape(-1)
         row_epoch = epoch_of_row[index]
-        information = np.bincount(
-            row_epoch,
-            rows.weight[index] * speed[row_epoch] ** 2 * np.sum(rows.los[index, :2] ** 2, axis=1),
-            minlength=m,
-        )[:m]
-        length = window_lengths(t_epoch, information, config, gyro_bias_sigma, speed)
+        per_epoch_clock = clock_per_epoch(t_epoch, config)
+        information, equations = epoch_information(
+            rows.weight[index], rows.los[index], speed, row_epoch, m, per_epoch_clock
+        )
+        length = window_lengths(
+            t_epoch,
+            information,
+            config,
+            gyro_bias_sigma,
+            speed,
+            (equations, 0 if per_epoch_clock else 2),
+        )
         lo = np.searchsorted(t_epoch[row_epoch], t_epoch - length, side="right")
         hi = np.searchsorted(t_epoch[row_epoch], t_epoch, side="right")
         if calibration is None:
@@ -907,13 +915,16 @@ def window_lengths(
     config: TightHeadingConfig,
     gyro_bias_sigma: np.ndarray | float = 0.0,
     speed: np.ndarray | float = 0.0,
+    equations: tuple[np.ndarray, int] | None = None,
 ) -> np.ndarray:
-    """Length (s) of the window ending at each epoch: ``config.window_s``, or longer, up to
-    ``config.max_window_s``, until the rows inside hold the information of a heading σ of
-    ``config.window_target_sigma_rad``.
+    """Length (s) of the window ending at each epoch: ``config.window_s``, or longer until the
+    rows inside hold the information of a heading σ of ``config.window_target_sigma_rad``, but
+    no longer than the gyro makes worthwhile, ``config.max_window_s`` and
+    ``config.max_window_m`` of road.
 
     ``information`` per epoch is Σ (s·|g_h|/σ_i)² over its rows (s the speed, g_h the line of
-    sight's horizontal part, σ_i the row's σ): the Fisher information on θ₀ of rows whose
+    sight's horizontal part, σ_i the row's σ; with one clock drift per epoch, times (n − 1)/n
+    for its n satellites, :func:`epoch_information`): the Fisher information on θ₀ of rows whose
     lines of sight surround the receiver, an upper bound otherwise. Rows closer in time than
     ``config.noise_correlation_s`` are not independent (a reflection's Doppler error lasts
     about that long), so an epoch counts for min(1, Δt / correlation time) of its rows: the
@@ -921,14 +932,22 @@ def window_lengths(
     minimum holds; at 1 Hz in a street canyon (weak signals, σ of metres per second) the
     window grows to several seconds.
 
-    A window grows only as far as the gyro allows: a bias error of σ_b turns the rows of a
-    window of length W by up to σ_b·W, which moves θ₀ by about σ_b·W/2, so W stays within
-    2·target/σ_b (``gyro_bias_sigma`` per epoch, rad/s). Before the bias is calibrated that
-    is the minimum: on the comma2k19 minute in a two-satellite canyon from its start, 8-s
-    windows with the prior's bias settled on the mirror root (15° median error). Nor does it
-    grow beyond ``config.max_window_m`` of road at the epoch's ``speed``: the model holds one
-    grade per window, and a road's grade changes over a few tens of metres (the same minute
-    with 8-s windows, 160 m at 20 m/s, went to the mirror root with the bias calibrated)."""
+    The gyro: a bias error of σ_b (``gyro_bias_sigma`` per epoch, rad/s) turns the rows of a
+    window of length W by up to σ_b·W, which moves θ₀ by about σ_b·W/2. The window stops
+    growing where 1/I(W) + (σ_b·W/2)² is least: before the bias is calibrated that keeps it
+    short wherever the rows are informative (on the comma2k19 minute in a two-satellite canyon
+    from its start at 10 Hz, 8-s windows with the prior's bias settled on the mirror root, 15°
+    median error), and lets it grow where a short window holds too little (the same at 1 Hz).
+    The road: the model holds one grade per window, and a road's grade changes over a few tens
+    of metres (at 10 Hz with 8-s windows, 160 m at 20 m/s, the minute went to the mirror root
+    with the bias calibrated).
+
+    Whatever those limits, up to ``config.max_window_s`` a window holds at least
+    ``config.min_window_equations`` rows beyond its clock unknowns (``equations``: per epoch
+    the rows left by its own clock drift, and how many unknowns the window's clock has besides):
+    two satellites of a 1-Hz receiver with one clock drift per epoch give one equation per
+    epoch, and a 2-s window of them cannot tell θ₀ from its mirror (the comma2k19 minute
+    decimated to 1 Hz in a two-satellite canyon had no heading at all)."""
     t_epoch = np.asarray(t_epoch, dtype=float)
     m = len(t_epoch)
     if m == 0:
@@ -938,19 +957,63 @@ def window_lengths(
         1.0, interval / config.noise_correlation_s
     )
     total = np.concatenate([[0.0], np.cumsum(counted)])
-    target = config.window_target_sigma_rad**-2.0
-    # the latest first epoch s with Σ_{s..k} ≥ target: total[s] ≤ total[k + 1] − target
-    first = np.searchsorted(total, total[1:] - target, side="right") - 1
-    enough = first >= 0
-    needed = np.where(enough, t_epoch - t_epoch[np.maximum(first, 0)], np.inf)
-    # the window (t_k − W, t_k] must hold epoch s: W just above t_k − t_s
-    needed = needed + 0.5 * np.minimum(interval, config.epoch_match_s * 1e3)
     with np.errstate(divide="ignore"):
-        gyro_limit = 2.0 * config.window_target_sigma_rad / np.asarray(gyro_bias_sigma, float)
         road_limit = config.max_window_m / np.abs(np.asarray(speed, dtype=float))
-    longest = np.minimum(max(config.max_window_s, config.window_s), gyro_limit)
-    longest = np.minimum(longest, np.nan_to_num(road_limit, nan=np.inf))
-    return np.clip(np.minimum(needed, longest), config.window_s, None)
+    longest = np.minimum(
+        max(config.max_window_s, config.window_s),
+        np.broadcast_to(np.nan_to_num(road_limit, nan=np.inf), (m,)),
+    )
+    bias = np.broadcast_to(np.asarray(gyro_bias_sigma, dtype=float), (m,))
+    target = config.window_target_sigma_rad**-2.0
+    k = np.arange(m)
+    best = np.full(m, np.inf)
+    length = np.full(m, config.window_s)
+    reached = np.zeros(m, dtype=bool)
+    for lag in range(m):
+        s = np.maximum(k - lag, 0)
+        # the window (t_k − W, t_k] holds epoch s: W half an epoch interval beyond t_k − t_s
+        w = t_epoch - t_epoch[s] + 0.5 * interval[s]
+        inside = (k - lag >= 0) & ((w <= longest) | (w <= config.window_s))
+        if not inside.any():
+            break
+        held = total[k + 1] - total[s]
+        with np.errstate(divide="ignore"):
+            cost = 1.0 / held + (bias * w / 2.0) ** 2
+        better = inside & ~reached & (cost < best)
+        best = np.where(better, cost, best)
+        length = np.where(better, w, length)
+        reached |= inside & (held >= target)
+    length = np.maximum(length, config.window_s)
+    if equations is None:
+        return length
+    per_epoch, clock_unknowns = equations
+    held = np.concatenate([[0.0], np.cumsum(per_epoch)])
+    needed = config.min_window_equations + clock_unknowns
+    first = np.searchsorted(held, held[1:] - needed, side="right") - 1
+    s = np.maximum(first, 0)
+    observable = np.where(first >= 0, t_epoch - t_epoch[s] + 0.5 * interval[s], np.inf)
+    return np.maximum(length, np.minimum(observable, max(config.max_window_s, config.window_s)))
+
+
+def epoch_information(
+    weight: np.ndarray,
+    los: np.ndarray,
+    speed: np.ndarray,
+    epoch: np.ndarray,
+    m: int,
+    per_epoch_clock: bool,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Σ (s·|g_h|/σ_i)² of the rows of each of ``m`` epochs (:func:`window_lengths`) and their
+    count n; with one clock drift per epoch, times (n − 1)/n and n − 1 (what that unknown
+    leaves of them)."""
+    information = np.bincount(
+        epoch, weight * speed[epoch] ** 2 * np.sum(los[:, :2] ** 2, axis=1), minlength=m
+    )[:m]
+    n = np.bincount(epoch, minlength=m)[:m].astype(float)
+    if not per_epoch_clock:
+        return information, n
+    left = np.maximum(n - 1.0, 0.0)
+    return information * left / np.maximum(n, 1.0), left
 
 
 def windows_per_chunk(width: int, n_groups: int, config: TightHeadingConfig) -> int:

@@ -73,9 +73,14 @@ class VelocitySolution:
     from elsewhere tests it (the heading stage's robust calibration against the wheels and the
     gyro); None: no such epoch flagged."""
 
+    continuity_tested: np.ndarray | None = None
+    """Valid epochs whose course the continuity test (2b) could judge: it needs neighbours
+    within ±0.5 s, which a 1-Hz receiver never has (None: not run)."""
+
     @property
     def speed_mps(self) -> np.ndarray:
-        return np.linalg.norm(self.velocity_enu, axis=1)
+        """Horizontal speed (m/s): a car's speed; the vertical of a canyon fix is noise."""
+        return np.hypot(self.velocity_enu[:, 0], self.velocity_enu[:, 1])
 
     @property
     def sigma_mps(self) -> np.ndarray:

@@ -14,6 +14,38 @@ DEFAULT_TC_WINDOW_S = 2.0
 """The tight heading's window where a heading file does not state its own."""
 
 
+@dataclass(frozen=True)
+class CalibrationSummary:
+    """Gyro bias (rad/s) and wheel scale over the epochs the vehicle signals cover: the median
+    of the estimates current at those epochs, their spread (normalised MAD: how far the causal
+    estimate wandered) and the median of their σ; and the value at the last covered epoch (the
+    table holds it beyond, where nothing calibrates)."""
+
+    gyro_bias: float
+    gyro_bias_spread: float
+    gyro_bias_sigma: float
+    final_gyro_bias: float
+    wheel_scale: float
+    wheel_scale_spread: float
+    wheel_scale_sigma: float
+    final_wheel_scale: float
+    epochs: int
+
+    def to_dict(self) -> dict:
+        """Degrees per second for the bias, for people."""
+        return {
+            "gyro_bias_dps": float(np.degrees(self.gyro_bias)),
+            "gyro_bias_spread_dps": float(np.degrees(self.gyro_bias_spread)),
+            "gyro_bias_sigma_dps": float(np.degrees(self.gyro_bias_sigma)),
+            "final_gyro_bias_dps": float(np.degrees(self.final_gyro_bias)),
+            "wheel_scale": self.wheel_scale,
+            "wheel_scale_spread": self.wheel_scale_spread,
+            "wheel_scale_sigma": self.wheel_scale_sigma,
+            "final_wheel_scale": self.final_wheel_scale,
+            "epochs": self.epochs,
+        }
+
+
 @dataclass
 class HeadingTable:
     """One row per GNSS epoch. Yaw in rad counter-clockwise from east (NaN when unavailable)."""
@@ -59,11 +91,10 @@ class HeadingTable:
     """What the checks of the heading stage found doubtful in its inputs and calibration
     (:func:`vo_doppler.heading.from_gnss.heading_from_gnss`); not written to a heading CSV."""
     clock_residual_offset_s: float | None = None
-    doppler_noise: dict | None = None
-    """The moving receiver's Doppler noise model the tight heading weighted its rows with
-    (``heading.row_noise.RowNoiseModel.to_dict``), where it was fitted."""
     """The wheel speed's residual clock offset (s) against the GNSS Doppler speed, None when
     no lag was found or not checked (:func:`vo_doppler.checks.estimate_clock_offset`)."""
+    calibration: CalibrationSummary | None = None
+    """The drive's calibration over the epochs the vehicle signals cover."""
 
     def __post_init__(self) -> None:
         n = len(self.t)

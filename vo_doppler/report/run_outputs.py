@@ -86,7 +86,14 @@ scalar key of the summary has one (a test checks), so that the report shows no r
 
 NOT_AVAILABLE = "not available"
 
-NOT_FACTS = ("evaluation", "absolute_position_error", "time_order", "warnings", "doppler_noise")
+NOT_FACTS = (
+    "evaluation",
+    "absolute_position_error",
+    "time_order",
+    "warnings",
+    "doppler_noise",
+    "calibration",
+)
 """Summary keys that are not scalars: the report shows them as tables or a list of their own,
 or (``time_order``, ``doppler_noise``) leaves them to summary.json."""
 
@@ -119,8 +126,8 @@ def summarise(result: RunResult) -> dict:
         "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "grade_prior_from_accelerometer": float(np.mean(table.grade_from_accelerometer)),
         "grade_prior_sigma_median": _finite_median(table.grade_prior_sigma),
-        "final_wheel_scale": float(table.wheel_scale[-1]),
-        "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
+        **final_calibration(table),
+        "calibration": None if table.calibration is None else table.calibration.to_dict(),
         "doppler_noise": doppler_noise_summary(result),
     }
     _vo_summary(summary, result)
@@ -141,13 +148,29 @@ def _finite_median(values: np.ndarray) -> float | None:
     return float(np.median(finite)) if finite.size else None
 
 
+def final_calibration(table) -> dict:
+    """The wheel scale and gyro bias at the last epoch the vehicle signals cover (the table's
+    last value where the table has no calibration summary)."""
+    if table.calibration is not None:
+        return {
+            "final_wheel_scale": table.calibration.final_wheel_scale,
+            "final_gyro_bias_dps": float(np.degrees(table.calibration.final_gyro_bias)),
+        }
+    return {
+        "final_wheel_scale": float(table.wheel_scale[-1]),
+        "final_gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
+    }
+
+
 def doppler_noise_summary(result: RunResult) -> dict:
-    """The Doppler σ(C/N0, elevation) model fitted per receiver signal (``gnss.noise_model``)
-    and whether the run weighted the Doppler with it."""
+    """The Doppler σ(C/N0, elevation) model fitted per receiver signal (``gnss.noise_model``),
+    whether the run weighted the Doppler with it, and the rest factor and speed share that
+    every run applies (``gnss.moving_noise``)."""
     gnss = result.gnss
     return {
         "applied": gnss.noise_fitted,
         "models": [model.to_dict() for model in gnss.noise_models.values()],
+        "moving": gnss.moving_noise.to_dict(),
     }
 
 
