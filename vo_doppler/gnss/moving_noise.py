@@ -69,6 +69,11 @@ class MovingNoiseModel:
     n_moving_rows: int = 0
     n_bins: int = 0
 
+    @property
+    def identity(self) -> bool:
+        """The a-priori σ unchanged (nothing fitted, or fitted to no change)."""
+        return self.rest_factor == 1.0 and self.k_ref == 0.0
+
     def speed_coefficient(self, cn0: np.ndarray) -> np.ndarray:
         """k (m/s of σ per m/s of speed) of rows of C/N0 ``cn0`` (dB-Hz; missing: reference)."""
         cn0 = np.nan_to_num(np.asarray(cn0, dtype=float), nan=CN0_REFERENCE_DBHZ)
@@ -149,6 +154,8 @@ def moving_noise_weights(
     solved = np.hypot(solution.velocity_enu[:, 0], solution.velocity_enu[:, 1])
     prior = rows.sigma()
     model = fit_moving_noise(normalised_residuals(rows, solution), prior, cn0, solved[rows.epoch])
+    if model.identity:
+        return rows, model
     speed = epoch_speed(solution.t, solved)[rows.epoch]
     sigma = np.where(np.isfinite(speed), model.sigma(prior, cn0, speed), prior)
     return replace(rows, weight=sigma**-2.0), model

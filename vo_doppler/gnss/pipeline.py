@@ -188,5 +188,6 @@ def gnss_velocity(
     moving = MovingNoiseModel()
     if moving_noise:
         rows, moving = moving_noise_weights(rows, velocity)
-        velocity = solve_velocity(rows, obs.epoch_time)
+        if not moving.identity:
+            velocity = solve_velocity(rows, obs.epoch_time)
     return GnssVelocityResult(velocity, rows, spp, np.asarray(position), models, fit_noise, moving)

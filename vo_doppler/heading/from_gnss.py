@@ -71,8 +71,9 @@ def emulated_canyon(
         reported_sigma=reported_sigma,
     )
     rows = keep_highest_satellites(rows, n_keep, after_t)
-    rows, _ = moving_noise_weights(rows, solve_velocity(rows, obs.epoch_time))
-    return rows, solve_velocity(rows, obs.epoch_time)
+    first = solve_velocity(rows, obs.epoch_time)
+    rows, model = moving_noise_weights(rows, first)
+    return rows, first if model.identity else solve_velocity(rows, obs.epoch_time)
 
 
 def conventional_heading_sigma(velocity: VelocitySolution, enu: EnuFrame) -> np.ndarray:
