@@ -919,12 +919,13 @@ def window_lengths(
 ) -> np.ndarray:
     """Length (s) of the window ending at each epoch: ``config.window_s``, or longer until the
     rows inside hold the information of a heading σ of ``config.window_target_sigma_rad``, but
-    no longer than the gyro makes worthwhile, ``config.max_window_s`` and
-    ``config.max_window_m`` of road.
+    no longer than the gyro allows, ``config.max_window_s`` and ``config.max_window_m`` of
+    road; and at least as long as it takes to hold ``config.min_window_equations`` rows beyond
+    the clock unknowns.
 
     ``information`` per epoch is Σ (s·|g_h|/σ_i)² over its rows (s the speed, g_h the line of
     sight's horizontal part, σ_i the row's σ; with one clock drift per epoch, times (n − 1)/n
-    for its n satellites, :func:`epoch_information`): the Fisher information on θ₀ of rows whose
+    for its n rows, :func:`epoch_information`): the Fisher information on θ₀ of rows whose
     lines of sight surround the receiver, an upper bound otherwise. Rows closer in time than
     ``config.noise_correlation_s`` are not independent (a reflection's Doppler error lasts
     about that long), so an epoch counts for min(1, Δt / correlation time) of its rows: the
@@ -933,21 +934,21 @@ def window_lengths(
     window grows to several seconds.
 
     The gyro: a bias error of σ_b (``gyro_bias_sigma`` per epoch, rad/s) turns the rows of a
-    window of length W by up to σ_b·W, which moves θ₀ by about σ_b·W/2. The window stops
-    growing where 1/I(W) + (σ_b·W/2)² is least: before the bias is calibrated that keeps it
-    short wherever the rows are informative (on the comma2k19 minute in a two-satellite canyon
-    from its start at 10 Hz, 8-s windows with the prior's bias settled on the mirror root, 15°
-    median error), and lets it grow where a short window holds too little (the same at 1 Hz).
-    The road: the model holds one grade per window, and a road's grade changes over a few tens
-    of metres (at 10 Hz with 8-s windows, 160 m at 20 m/s, the minute went to the mirror root
-    with the bias calibrated).
+    window of length W by up to σ_b·W, which moves θ₀ by about σ_b·W/2, so W stays within
+    2·target/σ_b: before the bias is calibrated that is the minimum (on the comma2k19 minute in
+    a two-satellite canyon from its start, 8-s windows with the prior's bias settled on the
+    mirror root, 15° median error; the sample's canyon gave a first pass whose bias was
+    −1.2 °/s for a true 0.3 with the bias traded against noise instead). The road: the model
+    holds one grade per window, and a road's grade changes over a few tens of metres (at 10 Hz
+    with 8-s windows, 160 m at 20 m/s, the minute went to the mirror root with the bias
+    calibrated).
 
-    Whatever those limits, up to ``config.max_window_s`` a window holds at least
-    ``config.min_window_equations`` rows beyond its clock unknowns (``equations``: per epoch
-    the rows left by its own clock drift, and how many unknowns the window's clock has besides):
-    two satellites of a 1-Hz receiver with one clock drift per epoch give one equation per
-    epoch, and a 2-s window of them cannot tell θ₀ from its mirror (the comma2k19 minute
-    decimated to 1 Hz in a two-satellite canyon had no heading at all)."""
+    ``equations``: per epoch the rows left by its own clock drift, and how many unknowns the
+    window's clock has besides. Whatever the limits above, up to ``config.max_window_s``, a
+    window holds ``config.min_window_equations`` of them: two satellites of a 1-Hz receiver
+    with one clock drift per epoch give one equation per epoch, and a 2-s window of them cannot
+    tell θ₀ from its mirror (the comma2k19 minute decimated to 1 Hz in a two-satellite canyon
+    from its start had no heading at all; 83 % with this rule)."""
     t_epoch = np.asarray(t_epoch, dtype=float)
     m = len(t_epoch)
     if m == 0:
@@ -956,43 +957,30 @@ def window_lengths(
     counted = np.asarray(information, dtype=float) * np.minimum(
         1.0, interval / config.noise_correlation_s
     )
-    total = np.concatenate([[0.0], np.cumsum(counted)])
+    longest_s = max(config.max_window_s, config.window_s)
     with np.errstate(divide="ignore"):
+        gyro_limit = 2.0 * config.window_target_sigma_rad / np.asarray(gyro_bias_sigma, float)
         road_limit = config.max_window_m / np.abs(np.asarray(speed, dtype=float))
-    longest = np.minimum(
-        max(config.max_window_s, config.window_s),
-        np.broadcast_to(np.nan_to_num(road_limit, nan=np.inf), (m,)),
-    )
-    bias = np.broadcast_to(np.asarray(gyro_bias_sigma, dtype=float), (m,))
-    target = config.window_target_sigma_rad**-2.0
-    k = np.arange(m)
-    best = np.full(m, np.inf)
-    length = np.full(m, config.window_s)
-    reached = np.zeros(m, dtype=bool)
-    for lag in range(m):
-        s = np.maximum(k - lag, 0)
-        # the window (t_k − W, t_k] holds epoch s: W half an epoch interval beyond t_k − t_s
-        w = t_epoch - t_epoch[s] + 0.5 * interval[s]
-        inside = (k - lag >= 0) & ((w <= longest) | (w <= config.window_s))
-        if not inside.any():
-            break
-        held = total[k + 1] - total[s]
-        with np.errstate(divide="ignore"):
-            cost = 1.0 / held + (bias * w / 2.0) ** 2
-        better = inside & ~reached & (cost < best)
-        best = np.where(better, cost, best)
-        length = np.where(better, w, length)
-        reached |= inside & (held >= target)
-    length = np.maximum(length, config.window_s)
+    longest = np.minimum(np.minimum(longest_s, gyro_limit), np.nan_to_num(road_limit, nan=np.inf))
+    needed = _span_holding(t_epoch, interval, counted, config.window_target_sigma_rad**-2.0)
+    length = np.maximum(np.minimum(needed, longest), config.window_s)
     if equations is None:
         return length
     per_epoch, clock_unknowns = equations
-    held = np.concatenate([[0.0], np.cumsum(per_epoch)])
-    needed = config.min_window_equations + clock_unknowns
-    first = np.searchsorted(held, held[1:] - needed, side="right") - 1
+    observable = _span_holding(
+        t_epoch, interval, per_epoch, config.min_window_equations + clock_unknowns
+    )
+    return np.maximum(length, np.minimum(observable, longest_s))
+
+
+def _span_holding(t_epoch, interval, amount, target) -> np.ndarray:
+    """Per epoch k the shortest window (t_k − W, t_k] whose epochs' ``amount`` sums to
+    ``target`` (inf where all the epochs so far hold less): back to the latest epoch s with
+    Σ_{s..k} ≥ target, half an epoch interval beyond it."""
+    total = np.concatenate([[0.0], np.cumsum(amount)])
+    first = np.searchsorted(total, total[1:] - target, side="right") - 1
     s = np.maximum(first, 0)
-    observable = np.where(first >= 0, t_epoch - t_epoch[s] + 0.5 * interval[s], np.inf)
-    return np.maximum(length, np.minimum(observable, max(config.max_window_s, config.window_s)))
+    return np.where(first >= 0, t_epoch - t_epoch[s] + 0.5 * interval[s], np.inf)
 
 
 def epoch_information(
