@@ -28,7 +28,8 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.geo import EnuFrame
+from vo_doppler.eval.gnss_scores import held_course
+from vo_doppler.geo import EnuFrame, course_to_yaw
 from vo_doppler.io.sensor_csv import write_sensor_csv
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.series import SensorSeries
@@ -94,22 +95,12 @@ def read_reference(recording: Recording, path: Path) -> tuple[np.ndarray, np.nda
 
 def reference_course(t: np.ndarray, enu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Horizontal speed (m/s) and yaw (rad, counter-clockwise from east, unwrapped) of the
-    reference by central differences, the yaw held through stops below ``COURSE_HOLD_MPS``."""
-    velocity = np.gradient(enu[:, :2], t, axis=0)
+    reference by central differences, the course held through stops below ``COURSE_HOLD_MPS``
+    (:func:`~vo_doppler.eval.gnss_scores.held_course`, as ``eval gnss`` scores it)."""
+    velocity = np.gradient(enu, t, axis=0)
     speed = np.hypot(velocity[:, 0], velocity[:, 1])
-    yaw = np.arctan2(velocity[:, 1], velocity[:, 0])
-    moving = speed >= COURSE_HOLD_MPS
-    if moving.any():
-        first = int(np.argmax(moving))
-        held = np.where(moving, yaw, np.nan)
-        held[:first] = yaw[first]
-        for k in range(first + 1, len(held)):
-            if not np.isfinite(held[k]):
-                held[k] = held[k - 1]
-        yaw = held
-    else:
-        yaw = np.zeros_like(speed)
-    return speed, np.unwrap(yaw)
+    course = held_course(velocity, None, COURSE_HOLD_MPS)
+    return speed, np.unwrap(np.nan_to_num(course_to_yaw(course)))
 
 
 def vehicle_signals(
