@@ -655,7 +655,6 @@ def tight_heading_series(
     if windows.empty:
         return _unavailable(t_epoch, n_sat_epoch)
     width, n_groups, padded = windows.width, windows.n_groups, windows.padded
-    per_epoch_clock = clock_per_epoch(t_epoch, config)
     size = windows_per_chunk(width, n_groups, config)
     chunks = [np.arange(start, min(start + size, m)) for start in range(0, m, size)]
     noise = None
@@ -696,7 +695,7 @@ def tight_heading_series(
                 noise,
                 grade_coefficient,
                 windows.grade_at(k),
-                clock_epoch if per_epoch_clock else None,
+                clock_epoch if windows.per_epoch_clock else None,
             )
         )
     solution = _concatenate(solutions)
@@ -780,7 +779,7 @@ def speed_scale_ratio(
         tau,
         grade_coefficient if use_grade else None,
         windows.grade_at(chosen),
-        clock_epoch if clock_per_epoch(t_epoch, config) else None,
+        clock_epoch if windows.per_epoch_clock else None,
     )
     if prior is not None:
         prior = (prior[0][..., 1:], prior[1], prior[2])
@@ -820,6 +819,8 @@ class _WindowRows:
     n_sat_epoch: np.ndarray
     length: np.ndarray
     """Each window's length (s, :func:`window_lengths`)."""
+    per_epoch_clock: bool
+    """One clock drift per epoch (:func:`clock_per_epoch`)."""
     width: int
     n_groups: int
 
@@ -883,6 +884,7 @@ class _WindowRows:
             grade,
             n_sat_epoch,
             length,
+            per_epoch_clock,
             max(int(np.max(hi - lo, initial=0)), 1),
             int(np.max(row_group, initial=0)) + 1,
         )
