@@ -72,6 +72,23 @@ def test_old_style_satellite_ids():
     assert satellite_id("R24") == "R24"
 
 
+@pytest.mark.parametrize("cut", ["", "P", "PG", "G0"])
+def test_a_satellite_field_cut_short_is_a_value_error(cut):
+    # a record line cut inside its satellite field (fuzz: IndexError in the trimmed-SP3 reader)
+    with pytest.raises(ValueError, match="no satellite"):
+        satellite_id(cut[1:4] if cut.startswith("P") else cut)
+
+
+def test_a_record_line_cut_inside_its_satellite_names_the_line(tmp_path):
+    lines = _good_text().splitlines(keepends=True)
+    record = next(i for i, line in enumerate(lines) if line.startswith("PG02"))
+    lines[record] = "PG\n"
+    path = tmp_path / "cut.sp3"
+    path.write_text("".join(lines))
+    with pytest.raises(InputError, match=f"cut.sp3:{record + 1}: bad satellite identifier"):
+        read_sp3(path)
+
+
 def _good_text():
     return sp3_text(
         np.array([T0, T0 + 900.0]), ["G01", "G02"], np.full((2, 2, 3), 2e7), np.zeros((2, 2))

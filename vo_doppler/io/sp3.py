@@ -57,6 +57,8 @@ def to_gps_seconds(calendar_seconds: np.ndarray, time_system: str) -> np.ndarray
 def satellite_id(text: str) -> str:
     """'G05' from an SP3 satellite field ('G05', 'G 5', ' 5' = GPS in old files); ValueError
     for a system or number that does not exist (``PRN_RANGE``)."""
+    if len(text) < 3:
+        raise ValueError(f"no satellite {text!r}")
     letter = text[0] if text[0] != " " else "G"
     number = int(text[1:3])
     if letter not in PRN_RANGE or not prn_in_range(letter, number):
