@@ -338,7 +338,6 @@ def _alive(pid: int) -> bool:
 
 
 def test_ray_executor_gives_the_local_aggregate(tmp_path_factory, tmp_path):
-    pytest.importorskip("ray", reason="Ray is not installed (pip install 'vo-doppler[ray]')")
     drives = [tiny_drive(tmp_path_factory, seed) for seed in (1, 2)]
     local = run_batch(drives, tmp_path / "local", workers=2)
     remote = run_batch(drives, tmp_path / "ray", executor="ray", workers=2)
