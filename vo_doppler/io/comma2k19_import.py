@@ -35,11 +35,14 @@ from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.io.can import check_dbc
 from vo_doppler.io.comma2k19 import (
+    RAW_GNSS,
     gps_minus_log,
     gps_minus_mono,
     load_array,
+    numeric_array,
     read_forward_acceleration,
     read_gyro_yaw_rate,
+    read_pose_arrays,
     read_raw_gnss,
     read_vehicle_poses,
     read_wheel_speed,
@@ -58,6 +61,7 @@ from vo_doppler.io.sensor_csv import (
 from vo_doppler.io.sequence import FORMAT, MANIFEST
 from vo_doppler.io.sp3 import read_sp3
 from vo_doppler.io.trajectory import write_tum
+from vo_doppler.io.vehicle_limits import GPS_TIME
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.series import SensorSeries
@@ -123,7 +127,20 @@ def import_comma2k19(
     offset = gps_minus_log(segment)
     pose_offset = gps_minus_mono(segment)
     raw = read_raw_gnss(segment)
+    if raw.t.size == 0:
+        raise InputError(
+            f"no usable GPS or GLONASS measurement ({raw.n_dropped} rows dropped)",
+            segment.joinpath(*RAW_GNSS, "value"),
+        )
     t_pose, ecef, vehicle_to_ecef, mount = read_vehicle_poses(segment)
+    late = GPS_TIME.outside(t_pose + offset)
+    if late.any():
+        row = int(np.flatnonzero(late)[0])
+        raise InputError(
+            f"row {row}: frame time {t_pose[row]:g} s is GPS time {t_pose[row] + offset:g} s "
+            f"through the receiver's clock offset {offset:g} s, outside {GPS_TIME} (1980-2100)",
+            segment / "global_pose" / "frame_times",
+        )
     lat, lon, height = (float(v) for v in ecef_to_geodetic(ecef[0]))
     epochs, obs_rows = _write_gnss(output / "gnss", raw, ecef[0])
     gnss = {
@@ -181,8 +198,7 @@ def import_comma2k19(
     has_video = (segment / VIDEO).is_file()
     camera = {}
     if has_video:
-        frame_times = load_array(segment, "global_pose", "frame_times")
-        decode_video(segment / VIDEO, frame_times, output, mount)
+        decode_video(segment / VIDEO, t_pose, output, mount)
         camera = {"images": IMAGES, "times": TIMES, "calib": CALIB, "time_offset_s": offset}
     manifest = {
         "format": FORMAT,
@@ -265,11 +281,7 @@ def _write_can(segment: Path, target: Path) -> None:
     if (segment / CAN_LOG).is_file():
         shutil.copyfile(segment / CAN_LOG, target)
         return
-    folder = ("processed_log", "CAN", "raw_can")
-    t = load_array(segment, *folder, "t")
-    address = load_array(segment, *folder, "address")
-    data = load_array(segment, *folder, "data")
-    source = load_array(segment, *folder, "src")
+    t, address, data, source = _raw_can_arrays(segment)
     with can.CanutilsLogWriter(str(target), channel="can0") as writer:
         for k in np.flatnonzero(source == 0):
             payload = bytes(data[k]).ljust(8, b"\0")
@@ -278,15 +290,47 @@ def _write_can(segment: Path, target: Path) -> None:
                     timestamp=float(t[k]),
                     arbitration_id=int(address[k]),
                     data=payload,
-                    is_extended_id=False,
+                    is_extended_id=bool(address[k] > MAX_STANDARD_ID),
                     channel="can0",
                 )
             )
 
 
+MAX_STANDARD_ID, MAX_EXTENDED_ID = 0x7FF, 0x1FFFFFFF
+"""Largest 11-bit and 29-bit CAN identifiers."""
+RAW_CAN = ("processed_log", "CAN", "raw_can")
+
+
+def _raw_can_arrays(segment: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``raw_can``'s times, identifiers, payloads (bytes, at most 8) and bus numbers, one row
+    each; an :class:`InputError` names the array file that is not."""
+    folder = segment.joinpath(*RAW_CAN)
+    t = numeric_array(segment, *RAW_CAN, "t")
+    address = numeric_array(segment, *RAW_CAN, "address")
+    source = numeric_array(segment, *RAW_CAN, "src")
+    data = load_array(segment, *RAW_CAN, "data")
+    if data.dtype.kind != "S" or data.dtype.itemsize > 8 or data.ndim != 1:
+        raise InputError(
+            f"array of shape {data.shape} and type {data.dtype}, expected (N,) of bytes (|S8)",
+            folder / "data",
+        )
+    for name, array in (("address", address), ("data", data), ("src", source)):
+        if array.shape[0] != t.size:
+            raise InputError(f"{array.shape[0]} rows for {t.size} times", folder / name)
+    wrong = (address != np.round(address)) | (address < 0) | (address > MAX_EXTENDED_ID)
+    if wrong.any():
+        row = int(np.flatnonzero(wrong)[0])
+        raise InputError(f"row {row}: {address[row]:g} is not a CAN identifier", folder / "address")
+    wild = GPS_TIME.outside(np.abs(t))
+    if wild.any():
+        row = int(np.flatnonzero(wild)[0])
+        raise InputError(f"row {row}: time {t[row]:g} s is beyond any clock", folder / "t")
+    return t, address.astype(np.int64), data, source
+
+
 def segment_gps_span(segment: str | Path) -> tuple[float, float]:
     """First and last GPS time (s) of the segment's ``global_pose`` frames."""
-    gps_times = load_array(segment, "global_pose", "frame_gps_times")
+    gps_times = read_pose_arrays(segment).gps_times
     t = gps_times[:, 0] * SECONDS_PER_WEEK + gps_times[:, 1]
     return float(t.min()), float(t.max())
 

@@ -1,5 +1,7 @@
-"""What a road vehicle's motion sensors can report, and how far its GNSS antenna can sit from
-its reference point.
+"""The physical bounds every reader checks its values against, in one place: what a road
+vehicle's motion sensors can report, how far its GNSS antenna can sit from its reference point,
+where on Earth and when a recording can be, and what a GNSS receiver can measure of the
+satellites it tracks (the second half of this module).
 
 A value beyond these bounds is not a measurement: it is a corrupt row, a wrong unit or a wrong
 DBC factor, and integrating it moves a dead-reckoned track by kilometres (one wheel-speed row of
@@ -27,6 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vo_doppler.geo import SPEED_OF_LIGHT
+
 
 @dataclass(frozen=True)
 class SignalBounds:
@@ -52,7 +56,11 @@ GROUND_SPEED = SignalBounds(0.0, SPEED.high, "m/s")
 YAW_RATE = SignalBounds(-5.0, 5.0, "rad/s")
 """Yaw rate, either sign."""
 FORWARD_ACCELERATION = SignalBounds(-50.0, 50.0, "m/s²")
-"""Specific force along the vehicle's forward axis."""
+"""Specific force along the vehicle's forward axis (the same bound holds on every axis)."""
+VELOCITY_COMPONENT = SignalBounds(-SPEED.high, SPEED.high, "m/s")
+"""One component (north, east, up, left …) of a vehicle's velocity."""
+ANGULAR_RATE = YAW_RATE
+"""Roll and pitch rates: bounded as the yaw rate (the same gyro's full scale)."""
 
 MAX_OUT_OF_RANGE_FRACTION = 0.01
 """Largest share of a signal's samples that may be out of range and skipped as isolated bad
@@ -75,4 +83,78 @@ def lever_arm_problem(arm) -> str | None:
             f"the lever arm is {length:.4g} m long, beyond any road vehicle "
             f"({MAX_LEVER_ARM_M:g} m): give it in metres, from the vehicle's reference point"
         )
+    return None
+
+
+# Where and when: a road vehicle on the Earth, a recording of the GNSS era.
+
+HEIGHT = SignalBounds(-1.0e3, 1.0e4, "m")
+"""Ellipsoidal height of a road vehicle: the lowest road (Dead Sea shore, −430 m) and the
+highest (about 5,800 m) with the geoid's ±110 m and a wide margin."""
+LATITUDE_DEG = SignalBounds(-90.0, 90.0, "°")
+LONGITUDE_DEG = SignalBounds(-180.0, 180.0, "°")
+GPS_TIME = SignalBounds(0.0, 3.8e9, "s")
+"""GPS seconds (since 1980-01-06) from the start of GPS time to 2100 (3.79e9 s)."""
+TIME_OFFSET = SignalBounds(-GPS_TIME.high, GPS_TIME.high, "s")
+"""A sensor clock's offset to GPS time: larger than every GPS time up to 2100, it would put the
+sensor's data outside the GNSS era whatever its own clock reads (a Unix clock is −3.2e8 s away,
+a monotonic log clock up to +3.8e9 s)."""
+
+# GNSS measurements of a receiver on the ground.
+
+RANGE_RATE = SignalBounds(-1.0e4, 1.0e4, "m/s")
+"""Pseudorange rate: a GNSS satellite approaches or recedes from a point on the ground at most
+about 1 km/s (GPS ≤ 930 m/s); with the vehicle's speed and a free-running receiver clock's drift
+(a few ppm: a few km/s) it stays well within 10 km/s."""
+HIGHEST_CARRIER_HZ = 1.61e9
+"""The highest GNSS carrier (GLONASS G1, channel +6: 1605.4 MHz), rounded up."""
+DOPPLER = SignalBounds(
+    -RANGE_RATE.high * HIGHEST_CARRIER_HZ / SPEED_OF_LIGHT,
+    RANGE_RATE.high * HIGHEST_CARRIER_HZ / SPEED_OF_LIGHT,
+    "Hz",
+)
+"""Doppler shift of any GNSS carrier at the largest range rate (±53.7 kHz)."""
+PSEUDORANGE = SignalBounds(1.0e6, 1.0e8, "m")
+"""Pseudorange: 19,100 km (GLONASS at zenith) to 42,000 km (a geostationary satellite at the
+horizon), widened for a receiver clock of a few milliseconds."""
+SIGNAL_TRAVEL_TIME = SignalBounds(1.0e-3, 0.5, "s")
+"""Signal travel time (pseudorange / c), the same bound as PSEUDORANGE widened."""
+CN0 = SignalBounds(0.0, 100.0, "dB-Hz")
+"""Carrier-to-noise density: real signals lie within 10–60 dB-Hz."""
+CARRIER_PHASE = SignalBounds(-1.0e10, 1.0e10, "cycles")
+"""Accumulated carrier phase: 1e10 cycles of L1 is 1.9e9 m (months of tracking at the largest
+Doppler) and the most a RINEX F14.3 field holds."""
+MEASUREMENT_SIGMA = SignalBounds(1.0e-9, 1.0e7, "SI")
+"""A reported standard deviation (m, m/s, Hz, cycles): positive and finite; beyond 1e7 it says
+nothing about the measurement."""
+SATELLITE_ORBIT_RADIUS = SignalBounds(1.0e7, 5.0e7, "m")
+"""Geocentric distance of a GNSS satellite (MEO 25,500–29,600 km, GEO/IGSO 42,200 km)."""
+RECEIVER_RADIUS = SignalBounds(6.0e6, 7.0e6, "m")
+"""Geocentric distance of a receiver on or near the ground."""
+SATELLITE_SPEED = SignalBounds(0.0, 5.0e3, "m/s")
+"""Speed of a GNSS satellite in the Earth-fixed frame (MEO about 3.9 km/s, GEO ≈ 0)."""
+SATELLITE_CLOCK_BIAS = SignalBounds(-0.01, 0.01, "s")
+"""A GNSS satellite clock stays within about 1 ms of system time."""
+SATELLITE_CLOCK_DRIFT = SignalBounds(-1.0e-7, 1.0e-7, "s/s")
+"""Satellite clock drift: broadcast af1 values are of order 1e-12–1e-10 s/s."""
+MAX_SATELLITES = 256
+"""More satellites than all GNSS systems together have (about 220 numbers)."""
+
+# Vehicle state estimates written by the toolkit (heading.csv).
+
+HEADING_SIGMA_DEG = SignalBounds(1.0e-9, 180.0, "°")
+"""A heading's standard deviation: positive; beyond 180° it says nothing about a direction."""
+HEADING_DEG = SignalBounds(-360.0, 360.0, "°")
+"""A heading or course in degrees as anyone writes it."""
+WHEEL_SCALE = SignalBounds(0.5, 2.0, "")
+"""Wheel-speed scale: tyre radius, load and wear change it by a few per cent; a factor beyond
+2 is a wrong unit (km/h read as m/s is 3.6), not a calibration."""
+DOP = SignalBounds(0.0, 1.0e4, "")
+"""A dilution of precision: positive; beyond 1e4 the geometry says nothing."""
+
+
+def problem(bounds: SignalBounds, value: float, name: str) -> str | None:
+    """Why ``value`` of ``name`` cannot be real (outside ``bounds`` or not finite), or None."""
+    if bounds.outside(np.asarray([value]))[0]:
+        return f"{name} = {value:g} is outside {bounds}"
     return None
