@@ -11,7 +11,7 @@ import pytest
 from pyubx2 import UBXMessage
 
 from tests.conftest import require_shared
-from tests.helpers.lnav import EXAMPLE, encode_ephemeris
+from tests.helpers.lnav import EXAMPLE, encode_ephemeris, with_parity
 from tests.io.test_android import synthetic_rows, write_log
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
@@ -40,7 +40,7 @@ def _constellation() -> bytes:
         eph["omega0"] = np.angle(np.exp(1j * (EXAMPLE["omega0"] + plane * 2 * np.pi / 3)))
         eph["iodc"] = 10 + k
         for words in encode_ephemeris(eph, 57599):
-            dwrd = {f"dwrd_{i + 1:02d}": w << 6 for i, w in enumerate(words)}
+            dwrd = {f"dwrd_{i + 1:02d}": w for i, w in enumerate(with_parity(words))}
             frames.append(
                 UBXMessage(
                     "RXM", "RXM-SFRBX", 0, gnssId=0, svId=k + 1, numWords=10, version=2, **dwrd

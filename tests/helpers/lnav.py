@@ -149,10 +149,42 @@ EXAMPLE = {
 }
 
 
-def sfrbx(prn: int, words: tuple[int, ...]) -> bytes:
+_PARITY = (
+    # IS-GPS-200 Table 20-XIV, written out again: (previous word's D29* or D30*, data bits)
+    (29, (1, 2, 3, 5, 6, 10, 11, 12, 13, 14, 17, 18, 20, 23)),
+    (30, (2, 3, 4, 6, 7, 11, 12, 13, 14, 15, 18, 19, 21, 24)),
+    (29, (1, 3, 4, 5, 7, 8, 12, 13, 14, 15, 16, 19, 20, 22)),
+    (30, (2, 4, 5, 6, 8, 9, 13, 14, 15, 16, 17, 20, 21, 23)),
+    (30, (1, 3, 5, 6, 7, 9, 10, 14, 15, 16, 17, 18, 21, 22, 24)),
+    (29, (3, 5, 6, 8, 9, 10, 11, 13, 15, 19, 22, 23, 24)),
+)
+
+
+def with_parity(words: tuple[int, ...]) -> tuple[int, ...]:
+    """The ten 24-bit data words as 30-bit words, each followed by its six parity bits (the
+    word before the first taken as ending in D29* = D30* = 0, as a word 10 does)."""
+    out, previous = [], (0, 0)
+    for word in words:
+        bits = [(word >> (23 - k)) & 1 for k in range(24)]
+        parity = 0
+        for which, terms in _PARITY:
+            bit = previous[0] if which == 29 else previous[1]
+            for n in terms:
+                bit ^= bits[n - 1]
+            parity = (parity << 1) | bit
+        out.append((word << 6) | parity)
+        previous = ((parity >> 1) & 1, parity & 1)
+    return tuple(out)
+
+
+def sfrbx(prn: int, words: tuple[int, ...], flip: int | None = None) -> bytes:
     """A UBX RXM-SFRBX frame carrying one GPS L1 C/A subframe (24-bit data words, each in bits
-    29…6 of its ``dwrd`` with parity bits set)."""
-    dwrd = {f"dwrd_{k + 1:02d}": (word << 6) | 0x15 for k, word in enumerate(words)}
+    29…6 of its ``dwrd`` followed by its parity bits); ``flip``: one bit (0…299, bit 0 the
+    first word's most significant) inverted after the parity was computed."""
+    full = list(with_parity(tuple(words)))
+    if flip is not None:
+        full[flip // 30] ^= 1 << (29 - flip % 30)
+    dwrd = {f"dwrd_{k + 1:02d}": word for k, word in enumerate(full)}
     return UBXMessage(
         "RXM", "RXM-SFRBX", 0, gnssId=0, svId=prn, sigId=0, numWords=10, chn=4, version=2, **dwrd
     ).serialize()

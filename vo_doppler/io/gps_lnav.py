@@ -6,10 +6,18 @@ words (parity stripped); ICD bit n (1…300, parity included) is data bit
 24·⌊(n−1)/30⌋ + (n−1) mod 30 of the 240. Angles in semicircles are multiplied by the ICD's
 π = 3.1415926535898.
 
+Parity (sec. 20.3.5.2, Table 20-XIV): each 30-bit word's six parity bits D25…D30 are the
+Hamming code of its 24 source data bits d1…d24 and the last two parity bits D29*, D30* of the
+word before it (for word 1, those of the previous subframe's word 10, which its two
+non-information bits make zero); :func:`parity_error` finds the first word whose parity does
+not match, as any one flipped bit makes it.
+
 An ephemeris is emitted when subframes 1, 2 and 3 of one satellite agree on their issue of data
-(IODE of 2 and 3 = the 8 LSBs of IODC, sec. 20.3.4.4); a repeated (PRN, IODC, toe) is emitted
-once. Not decoded: subframes 4 and 5 (almanac, ionosphere and UTC parameters, pages of
-sec. 20.3.3.5). The 10-bit week number is resolved with a full GPS week from the same recording.
+(IODE of 2 and 3 = the 8 LSBs of IODC, sec. 20.3.4.4) and describe a GPS orbit
+(:func:`off_gps_orbit`: semi-major axis, eccentricity and inclination of the constellation,
+:mod:`vo_doppler.io.vehicle_limits`); a repeated (PRN, IODC, toe) is emitted once. Not
+decoded: subframes 4 and 5 (almanac, ionosphere and UTC parameters, pages of sec. 20.3.3.5).
+The 10-bit week number is resolved with a full GPS week from the same recording.
 """
 
 from __future__ import annotations
@@ -19,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.io.rinex_nav import GLONASS_FIELDS, KEPLER_FIELDS
+from vo_doppler.io.vehicle_limits import GPS_ECCENTRICITY, GPS_INCLINATION, GPS_SQRT_A
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.navigation import NavRecords
 
@@ -70,6 +79,48 @@ _SUBFRAME_FIELDS: dict[int, tuple[tuple[str, tuple[tuple[int, int], ...], bool, 
 }
 
 
+_PARITY_TERMS = (
+    # (D29* or D30*, source data bits d1…d24): IS-GPS-200 Table 20-XIV, D25 first
+    (29, (1, 2, 3, 5, 6, 10, 11, 12, 13, 14, 17, 18, 20, 23)),
+    (30, (2, 3, 4, 6, 7, 11, 12, 13, 14, 15, 18, 19, 21, 24)),
+    (29, (1, 3, 4, 5, 7, 8, 12, 13, 14, 15, 16, 19, 20, 22)),
+    (30, (2, 4, 5, 6, 8, 9, 13, 14, 15, 16, 17, 20, 21, 23)),
+    (30, (1, 3, 5, 6, 7, 9, 10, 14, 15, 16, 17, 18, 21, 22, 24)),
+    (29, (3, 5, 6, 8, 9, 10, 11, 13, 15, 19, 22, 23, 24)),
+)
+
+
+def lnav_parity(data: int, d29: int, d30: int) -> int:
+    """The six parity bits (D25 as the most significant) of the 24 source data bits ``data``
+    (d1 the most significant) after a word ending in the bits ``d29``, ``d30``."""
+    parity = 0
+    for previous, terms in _PARITY_TERMS:
+        bit = d29 if previous == 29 else d30
+        for n in terms:
+            bit ^= (data >> (24 - n)) & 1
+        parity = (parity << 1) | bit
+    return parity
+
+
+def parity_error(words30: tuple[int, ...]) -> int | None:
+    """The number (1…10) of the first 30-bit word (24 data bits, then 6 parity bits) whose
+    parity is wrong, or None when all ten match (module docstring)."""
+    d29 = d30 = 0
+    for number, word in enumerate(words30, start=1):
+        if lnav_parity((word >> 6) & 0xFFFFFF, d29, d30) != word & 0x3F:
+            return number
+        d29, d30 = (word >> 1) & 1, word & 1
+    return None
+
+
+def off_gps_orbit(fields: dict[str, float]) -> str | None:
+    """Why decoded subframe fields cannot be a GPS satellite's orbit, or None."""
+    for name, bounds in (("sqrt_a", GPS_SQRT_A), ("e", GPS_ECCENTRICITY), ("i0", GPS_INCLINATION)):
+        if name in fields and bounds.outside(np.array([fields[name]]))[0]:
+            return f"{name} = {fields[name]:.6g} is outside {bounds}"
+    return None
+
+
 def data_bit(icd_bit: int) -> int:
     """Index (0…239) among the 240 data bits of ICD bit number ``icd_bit`` (1…300)."""
     word, position = divmod(icd_bit - 1, 30)
@@ -118,10 +169,12 @@ class LnavAssembler:
     records: list[dict[str, float]]
     pending: dict[int, dict[int, dict[str, float]]]
     emitted: set[tuple[int, int, float]]
+    rejected: list[tuple[int, int, str]]
+    """(where, PRN, why) of each subframe set whose orbit is not a GPS orbit."""
 
     @classmethod
     def new(cls) -> LnavAssembler:
-        return cls([], {}, set())
+        return cls([], {}, set(), [])
 
     def add(self, prn: int, words: tuple[int, ...], reference_week: int | None, where: int) -> None:
         """One subframe of satellite ``prn``; ``where`` (e.g. a byte offset) is kept per record."""
@@ -136,6 +189,10 @@ class LnavAssembler:
             return
         key = (prn, int(one["iodc"]), two["toe_sow"])
         if key in self.emitted:
+            return
+        why = off_gps_orbit(two | three)
+        if why is not None:
+            self.rejected.append((where, prn, why))
             return
         self.emitted.add(key)
         self.records.append(_record(prn, one, two, three, reference_week, where))

@@ -3,8 +3,10 @@
 Framing (u-blox interface description, "UBX frame structure"): sync 0xB5 0x62, class, id,
 little-endian length, payload, 8-bit Fletcher checksum over class…payload. The stream is
 scanned here so that every problem names its byte offset; bytes between frames (NMEA, RTCM)
-are skipped and counted; a frame with a bad checksum or a payload pyubx2 cannot parse is
-skipped with a message ``FILE, byte OFFSET: …`` in ``problems``; a truncated last frame likewise.
+are skipped and counted; a frame with a bad checksum, a payload shorter or longer than its
+message needs (an empty one included) or one pyubx2 cannot parse is skipped with a message
+``FILE, byte OFFSET: …`` in ``problems`` (and the log); a truncated last frame likewise.
+Physical bounds come from :mod:`vo_doppler.io.vehicle_limits`.
 
 - RXM-RAWX → :class:`Observations`, epoch = week·604800 + rcvTow (receiver time, like a RINEX
   epoch). Per signal (gnssId, sigId → RINEX 3 code, ``SIGNAL_CODES``): pseudorange ``C`` when
@@ -12,17 +14,22 @@ skipped with a message ``FILE, byte OFFSET: …`` in ``problems``; a truncated l
   already the RINEX sign, RINEX 3.05 sec. 5.2.10), C/N0 ``S`` (dB-Hz). LLI on ``L`` rows:
   bit 0 when the lock time dropped since the signal's previous epoch, bit 1 when the half cycle
   is not resolved (halfCyc = 0). Values outside ``VALUE_RANGES`` (or not finite) are dropped
-  and counted. Reported σ (prStdev 0.01·2ⁿ m, cpStdev 0.004·n cycles,
-  doStdev 0.002·2ⁿ Hz) are kept as a :class:`RowSigma`. GLONASS channel k = freqId − 7; rows
+  and counted, and so are signals of a satellite number outside the system's (``PRN_RANGE``).
+  Reported σ (prStdev 0.01·2ⁿ m, cpStdev 0.004·n cycles, doStdev 0.002·2ⁿ Hz) are kept as a
+  :class:`RowSigma`. GLONASS channel k = freqId − 7; rows
   with an unknown GLONASS slot (svId 255) are skipped.
 - RXM-SFRBX → GPS L1 C/A LNAV subframes 1–3 decoded into ephemerides
-  (:mod:`vo_doppler.io.gps_lnav`); the data bits of each word are bits 29…6 of ``dwrd``.
+  (:mod:`vo_doppler.io.gps_lnav`); the data bits of each word are bits 29…6 of ``dwrd``, its
+  parity bits 5…0: a subframe failing the LNAV parity check is skipped, and so is an ephemeris
+  off any GPS orbit (both named by byte offset in ``problems``).
   Not decoded: GPS subframes 4–5 (almanac, ionosphere, UTC), and every other system's
   navigation data (Galileo I/NAV, BeiDou D1/D2, GLONASS strings, QZSS, SBAS); they are counted.
 - NAV-PVT → :class:`ReceiverSolution`; the time is the GPS time whose second of week is iTOW,
   nearest to the message's UTC date and time plus the leap seconds of that date; a message
   whose two times disagree by more than 2 s, or without a valid date, is skipped, and so is one
-  repeating the previous fix's time; a fix earlier than the previous one is an error.
+  repeating the previous fix's time, or with a velocity or height no road vehicle has
+  (``VELOCITY_COMPONENT``, ``GROUND_SPEED``, ``HEIGHT``); a fix earlier than the previous one
+  is an error.
 """
 
 from __future__ import annotations
@@ -36,8 +43,18 @@ import numpy as np
 from pyubx2 import UBXMessageError, UBXParseError, UBXReader, UBXTypeError
 
 from vo_doppler.errors import InputError
-from vo_doppler.io.gps_lnav import LnavAssembler, empty_glonass, subframe_id
+from vo_doppler.io.gps_lnav import LnavAssembler, empty_glonass, parity_error, subframe_id
 from vo_doppler.io.obs_rows import observations_from_rows
+from vo_doppler.io.rinex_common import prn_in_range
+from vo_doppler.io.vehicle_limits import (
+    CARRIER_PHASE,
+    CN0,
+    DOPPLER,
+    GROUND_SPEED,
+    HEIGHT,
+    PSEUDORANGE,
+    VELOCITY_COMPONENT,
+)
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK, calendar_to_gps_seconds, utc_to_gps_seconds
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
@@ -89,11 +106,13 @@ SIGNAL_CODES: dict[tuple[int, int], str] = {
     (7, 0): "5A",
 }
 VALUE_RANGES = {  # plausible RXM-RAWX values; others (and NaN) are dropped and counted
-    "C": (1.0e6, 1.0e8),  # pseudorange, m (clock offsets of a few ms included)
-    "L": (-1.0e12, 1.0e12),  # carrier phase, cycles
-    "D": (-1.0e5, 1.0e5),  # Doppler, Hz
-    "S": (0.0, 100.0),  # C/N0, dB-Hz
+    "C": (PSEUDORANGE.low, PSEUDORANGE.high),  # pseudorange, m
+    "L": (CARRIER_PHASE.low, CARRIER_PHASE.high),  # carrier phase, cycles
+    "D": (DOPPLER.low, DOPPLER.high),  # Doppler, Hz
+    "S": (CN0.low, CN0.high),  # C/N0, dB-Hz
 }
+PVT_PAYLOAD = 92
+"""NAV-PVT payload length (bytes, u-blox 8 / 9 interface descriptions)."""
 PVT_TIME_TOLERANCE_S = 2.0  # iTOW vs UTC + leap seconds: a leap second unknown to the table
 _PARSE_ERRORS = (UBXParseError, UBXMessageError, UBXTypeError, ValueError, struct.error)
 
@@ -146,6 +165,21 @@ def frames(data: bytes, path: Path, problems: list[str]):
         _problem(problems, path, 0, f"{skipped} bytes outside UBX frames skipped")
 
 
+def _payload_problem(kind: tuple[int, int], payload: bytes) -> str | None:
+    """Why a RXM-RAWX, RXM-SFRBX or NAV-PVT payload cannot hold its message, or None: its length
+    must be the fixed part plus what its own count field announces."""
+    name, length = {RAWX: "RXM-RAWX", SFRBX: "RXM-SFRBX", PVT: "NAV-PVT"}[kind], len(payload)
+    if kind == PVT:
+        expected = PVT_PAYLOAD
+    elif kind == RAWX:
+        expected = 16 + 32 * payload[11] if length >= 16 else 16
+    else:
+        expected = 8 + 4 * payload[4] if length >= 8 else 8
+    if length != expected:
+        return f"{name} payload of {length} bytes, expected {expected}"
+    return None
+
+
 def _problem(problems: list[str], path: Path, offset: int, message: str) -> None:
     text = f"{path}, byte {offset}: {message}"
     log.warning(text)
@@ -168,6 +202,10 @@ def read_ubx(path: str | Path) -> UbxRecording:
     for offset, cls, mid, frame in frames(data, path, problems):
         if (cls, mid) not in (RAWX, SFRBX, PVT):
             continue
+        wrong = _payload_problem((cls, mid), frame[6:-2])
+        if wrong:
+            _problem(problems, path, offset, f"{wrong}: frame skipped")
+            continue
         try:
             message = UBXReader.parse(frame)
         except _PARSE_ERRORS as exc:
@@ -180,8 +218,13 @@ def read_ubx(path: str | Path) -> UbxRecording:
             if fix is not None and _in_order(pvt, fix["t"], offset, path, problems):
                 pvt.append(fix)
         elif message.gnssId == 0 and message.numWords == 10 and message.sigId == 0:
-            words = tuple((getattr(message, f"dwrd_{k:02d}") >> 6) & 0xFFFFFF for k in range(1, 11))
-            subframes.append((offset, message.svId, words))
+            words30 = tuple(getattr(message, f"dwrd_{k:02d}") & 0x3FFFFFFF for k in range(1, 11))
+            word = parity_error(words30)
+            if word is not None or not prn_in_range("G", message.svId):
+                why = f"word {word} fails the LNAV parity check" if word else "no GPS satellite"
+                _problem(problems, path, offset, f"GPS subframe of SV {message.svId}: {why}")
+                continue
+            subframes.append((offset, message.svId, tuple(w >> 6 for w in words30)))
         else:
             n_other_nav += 1
     if not (raw.time or pvt or subframes):
@@ -235,6 +278,9 @@ class _RawxRows:
             return
         system = SYSTEMS[gnss]
         prn = sv - 100 if system == "S" else sv
+        if not prn_in_range(system, prn):
+            self.n_unknown += 1
+            return
         if system == "R":
             self.channels[prn] = int(getattr(m, "freqId" + s)) - 7
         lock = int(getattr(m, "locktime" + s))
@@ -263,7 +309,12 @@ class _RawxRows:
 
     def observations(self, path: Path, problems: list[str]) -> Observations:
         if self.n_unknown:
-            _problem(problems, path, 0, f"{self.n_unknown} RXM-RAWX signals of unknown kind")
+            _problem(
+                problems,
+                path,
+                0,
+                f"{self.n_unknown} RXM-RAWX signals of unknown kind or satellite number",
+            )
         if self.n_out_of_range:
             _problem(problems, path, 0, f"{self.n_out_of_range} RXM-RAWX values out of range")
         return observations_from_rows(
@@ -297,6 +348,21 @@ def _pvt_fields(message, offset: int, path: Path, problems: list[str]) -> dict[s
         return None
     if abs(m.lat) > 90 or abs(m.lon) > 180 or not 0 <= m.iTOW < SECONDS_PER_WEEK * 1000:
         _problem(problems, path, offset, "NAV-PVT latitude, longitude or iTOW out of range")
+        return None
+    velocity = np.array([m.velN, m.velE, m.velD]) / 1000.0
+    if (
+        VELOCITY_COMPONENT.outside(velocity).any()
+        or GROUND_SPEED.outside(np.array([m.gSpeed / 1000.0]))[0]
+        or HEIGHT.outside(np.array([m.height / 1000.0]))[0]
+    ):
+        _problem(
+            problems,
+            path,
+            offset,
+            f"NAV-PVT velocity (N {velocity[0]:g}, E {velocity[1]:g}, D {velocity[2]:g} m/s), "
+            f"speed {m.gSpeed / 1000.0:g} m/s or height {m.height / 1000.0:g} m beyond a road "
+            f"vehicle's ({VELOCITY_COMPONENT}, {GROUND_SPEED}, {HEIGHT}): skipped",
+        )
         return None
     try:
         utc = calendar_to_gps_seconds(m.year, m.month, m.day, m.hour, m.min, m.second)
@@ -379,6 +445,8 @@ def _navigation(subframes, week: int | None, path: Path, problems, n_other: int)
             assembler.add(prn, words, week, offset)
         else:
             n_not_ephemeris += 1
+    for offset, prn, why in assembler.rejected:
+        _problem(problems, path, offset, f"GPS ephemeris of G{prn:02d} off any GPS orbit: {why}")
     if n_not_ephemeris or n_other:
         _problem(
             problems,

@@ -137,6 +137,14 @@ SATELLITE_CLOCK_BIAS = SignalBounds(-0.01, 0.01, "s")
 """A GNSS satellite clock stays within about 1 ms of system time."""
 SATELLITE_CLOCK_DRIFT = SignalBounds(-1.0e-7, 1.0e-7, "s/s")
 """Satellite clock drift: broadcast af1 values are of order 1e-12–1e-10 s/s."""
+GPS_SQRT_A = SignalBounds(5100.0, 5210.0, "√m")
+"""√a of a GPS orbit: the constellation's semi-major axis is 26,560 km (√a = 5153.7 √m) within
+about ±1 %."""
+GPS_ECCENTRICITY = SignalBounds(0.0, 0.05, "")
+"""GPS orbits are near circular (the specification allows e ≤ 0.02; the oldest satellites
+reached 0.03)."""
+GPS_INCLINATION = SignalBounds(0.87, 1.05, "rad")
+"""GPS orbital planes are inclined 55° ± a few degrees (50°–60°)."""
 MAX_SATELLITES = 256
 """More satellites than all GNSS systems together have (about 220 numbers)."""
 
