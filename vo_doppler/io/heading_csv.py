@@ -34,6 +34,17 @@ import numpy as np
 from vo_doppler.errors import InputError
 from vo_doppler.geo import course_to_yaw
 from vo_doppler.io.textfile import read_text
+from vo_doppler.io.vehicle_limits import (
+    DOP,
+    HEADING_DEG,
+    HEADING_SIGMA_DEG,
+    MAX_COUNT,
+    MAX_SATELLITES,
+    MEASUREMENT_SIGMA,
+    WHEEL_SCALE,
+    YAW_RATE,
+    SignalBounds,
+)
 from vo_doppler.model.heading import DEFAULT_TC_WINDOW_S, HeadingTable
 
 COLUMNS = (
@@ -142,7 +153,7 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
     if not rows:
         raise InputError("heading CSV has its header but no rows", path)
     data = np.array(rows, dtype=float).reshape(-1, len(index))
-    _check_values(data, lines, path)
+    _check_values(data, lines, path, [c for c in COLUMNS + OPTIONAL_COLUMNS if c in header])
     optional = {
         c: data[:, len(COLUMNS) + i]
         for i, c in enumerate(c for c in OPTIONAL_COLUMNS if c in header)
@@ -175,18 +186,58 @@ def read_heading_csv(path: str | Path) -> HeadingTable:
 
 HEADING_COLUMNS = (1, 2, 6)
 """Heading and sigma columns: NaN where unavailable; every other column must be finite."""
+FLAGS = ("tc_reliable", "conv_valid", "tc_verifiable", "conv_gnss_valid")
+COUNTS = {"n_obs_window": MAX_COUNT, "n_sat_epoch": MAX_SATELLITES, "rejected_rows": MAX_COUNT}
+GYRO_BIAS_DEG_S = SignalBounds(-math.degrees(YAW_RATE.high), math.degrees(YAW_RATE.high), "°/s")
+"""A gyro bias beyond the largest yaw rate a car's gyro measures is not a bias."""
+RANGES: dict[str, SignalBounds] = {
+    "heading_tc_deg": HEADING_DEG,
+    "heading_conv_deg": HEADING_DEG,
+    "heading_tc_sigma_deg": HEADING_SIGMA_DEG,
+    "heading_conv_sigma_deg": HEADING_SIGMA_DEG,
+    "heading_conv_gnss_sigma_deg": HEADING_SIGMA_DEG,
+    "conv_speed_sigma_mps": MEASUREMENT_SIGMA,
+    "conv_hdop": DOP,
+    "gyro_bias_dps": GYRO_BIAS_DEG_S,
+    "wheel_scale": WHEEL_SCALE,
+}
+"""Physical bounds of the columns (:mod:`vo_doppler.io.vehicle_limits`); NaN, where a column
+may hold it, is checked apart."""
 
 
-def _check_values(data: np.ndarray, lines: list[str], path: Path) -> None:
-    """No infinite value anywhere and no NaN outside the heading columns (names the line)."""
+def _check_values(data: np.ndarray, lines: list[str], path: Path, names: list[str]) -> None:
+    """No infinite value anywhere, no NaN outside the heading and optional columns, every value
+    within its column's bounds (``RANGES``), flags 0 or 1 and counts whole numbers from zero to
+    their bound (``COUNTS``); an :class:`InputError` names the line and the column."""
     optional = np.zeros(data.shape[1], dtype=bool)
     optional[list(HEADING_COLUMNS)] = True
     optional[len(COLUMNS) :] = True  # optional columns may hold NaN (e.g. the conventional sigma)
     bad = np.isinf(data) | (np.isnan(data) & ~optional)
+    why = np.full(data.shape, "", dtype=object)
+    why[bad] = "is not usable"
+    for column, name in enumerate(names):
+        values = data[:, column]
+        given = ~np.isnan(values)
+        if name in RANGES:
+            outside = given & RANGES[name].outside(values)
+            why[outside & ~bad[:, column], column] = f"is outside {RANGES[name]}"
+            bad[:, column] |= outside
+        elif name in FLAGS:
+            wrong = given & (values != 0) & (values != 1)
+            why[wrong & ~bad[:, column], column] = "is not 0 or 1"
+            bad[:, column] |= wrong
+        elif name in COUNTS:
+            wrong = given & ((values != np.round(values)) | (values < 0) | (values > COUNTS[name]))
+            why[wrong & ~bad[:, column], column] = f"is not a count from 0 to {COUNTS[name]:g}"
+            bad[:, column] |= wrong
     if bad.any():
         row, column = (int(v) for v in np.argwhere(bad)[0])
         number = [n for n, line in enumerate(lines[1:], start=2) if line.strip()][row]
-        raise InputError(f"heading CSV value {data[row, column]} is not usable", path, number)
+        raise InputError(
+            f"heading CSV column {names[column]}: {data[row, column]:g} {why[row, column]}",
+            path,
+            number,
+        )
 
 
 def _window_s(column: np.ndarray | None, path: Path) -> float:

@@ -157,8 +157,11 @@ HEADING_DEG = SignalBounds(-360.0, 360.0, "°")
 WHEEL_SCALE = SignalBounds(0.5, 2.0, "")
 """Wheel-speed scale: tyre radius, load and wear change it by a few per cent; a factor beyond
 2 is a wrong unit (km/h read as m/s is 3.6), not a calibration."""
-DOP = SignalBounds(0.0, 1.0e4, "")
-"""A dilution of precision: positive; beyond 1e4 the geometry says nothing."""
+DOP = SignalBounds(1.0e-3, 1.0e4, "")
+"""A dilution of precision: positive (0.5 with very many satellites); beyond 1e4 the geometry
+says nothing."""
+MAX_COUNT = 10_000_000
+"""Largest count of observations or rows a heading window can hold (hours of 100 Hz data)."""
 
 
 def problem(bounds: SignalBounds, value: float, name: str) -> str | None:
