@@ -248,10 +248,12 @@ def _check_sensor(path: Path, rows: Records, t: np.ndarray, values: np.ndarray) 
         raise InputError(
             "sensor row with a missing or non-finite value", path, int(rows.line[bad][0])
         )
-    back = np.flatnonzero(np.diff(t) < 0)
+    back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
         raise InputError(
-            "sensor row earlier than the one before it", path, int(rows.line[back[0] + 1])
+            "sensor row not after the one before it (an earlier or repeated time)",
+            path,
+            int(rows.line[back[0] + 1]),
         )
 
 

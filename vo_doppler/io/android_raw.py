@@ -14,18 +14,22 @@ Google's white paper "Using GNSS raw measurements on Android devices" (2017, sec
 - Doppler: PseudorangeRateMetersPerSecond ρ̇ is a range rate (positive receding), so the RINEX
   Doppler is D = −ρ̇·f/c (Hz, positive approaching, RINEX 3.05 sec. 5.2.10), f the row's
   CarrierFrequencyHz; the GNSS stage's ρ̇ = −λ·D gives ρ̇ back with its nominal λ (equal to
-  c/f within 3·10⁻⁸ for the phones' reported frequencies). Rows whose uncertainty is not finite
-  or ≥ 1 km/s (phones write c there for "unknown") are dropped and counted.
+  c/f within 3·10⁻⁸ for the phones' reported frequencies). Rows whose uncertainty is not
+  positive and below 1 km/s (phones write c there for "unknown"), or whose ρ̇ is beyond any
+  satellite's (``RANGE_RATE``), are dropped and counted.
 - Carrier phase L = AccumulatedDeltaRangeMeters·f/c when ADR_STATE_VALID (1); LLI bit 0 when
   RESET (2) or CYCLE_SLIP (4), or in an epoch whose HardwareClockDiscontinuityCount differs
   from the previous epoch's.
 - C/N0 → ``S`` rows. The receiver-reported σ of D (PseudorangeRateUncertaintyMetersPerSecond,
-  converted to Hz) and of C (ReceivedSvTimeUncertaintyNanos·c) are returned as a RowSigma.
+  converted to Hz) and of C (ReceivedSvTimeUncertaintyNanos·c, NaN when not positive and
+  finite) are returned as a RowSigma. C/N0 outside ``CN0`` and carrier phases outside
+  ``CARRIER_PHASE`` are dropped and counted (bounds: :mod:`vo_doppler.io.vehicle_limits`).
 
 Signals: band from CarrierFrequencyHz, attribute from CodeType, or for logs without CodeType
 the usual phone signal of that band (``DEFAULT_ATTRIBUTE``). Satellite numbers: SBAS 120–158 →
 S20–S58, QZSS 193–200 → J01–J08; GLONASS rows with an unknown slot (Svid 93–106, FCN + 100) are
-dropped; GLONASS channel k = (f − 1602 MHz)/0.5625 MHz.
+dropped, and so are rows whose number is outside the system's (``PRN_RANGE``: Svid 0 …);
+GLONASS channel k = (f − 1602 MHz)/0.5625 MHz.
 """
 
 from __future__ import annotations
@@ -38,6 +42,15 @@ import numpy as np
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT
 from vo_doppler.io.obs_rows import observations_from_rows
+from vo_doppler.io.rinex_common import PRN_RANGE
+from vo_doppler.io.vehicle_limits import (
+    CARRIER_PHASE,
+    CN0,
+    GPS_TIME,
+    MEASUREMENT_SIGMA,
+    RANGE_RATE,
+    SIGNAL_TRAVEL_TIME,
+)
 from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, gps_minus_utc
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.row_sigma import RowSigma
@@ -53,8 +66,8 @@ STATE_TOW_KNOWN = 16384
 STATE_GLO_TOD_KNOWN = 32768
 ADR_VALID, ADR_RESET, ADR_CYCLE_SLIP = 1, 2, 4
 MAX_PRR_UNCERTAINTY_MPS = 1000.0
-TRAVEL_TIME_RANGE_S = (1e-3, 0.5)
-GPS_TIME_RANGE_S = (0.0, 3.8e9)  # 1980-01-06 … 2100
+TRAVEL_TIME_RANGE_S = (SIGNAL_TRAVEL_TIME.low, SIGNAL_TRAVEL_TIME.high)
+GPS_TIME_RANGE_S = (GPS_TIME.low, GPS_TIME.high)  # 1980-01-06 … 2100
 # band centres (Hz) per system → RINEX band digit (RINEX 3.05 sec. 5.1)
 BANDS = {
     "G": ((1575.42e6, "1"), (1227.60e6, "2"), (1176.45e6, "5")),
@@ -117,6 +130,15 @@ def signal_codes(system: np.ndarray, frequency: np.ndarray, code_type: np.ndarra
     return out
 
 
+def numbered(system: np.ndarray, prn: np.ndarray) -> np.ndarray:
+    """Rows whose satellite number lies within its system's (``PRN_RANGE``)."""
+    ok = np.zeros(system.shape, dtype=bool)
+    for letter, (low, high) in PRN_RANGE.items():
+        rows = system == letter
+        ok[rows] = (prn[rows] >= low) & (prn[rows] <= high)
+    return ok
+
+
 def satellite_ids(constellation: np.ndarray, svid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """System letter ('' when unknown) and RINEX satellite number of Android's Svid."""
     system = np.array([CONSTELLATIONS.get(int(c), "") for c in constellation], dtype="U1")
@@ -130,7 +152,7 @@ def raw_observations(raw: RawColumns, receiver_type: str, problems: list[str]):
     """(Observations, RowSigma) of the Raw records (module docstring)."""
     path = raw.path
     system, prn = satellite_ids(raw.constellation, raw.svid)
-    usable = (system != "") & (prn > 0) & np.isfinite(raw.frequency)
+    usable = (system != "") & numbered(system, prn) & np.isfinite(raw.frequency)
     usable &= ~((system == "R") & (raw.svid > 90))
     band = signal_codes(system, raw.frequency, raw.code_type)
     usable &= np.char.str_len(band) == 2
@@ -139,16 +161,27 @@ def raw_observations(raw: RawColumns, receiver_type: str, problems: list[str]):
     _check_order(path, raw.line, epoch_time)
     f = raw.frequency
     doppler = -raw.prr * f / SPEED_OF_LIGHT
-    doppler_ok = np.isfinite(doppler) & (raw.prr_uncertainty < MAX_PRR_UNCERTAINTY_MPS)
+    doppler_ok = np.isfinite(doppler) & ~RANGE_RATE.outside(raw.prr)
+    doppler_ok &= (raw.prr_uncertainty > 0) & (raw.prr_uncertainty < MAX_PRR_UNCERTAINTY_MPS)
     _count(problems, path, usable & ~doppler_ok, "Doppler rows without a usable uncertainty")
-    carrier_ok = (raw.adr_state.astype(np.int64) & ADR_VALID) > 0
+    carrier = raw.adr * f / SPEED_OF_LIGHT
+    carrier_ok = ((raw.adr_state.astype(np.int64) & ADR_VALID) > 0) & ~CARRIER_PHASE.outside(
+        carrier
+    )
+    cn0_ok = ~CN0.outside(raw.cn0)
+    _count(problems, path, usable & np.isfinite(raw.cn0) & ~cn0_ok, "C/N0 outside 0-100 dB-Hz")
+    code_sigma = np.where(
+        MEASUREMENT_SIGMA.outside(raw.received_sv_time_uncertainty_nanos),
+        np.nan,
+        raw.received_sv_time_uncertainty_nanos,
+    )
     slip = (raw.adr_state.astype(np.int64) & (ADR_RESET | ADR_CYCLE_SLIP)) > 0
     slip |= _clock_reset(raw.clock_discontinuity, epoch_time)
     kinds = (
         ("D", doppler, doppler_ok, raw.prr_uncertainty * f / SPEED_OF_LIGHT, -1),
-        ("C", pseudorange, np.isfinite(pseudorange), raw.received_sv_time_uncertainty_nanos, -1),
-        ("L", raw.adr * f / SPEED_OF_LIGHT, carrier_ok, np.full(f.shape, np.nan), slip),
-        ("S", raw.cn0, np.isfinite(raw.cn0), np.full(f.shape, np.nan), -1),
+        ("C", pseudorange, np.isfinite(pseudorange), code_sigma, -1),
+        ("L", carrier, carrier_ok, np.full(f.shape, np.nan), slip),
+        ("S", raw.cn0, cn0_ok, np.full(f.shape, np.nan), -1),
     )
     columns: dict[str, list[np.ndarray]] = {k: [] for k in "tsnpcvlq"}
     for kind, value, ok, sigma, lli in kinds:

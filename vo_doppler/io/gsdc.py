@@ -23,8 +23,16 @@ import numpy as np
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT
 from vo_doppler.io.android import Records, raw_columns, records
-from vo_doppler.io.android_raw import raw_observations, satellite_ids
+from vo_doppler.io.android_raw import numbered, raw_observations, satellite_ids
 from vo_doppler.io.textfile import read_text
+from vo_doppler.io.vehicle_limits import (
+    RECEIVER_RADIUS,
+    SATELLITE_CLOCK_BIAS,
+    SATELLITE_CLOCK_DRIFT,
+    SATELLITE_ORBIT_RADIUS,
+    SATELLITE_SPEED,
+    SIGNAL_TRAVEL_TIME,
+)
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.row_sigma import RowSigma
 from vo_doppler.model.satellite_table import SatelliteTable
@@ -37,8 +45,8 @@ REQUIRED = (
     "SvClockBiasMeters",
     "SvClockDriftMetersPerSecond",
 )
-ORBIT_RADIUS_RANGE_M = (1.0e7, 5.0e7)
-EARTH_RADIUS_RANGE_M = (6.0e6, 7.0e6)
+ORBIT_RADIUS_RANGE_M = (SATELLITE_ORBIT_RADIUS.low, SATELLITE_ORBIT_RADIUS.high)
+EARTH_RADIUS_RANGE_M = (RECEIVER_RADIUS.low, RECEIVER_RADIUS.high)
 """Geocentric distances of a receiver on or near the ground (m)."""
 
 
@@ -80,7 +88,7 @@ def read_device_gnss(path: str | Path) -> GsdcRecording:
         pseudorange_m=number("RawPseudorangeMeters"),
     )
     observations, sigma = raw_observations(columns, "Android (GSDC device_gnss.csv)", problems)
-    satellites = _satellite_table(rows, path, arrival_ns)
+    satellites = _satellite_table(rows, path, arrival_ns, problems)
     wls = np.stack([number(f"WlsPosition{a}EcefMeters") for a in "XYZ"], axis=1)
     radius = np.linalg.norm(wls, axis=1)
     off = np.isfinite(radius) & (
@@ -119,8 +127,13 @@ def _read_csv(path: Path) -> Records:
     return records(names, body, lines, path)
 
 
-def _satellite_table(rows: Records, path: Path, arrival_ns: np.ndarray) -> SatelliteTable:
-    """One row per (epoch, satellite), validated: finite states, orbit-sized radius."""
+def _satellite_table(
+    rows: Records, path: Path, arrival_ns: np.ndarray, problems: list[str]
+) -> SatelliteTable:
+    """One row per (epoch, satellite), validated: finite states; a radius off any GNSS orbit is
+    an :class:`InputError` naming the line; rows with a satellite speed, clock bias or drift,
+    signal travel time or satellite number no GNSS satellite has (bounds of
+    :mod:`vo_doppler.io.vehicle_limits`) are dropped and counted in ``problems``."""
     number = lambda name: rows.numbers(name, path)  # noqa: E731
     position = np.stack([number(f"SvPosition{a}EcefMeters") for a in "XYZ"], axis=1)
     velocity = np.stack([number(f"SvVelocity{a}EcefMetersPerSecond") for a in "XYZ"], axis=1)
@@ -135,6 +148,17 @@ def _satellite_table(rows: Records, path: Path, arrival_ns: np.ndarray) -> Satel
     if np.any(wrong):
         raise InputError("satellite position off any GNSS orbit", path, int(rows.line[wrong][0]))
     system, prn = satellite_ids(number("ConstellationType"), number("Svid"))
+    possible = ~SATELLITE_SPEED.outside(np.linalg.norm(velocity, axis=1))
+    possible &= ~SATELLITE_CLOCK_BIAS.outside(bias) & ~SATELLITE_CLOCK_DRIFT.outside(drift)
+    possible &= ~SIGNAL_TRAVEL_TIME.outside(travel) & numbered(system, prn)
+    impossible = ok & ~possible
+    if np.any(impossible):
+        problems.append(
+            f"{path}: {int(impossible.sum())} satellite states with a speed, clock, signal travel "
+            f"time or satellite number no GNSS satellite has dropped (first: line "
+            f"{int(rows.line[impossible][0])})"
+        )
+    ok &= possible
     t = arrival_ns * 1e-9
     key = np.char.add(np.char.add(t.astype(str), system), prn.astype(str))
     _, first = np.unique(key, return_index=True)
