@@ -63,7 +63,7 @@ from enum import StrEnum
 from pathlib import Path
 
 from vo_doppler import __version__
-from vo_doppler.errors import InputError, VoDopplerError
+from vo_doppler.errors import InputError, VoDopplerError, storage_refused
 from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
 from vo_doppler.io.output_folder import (
     RUN,
@@ -350,6 +350,9 @@ def _logged_run(job: RecordingJob, staging: Path, start: float) -> RecordingOutc
         package_log.error("%s", exc)
         return _failed(job, Failure.INPUT, str(exc), time.perf_counter() - start)
     except Exception as exc:
+        if storage_refused(exc):  # a full disk: the environment, as for ``run``
+            message = f"{job.out}: cannot write the results: {exc.strerror}"
+            return _failed(job, Failure.INPUT, message, time.perf_counter() - start)
         package_log.error("%s", traceback.format_exc())
         message = f"{type(exc).__name__}: {exc}"
         return _failed(job, Failure.INTERNAL, message, time.perf_counter() - start)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import os
 import sys
 import traceback
 
@@ -20,6 +21,8 @@ from vo_doppler.errors import (
     EXIT_OK,
     EXIT_USAGE,
     VoDopplerError,
+    shown,
+    storage_refused,
 )
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
@@ -109,6 +112,9 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(exc, OSError) and exc.filename is not None:
             _report(args, f"error: {_refused_file_operation(exc)}")
             return EXIT_FAILURE
+        if storage_refused(exc):
+            _report(args, f"error: {_refused_storage(args, exc)}")
+            return EXIT_FAILURE
         _report(
             args,
             f"internal error: {type(exc).__name__}: {exc} (a bug; rerun with --debug for the "
@@ -126,12 +132,28 @@ def _refused_file_operation(exc: OSError) -> str:
     return f"{exc.filename}{other}: {reason} (the system refused this file operation)"
 
 
+OUTPUT_OPTIONS = ("output", "figure", "json")
+"""The options that name what a command writes (``eval``'s ``--json`` is a path or a flag)."""
+
+
+def _refused_storage(args: argparse.Namespace, exc: OSError) -> str:
+    """The message of a write the system refused without naming the file (a full disk found
+    when a buffered file is flushed): the command's outputs named instead."""
+    outputs = [
+        str(value)
+        for name in OUTPUT_OPTIONS
+        if isinstance(value := getattr(args, name, None), str | os.PathLike)
+    ]
+    where = " / ".join(outputs) or "the output"
+    return f"{where}: {exc.strerror} (the system refused to store the results)"
+
+
 def _report(args: argparse.Namespace, message: str) -> None:
-    """One line on stderr (a multi-line message joined by "; "), the traceback under
-    ``--debug``."""
+    """One line on stderr (a multi-line message joined by "; "; a name that is not UTF-8 with
+    ``\\xff`` escapes), the traceback under ``--debug``."""
     if args.debug:
         traceback.print_exc(file=sys.stderr)
-    one_line = "; ".join(part.strip() for part in message.splitlines() if part.strip())
+    one_line = "; ".join(part.strip() for part in shown(message).splitlines() if part.strip())
     print(f"vo-doppler {args.command}: {one_line}", file=sys.stderr)
 
 

@@ -11,6 +11,8 @@ Exit codes of the ``vo-doppler`` command (the one error contract):
 
 from __future__ import annotations
 
+import errno
+import os
 from pathlib import Path
 
 EXIT_OK = 0
@@ -59,3 +61,30 @@ class ManifestError(InputError):
 class OutputError(VoDopplerError):
     """An output location is unusable (a file where a folder is wanted, not writable) or is
     one of the command's inputs (writing it would destroy the input)."""
+
+
+STORAGE_ERRNOS = frozenset(
+    getattr(errno, name)
+    for name in ("ENOSPC", "EDQUOT", "EFBIG", "EROFS", "EIO")
+    if hasattr(errno, name)
+)
+"""The system's refusals to store what is written (a full disk or quota, a file too large for
+the file system, a read-only or failing device): the environment, not a bug."""
+
+
+def storage_refused(exc: BaseException) -> bool:
+    """Whether ``exc`` is the system refusing to store written data (:data:`STORAGE_ERRNOS`);
+    such an error often names no file (a buffered write failing at its flush)."""
+    return isinstance(exc, OSError) and exc.errno in STORAGE_ERRNOS
+
+
+def shown(text: str | os.PathLike[str]) -> str:
+    """``text`` (a path or a name taken from one) as text any UTF-8 output takes: the bytes of
+    a name that is not UTF-8, which Python holds as lone surrogates (``os.fsdecode``), become
+    ``\\xff`` escapes, so that a report, a JSON file or a figure title names it instead of
+    failing with ``UnicodeEncodeError``."""
+    text = os.fspath(text)
+    try:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:  # a surrogate no file name decodes to ('\\ud800')
+        return text.encode("utf-8", "backslashreplace").decode("utf-8")

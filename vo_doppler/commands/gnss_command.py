@@ -28,7 +28,7 @@ from vo_doppler.commands.satellite_options import (
     satellite_inputs,
     satellite_states,
 )
-from vo_doppler.errors import InputError, VoDopplerError
+from vo_doppler.errors import InputError, VoDopplerError, shown
 from vo_doppler.gnss.doppler_velocity import doppler_codes
 from vo_doppler.gnss.ephemeris import GLONASS_MAX_AGE_S, KEPLER_MAX_AGE_S
 from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
@@ -296,7 +296,7 @@ def run(args: argparse.Namespace) -> int:
     mask = np.deg2rad(args.elev_mask)
     bands = getattr(args, "bands", None)
     used = _glonass_dropped(obs, nav, args.systems, bands)
-    title = f"{args.obs.name} ({used})"
+    title = f"{shown(args.obs.name)} ({used})"
     if args.gnss_command == "spp":
         solution = solve_spp(obs, nav, args.systems, mask)
         valid = solution.valid

@@ -18,7 +18,7 @@ from vo_doppler.commands.arg_types import window_size
 from vo_doppler.commands.correction_options import add_correction_options, correction_config
 from vo_doppler.commands.heading_method import add_heading_method_option, heading_method_config
 from vo_doppler.commands.satellite_options import add_selection_options
-from vo_doppler.errors import InputError
+from vo_doppler.errors import InputError, shown
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.io.output_folder import RUN, check_output_folder, staged_output, untouched
 from vo_doppler.io.sequence import manifest_inputs, read_manifest, read_sequence_with_report
@@ -131,7 +131,8 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
         console.print(f"{inputs.name} has no camera: only the non-visual pipelines ran")
     print_summary(console, summary)
     console.print(
-        f"wrote {args.output}/report.html (open it in a browser) and the trajectories, figures"
+        f"wrote {shown(args.output)}/report.html (open it in a browser) and the trajectories, "
+        "figures"
     )
     return result
 

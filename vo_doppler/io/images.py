@@ -35,10 +35,19 @@ def list_images(folder: str | Path) -> list[Path]:
 
 
 def read_image(path: Path) -> np.ndarray | None:
-    """Grey uint8 image, or ``None`` (with a warning) when the file cannot be decoded."""
+    """Grey uint8 image, or ``None`` (with a warning) when the file cannot be read or decoded.
+
+    The file is read by Python and decoded from memory: ``cv2.imread`` encodes the path as
+    UTF-8, and a name that is not (bytes ``\\xff``, held as a lone surrogate) crashes OpenCV
+    with a segmentation fault."""
     import cv2  # OpenCV (16 MiB resident) is loaded by the first image read, not with the package
 
-    image = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+    try:
+        data = np.fromfile(path, dtype=np.uint8)
+    except OSError as exc:
+        log.warning("%s: cannot read image (%s); the frame is flagged and bridged", path, exc)
+        return None
+    image = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE) if data.size else None
     if image is None:
         log.warning("%s: cannot decode image; the frame is flagged and bridged", path)
     return image

@@ -36,7 +36,7 @@ from contextlib import contextmanager
 from fnmatch import fnmatch
 from pathlib import Path
 
-from vo_doppler.errors import InputError, OutputError
+from vo_doppler.errors import InputError, OutputError, storage_refused
 from vo_doppler.io.yaml_file import load_yaml
 
 MARKER = ".vo-doppler-output.json"
@@ -382,13 +382,18 @@ def staged_output(
 ) -> Iterator[Path]:
     """A temporary folder beside ``path`` to write into; on normal exit it is marked as
     ``command``'s and replaces ``path`` (:func:`swap_in`), on an exception it is removed and
-    ``path`` is unchanged."""
+    ``path`` is unchanged (the system refusing to store the files, a full disk, becomes an
+    :class:`OutputError` naming ``path``)."""
     inputs = list(inputs)
     staging = begin_staging(path, command, inputs)
     try:
         yield staging
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(staging, ignore_errors=True)
+        if storage_refused(exc):  # a full disk: named as the output's, not the temporary's
+            raise OutputError(
+                f"{path}: cannot write the results: {exc.strerror}; {untouched(path)}"
+            ) from exc
         raise
     swap_in(staging, path, command, inputs)
 

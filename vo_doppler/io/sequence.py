@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from vo_doppler.errors import InputError, ManifestError
+from vo_doppler.errors import InputError, ManifestError, shown
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import CanDecodeReport, SignalError, read_can_motion
@@ -253,7 +253,7 @@ def read_sequence_with_report(
         forward_acceleration = _sensor_csv(
             m, "imu", "forward_acceleration", FORWARD_ACCELERATION_COLUMN, report
         )
-    name = m.data.get("name", m.root.name)
+    name = m.data.get("name", shown(m.root.name))
     if not isinstance(name, str | int | float) or isinstance(name, bool):
         raise m.error("name", f"{name!r} is not a name")
     sequence = Sequence(

@@ -18,6 +18,7 @@ from urllib.parse import quote
 
 import numpy as np
 
+from vo_doppler.errors import shown
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.run import Pipeline
 
@@ -196,4 +197,4 @@ def write_batch_html(path: Path, rows: list[dict], title: str = "vo-doppler batc
         ]
         parts.append("</ul>")
     parts.append("</body></html>")
-    path.write_text("\n".join(parts))
+    path.write_text(shown("\n".join(parts)), encoding="utf-8")

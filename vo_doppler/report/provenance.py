@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler import __version__
+from vo_doppler.errors import shown
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.run import RunConfig
 
@@ -98,9 +99,10 @@ def describe_data(
 
 
 def command_line(argv: list[str] | None = None) -> str:
-    """The command as typed (program name shortened to ``vo-doppler``), shell-quoted."""
+    """The command as typed (program name shortened to ``vo-doppler``), shell-quoted; the
+    bytes of a name that is not UTF-8 as ``\\xff`` escapes (:func:`~vo_doppler.errors.shown`)."""
     argv = sys.argv if argv is None else argv
-    return shlex.join(["vo-doppler", *argv[1:]])
+    return shlex.join(["vo-doppler", *(shown(arg) for arg in argv[1:])])
 
 
 def version() -> str:

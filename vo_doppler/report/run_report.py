@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from vo_doppler.errors import shown
 from vo_doppler.eval.per_distance import MIN_PATH_M, ErrorPerDistance
 from vo_doppler.eval.pipelines import (
     PIPELINE_LABELS,
@@ -555,4 +556,6 @@ TRACK_LABELS = {TRUTH: "ground truth", **PIPELINE_LABELS}
 
 
 def write_run_report(path: Path, report: RunReport) -> None:
-    path.write_text(render(report), encoding="utf-8")
+    """The report as UTF-8 HTML; a path in it that is not UTF-8 (in a warning, the command
+    line) with its bytes as ``\\xff`` escapes (:func:`~vo_doppler.errors.shown`)."""
+    path.write_text(shown(render(report)), encoding="utf-8")
