@@ -61,14 +61,15 @@ def test_run_with_names_that_are_not_utf8_writes_its_report(first_run):
 
 
 def test_run_on_a_full_disk_is_exit_1_naming_the_folder_and_keeps_the_results(
-    drive, first_run, monkeypatch, capsys
+    drive, first_run, monkeypatch, capsys, caplog
 ):
     before = snapshot(first_run)
     monkeypatch.setattr(run_outputs, "write_geojson", full_disk)
     assert main(["-q", "run", str(drive), "-o", str(first_run)]) == EXIT_FAILURE
     err = capsys.readouterr().err
     assert "No space left on device" in err and shown(first_run) in err
-    assert "left as it was" in err and "internal error" not in err
+    assert "internal error" not in err and len(err.splitlines()) == 1
+    assert "left as it was" in caplog.text
     assert snapshot(first_run) == before
     leftovers = [p.name for p in first_run.parent.iterdir() if p.name.startswith(".")]
     assert leftovers == []

@@ -391,9 +391,7 @@ def staged_output(
     except BaseException as exc:
         shutil.rmtree(staging, ignore_errors=True)
         if storage_refused(exc):  # a full disk: named as the output's, not the temporary's
-            raise OutputError(
-                f"{path}: cannot write the results: {exc.strerror}; {untouched(path)}"
-            ) from exc
+            raise OutputError(f"{path}: cannot write the results: {exc.strerror}") from exc
         raise
     swap_in(staging, path, command, inputs)
 
