@@ -10,8 +10,15 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tests.conftest import shared_data_dir
 from vo_doppler.errors import InputError
-from vo_doppler.io.kitti_oxts import EARTH_RADIUS_M, OXTS_FIELDS, read_oxts, read_timestamps
+from vo_doppler.io.kitti_oxts import (
+    BOUNDS,
+    EARTH_RADIUS_M,
+    OXTS_FIELDS,
+    read_oxts,
+    read_timestamps,
+)
 
 LAT0 = 49.011
 LON0 = 8.423
@@ -241,7 +248,11 @@ def test_timestamp_lines_are_utc_with_the_leap_seconds_of_their_date(
     angles=st.lists(st.floats(-3.14159, 3.14159), min_size=3, max_size=3),
 )
 def test_packet_lines_read_back_every_number_exactly(tmp_path_factory, values, lat, lon, angles):
+    """Any numbers within the fields' bounds (a drawn ±1e6 mapped into ``BOUNDS``) read back."""
     values[0], values[1], values[3:6] = lat, lon, angles
+    for name, bounds in BOUNDS.items():
+        k = OXTS_FIELDS.index(name)
+        values[k] = bounds.low + (values[k] + 1e6) / 2e6 * (bounds.high - bounds.low)
     folder = tmp_path_factory.mktemp("oxts") / "oxts"
     (folder / "data").mkdir(parents=True)
     (folder / "data" / "0000000000.txt").write_text(" ".join(repr(v) for v in values) + "\n")
@@ -271,3 +282,27 @@ def test_damaged_packet_or_timestamp_fails_only_with_input_errors(tmp_path_facto
         assert "timestamps.txt:" in str(exc) or "0000000003.txt" in str(exc)
         return
     assert np.all(np.isfinite(record.poses)) and np.all(np.diff(record.t) > 0)
+
+
+OXTS_BAD = {"vf": 1.0e9, "wz": 50.0, "alt": 1.0e6, "vn": -200.0, "af": 100.0, "wx": -6.0}
+
+
+@pytest.mark.parametrize("name", sorted(OXTS_BAD))
+def test_a_value_no_vehicle_reports_names_the_packet_and_field(tmp_path, name):
+    values = [49.0, 8.4, 110.0, 0.0, 0.0, 0.1] + [1.0] * 19 + [4, 11, 6, 6, 6]
+    values[OXTS_FIELDS.index(name)] = OXTS_BAD[name]
+    folder = tmp_path / "oxts"
+    (folder / "data").mkdir(parents=True)
+    packet = folder / "data" / "0000000000.txt"
+    packet.write_text(" ".join(repr(v) for v in values) + "\n")
+    (folder / "timestamps.txt").write_text("2011-09-26 13:02:25.964389445\n")
+    with pytest.raises(InputError, match=rf"0000000000\.txt:1: {name} = .* is outside"):
+        read_oxts(folder)
+
+
+def test_the_shared_oxts_of_1e9_mps_is_refused():
+    folder = shared_data_dir() / "bad_inputs_found" / "oxts_1e9"
+    if not folder.is_dir():
+        pytest.skip(f"{folder} absent")
+    with pytest.raises(InputError, match=r"oxts_1e9/data/0000000000\.txt:1: .* is outside"):
+        read_oxts(folder)

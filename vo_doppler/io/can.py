@@ -396,7 +396,7 @@ def si_factor(unit: str | None, where: str) -> tuple[float, str]:
     """Factor and SI unit for a DBC unit string; unknown units are an input error."""
     key = (unit or "").strip().lower().replace(" ", "")
     if key not in UNIT_TO_SI:
-        raise InputError(f"signal {where} has unit {unit!r}, which has no known SI conversion")
+        raise SignalError(f"signal {where} has unit {unit!r}, which has no known SI conversion")
     return UNIT_TO_SI[key]
 
 

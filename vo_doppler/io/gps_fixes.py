@@ -34,7 +34,12 @@ from vo_doppler.errors import InputError
 from vo_doppler.io.sensor_csv import read_numeric_csv
 from vo_doppler.io.textfile import read_text, regular_file
 from vo_doppler.io.time_order import order_samples
-from vo_doppler.io.vehicle_limits import GROUND_SPEED, too_many_out_of_range
+from vo_doppler.io.vehicle_limits import (
+    GROUND_SPEED,
+    LATITUDE_DEG,
+    LONGITUDE_DEG,
+    too_many_out_of_range,
+)
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.model.gpstime import utc_to_gps_seconds as gpstime_utc_to_gps
 
@@ -174,6 +179,18 @@ def _parse_sentences(path: Path, lines: list[bytes]) -> _Sentences:
         anchor = message.time or None
         if no_fix or "" in (message.lat, message.lon, message.time):
             found.n_nofix += 1
+            continue
+        if LATITUDE_DEG.outside([message.lat])[0] or LONGITUDE_DEG.outside([message.lon])[0]:
+            found.n_bad += 1
+            log.warning(
+                "%s:%d: latitude %s, longitude %s outside %s, %s: sentence skipped",
+                path,
+                number,
+                message.lat,
+                message.lon,
+                LATITUDE_DEG,
+                LONGITUDE_DEG,
+            )
             continue
         if not gga and message.spd != "":
             speed = float(message.spd) * KNOT_MPS

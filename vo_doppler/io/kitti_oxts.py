@@ -9,8 +9,10 @@ navstat numsats posmode velmode orimode.
 Poses follow the devkit's ``convertOxtsToPose``: a Mercator projection whose scale
 s = cos(lat₀) is fixed by the first frame's latitude, x = s·R_e·lon, y = s·R_e·ln tan(π/4 + lat/2)
 (R_e = 6378137 m), z = alt; the rotation R = R_z(yaw)·R_y(pitch)·R_x(roll); each pose is then
-expressed relative to the first one: T_i ← T_0⁻¹·T_i. Vehicle signals: yaw rate ``wz`` (rad/s,
-about the vehicle's up axis) and forward speed ``vf`` (m/s) as ``SensorSeries``.
+expressed relative to the first one: T_i ← T_0⁻¹·T_i. Every field is checked against what a road
+vehicle's OXTS can report (``BOUNDS``: height, speeds, accelerations, angular rates). Vehicle
+signals: yaw rate ``wz`` (rad/s, about the vehicle's up axis) and forward speed ``vf`` (m/s) as
+``SensorSeries``.
 
 ENU poses (:meth:`OxtsRecord.enu_trajectory`, what ``vo-doppler import kitti-raw`` writes as
 ground truth): each fix (lat, lon, alt; alt taken as the ellipsoidal height, which KITTI does not
@@ -46,6 +48,14 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, ecef_to_enu_rotation, geodetic_to_ecef
+from vo_doppler.io.vehicle_limits import (
+    ANGULAR_RATE,
+    FORWARD_ACCELERATION,
+    HEIGHT,
+    SPEED,
+    VELOCITY_COMPONENT,
+    SignalBounds,
+)
 from vo_doppler.model.gpstime import calendar_to_gps_seconds, utc_to_gps_seconds
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
@@ -61,6 +71,15 @@ OXTS_FIELDS = (
 _TIMESTAMP = re.compile(r"^(\d{4})-(\d\d)-(\d\d) (\d\d):(\d\d):(\d\d)(?:\.(\d{1,9}))?$")
 _FRAME_NAME = re.compile(r"^\d{1,10}$")
 _LIMITS = {"lat": 90.0, "lon": 180.0, "roll": np.pi, "pitch": np.pi, "yaw": np.pi + 1e-6}
+BOUNDS: dict[str, SignalBounds] = {
+    "alt": HEIGHT,
+    "vf": SPEED,
+    **dict.fromkeys(("vn", "ve", "vl", "vu"), VELOCITY_COMPONENT),
+    **dict.fromkeys(("ax", "ay", "az", "af", "al", "au"), FORWARD_ACCELERATION),
+    **dict.fromkeys(("wx", "wy", "wz", "wf", "wl", "wu"), ANGULAR_RATE),
+}
+"""What a road vehicle's OXTS can report (:mod:`vo_doppler.io.vehicle_limits`): a packet with
+a value beyond is an error naming the file and the field."""
 
 
 @dataclass(frozen=True)
@@ -209,6 +228,10 @@ def _read_packet(path: Path) -> np.ndarray:
         value = values[OXTS_FIELDS.index(name)]
         if abs(value) > limit:
             raise InputError(f"{name} = {value} out of range", path, 1)
+    for name, bounds in BOUNDS.items():
+        value = values[OXTS_FIELDS.index(name)]
+        if bounds.outside(np.array([value]))[0]:
+            raise InputError(f"{name} = {value:g} is outside {bounds}", path, 1)
     return values
 
 

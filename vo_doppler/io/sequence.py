@@ -35,7 +35,7 @@ from vo_doppler.io.sensor_csv import (
 from vo_doppler.io.textfile import regular_file
 from vo_doppler.io.time_order import TimeOrderReport
 from vo_doppler.io.trajectory import read_tum
-from vo_doppler.io.vehicle_limits import lever_arm_problem
+from vo_doppler.io.vehicle_limits import TIME_OFFSET, lever_arm_problem
 from vo_doppler.io.yaml_file import load_yaml
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
@@ -156,6 +156,11 @@ class Manifest:
             raise self.error(f"{section}.{key}", f"{value:g} is outside [{low:g}, {high:g}]")
         return value
 
+    def time_offset(self, section: str) -> float:
+        """The section's ``time_offset_s`` (0 when absent), within ``TIME_OFFSET``: an offset to
+        GPS time beyond every GPS time up to 2100 is a wrong value, not a clock."""
+        return self.number(section, "time_offset_s", 0.0, TIME_OFFSET.low, TIME_OFFSET.high)
+
     def string(self, section: str, key: str, default: Any = _REQUIRED) -> str:
         value = self.value(section, key, default)
         if not isinstance(value, str) or not value.strip():
@@ -231,8 +236,14 @@ def read_sequence_with_report(
     images, times, camera, camera_offset = [], np.zeros(0), None, 0.0
     if "camera" in m.data:  # a recording without video has no camera section
         images = list_images(m.folder("camera", "images"))
-        camera_offset = m.number("camera", "time_offset_s", 0.0)
+        camera_offset = m.time_offset("camera")
         times = read_times(m.file("camera", "times"), len(images))
+        if np.any(np.diff(times + camera_offset) <= 0):
+            raise m.error(
+                "camera.time_offset_s",
+                f"{camera_offset:g} s added to the image times makes them stop increasing "
+                "(the sum loses their spacing to rounding)",
+            )
         camera = read_camera(m.file("camera", "calib"))
     obs, nav, sigma, lever_arm = None, None, None, (0.0, 0.0, 0.0)
     if "gnss" in m.data:  # a recording without GNSS (a KITTI raw drive) runs VO and DR only
@@ -318,7 +329,7 @@ def _vehicle_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
         )
     if has["can"]:
         return _can_motion(m, report)
-    offset = m.number("vehicle", "time_offset_s", 0.0)
+    offset = m.time_offset("vehicle")
     yaw_rate = _sensor_csv(m, "vehicle", "yaw_rate", YAW_RATE_COLUMN, report)
     speed = _sensor_csv(m, "vehicle", "wheel_speed", SPEED_COLUMN, report)
     report.yaw_rate_dbc_unit = "rad/s"
@@ -342,7 +353,7 @@ def _sensor_csv(
     """The ``t,<column>`` CSV named by ``section.key`` on GPS time (the section's
     ``time_offset_s``); the rows it skipped go to the report's warnings."""
     series, csv_report = read_sensor_csv_with_report(
-        m.file(section, key), column, m.number(section, "time_offset_s", 0.0)
+        m.file(section, key), column, m.time_offset(section)
     )
     report.skipped.extend(csv_report.problems())
     return series
@@ -350,7 +361,7 @@ def _sensor_csv(
 
 def _can_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
     """The ``can`` section: the log decoded with its DBC."""
-    can_offset = m.number("can", "time_offset_s", 0.0)
+    can_offset = m.time_offset("can")
     short_frames = m.string("can", "short_frames", "skip")
     if short_frames not in ("skip", "pad"):
         raise m.error("can.short_frames", f"can.short_frames is {short_frames!r}, not skip or pad")
