@@ -19,6 +19,7 @@ import tempfile
 import zlib
 from importlib import resources
 from pathlib import Path
+from typing import BinaryIO
 
 import hatanaka
 import ncompress
@@ -87,14 +88,21 @@ def read_rinex_bytes(path: str | Path, problems: list[str] | None = None) -> byt
     """
     path = Path(path)
     try:
-        if not stat.S_ISREG(path.stat().st_mode):
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode):
             raise InputError("not a regular file", path)
+        if info.st_size > MAX_TEXT_BYTES:  # refused before a byte is read
+            raise InputError(
+                f"file is {info.st_size} bytes, larger than the {MAX_TEXT_BYTES >> 20} MiB "
+                "this reader accepts",
+                path,
+            )
         with path.open("rb") as stream:
-            raw = stream.read(MAX_TEXT_BYTES + 1)
+            raw = _read_until_nul(stream, path, problems)
     except OSError as exc:
         raise InputError(f"cannot read file: {exc.strerror or exc}", path) from exc
     if len(raw) > MAX_TEXT_BYTES:
-        raise InputError(f"file is larger than {MAX_TEXT_BYTES >> 20} MiB", path)
+        raise InputError(f"file grew beyond {MAX_TEXT_BYTES >> 20} MiB while being read", path)
     limit = expanded_limit(len(raw))
     try:
         if raw[:2] == b"\x1f\x8b":
@@ -120,6 +128,32 @@ def read_rinex_bytes(path: str | Path, problems: list[str] | None = None) -> byt
     if b"\r" in raw:
         raw = raw.replace(b"\r\n", b"\n")
     return raw
+
+
+def _read_until_nul(stream: BinaryIO, path: Path, problems: list[str] | None) -> bytes:
+    """The bytes of a file (at most :data:`MAX_TEXT_BYTES` + 1), read a chunk at a time; a
+    text file (not gzip or compress data) ends at its first NUL byte, which no RINEX line
+    holds: a logger's reserved space it never wrote, or a sparse file. With ``problems`` the
+    complete lines before it are kept and a problem names the line (as for a truncated file);
+    without, it is an :class:`InputError`. Nothing after it is read."""
+    chunks: list[bytes] = []
+    size = 0
+    while size <= MAX_TEXT_BYTES and (chunk := stream.read(_CHUNK)):
+        if not chunks and chunk[:2] in (b"\x1f\x8b", b"\x1f\x9d"):  # compressed: NULs are data
+            return chunk + stream.read(MAX_TEXT_BYTES + 1 - len(chunk))
+        nul = chunk.find(b"\0")
+        if nul >= 0:
+            chunks.append(chunk[:nul])
+            text = b"".join(chunks)
+            line = text.count(b"\n") + 1
+            message = "NUL bytes where a line should be: the file ends here (not RINEX text)"
+            if problems is None:
+                raise InputError(message, path, line)
+            add_problem(problems, path, line, f"{message}; the {line - 1} lines before are read")
+            return text[: text.rfind(b"\n") + 1]
+        chunks.append(chunk)
+        size += len(chunk)
+    return b"".join(chunks)
 
 
 def _one_line(exc: Exception) -> str:

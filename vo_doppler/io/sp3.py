@@ -22,6 +22,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.rinex_common import PRN_RANGE, parse_calendar, prn_in_range
+from vo_doppler.io.textfile import regular_file
 from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, calendar_to_gps_seconds, utc_to_gps_seconds
 from vo_doppler.model.precise_orbits import PreciseOrbits
 
@@ -66,12 +67,24 @@ def satellite_id(text: str) -> str:
     return f"{letter}{number:02d}"
 
 
+PRODUCT_MAX_BYTES = 256 << 20
+"""Largest SP3 or RINEX clock file read (a day of 5-s clocks of every satellite is about
+120 MB): a larger one is refused before it is read."""
+
+
 def text_lines(path: Path, what: str) -> list[str]:
-    """The lines of a text product, LF or CRLF (splitlines drops either)."""
+    """The lines of a text product, LF or CRLF (splitlines drops either); a file larger than
+    :data:`PRODUCT_MAX_BYTES` or holding a NUL byte (no text does) is an error."""
+    regular_file(path, f"{what} file", PRODUCT_MAX_BYTES)
     try:
-        return path.read_text(encoding="ascii", errors="replace").splitlines()
+        data = path.read_bytes()
     except OSError as exc:
         raise InputError(f"cannot read {what} file: {exc}", path) from exc
+    nul = data.find(b"\0")
+    if nul >= 0:
+        line = data.count(b"\n", 0, nul) + 1
+        raise InputError(f"NUL bytes: not a {what} text file", path, line)
+    return data.decode("ascii", errors="replace").splitlines()
 
 
 def read_sp3(path: str | Path) -> PreciseOrbits:

@@ -6,6 +6,8 @@ scanned here so that every problem names its byte offset; bytes between frames (
 are skipped and counted; a frame with a bad checksum, a payload shorter or longer than its
 message needs (an empty one included) or one pyubx2 cannot parse is skipped with a message
 ``FILE, byte OFFSET: …`` in ``problems`` (and the log); a truncated last frame likewise.
+A file larger than ``MAX_UBX_BYTES`` is refused before it is read; the file is scanned a chunk
+at a time, and after ``MAX_GAP`` bytes without a frame the rest of it is not read (a problem).
 Physical bounds come from :mod:`vo_doppler.io.vehicle_limits`.
 
 - RXM-RAWX → :class:`Observations`, epoch = week·604800 + rcvTow (receiver time, like a RINEX
@@ -36,8 +38,10 @@ from __future__ import annotations
 
 import logging
 import struct
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 from pyubx2 import UBXMessageError, UBXParseError, UBXReader, UBXTypeError
@@ -46,6 +50,7 @@ from vo_doppler.errors import InputError
 from vo_doppler.io.gps_lnav import LnavAssembler, empty_glonass, parity_error, subframe_id
 from vo_doppler.io.obs_rows import observations_from_rows
 from vo_doppler.io.rinex_common import prn_in_range
+from vo_doppler.io.textfile import regular_file
 from vo_doppler.io.vehicle_limits import (
     CARRIER_PHASE,
     CN0,
@@ -111,6 +116,13 @@ VALUE_RANGES = {  # plausible RXM-RAWX values; others (and NaN) are dropped and 
     "D": (DOPPLER.low, DOPPLER.high),  # Doppler, Hz
     "S": (CN0.low, CN0.high),  # C/N0, dB-Hz
 }
+MAX_UBX_BYTES = 1 << 30
+"""Largest UBX log read, 1 GiB (about 10 h of 10-Hz RXM-RAWX with 30 signals; its rows fill
+several GB of memory): a larger file is refused before any byte is read."""
+MAX_GAP = 16 << 20
+"""Bytes without a UBX frame after which the rest of a file is not read: NMEA or RTCM between
+frames take far less; a file whose logger reserved space it never wrote is NUL bytes."""
+READ_CHUNK = 1 << 20
 PVT_PAYLOAD = 92
 """NAV-PVT payload length (bytes, u-blox 8 / 9 interface descriptions)."""
 PVT_TIME_TOLERANCE_S = 2.0  # iTOW vs UTC + leap seconds: a leap second unknown to the table
@@ -139,28 +151,77 @@ def checksum(body: bytes) -> bytes:
     return bytes((a, b))
 
 
-def frames(data: bytes, path: Path, problems: list[str]):
-    """(offset, class, id, frame) of every well-formed UBX frame, in stream order."""
-    position, skipped = 0, 0
+class _Window:
+    """The part of a binary stream being scanned, read a chunk at a time: a UBX frame is at most
+    65,543 bytes, so the scan holds about one chunk whatever the file's size."""
+
+    def __init__(self, stream: BinaryIO, path: Path) -> None:
+        self.stream, self.path = stream, path
+        self.data = b""
+        self.base = 0
+        """The file offset of ``data[0]``."""
+        self.eof = False
+
+    def need(self, start: int, count: int) -> tuple[int, bool]:
+        """Make ``count`` bytes from index ``start`` available, dropping the bytes before
+        ``start`` when more must be read; the index of those bytes now, and whether there are
+        that many (False at the end of the file)."""
+        while len(self.data) - start < count and not self.eof:
+            self.data, self.base, start = self.data[start:], self.base + start, 0
+            try:
+                chunk = self.stream.read(max(READ_CHUNK, count))
+            except OSError as exc:
+                raise InputError(f"cannot read UBX file: {exc.strerror or exc}", self.path) from exc
+            self.eof = not chunk
+            self.data += chunk
+        return start, len(self.data) - start >= count
+
+
+def frames(
+    stream: BinaryIO, path: Path, problems: list[str]
+) -> Iterator[tuple[int, int, int, bytes]]:
+    """(offset, class, id, frame) of every well-formed UBX frame, in stream order, read from
+    ``stream`` a chunk at a time; after :data:`MAX_GAP` bytes without a frame the rest of the
+    stream is not read (with a problem saying so)."""
+    window = _Window(stream, path)
+    position = skipped = gap = 0
     while True:
-        start = data.find(SYNC, position)
-        skipped += (len(data) if start < 0 else start) - position
+        start = window.data.find(SYNC, position)
         if start < 0:
+            tail = max(position, len(window.data) - 1)  # its last byte may begin a sync
+            skipped, gap = skipped + tail - position, gap + tail - position
+            if gap > MAX_GAP:
+                _problem(
+                    problems,
+                    path,
+                    window.base + tail,
+                    f"no UBX frame in the {MAX_GAP >> 20} MiB before: the rest of the file is "
+                    "not read (not UBX data, or space the logger reserved and never wrote)",
+                )
+                break
+            position, more = window.need(tail, 2)
+            if not more:
+                skipped += len(window.data) - position
+                break
+            continue
+        skipped, gap = skipped + start - position, gap + start - position
+        start, complete = window.need(start, 6)
+        if not complete:
+            _problem(problems, path, window.base + start, "truncated UBX header at end of file")
             break
-        if start + 6 > len(data):
-            _problem(problems, path, start, "truncated UBX header at end of file")
+        length = int.from_bytes(window.data[start + 4 : start + 6], "little")
+        start, complete = window.need(start, 8 + length)
+        offset = window.base + start
+        if not complete:
+            _problem(problems, path, offset, f"truncated UBX frame ({length}-byte payload)")
             break
-        length = int.from_bytes(data[start + 4 : start + 6], "little")
-        end = start + 8 + length
-        if end > len(data):
-            _problem(problems, path, start, f"truncated UBX frame ({length}-byte payload)")
-            break
-        if checksum(data[start + 2 : end - 2]) != data[end - 2 : end]:
-            _problem(problems, path, start, "UBX checksum mismatch: frame skipped")
+        frame = window.data[start : start + 8 + length]
+        if checksum(frame[2:-2]) != frame[-2:]:
+            _problem(problems, path, offset, "UBX checksum mismatch: frame skipped")
             position = start + 2
             continue
-        yield start, data[start + 2], data[start + 3], data[start:end]
-        position = end
+        yield offset, frame[2], frame[3], frame
+        position, gap = start + 8 + length, 0
     if skipped:
         _problem(problems, path, 0, f"{skipped} bytes outside UBX frames skipped")
 
@@ -190,16 +251,23 @@ def read_ubx(path: str | Path) -> UbxRecording:
     """Read a UBX log (module docstring). Raises :class:`InputError` when nothing usable is in
     it or when RXM-RAWX epochs go back in time."""
     path = Path(path)
+    regular_file(path, "UBX file", MAX_UBX_BYTES)
     try:
-        data = path.read_bytes()
+        stream = path.open("rb")
     except OSError as exc:
-        raise InputError(f"cannot read UBX file: {exc}", path) from exc
+        raise InputError(f"cannot read UBX file: {exc.strerror or exc}", path) from exc
+    with stream:
+        return _read_stream(stream, path)
+
+
+def _read_stream(stream: BinaryIO, path: Path) -> UbxRecording:
+    """What :func:`read_ubx` returns, from the open file ``stream``."""
     problems: list[str] = []
     raw = _RawxRows()
     pvt: list[dict[str, float]] = []
     subframes: list[tuple[int, int, tuple[int, ...]]] = []
     n_other_nav = 0
-    for offset, cls, mid, frame in frames(data, path, problems):
+    for offset, cls, mid, frame in frames(stream, path, problems):
         if (cls, mid) not in (RAWX, SFRBX, PVT):
             continue
         wrong = _payload_problem((cls, mid), frame[6:-2])
