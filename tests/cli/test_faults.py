@@ -107,3 +107,10 @@ def test_an_image_whose_name_is_not_utf8_is_read(tmp_path):
     path.write_bytes(encoded.tobytes())
     assert np.array_equal(read_image(path), image)
     assert read_image(tmp_path / "missing.png") is None
+
+
+def test_an_image_file_past_the_bound_is_not_read(tmp_path):
+    path = tmp_path / "000000.png"
+    path.write_bytes(b"\x89PNG\r\n\x1a\n")
+    os.truncate(path, 8 << 30)  # sparse: no disk used
+    assert read_image(path) is None

@@ -18,6 +18,9 @@ from vo_doppler.io.textfile import read_text
 
 log = logging.getLogger(__name__)
 
+IMAGE_MAX_BYTES = 256 << 20
+"""Largest image file read (an uncompressed 8K frame is 100 MB); a larger one is a damaged
+frame, not read."""
 IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm"}
 
 
@@ -43,6 +46,16 @@ def read_image(path: Path) -> np.ndarray | None:
     import cv2  # OpenCV (16 MiB resident) is loaded by the first image read, not with the package
 
     try:
+        size = Path(path).stat().st_size
+        if size > IMAGE_MAX_BYTES:
+            log.warning(
+                "%s: image of %d bytes, more than %d MiB: not read; the frame is flagged and "
+                "bridged",
+                path,
+                size,
+                IMAGE_MAX_BYTES >> 20,
+            )
+            return None
         data = np.fromfile(path, dtype=np.uint8)
     except OSError as exc:
         log.warning("%s: cannot read image (%s); the frame is flagged and bridged", path, exc)
