@@ -1,6 +1,6 @@
-"""``vo-doppler import comma2k19 SEGMENT --orbits SP3 -o SEQ`` and ``vo-doppler import
-kitti-raw DRIVE -o SEQ``: a recording in another layout → a standard sequence folder for
-``vo-doppler run``."""
+"""``vo-doppler import comma2k19 SEGMENT --orbits SP3 -o SEQ``, ``vo-doppler import
+kitti-raw DRIVE -o SEQ`` and ``vo-doppler import smartloc CSV -o SEQ``: a recording in another
+layout → a standard sequence folder for ``vo-doppler run``."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from pathlib import Path
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.kitti_raw_import import CAMERAS as KITTI_CAMERAS
 from vo_doppler.io.kitti_raw_import import import_kitti_raw
+from vo_doppler.io.smartloc_import import import_smartloc
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +61,29 @@ def register(subparsers, summary: str) -> None:
     )
     kitti.add_argument("-o", "--output", type=Path, required=True, help="sequence folder")
     kitti.set_defaults(func=run_kitti_raw)
+    smartloc = kinds.add_parser(
+        "smartloc",
+        help="a TU Chemnitz smartLoc raw CSV (';'-separated u-blox measurements + ground truth)",
+        description="Write RINEX 3 observations of every measurement row (pseudorange, carrier, "
+        "Doppler, C/N0; GLONASS channels from freqId), the Doppler sigma as range-rate sigma "
+        "(wavelength x doStdev), the per-row NLOS label with each Doppler's range rate "
+        "(gnss/doppler_nlos.csv), the ground truth's velocity and yaw rate as the vehicle "
+        "signals, its positions and heading as ENU ground truth (origin: the first epoch) and "
+        "sequence.yaml. smartLoc has no navigation file: without --nav the sequence has no gnss "
+        "section and run runs the dead reckoning only; with the day's broadcast navigation "
+        "(--nav) it runs the GNSS pipelines too. No images: no camera.",
+    )
+    smartloc.add_argument("csv", type=Path, help="smartLoc raw CSV (*_raw.csv)")
+    smartloc.add_argument(
+        "--nav",
+        type=Path,
+        action="append",
+        default=[],
+        help="RINEX navigation file of the recording's day (repeatable); copied into the "
+        "sequence's gnss section",
+    )
+    smartloc.add_argument("-o", "--output", type=Path, required=True, help="sequence folder")
+    smartloc.set_defaults(func=run_smartloc)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -96,4 +120,26 @@ def run_kitti_raw(args: argparse.Namespace) -> int:
         "rectified" if summary.rectified else "raw (distorted)",
         summary.extrinsic_from,
     )
+    return 0
+
+
+def run_smartloc(args: argparse.Namespace) -> int:
+    summary = import_smartloc(args.csv, args.output, args.nav)
+    log.info(
+        "wrote %s: %d measurement rows in %d epochs (NLOS %d, line of sight %d, unlabelled %d), "
+        "%d ground-truth poses, vehicle speed and yaw rate from the ground truth; %s",
+        summary.folder,
+        summary.rows,
+        summary.epochs,
+        summary.nlos,
+        summary.line_of_sight,
+        summary.unlabelled,
+        summary.ground_truth_poses,
+        f"navigation {', '.join(p.name for p in summary.navigation)}: run runs the GNSS pipelines"
+        if summary.navigation
+        else "no navigation file (smartLoc ships none): no gnss section, run runs the dead "
+        "reckoning only; import again with --nav for the GNSS pipelines",
+    )
+    for problem in summary.problems:
+        log.warning("%s", problem)
     return 0

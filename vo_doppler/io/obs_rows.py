@@ -30,8 +30,10 @@ def observations_from_rows(
     glonass_channels: dict[int, int] | None = None,
     problems: tuple[str, ...] = (),
     n_lines: int = 0,
+    row_fields: dict[str, np.ndarray] | None = None,
 ) -> Observations:
-    """Columnar :class:`Observations` from flat row arrays (``code`` as RINEX 3 strings)."""
+    """Columnar :class:`Observations` from flat row arrays (``code`` as RINEX 3 strings);
+    ``row_fields`` (per-row arrays of the same length, by name) follow their rows."""
     time = np.asarray(time, dtype=float)
     value = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(time)):
@@ -39,6 +41,7 @@ def observations_from_rows(
     lli = np.full(time.shape, -1, dtype=np.int8) if lli is None else np.asarray(lli, np.int8)
     keep = np.isfinite(value)
     time, value, lli = time[keep], value[keep], lli[keep]
+    extra = {name: np.asarray(v)[keep] for name, v in (row_fields or {}).items()}
     system = np.asarray(system, dtype="U1")[keep]
     prn = np.asarray(prn, dtype=np.int16)[keep]
     code = np.asarray(code, dtype="U3")[keep]
@@ -87,4 +90,5 @@ def observations_from_rows(
         epoch_time=epoch_time,
         epoch_flag=np.zeros(epoch_time.size, dtype=np.int8),
         problems=tuple(problems),
+        row_fields={name: v[order] for name, v in extra.items()},
     )

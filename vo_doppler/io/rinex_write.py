@@ -53,11 +53,11 @@ def gps_calendar(gps_seconds: float) -> tuple[int, int, int, int, int, float]:
     return stamp.year, stamp.month, stamp.day, stamp.hour, stamp.minute, second
 
 
-def _program_line(gps_seconds: float) -> str:
+def _program_line(gps_seconds: float, program: str = PROGRAM) -> str:
     """'PGM / RUN BY / DATE' dated at the data's first epoch, so output is reproducible."""
     year, month, day, hour, minute, second = gps_calendar(gps_seconds)
     stamp = f"{year:04d}{month:02d}{day:02d} {hour:02d}{minute:02d}{int(second):02d} GPS"
-    return header_line(f"{PROGRAM:<20}{'vo-doppler':<20}{stamp:<20}", "PGM / RUN BY / DATE")
+    return header_line(f"{program:<20}{'vo-doppler':<20}{stamp:<20}", "PGM / RUN BY / DATE")
 
 
 @dataclass(frozen=True)
@@ -138,8 +138,14 @@ def write_obs(
     receiver: str = "SIMULATED",
     antenna_height_m: float = 0.0,
     glonass_channels: dict[int, int] | None = None,
+    program: str = PROGRAM,
+    observer: str = "simulation",
+    antenna: str = "SIMULATED",
 ) -> None:
     """Write a RINEX 3.04 mixed observation file (GPS time).
+
+    ``program``, ``observer`` and ``antenna`` fill the header's PGM, OBSERVER / AGENCY and
+    ANT # / TYPE records (defaults: a simulation's; an importer names the recording's).
 
     The signal-strength digit of every observable comes from the row's ``S`` observable (the
     C/N0), when there is one. ``glonass_channels`` (slot → frequency channel) are written as
@@ -152,12 +158,12 @@ def write_obs(
         header_line(
             f"{3.04:9.2f}{'':11}{'OBSERVATION DATA':<20}{'M: MIXED':<20}", "RINEX VERSION / TYPE"
         ),
-        _program_line(float(data.epoch_time[0])),
+        _program_line(float(data.epoch_time[0]), program),
         header_line(marker_name, "MARKER NAME"),
         header_line("NON_PHYSICAL", "MARKER TYPE"),
-        header_line(f"{'vo-doppler':<20}{'simulation':<40}", "OBSERVER / AGENCY"),
+        header_line(f"{'vo-doppler':<20}{observer:<40}", "OBSERVER / AGENCY"),
         header_line(f"{'0':<20}{receiver:<20}{'1.0':<20}", "REC # / TYPE / VERS"),
-        header_line(f"{'0':<20}{'SIMULATED':<20}", "ANT # / TYPE"),
+        header_line(f"{'0':<20}{antenna:<20}", "ANT # / TYPE"),
         header_line(f"{x:14.4f}{y:14.4f}{z:14.4f}", "APPROX POSITION XYZ"),
         header_line(f"{antenna_height_m:14.4f}{0.0:14.4f}{0.0:14.4f}", "ANTENNA: DELTA H/E/N"),
     ]

@@ -40,6 +40,9 @@ class Observations:
     ``D1`` kept as written); ``lli`` and ``ssi`` −1 where blank. ``epoch_time``/``epoch_flag``
     list the data epochs. ``problems`` holds one message per problem the reader met: a skipped
     record, or a header value read otherwise than written (e.g. an unknown time system).
+    ``row_fields`` holds per-row values a format carries beyond RINEX's, by name, each an array
+    aligned with ``value`` (smartLoc's NLOS label and σ, :mod:`vo_doppler.io.smartloc`); empty
+    for RINEX. :meth:`subset` keeps them with their rows.
     """
 
     header: ObsHeader
@@ -54,6 +57,7 @@ class Observations:
     epoch_time: np.ndarray
     epoch_flag: np.ndarray
     problems: tuple[str, ...] = field(default=())
+    row_fields: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(self.value.size)
@@ -97,6 +101,7 @@ class Observations:
             epoch_time=self.epoch_time,
             epoch_flag=self.epoch_flag,
             problems=self.problems,
+            row_fields={name: values[rows] for name, values in self.row_fields.items()},
         )
 
     def select(self, system: str | None = None, code: str | None = None) -> Observations:
