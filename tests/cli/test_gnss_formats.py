@@ -147,3 +147,65 @@ def test_gsdc_file_without_nav_is_an_error_pointing_to_the_docs(tmp_path, capsys
     assert "device_gnss.csv: no satellite states: give --nav or --orbits" in err
     assert "GSDC file's satellite states are for the library only" in err
     assert not (tmp_path / "v.csv").exists()
+
+
+def test_a_smartloc_csv_is_recognised_and_read(tmp_path):
+    from tests.helpers.smartloc_text import Measurement, Truth, smartloc_text
+
+    path = tmp_path / "berlin_raw.csv"
+    path.write_text(smartloc_text([(Truth(10.0), [Measurement(sv=5), Measurement(sv=9)])]))
+    assert sniff_format(path) == "smartloc"
+    obs, nav = read_observation_file(path)
+    assert nav is None
+    assert obs.select(code="D1C").satellites().tolist() == ["G05", "G09"]
+    assert obs.row_fields["nlos"].tolist() == [0] * len(obs)
+
+
+@pytest.mark.parametrize(
+    "content", [b"# some notes\nGPSWeek;x\n", b"t,lat,lon\n1,2,3\n", b"", b"\xff\xfe junk"]
+)
+def test_an_unknown_format_lists_the_readable_formats_and_their_commands(tmp_path, content):
+    path = tmp_path / "recording.dat"
+    path.write_bytes(content)
+    with pytest.raises(InputError) as caught:
+        sniff_format(path)
+    message = str(caught.value)
+    assert message.startswith(f"{path}: not a GNSS observation file of a format")
+    for expected in (
+        "RINEX 2/3/4 observations",
+        "u-blox UBX",
+        "Android GnssLogger",
+        "GSDC device_gnss.csv",
+        "smartLoc raw CSV",
+        "vo-doppler import smartloc FILE -o SEQ",
+        "vo-doppler import kitti-raw DRIVE -o SEQ",
+        "vo-doppler import comma2k19 SEGMENT --orbits SP3 -o SEQ",
+        "vo-doppler import rosbag BAG -o SEQ [--list-topics]",
+        "docs/formats.md",
+    ):
+        assert expected in message
+
+
+def test_gnss_velocity_on_an_unknown_file_exits_1_with_the_list(tmp_path, capsys):
+    path = tmp_path / "notes.txt"
+    path.write_text("hello\n")
+    code = main(["gnss", "velocity", str(path), "-o", str(tmp_path / "v.csv")])
+    assert code == 1
+    err = capsys.readouterr().err
+    assert "not a GNSS observation file" in err and "'hello'" in err
+    assert "END OF HEADER" not in err
+    assert not (tmp_path / "v.csv").exists()
+
+
+def test_compressed_and_truncated_rinex_still_reach_the_rinex_reader(tmp_path):
+    import gzip
+
+    gz = tmp_path / "rover.obs.gz"
+    gz.write_bytes(gzip.compress(b"junk"))
+    assert sniff_format(gz) == "rinex"
+    cut = tmp_path / "rover.obs"
+    cut.write_text(
+        "     3.04           OBSERVATION DATA    M: MIXED            RINEX VERSION / TYPE\n"
+    )
+    with pytest.raises(InputError, match="END OF HEADER"):
+        read_observation_file(cut)
