@@ -162,6 +162,18 @@ def test_bad_calibration_names_the_file_and_line(tmp_path):
     assert not (tmp_path / "seq").exists()  # nothing written before every input was read
 
 
+def test_a_singular_projection_matrix_is_an_error_naming_its_line(tmp_path):
+    """Found by the fuzz (kitti-raw case 634): a P_rect whose 1 in K became 0 crashed the
+    camera offset's solve with a LinAlgError (exit 3)."""
+    drive = _fake_drive(tmp_path)
+    calib = drive.parent / "calib_cam_to_cam.txt"
+    singular = P_RECT_00.replace("0.0 0.0 1.0 0.0", "0.0 0.0 0.0 0.0")
+    calib.write_text(calib.read_text().replace(f"P_rect_00: {P_RECT_00}", f"P_rect_00: {singular}"))
+    with pytest.raises(InputError, match=r"calib_cam_to_cam.txt:4: P_rect_00's left 3×3 part"):
+        import_kitti_raw(drive, tmp_path / "seq")
+    assert not (tmp_path / "seq").exists()
+
+
 def test_bad_oxts_or_image_names_stop_the_import_before_writing(tmp_path):
     drive = _fake_drive(tmp_path)
     (drive / "oxts" / "data" / "0000000003.txt").write_text("1 2 3\n")

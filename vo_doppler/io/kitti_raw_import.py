@@ -68,6 +68,8 @@ CALIB = "calib.yaml"
 YAW_RATE_CSV = "vehicle/yaw_rate.csv"
 SPEED_CSV = "vehicle/wheel_speed.csv"
 GROUND_TRUTH = "ground_truth.tum"
+MAX_CONDITION = 1e12
+"""Largest condition number of a projection matrix's left 3×3 part (K: about fx/1 ≈ 1e3)."""
 _KEY = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*):(.*)$")
 
 
@@ -269,6 +271,13 @@ def _extrinsic(folder: Path, camera: str, rectified: bool) -> tuple[np.ndarray, 
         rect = np.eye(4)
         rect[:3, :3] = _row(rows, "R_rect_00", 9, path).reshape(3, 3)
         P = _row(rows, f"P_rect_{n}", 12, path).reshape(3, 4)
+        if not np.linalg.cond(P[:, :3]) < MAX_CONDITION:
+            raise InputError(
+                f"P_rect_{n}'s left 3×3 part is not a camera matrix (singular): the camera's "
+                "offset K⁻¹·P[:, 3] cannot be computed",
+                path,
+                rows[f"P_rect_{n}"][0],
+            )
         shift = np.eye(4)
         shift[:3, 3] = np.linalg.solve(P[:, :3], P[:, 3])
         camera_cam0 = shift @ rect
