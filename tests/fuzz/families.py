@@ -19,6 +19,7 @@ import numpy as np
 
 from tests.conftest import REPO_ROOT, shared_data_dir
 from tests.fuzz.gnss_families import register_gnss
+from tests.fuzz.import_families import register_imports
 from tests.fuzz.mutators import SHRINKING
 from tests.helpers.rinex_text import as_rinex4
 from tests.io.fuzz_families import register_all
@@ -294,3 +295,4 @@ register(
 
 register_all(register, Family, Seed)  # CAN, DBC, CSV, NMEA, trajectory, calibration, manifest
 register_gnss(register, Family, Seed, check_observations, check_navigation)  # SP3 … raw_gnss
+register_imports(register, Family, Seed, check_observations, same_observations)  # smartLoc …
