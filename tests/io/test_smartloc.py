@@ -16,6 +16,7 @@ from tests.helpers.smartloc_text import HEADER, Measurement, Truth, row, smartlo
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT
 from vo_doppler.io.smartloc import read_smartloc
+from vo_doppler.io.vehicle_limits import DOPPLER
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 
 REAL = "smartloc_berlin/tu_chemnitz_berlin_1_raw.csv"
@@ -174,7 +175,7 @@ def test_skipped_rows_are_counted_in_problems(tmp_path):
         (Measurement(nlos="2"), "NLOS label '2'"),
         (Measurement(sv=40), "no GPS satellite 40"),
         (Measurement(gnss="Glonass", sv=3, freq_id=14), r"\(freqId\): 14"),
-        (Measurement(doppler_sigma_hz=0.0), "is not positive"),
+        (Measurement(doppler_sigma_hz=0.0), r"\(doStdev\): 0 SI outside 1e-09"),
         (Measurement(cn0=120.0), r"\(cno\): 120"),
         (Measurement(extra={"GPS week number (week) [weeks]": "4096"}), r"\(week\): 4096"),
         (Measurement(extra={"Latitude (GT Lat) [deg]": "91"}), r"\(GT Lat\): 91"),
@@ -236,7 +237,7 @@ def measurements(draw):
     return Measurement(
         gnss=name,
         sv=draw(st.integers(low, high)),
-        doppler_hz=draw(st.floats(-9.9e4, 9.9e4, allow_nan=False)),
+        doppler_hz=draw(st.floats(DOPPLER.low, DOPPLER.high, allow_nan=False)),
         doppler_sigma_hz=draw(st.floats(1e-3, 1e3)),
         freq_id=draw(st.integers(0, 13)),
         nlos=draw(st.sampled_from(["0", "1", "#"])),

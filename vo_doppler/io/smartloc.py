@@ -34,8 +34,9 @@ signal's wavelength
 ground truth comes as a :class:`SmartLocTruth`, one state per epoch.
 
 Every value is checked: a field that is not a number, outside what the format can hold (a GPS
-week beyond 4095, a latitude beyond ±90°, a vehicle speed or yaw rate beyond
-:mod:`vo_doppler.io.vehicle_limits`, a σ that is not positive) or an epoch whose rows disagree
+week beyond 4095, a second of week beyond 604,800, a GLONASS freqId beyond 0–13) or beyond the
+bounds of :mod:`vo_doppler.io.vehicle_limits` (latitude, longitude, height, speed, yaw rate,
+acceleration, C/N0, a σ not within 1e-9 … 1e7), or an epoch whose rows disagree
 on the ground truth is an :class:`InputError` naming the file, line and column; epochs must
 not go back in time. A pseudorange, carrier phase or Doppler beyond the u-blox ranges of
 :data:`vo_doppler.io.ubx.VALUE_RANGES` is dropped and counted in ``problems``, as the UBX
@@ -57,7 +58,17 @@ from vo_doppler.io.obs_rows import observations_from_rows
 from vo_doppler.io.rinex_common import PRN_RANGE
 from vo_doppler.io.textfile import read_text
 from vo_doppler.io.ubx import VALUE_RANGES
-from vo_doppler.io.vehicle_limits import FORWARD_ACCELERATION, SPEED, YAW_RATE
+from vo_doppler.io.vehicle_limits import (
+    CN0,
+    FORWARD_ACCELERATION,
+    HEIGHT,
+    LATITUDE_DEG,
+    LONGITUDE_DEG,
+    MEASUREMENT_SIGMA,
+    SPEED,
+    YAW_RATE,
+    SignalBounds,
+)
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.observations import Observations
@@ -65,10 +76,6 @@ from vo_doppler.model.signals import carrier_frequency
 
 SEPARATOR = ";"
 LAST_WEEK = 4095
-MAX_HEIGHT_M = 10_000.0
-MIN_HEIGHT_M = -1_000.0
-MAX_SIGMA = 1.0e6
-"""Larger σ (in any of the units) is not a measurement's uncertainty but a corrupt field."""
 COLUMNS: dict[str, str] = {
     # name used here → identifier found in the header name of the column
     "gt_week": "GPSWeek",
@@ -263,14 +270,13 @@ class _Rows:
     ) -> float:
         value = self._number(row, name, line)
         if not low <= value <= high:
-            raise InputError(
-                f"column {COLUMNS[name]}: {value:g} {unit} outside {low:g} … {high:g}".replace(
-                    "  ", " "
-                ),
-                self.path,
-                line,
-            )
+            where = f"column {COLUMNS[name]}: {value:g}" + (f" {unit}" if unit else "")
+            raise InputError(f"{where} outside {low:g} … {high:g}", self.path, line)
         return value
+
+    def _within(self, row: dict[str, str], name: str, line: int, bounds: SignalBounds) -> float:
+        """The column's value, checked against the bounds of :mod:`.vehicle_limits`."""
+        return self._bounded(row, name, line, bounds.low, bounds.high, bounds.unit)
 
     def _integer(self, row: dict[str, str], name: str, line: int, low: int, high: int) -> int:
         value = self._bounded(row, name, line, low, high)
@@ -341,18 +347,12 @@ class _Rows:
             self._measured(row, "pseudorange", "C", line, tracking & 1),
             self._measured(row, "carrier", "L", line, tracking & 2),
             self._measured(row, "doppler", "D", line, True),
-            self._bounded(row, "cn0", line, *VALUE_RANGES["S"], "dB-Hz"),
+            self._within(row, "cn0", line, CN0),
         ]
         sigmas = tuple(
-            self._bounded(row, name, line, 0.0, MAX_SIGMA)
+            self._within(row, name, line, MEASUREMENT_SIGMA)
             for name in ("pseudorange_sigma", "carrier_sigma", "doppler_sigma")
         )
-        if sigmas[2] <= 0.0:
-            raise InputError(
-                f"column {COLUMNS['doppler_sigma']}: σ {sigmas[2]:g} Hz is not positive",
-                self.path,
-                line,
-            )
         label = row["nlos"]
         if label not in NLOS_LABELS:
             raise InputError(f"NLOS label {label[:10]!r} is not 0, 1 or #", self.path, line)
@@ -401,20 +401,13 @@ class _Rows:
             )
         state = (
             gt_t,
-            math.radians(self._bounded(row, "lat", line, -90.0, 90.0, "°")),
-            math.radians(self._bounded(row, "lon", line, -180.0, 180.0, "°")),
-            self._bounded(row, "height", line, MIN_HEIGHT_M, MAX_HEIGHT_M, "m"),
+            math.radians(self._within(row, "lat", line, LATITUDE_DEG)),
+            math.radians(self._within(row, "lon", line, LONGITUDE_DEG)),
+            self._within(row, "height", line, HEIGHT),
             self._bounded(row, "heading", line, -2 * math.pi, 2 * math.pi, "rad"),
-            self._bounded(row, "speed", line, SPEED.low, SPEED.high, SPEED.unit),
-            self._bounded(row, "yaw_rate", line, YAW_RATE.low, YAW_RATE.high, YAW_RATE.unit),
-            self._bounded(
-                row,
-                "acceleration",
-                line,
-                FORWARD_ACCELERATION.low,
-                FORWARD_ACCELERATION.high,
-                "m/s²",
-            ),
+            self._within(row, "speed", line, SPEED),
+            self._within(row, "yaw_rate", line, YAW_RATE),
+            self._within(row, "acceleration", line, FORWARD_ACCELERATION),
             float(line),
         )
         self.truth.append(state)
