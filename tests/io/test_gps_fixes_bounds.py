@@ -34,3 +34,10 @@ def test_the_shared_minimal_log_is_an_input_error_naming_it():
         pytest.skip(f"{path} absent")
     with pytest.raises(InputError, match=str(path)):
         read_gps_fixes(path)
+
+
+def test_a_negative_speed_over_ground_in_a_gps_csv_reads_as_unknown(tmp_path):
+    path = tmp_path / "gps.csv"
+    path.write_text("t,lat_deg,lon_deg,speed_mps\n0,35.0,139.0,-1\n1,35.0,139.0,10.0\n")
+    fixes = read_gps_fixes(path)
+    assert np.isnan(fixes.speed[0]) and fixes.speed[1] == 10.0

@@ -76,9 +76,20 @@ def utc_to_gps_seconds(moment: dt.datetime) -> float:
 
 
 def read_gps_csv(path: str | Path) -> GpsFixes:
-    """Read a ``t,lat_deg,lon_deg`` CSV, optionally with a ``speed_mps`` column."""
+    """Read a ``t,lat_deg,lon_deg`` CSV, optionally with a ``speed_mps`` column (a speed over
+    ground: a negative one is read as unknown, with a warning)."""
     columns, report = read_numeric_csv(path, ("t", "lat_deg", "lon_deg"), ("speed_mps",))
     speed = columns.get("speed_mps", np.full(len(columns["t"]), np.nan))
+    negative = speed < GROUND_SPEED.low
+    if np.any(negative):
+        log.warning(
+            "%s: %d speeds over ground below %g m/s (first %g): read as unknown",
+            path,
+            int(negative.sum()),
+            GROUND_SPEED.low,
+            speed[negative][0],
+        )
+        speed = np.where(negative, np.nan, speed)
     bad = (np.abs(columns["lat_deg"]) > 90) | (np.abs(columns["lon_deg"]) > 180)
     if np.all(bad) and bad.size:
         raise InputError(
