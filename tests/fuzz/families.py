@@ -18,6 +18,7 @@ import hatanaka
 import numpy as np
 
 from tests.conftest import REPO_ROOT, shared_data_dir
+from tests.fuzz.bound_families import register_bounds
 from tests.fuzz.gnss_families import register_gnss
 from tests.fuzz.import_families import register_imports
 from tests.fuzz.mutators import SHRINKING
@@ -57,6 +58,9 @@ class Family:
     check: Callable[[object, Path], list[str]]
     same_content: Callable[[object, object], list[str]] | None = None
     notes: dict[str, str] = field(default_factory=dict)
+    mutations: dict[str, Callable] = field(default_factory=dict)
+    """Text mutations of this family's format alone (e.g. of arrays in a container), drawn
+    with the common ones."""
 
 
 FAMILIES: dict[str, Family] = {}
@@ -296,3 +300,4 @@ register(
 register_all(register, Family, Seed)  # CAN, DBC, CSV, NMEA, trajectory, calibration, manifest
 register_gnss(register, Family, Seed, check_observations, check_navigation)  # SP3 … raw_gnss
 register_imports(register, Family, Seed, check_observations, same_observations)  # smartLoc …
+register_bounds(FAMILIES, register, Family, Seed, check_observations, check_navigation)

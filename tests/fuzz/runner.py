@@ -57,7 +57,7 @@ def make_case(family: Family, seeds: list[Seed], number: int, run_seed: int) -> 
     index = rng.randrange(len(seeds))
     packed = seeds[index].pack is not stored_as_is
     stage = "stored" if packed and rng.random() < 0.25 else "text"
-    table = BYTE_MUTATIONS if stage == "stored" else TEXT_MUTATIONS
+    table = BYTE_MUTATIONS if stage == "stored" else text_mutations(family)
     count = 1 if rng.random() < 0.8 else 2
     mutations = tuple(rng.choice(sorted(table)) for _ in range(count))
     return Case(
@@ -72,9 +72,15 @@ def mutated_bytes(case: Case, seed: Seed, plain: bytes) -> bytes:
         for name in case.mutations:
             data = BYTE_MUTATIONS[name](data, rng)
         return data
+    table = text_mutations(FAMILIES[case.family])
     for name in case.mutations:
-        plain = TEXT_MUTATIONS[name](plain, rng)
+        plain = table[name](plain, rng)
     return seed.pack(plain)
+
+
+def text_mutations(family: Family) -> dict:
+    """The text mutations of every family and the family's own (``Family.mutations``)."""
+    return {**TEXT_MUTATIONS, **family.mutations}
 
 
 @dataclass
