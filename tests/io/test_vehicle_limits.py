@@ -31,3 +31,23 @@ def test_a_lever_arm_longer_than_a_vehicle_is_named():
     assert lever_arm_problem((12.0, 16.0)) is None  # exactly 20 m
     problem = lever_arm_problem((1000.0, 0.0, 0.0))
     assert problem is not None and problem.startswith("the lever arm is 1000 m long")
+
+
+def test_the_gnss_bounds_follow_from_each_other():
+    """The Doppler bound is the range-rate bound at the highest GNSS carrier; the travel time
+    bound covers every pseudorange bound; the clock-offset bound covers every GPS time."""
+    from vo_doppler.geo import SPEED_OF_LIGHT
+    from vo_doppler.io.vehicle_limits import (
+        DOPPLER,
+        GPS_TIME,
+        PSEUDORANGE,
+        RANGE_RATE,
+        SIGNAL_TRAVEL_TIME,
+        TIME_OFFSET,
+    )
+
+    assert DOPPLER.high == RANGE_RATE.high * 1.61e9 / SPEED_OF_LIGHT
+    assert 53_000 < DOPPLER.high < 54_000
+    assert SIGNAL_TRAVEL_TIME.low * SPEED_OF_LIGHT <= PSEUDORANGE.low
+    assert SIGNAL_TRAVEL_TIME.high * SPEED_OF_LIGHT >= PSEUDORANGE.high
+    assert TIME_OFFSET.high == GPS_TIME.high

@@ -163,9 +163,3 @@ says nothing."""
 MAX_COUNT = 10_000_000
 """Largest count of observations or rows a heading window can hold (hours of 100 Hz data)."""
 
-
-def problem(bounds: SignalBounds, value: float, name: str) -> str | None:
-    """Why ``value`` of ``name`` cannot be real (outside ``bounds`` or not finite), or None."""
-    if bounds.outside(np.asarray([value]))[0]:
-        return f"{name} = {value:g} is outside {bounds}"
-    return None
