@@ -162,4 +162,3 @@ DOP = SignalBounds(1.0e-3, 1.0e4, "")
 says nothing."""
 MAX_COUNT = 10_000_000
 """Largest count of observations or rows a heading window can hold (hours of 100 Hz data)."""
-
