@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from numpy.lib import format as npformat
 
+from tests.conftest import shared_data_dir
 from tests.helpers.comma2k19_segment import (
     npy_bytes,
     segment_arrays,
@@ -194,3 +195,56 @@ def test_any_one_bad_number_is_an_input_error_or_an_import_of_possible_values(
         return
     obs = read_obs(folder / "out" / "gnss" / "raw_gnss_ublox.obs")
     assert np.isfinite(obs.value).all()
+
+
+RAW_CAN = "processed_log/CAN/raw_can"
+
+
+def _raw_can(n: int = 20) -> dict[str, np.ndarray]:
+    return {
+        f"{RAW_CAN}/t": 100.0 + 0.01 * np.arange(n),
+        f"{RAW_CAN}/address": np.full(n, 0x24, dtype=np.int64),
+        f"{RAW_CAN}/data": np.array([b"\x01\x02\x03"] * n, dtype="S8"),
+        f"{RAW_CAN}/src": np.zeros(n, dtype=np.int64),
+    }
+
+
+@pytest.mark.parametrize(
+    ("name", "array"),
+    [
+        ("data", np.zeros(20)),
+        ("data", np.array([b"0123456789"] * 20, dtype="S10")),
+        ("address", np.full(20, -1.0)),
+        ("address", np.full(20, 2.0**40)),
+        ("t", np.full(20, np.nan)),
+        ("src", np.zeros(19)),
+    ],
+)
+def test_bad_raw_can_arrays_are_named_when_the_can_log_is_written_from_them(tmp_path, name, array):
+    """A segment with the DBC but no candump log: the log is written from ``raw_can``."""
+    dbc = shared_data_dir() / "comma2k19_example1" / "toyota_2017_motion.dbc"
+    if not dbc.is_file():
+        pytest.skip(f"{dbc} absent")
+    arrays = {**_raw_can(), f"{RAW_CAN}/{name}": array}
+    segment, orbits = _import(tmp_path, {k: npy_bytes(v) for k, v in arrays.items()})
+    for relative, value in arrays.items():
+        (segment / relative).parent.mkdir(parents=True, exist_ok=True)
+        (segment / relative).write_bytes(npy_bytes(value))
+    (segment / dbc.name).write_bytes(dbc.read_bytes())
+    with pytest.raises(InputError) as caught:
+        import_comma2k19(segment, tmp_path / "out", orbits)
+    assert str(segment / RAW_CAN / name) in str(caught.value)
+
+
+def test_good_raw_can_arrays_are_written_as_a_candump_log(tmp_path):
+    dbc = shared_data_dir() / "comma2k19_example1" / "toyota_2017_motion.dbc"
+    if not dbc.is_file():
+        pytest.skip(f"{dbc} absent")
+    segment, orbits = _import(tmp_path, {})
+    for relative, value in _raw_can().items():
+        (segment / relative).parent.mkdir(parents=True, exist_ok=True)
+        (segment / relative).write_bytes(npy_bytes(value))
+    (segment / dbc.name).write_bytes(dbc.read_bytes())
+    import_comma2k19(segment, tmp_path / "out", orbits)
+    lines = (tmp_path / "out" / "can" / "can_motion.log").read_text().splitlines()
+    assert len(lines) == 20 and " 024#0102030000000000" in lines[0]
