@@ -296,8 +296,10 @@ def worst_reliable_tight_errors(
 def headline(
     errors: dict[str, PipelineErrors], used_fraction: float | None, truth_unused: bool = False
 ) -> str:
-    """The result in one sentence: how much the tightly coupled heading changed the VO's error
-    per 100 m, or the wheel + gyro dead reckoning's without a camera (or, without ground truth
+    """The result in one sentence: the VO's error per 100 m with the tightly coupled heading
+    against the best of the VO's other pipelines (alone, with the conventional heading), or the
+    wheel + gyro dead reckoning's without a camera (:func:`tight_verdict`: said plainly when the
+    tightly coupled heading did not help), as the run measured them (or, without ground truth
     or with one that could not be used (``truth_unused``), how often it was used;
     ``used_fraction`` None: the recording had no GNSS)."""
     used = (
@@ -321,28 +323,43 @@ def headline(
             "The ground-truth path is too short for errors per distance (see the warnings); "
             f"the table shows the heading errors. {used}"
         )
-    base = "vo" if "vo" in errors else "dr"
-    if base not in errors or f"{base}_gps_tc" not in errors:
+    base = "vo" if any(name.startswith("vo") for name in errors) else "dr"
+    tight_name = f"{base}_gps_tc"
+    others = [name for name in (base, f"{base}_gps_conv") if name in errors]
+    if tight_name not in errors or not others:
         shown = "; ".join(f"{label(n)} {e.error_per_100m_m:.2f}" for n, e in errors.items())
         return f"Error per 100 m (m): {shown}."
-    what = "the VO's" if base == "vo" else "the wheel + gyro dead reckoning's"
     camera = "" if base == "vo" else "No camera: "
-    alone = errors[base].error_per_100m_m
-    tight = errors[f"{base}_gps_tc"].error_per_100m_m
-    conv = errors.get(f"{base}_gps_conv")
-    versus = (
-        f" (the conventional Doppler heading: {conv.error_per_100m_m:.2f} m per 100 m)"
-        if conv is not None
-        else ""
+    return camera + tight_verdict(
+        "the VO" if base == "vo" else "the wheel + gyro dead reckoning",
+        errors[tight_name].error_per_100m_m,
+        {OTHER_WORDS[name.removeprefix(base)]: errors[name].error_per_100m_m for name in others},
     )
-    if tight < alone:
+
+
+OTHER_WORDS = {"": "alone", "_gps_conv": "with the conventional Doppler heading"}
+"""How the headline names a pipeline beside the tightly coupled one, by its name's suffix."""
+
+
+def tight_verdict(subject: str, tight: float, others: dict[str, float]) -> str:
+    """Whether the tightly coupled heading helped ``subject`` (e.g. "the VO"), in one sentence:
+    its error per 100 m (m) ``tight`` against the best of ``others`` (how the pipeline is
+    named → its error), compared as shown (two decimals): lower than the best other is a help,
+    equal or higher is said plainly not to be."""
+    best = min(others, key=others.__getitem__)
+    rest = "".join(
+        f"; {subject} {words}: {value:.2f}" for words, value in others.items() if words != best
+    )
+    if round(tight, 2) < round(others[best], 2):
+        ratio = f", {others[best] / tight:.1f}× less than" if tight > 0 else ", below"
         return (
-            f"{camera}The tightly coupled Doppler heading cut {what} error from {alone:.2f} to "
-            f"{tight:.2f} m per 100 m ({alone / tight:.1f}× less){versus}."
+            f"The tightly coupled Doppler heading gave {subject} its lowest error: {tight:.2f} m "
+            f"per 100 m{ratio} the best other, {subject} {best} ({others[best]:.2f}){rest}."
         )
     return (
-        f"{camera}The tightly coupled Doppler heading did not reduce {what} error on this "
-        f"drive: {alone:.2f} m per 100 m alone, {tight:.2f} m per 100 m corrected{versus}."
+        f"The tightly coupled Doppler heading did not help on this drive: {subject} {best} did "
+        f"as well or better, {others[best]:.2f} m per 100 m against {tight:.2f} with the "
+        f"tightly coupled heading{rest}."
     )
 
 
