@@ -11,8 +11,10 @@ from scipy.spatial.transform import Rotation
 from tests.helpers.heading_table import plain_heading_table
 from vo_doppler.eval.pipelines import (
     absolute_position_errors,
+    epochs_within,
     evaluate_pipelines,
     evaluation_warnings,
+    heading_availability,
 )
 from vo_doppler.model.trajectory import Trajectory
 
@@ -63,6 +65,24 @@ def test_a_truth_starting_late_is_evaluated_from_its_start():
         "0.00 s before its last: the ground truth covers no more of it in time (moved to the "
         "truth's position at the first pose evaluated)"
     ]
+
+
+def test_heading_use_counts_only_the_epochs_with_vehicle_signals_inside_the_trajectory():
+    """Issue 30: "absolute heading used [% of GNSS epochs]" counted the epochs without vehicle
+    signals, where no tightly coupled heading can exist. Vehicle signals over the middle 30 s
+    of a 60-s GNSS record, the tight heading used at every epoch they cover; the conventional
+    one valid at every epoch, the dead reckoning over the covered 30 s."""
+    vehicle = (T0 + 15.0, T0 + 45.0)
+    covered = (TABLE.t >= vehicle[0]) & (TABLE.t <= vehicle[1])
+    dr = drive(T[epochs_within(T, vehicle)])
+    shares = heading_availability(TABLE, covered, {"dr_gps_tc": dr, "dr_gps_conv": dr}, vehicle)
+    assert shares["dr_gps_tc"] == 1.0 and shares["dr_gps_conv"] == 1.0
+    assert shares["dr"] == shares["vo"] == 0.0
+    # without the spans every GNSS epoch counts, as before: about half
+    assert heading_availability(TABLE, covered)["dr_gps_tc"] == pytest.approx(61 / 120)
+    truth = drive(T)
+    errors, _, _ = evaluate_pipelines({"dr_gps_tc": dr}, TABLE, covered, truth, vehicle)
+    assert errors["dr_gps_tc"].heading_availability == 1.0
 
 
 def test_a_truth_covering_all_but_the_last_sample_raises_no_warning():

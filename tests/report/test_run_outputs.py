@@ -190,6 +190,43 @@ def test_geojson_and_map_show_the_trajectories_as_written(drive_run, tmp_path):
     assert "trajectories.png" in page
 
 
+def test_heading_use_is_a_share_of_the_epochs_with_vehicle_signals(drive_run, tmp_path):
+    """Issue 30: the share of GNSS epochs whose tightly coupled heading was used counted the
+    epochs without vehicle signals. Vehicle signals kept over the middle of the drive only."""
+    sequence, result = drive_run
+    t = sequence.observations.epoch_time
+    begin, end = t[0] + 3.0, t[-1] - 3.0
+
+    def middle(series):
+        inside = (series.t >= begin) & (series.t <= end)
+        return dataclasses.replace(series, t=series.t[inside], value=series.value[inside])
+
+    partial = dataclasses.replace(
+        sequence, wheel_speed=middle(sequence.wheel_speed), yaw_rate=middle(sequence.yaw_rate)
+    )
+    summary = write_run_outputs(partial, result, RunConfig(), tmp_path)
+    covered = (result.heading.t >= partial.vehicle_span[0]) & (
+        result.heading.t <= partial.vehicle_span[1]
+    )
+    assert 0 < summary["vehicle_signal_epochs"] == covered.sum() < summary["gnss_epochs"]
+    share = summary["tight_heading_used_with_vehicle_signals"]
+    assert share == pytest.approx(result.tc_usable[covered].mean())
+    for name in ("dr_gps_tc", "dr_gps_conv"):
+        assert summary["evaluation"][name]["heading_availability"] == pytest.approx(
+            np.mean(
+                (
+                    result.tc_usable
+                    if name.endswith("tc")
+                    else result.heading.published_conventional[0]
+                )[
+                    covered
+                    & (result.heading.t >= result.trajectories[name].t[0])
+                    & (result.heading.t <= result.trajectories[name].t[-1])
+                ]
+            )
+        )
+
+
 def test_every_summary_key_has_a_label_and_units(drive_run, tmp_path):
     """Every key a run's summary can hold, with and without a camera: a new key without a
     label in ``FACT_FORMATS`` would show in the report as its raw name."""

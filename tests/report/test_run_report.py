@@ -46,6 +46,10 @@ def test_headline_states_the_cut_or_says_plainly_it_did_not_help():
     worse = headline({"vo": _errors(0.2), "vo_gps_tc": _errors(0.23)}, 0.9)
     assert "did not help" in worse and "the VO alone did as well or better, 0.20" in worse
     assert "No ground truth" in headline({}, 0.93) and "93%" in headline({}, 0.93)
+    assert headline({}, 0.93, covered_epochs=700).endswith(
+        "used by the correction at 93% of the 700 GNSS epochs with vehicle signals (wheel speed "
+        "and yaw rate)."
+    )
     no_camera = headline(
         {"dr": _errors(2.0), "dr_gps_conv": _errors(0.8), "dr_gps_tc": _errors(0.4)}, 0.9
     )

@@ -125,21 +125,42 @@ def with_initial_heading(estimate: Trajectory, truth: Trajectory, first: int = 0
     return estimate.transformed(rotation, origin - rotation @ origin)
 
 
-def heading_availability(table: HeadingTable | None, tc_usable: np.ndarray) -> dict[str, float]:
-    """Fraction of GNSS epochs whose absolute heading each pipeline could use (``table`` None:
-    a recording without GNSS, whose VO and dead reckoning use none)."""
+def epochs_within(t: np.ndarray, *spans: tuple[float, float] | None) -> np.ndarray:
+    """Mask of the times ``t`` inside every one of ``spans`` ((first, last) s; None: no
+    bound)."""
+    inside = np.ones(len(t), dtype=bool)
+    for span in spans:
+        if span is not None:
+            inside &= (t >= span[0]) & (t <= span[1])
+    return inside
+
+
+def heading_availability(
+    table: HeadingTable | None,
+    tc_usable: np.ndarray,
+    trajectories: dict[str, Trajectory] | None = None,
+    vehicle_span: tuple[float, float] | None = None,
+) -> dict[str, float]:
+    """Per pipeline, the share of the GNSS epochs where its absolute heading could be used that
+    it did use: those inside its trajectory's time span (of ``trajectories``, when given) and
+    inside ``vehicle_span`` (the vehicle signals' span, when given; the tightly coupled heading
+    and the dead reckoning need them). NaN where no epoch could be; ``table`` None: a recording
+    without GNSS, whose VO and dead reckoning use none."""
     if table is None:
         return {"vo": 0.0, "dr": 0.0}
-    tc = float(np.mean(tc_usable))
-    conventional = float(np.mean(table.published_conventional[0]))
-    return {
-        "vo": 0.0,
-        "vo_gps_conv": conventional,
-        "vo_gps_tc": tc,
-        "dr": 0.0,
-        "dr_gps_conv": conventional,
-        "dr_gps_tc": tc,
+    used = {
+        "tc": np.asarray(tc_usable, dtype=bool),
+        "conv": np.asarray(table.published_conventional[0], dtype=bool),
     }
+    shares = {"vo": 0.0, "dr": 0.0}
+    for base in ("vo", "dr"):
+        for source in ("conv", "tc"):
+            name = f"{base}_gps_{source}"
+            track = (trajectories or {}).get(name)
+            span = None if track is None or not len(track) else (track.t[0], track.t[-1])
+            could = epochs_within(table.t, span, vehicle_span)
+            shares[name] = float(np.mean(used[source][could])) if could.any() else float("nan")
+    return shares
 
 
 def evaluate_pipelines(
@@ -147,6 +168,7 @@ def evaluate_pipelines(
     table: HeadingTable | None,
     tc_usable: np.ndarray,
     truth: Trajectory,
+    vehicle_span: tuple[float, float] | None = None,
 ) -> tuple[dict[str, PipelineErrors], dict[str, ErrorPerDistance], dict[str, Trajectory]]:
     """Errors of every pipeline, its per-window errors, and the trajectories as evaluated:
     translated to the truth at their first pose inside the truth's time span, the uncorrected
@@ -154,8 +176,9 @@ def evaluate_pipelines(
 
     Only the time the ground truth covers is evaluated (``PipelineErrors.coverage`` says how
     much); a trajectory with fewer than two poses in it is left out of all three dictionaries
-    (:func:`evaluation_warnings` says so)."""
-    availability = heading_availability(table, tc_usable)
+    (:func:`evaluation_warnings` says so). The heading availability counts the GNSS epochs
+    inside each trajectory's span and ``vehicle_span`` (:func:`heading_availability`)."""
+    availability = heading_availability(table, tc_usable, trajectories, vehicle_span)
     errors, per_100m, shown = {}, {}, {}
     for name, trajectory in trajectories.items():
         inside = overlap(trajectory, truth)

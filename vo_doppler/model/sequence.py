@@ -63,3 +63,14 @@ class Sequence:
     @property
     def has_camera(self) -> bool:
         return self.camera is not None and len(self.image_paths) > 0
+
+    @property
+    def vehicle_span(self) -> tuple[float, float] | None:
+        """The GPS-time span (s) both vehicle signals (wheel speed and yaw rate) cover: where
+        the calibration, the tightly coupled heading and the dead reckoning can run; None when
+        they do not overlap."""
+        if len(self.wheel_speed) == 0 or len(self.yaw_rate) == 0:
+            return None
+        begin = max(float(self.wheel_speed.t[0]), float(self.yaw_rate.t[0]))
+        end = min(float(self.wheel_speed.t[-1]), float(self.yaw_rate.t[-1]))
+        return (begin, end) if begin <= end else None

@@ -14,6 +14,7 @@ from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
 from vo_doppler.eval.pipelines import (
     absolute_position_errors,
+    epochs_within,
     evaluate_pipelines,
     evaluation_warnings,
 )
@@ -61,6 +62,14 @@ FACT_FORMATS = {
     "tight_heading_availability": ("tightly coupled heading available", "{:.1%}"),
     "tight_heading_reliable": ("tightly coupled heading reliable (gyro-consistent)", "{:.1%}"),
     "tight_heading_used": ("tightly coupled heading used by the correction", "{:.1%}"),
+    "vehicle_signal_epochs": (
+        "GNSS epochs with vehicle signals (wheel speed and yaw rate)",
+        "{:d}",
+    ),
+    "tight_heading_used_with_vehicle_signals": (
+        "tightly coupled heading used by the correction, of the epochs with vehicle signals",
+        "{:.1%}",
+    ),
     "tight_heading_rejected_rows": ("Doppler rows rejected by the NLOS tests", "{:d}"),
     "tight_heading_epochs_with_rejection": ("epochs with a rejection", "{:d}"),
     "grade_prior_from_accelerometer": (
@@ -104,9 +113,12 @@ def correction_label(config: RunConfig) -> str:
     return correction.method + ("" if correction.blend.smooth else " (causal)")
 
 
-def summarise(result: RunResult) -> dict:
+def summarise(result: RunResult, vehicle_span: tuple[float, float] | None = None) -> dict:
     """Heading availability, calibration and VO figures of a run (JSON-ready scalars); without
-    GNSS only the VO figures and ``gnss``, saying that the GNSS pipelines were not run."""
+    GNSS only the VO figures and ``gnss``, saying that the GNSS pipelines were not run.
+    ``vehicle_span``: the span both vehicle signals cover (``Sequence.vehicle_span``), outside
+    which no tightly coupled heading can be used (``vehicle_signal_epochs``, and the share of
+    them used, ``tight_heading_used_with_vehicle_signals``; None: every epoch)."""
     table = result.heading
     if table is None:
         summary: dict = {
@@ -115,6 +127,7 @@ def summarise(result: RunResult) -> dict:
         }
         _vo_summary(summary, result)
         return summary
+    covered = epochs_within(table.t, vehicle_span)
     summary = {
         "gnss_epochs": len(table),
         "conventional_heading_availability": float(np.mean(table.published_conventional[0])),
@@ -122,6 +135,10 @@ def summarise(result: RunResult) -> dict:
         "tight_heading_availability": float(np.mean(table.tc_available)),
         "tight_heading_reliable": float(np.mean(table.tc_reliable)),
         "tight_heading_used": float(np.mean(result.tc_usable)),
+        "vehicle_signal_epochs": int(np.count_nonzero(covered)),
+        "tight_heading_used_with_vehicle_signals": (
+            float(np.mean(result.tc_usable[covered])) if covered.any() else None
+        ),
         "tight_heading_rejected_rows": int(table.rejected_rows.sum()),
         "tight_heading_epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "grade_prior_from_accelerometer": float(np.mean(table.grade_from_accelerometer)),
@@ -273,7 +290,7 @@ def write_run_outputs(
         write_tum(out / file, trajectory)
     if result.heading is not None:
         write_heading_csv(out / "heading.csv", result.heading)
-    summary = summarise(result)
+    summary = summarise(result, sequence.vehicle_span)
     summary["heading_correction"] = correction_label(config)
     summary.update(checks or {})
     table, truth = result.heading, sequence.truth
@@ -306,8 +323,12 @@ def write_run_outputs(
             out / "heading.png",
         )
         release_figures()
+    covered = summary.get("vehicle_signal_epochs")
+    used = summary.get("tight_heading_used_with_vehicle_signals")
+    if used is None:  # no epoch with vehicle signals: the share of every epoch
+        covered, used = None, summary.get("tight_heading_used")
     report.headline = headline(
-        report.errors, summary.get("tight_heading_used"), truth is not None and not report.errors
+        report.errors, used, truth is not None and not report.errors, covered
     )
     report.facts = readable_facts(summary)
     (out / SUMMARY_FILE).write_text(json_text(summary, indent=2))
@@ -334,7 +355,7 @@ def evaluate_into(
             if (found := absolute_position_errors(trajectory, truth)) is not None
         }
         errors, per_100m, shown = evaluate_pipelines(
-            result.trajectories, table, result.tc_usable, truth
+            result.trajectories, table, result.tc_usable, truth, sequence.vehicle_span
         )
         found = evaluation_warnings(result.trajectories, errors, truth)
     except Exception as exc:  # a bug in the evaluation must not lose the trajectories

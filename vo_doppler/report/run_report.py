@@ -43,7 +43,7 @@ TABLE_COLUMNS = (
     ("error_per_100m_3d_m", "3-D error per 100 m, mean [m]", "{:.2f}"),
     ("kitti_translation_pct", "KITTI translation error [%]", "{:.2f}"),
     ("heading_rmse_deg", "heading RMSE [deg]", "{:.2f}"),
-    ("heading_availability", "absolute heading used [% of GNSS epochs]", "{:.0%}"),
+    ("heading_availability", "absolute heading used [% of the GNSS epochs it could use]", "{:.0%}"),
     ("final_position_error_m", "final horizontal error [m]", "{:.2f}"),
 )
 """(key of :class:`PipelineErrors`, column title with unit, format): the report's table and
@@ -83,8 +83,10 @@ GLOSSARY = (
     ),
     (
         "absolute heading used",
-        "Share of GNSS epochs whose absolute (GNSS) heading corrected the pipeline. “—”: the "
-        "pipeline uses no absolute heading (VO alone).",
+        "Share of the GNSS epochs where the pipeline could use an absolute (GNSS) heading whose "
+        "heading corrected it: the epochs inside its trajectory's time span that the vehicle "
+        "signals (wheel speed and yaw rate) cover; the epochs without them count in no share. "
+        "“—”: the pipeline uses no absolute heading (VO or dead reckoning alone).",
     ),
     (
         "available",
@@ -294,17 +296,26 @@ def worst_reliable_tight_errors(
 
 
 def headline(
-    errors: dict[str, PipelineErrors], used_fraction: float | None, truth_unused: bool = False
+    errors: dict[str, PipelineErrors],
+    used_fraction: float | None,
+    truth_unused: bool = False,
+    covered_epochs: int | None = None,
 ) -> str:
     """The result in one sentence: the VO's error per 100 m with the tightly coupled heading
     against the best of the VO's other pipelines (alone, with the conventional heading), or the
     wheel + gyro dead reckoning's without a camera (:func:`tight_verdict`: said plainly when the
     tightly coupled heading did not help), as the run measured them (or, without ground truth
-    or with one that could not be used (``truth_unused``), how often it was used;
-    ``used_fraction`` None: the recording had no GNSS)."""
+    or with one that could not be used (``truth_unused``), how often it was used: the share
+    ``used_fraction`` of the ``covered_epochs`` GNSS epochs with vehicle signals (of every GNSS
+    epoch when None); ``used_fraction`` None: the recording had no GNSS)."""
+    epochs = (
+        "GNSS epochs"
+        if covered_epochs is None
+        else f"{covered_epochs} GNSS epochs with vehicle signals (wheel speed and yaw rate)"
+    )
     used = (
         f"The tightly coupled heading was used by the correction at {used_fraction:.0%} of the "
-        "GNSS epochs."
+        f"{epochs}."
         if used_fraction is not None
         else "No GNSS: only the VO and the dead reckoning ran, the GNSS pipelines were not run."
     )
