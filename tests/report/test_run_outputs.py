@@ -190,6 +190,16 @@ def test_geojson_and_map_show_the_trajectories_as_written(drive_run, tmp_path):
     assert "trajectories.png" in page
 
 
+def test_the_report_of_a_drive_without_camera_names_no_vo_setting(drive_run, tmp_path):
+    """Issue 30: "VO window 20 frames" and the VO's definitions on a drive without camera."""
+    assert not drive_run[0].has_camera
+    _write(drive_run, tmp_path, drive_run[0].truth)
+    page = html.unescape((tmp_path / "report.html").read_text())
+    assert "VO window" not in page and "vo.window_size" not in page
+    assert "VO alone / + GPS" not in page and "wheel + gyro DR alone / + GPS" in page
+    assert "dead-reckoning heading compared as" in page
+
+
 def test_heading_use_is_a_share_of_the_epochs_with_vehicle_signals(drive_run, tmp_path):
     """Issue 30: the share of GNSS epochs whose tightly coupled heading was used counted the
     epochs without vehicle signals. Vehicle signals kept over the middle of the drive only."""

@@ -21,6 +21,7 @@ from vo_doppler.report.provenance import config_rows, describe_data, is_syntheti
 from vo_doppler.report.run_report import (
     GLOSSARY,
     build_heading_error_figure,
+    glossary,
     heading_error_over_time,
     headline,
     table_cell,
@@ -192,6 +193,30 @@ def test_configuration_is_in_degrees_for_people():
     assert rows["heading.gate.max_yaw_jump_deg"] == "2 deg"
     assert rows["heading.gate.max_yaw_drift_deg_s"] == "1 deg/s"
     assert dict(main_settings(RunConfig()))["elevation mask"] == "10.0 deg"
+
+
+def test_settings_and_definitions_of_what_did_not_run_are_left_out():
+    """Issue 30: a drive without a camera showed "VO window 20 frames" and the VO's
+    definitions."""
+    config = RunConfig()
+    assert "VO window" in dict(main_settings(config))
+    no_camera = dict(main_settings(config, camera=False))
+    assert "VO window" not in no_camera and "GNSS systems" in no_camera
+    assert "dead-reckoning heading compared as" in no_camera
+    assert not [name for name, _ in config_rows(config, camera=False) if name.startswith("vo.")]
+    assert dict(config_rows(config, camera=False))["correction.method"] == "kalman"
+    terms = dict(glossary(camera=False))
+    assert "VO alone / + GPS" not in terms and "available" in terms
+    assert "wheel + gyro DR alone / + GPS" in terms
+    no_gnss = dict(main_settings(config, gnss=False))
+    assert set(no_gnss) == {"VO window", "dead-reckoning rate"}
+    assert not [
+        name
+        for name, _ in config_rows(config, gnss=False)
+        if name.startswith(("heading.", "correction.", "systems", "elevation_mask"))
+    ]
+    assert set(dict(glossary(gnss=False))) & {"available", "reliable", "σ (sigma)"} == set()
+    assert glossary() == list(GLOSSARY)
 
 
 def test_a_manifest_with_the_simulators_keys_is_synthetic():

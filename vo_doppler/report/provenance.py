@@ -135,8 +135,17 @@ def _people_value(name: str, value) -> tuple[str, str]:
     return name, str(value)
 
 
-def config_rows(config: RunConfig) -> list[tuple[str, str]]:
-    """Every RunConfig setting as (dotted name, value for people), angles in degrees."""
+GNSS_CONFIG = ("systems", "elevation_mask", "heading.", "correction.")
+"""RunConfig settings (dotted-name prefixes) of the GNSS stages, the heading and its correction:
+not run on a recording without GNSS."""
+CAMERA_CONFIG = ("vo.",)
+"""RunConfig settings of the VO: not run on a recording without a camera."""
+
+
+def config_rows(config: RunConfig, camera: bool = True, gnss: bool = True) -> list[tuple[str, str]]:
+    """Every RunConfig setting as (dotted name, value for people), angles in degrees; those of
+    the stages that did not run (the VO without a ``camera``, the GNSS, heading and correction
+    stages without ``gnss``: :data:`CAMERA_CONFIG`, :data:`GNSS_CONFIG`) left out."""
     rows: list[tuple[str, str]] = []
 
     def walk(prefix: str, obj) -> None:
@@ -149,31 +158,46 @@ def config_rows(config: RunConfig) -> list[tuple[str, str]]:
                 rows.append((prefix + name, shown))
 
     walk("", config)
-    return rows
+    skipped = (() if camera else CAMERA_CONFIG) + (() if gnss else GNSS_CONFIG)
+    return [(name, value) for name, value in rows if not name.startswith(skipped)]
 
 
-def main_settings(config: RunConfig) -> list[tuple[str, str]]:
-    """The settings a person chooses on the command line, in people units."""
+def main_settings(
+    config: RunConfig, camera: bool = True, gnss: bool = True
+) -> list[tuple[str, str]]:
+    """The settings a person chooses on the command line, in people units: only those of the
+    stages that ran (the VO window with a ``camera``; the satellites, the heading and its
+    correction with ``gnss``; the dead reckoning's rate always)."""
     correction = config.correction
     method = {
         "kalman": "adaptive blend (Kalman filter on the VO heading offset)",
         "window": "[TK18] window method, Eq. 11–13",
     }[correction.method]
+    if not camera:
+        method = method.replace("the VO heading offset", "the heading offset")
     smoothing = "smoothed (forward filter and backward smoother)"
     if correction.method == "kalman" and not correction.blend.smooth:
         smoothing = "causal (forward filter only)"
-    return [
-        ("GNSS systems", config.systems),
-        ("elevation mask", f"{np.degrees(config.elevation_mask):.1f} deg"),
-        ("VO window", f"{config.vo.window_size} frames"),
-        (
-            "heading correction",
-            method + ("; " + smoothing if correction.method == "kalman" else ""),
-        ),
-        ("VO heading compared as", correction.reference),
-        (
-            "tightly coupled heading used when σ <",
-            f"{np.degrees(correction.tc_max_sigma):.1f} deg",
-        ),
-        ("heading calibration", config.heading.calibration),
-    ]
+    rows = []
+    if gnss:
+        rows += [
+            ("GNSS systems", config.systems),
+            ("elevation mask", f"{np.degrees(config.elevation_mask):.1f} deg"),
+        ]
+    if camera:
+        rows.append(("VO window", f"{config.vo.window_size} frames"))
+    rows.append(("dead-reckoning rate", f"{config.dead_reckoning_rate_hz:g} Hz"))
+    if gnss:
+        rows += [
+            (
+                "heading correction",
+                method + ("; " + smoothing if correction.method == "kalman" else ""),
+            ),
+            (f"{'VO' if camera else 'dead-reckoning'} heading compared as", correction.reference),
+            (
+                "tightly coupled heading used when σ <",
+                f"{np.degrees(correction.tc_max_sigma):.1f} deg",
+            ),
+            ("heading calibration", config.heading.calibration),
+        ]
+    return rows

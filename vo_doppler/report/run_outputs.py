@@ -38,6 +38,7 @@ from vo_doppler.report.run_report import (
     RunReport,
     build_error_per_100m_figure,
     build_heading_error_figure,
+    glossary,
     headline,
     png_data_uri,
     trajectories_figure,
@@ -300,13 +301,14 @@ def write_run_outputs(
         data=describe_data(sequence, manifest, driven_m(result)),
         command=command or command_line(),
         version=version(),
-        settings=main_settings(config),
-        config_rows=config_rows(config),
+        settings=main_settings(config, sequence.has_camera, sequence.has_gnss),
+        config_rows=config_rows(config, sequence.has_camera, sequence.has_gnss),
         facts={},
         tracks=dict(result.trajectories),
         enu=sequence.enu,
         heading_figure="",
         warnings=list(summary.get("warnings", [])),
+        definitions=glossary(sequence.has_camera, sequence.has_gnss),
     )
     truth_yaw = truth.yaw_at(table.t) if truth is not None and table is not None else None
     if truth is not None:

@@ -124,7 +124,33 @@ GLOSSARY = (
         "(conventional): VO heading corrected by the heading of the Doppler velocity. VO + GPS "
         "(tightly coupled): corrected by the [TK18] tightly coupled Doppler heading.",
     ),
+    (
+        "wheel + gyro DR alone / + GPS",
+        "Dead reckoning of the wheel speed and the yaw-rate gyro (calibrated by the GNSS Doppler "
+        "where the recording has GNSS), turned to the absolute headings of its first seconds "
+        "(without GNSS: started facing east); + GPS: corrected by the conventional or the "
+        "tightly coupled heading as the VO is.",
+    ),
 )
+
+GLOSSARY_NEEDS = {
+    "absolute heading used": "gnss",
+    "available": "gnss",
+    "reliable": "gnss",
+    "used by the correction": "gnss",
+    "σ (sigma)": "gnss",
+    "VO alone / + GPS": "camera",
+}
+"""The definitions of what runs only with a sensor: left out of the report of a recording
+without it (:func:`glossary`)."""
+
+
+def glossary(camera: bool = True, gnss: bool = True) -> list[tuple[str, str]]:
+    """The definitions the report of a recording with (or without) a ``camera`` and ``gnss``
+    needs: those of :data:`GLOSSARY` whose pipelines or figures it shows."""
+    present = {"camera": camera, "gnss": gnss}
+    return [(k, v) for k, v in GLOSSARY if present.get(GLOSSARY_NEEDS.get(k, ""), True)]
+
 
 WORST_EPOCHS = 8
 WORST_SEPARATION_S = 1.0
@@ -404,6 +430,8 @@ class RunReport:
     warnings: list[str] = field(default_factory=list)
     """What the input checks found (time order, clocks, origin) and what the evaluation could
     not do (ground truth covering part of the drive), shown under the data."""
+    definitions: list[tuple[str, str]] = field(default_factory=glossary)
+    """The definitions shown (:func:`glossary`: only those of what ran)."""
 
 
 STYLE = (
@@ -514,7 +542,7 @@ def render(report: RunReport) -> str:
         f"Version: {html.escape(report.version)}</p>",
         _definitions(report.settings),
         "<details><summary>Full configuration (RunConfig; angles in degrees, everything else "
-        "in SI units)</summary>",
+        "in SI units; the settings of stages that did not run left out)</summary>",
         _definitions(report.config_rows),
         "</details>",
     ]
@@ -572,7 +600,7 @@ def render(report: RunReport) -> str:
         "<h2>Run figures</h2>",
         _definitions(list(report.facts.items())),
         "<h2>Definitions</h2><dl>",
-        *(f"<dt>{html.escape(k)}</dt><dd>{html.escape(v)}</dd>" for k, v in GLOSSARY),
+        *(f"<dt>{html.escape(k)}</dt><dd>{html.escape(v)}</dd>" for k, v in report.definitions),
         "</dl><p class='note'>[TK18]: Takeyama &amp; Kojima (2018), the tightly coupled Doppler "
         "heading this toolkit implements (see docs/design.md).</p>",
         "</body></html>",
