@@ -312,6 +312,43 @@ def test_a_wheel_speed_covering_half_the_epochs_is_a_warning_naming_the_offset()
     assert coverage_warning("CAN", SensorSeries(T + 7.0, SPEED.value), t_gnss, 0.0, "x")
 
 
+def test_vehicle_signals_covering_part_of_the_drive_are_not_blamed_on_the_clock():
+    """Issue 30: the coverage warning suggested a clock error when the signals simply cover part
+    of the drive. A wheel speed over 20-40 s of a 60-s GNSS record (its clock right): part
+    coverage, with the clock check's confirmation when it has one; shifted by 30 s over as long
+    a record: a clock offset, naming the option."""
+    t_gnss = np.arange(0.0, 60.0, 0.1)
+    inside = (T >= 20.0) & (T <= 40.0)
+    part = SensorSeries(T[inside], SPEED.value[inside])
+    confirmed = ClockOffsetEstimate(0.01)
+    said = coverage_warning("CAN", part, t_gnss, 12.5, "--time-offset-can", confirmed)
+    assert said.startswith("CAN: the wheel speed covers only 34% of the GNSS epochs")
+    assert "(clock residual +0.01 s), so the vehicle signals cover part of the drive" in said
+    assert "check --" not in said
+    unchecked = coverage_warning("CAN", part, t_gnss, 12.5, "--time-offset-can")
+    assert "recorded over 20.0 s of the 59.9 s of GNSS, so they cover part of the drive" in (
+        unchecked
+    )
+    assert "check --" not in unchecked
+    shifted = SensorSeries(T + 30.0, SPEED.value)
+    for clock in (None, ClockOffsetEstimate(None, no_lag_reason="no match")):
+        offset = coverage_warning("CAN", shifted, t_gnss, 12.5, "--time-offset-can", clock)
+        assert offset.startswith("CAN clock: the wheel speed covers only 50% of the GNSS epochs")
+        assert "shifted by +30.0 s" in offset and offset.endswith(
+            "check --time-offset-can 12.500 s"
+        )
+    # through the calibration's checks: the clock confirmed over the overlap
+    velocity = velocity_solution(
+        t_gnss,
+        np.column_stack(
+            [np.zeros_like(t_gnss), np.interp(t_gnss, SPEED.t, SPEED.value), 0 * t_gnss]
+        ),
+        np.ones(t_gnss.size, bool),
+    )
+    _, found = calibration_warnings(part, velocity, 1.0, "CAN", 0.0)
+    assert len(found) == 1 and "cover part of the drive: not a clock offset" in found[0]
+
+
 @pytest.mark.parametrize("scale", [1.0, 1.099, 0.901, float("nan")])
 def test_wheel_scales_within_ten_percent_pass(scale):
     assert wheel_scale_warning(scale) is None

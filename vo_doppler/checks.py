@@ -45,8 +45,11 @@ CAN signal and its DBC, an option). Each check states its threshold:
   difference with the noise);
 * the wheel-speed times against the GNSS epochs: when more than 10 % of the epochs lie outside
   the wheel speed's time span, it is a warning, since those epochs get no tightly coupled
-  heading and a clock offset wrong by more than the ±5 s searched looks like this (comma2k19
-  with its CAN clock 30 s off: half the epochs);
+  heading. It tells why: vehicle signals whose clock the GNSS Doppler speed confirms where
+  they overlap, or recorded over less than 90 % of the GNSS span, cover part of the drive; a
+  wheel speed recorded as long but shifted is a clock offset wrong by more than the ±5 s
+  searched (comma2k19 with its CAN clock 30 s off: half the epochs), and the warning names the
+  setting;
 * the calibrated wheel scale: beyond 1 ± 0.10 it is a warning, since a tyre's rolling radius
   changes by a few per cent with wear and pressure, and a scale far from 1 means a speed in
   other units (km/h: 0.28, mph: 0.45) or a wheel speed that is not this drive's; so is the
@@ -455,23 +458,62 @@ def clock_warning(
     )
 
 
+SAME_SPAN_RATIO = 0.9
+"""A wheel speed whose span is at least this share of the GNSS epochs' span was recorded over
+as long as the GNSS: when it leaves epochs uncovered it is shifted (a clock offset), not cut."""
+
+
 def coverage_warning(
-    sensor: str, speed: SensorSeries, t_gnss: np.ndarray, offset_s: float, offset_name: str
+    sensor: str,
+    speed: SensorSeries,
+    t_gnss: np.ndarray,
+    offset_s: float,
+    offset_name: str,
+    clock: ClockOffsetEstimate | None = None,
 ) -> str | None:
     """A warning when more than 10 % of the GNSS epochs lie outside the wheel speed's time
-    span (module docstring)."""
+    span (module docstring), telling part coverage from a clock offset: a clock the GNSS
+    Doppler speed confirms where the two overlap (``clock``: its residual within the clock
+    tolerance) or a wheel speed recorded over a shorter time than the GNSS (less than
+    :data:`SAME_SPAN_RATIO` of it) covers part of the drive; one recorded as long but shifted
+    is a clock offset beyond the ±5 s the clock check searches, and the warning names the
+    setting that fixes it."""
     t_gnss = np.asarray(t_gnss, dtype=float)
     if t_gnss.size == 0 or len(speed) == 0:
         return None
     inside = (t_gnss >= speed.t[0]) & (t_gnss <= speed.t[-1])
     if inside.mean() >= MIN_SPEED_COVERAGE:
         return None
+    starts, ends = speed.t[0] - t_gnss[0], speed.t[-1] - t_gnss[-1]
+    recorded, drive = float(speed.t[-1] - speed.t[0]), float(t_gnss[-1] - t_gnss[0])
+    found = (
+        f"the wheel speed covers only {inside.mean():.0%} of the GNSS epochs (it "
+        f"starts {starts:+.1f} s and ends {ends:+.1f} s from them), and the epochs outside get "
+        "no tightly coupled heading"
+    )
+    confirmed = (
+        clock is not None
+        and clock.residual_s is not None
+        and abs(clock.residual_s) <= CLOCK_TOLERANCE_S
+    )
+    if confirmed:
+        return (
+            f"{sensor}: {found}; where the two overlap, the wheel speed matches the GNSS "
+            f"Doppler speed (clock residual {clock.residual_s:+.2f} s), so the vehicle signals "
+            f"cover part of the drive: not a clock offset ({offset_name} {offset_s:.3f} s fits)"
+        )
+    if recorded < SAME_SPAN_RATIO * drive:
+        return (
+            f"{sensor}: {found}; the wheel speed was recorded over {recorded:.1f} s of the "
+            f"{drive:.1f} s of GNSS, so they cover part of the drive (were they recorded over "
+            f"all of it, {offset_name} {offset_s:.3f} s would be off by more than the "
+            f"±{CLOCK_SEARCH_S:g} s the clock check searches)"
+        )
     return (
-        f"{sensor} clock: the wheel speed covers only {inside.mean():.0%} of the GNSS epochs "
-        f"(it starts {speed.t[0] - t_gnss[0]:+.1f} s and ends {speed.t[-1] - t_gnss[-1]:+.1f} s "
-        "from them), and the epochs outside get no tightly coupled heading; a clock offset "
-        f"wrong by more than the ±{CLOCK_SEARCH_S:g} s the clock check searches looks like "
-        f"this: check {offset_name} {offset_s:.3f} s"
+        f"{sensor} clock: {found}; recorded over as long as the GNSS ({recorded:.1f} of "
+        f"{drive:.1f} s) but shifted by {starts:+.1f} s, as a clock offset wrong by more than "
+        f"the ±{CLOCK_SEARCH_S:g} s the clock check searches: check {offset_name} "
+        f"{offset_s:.3f} s"
     )
 
 
@@ -507,7 +549,7 @@ def calibration_warnings(
     if wheel_scale is not None and scale is None:
         scale = speed_ratio_warning(wheel_speed, velocity.t, horizontal, wheel_scale)
     found = [
-        coverage_warning(sensor, wheel_speed, velocity.t, offset_s, offset_name),
+        coverage_warning(sensor, wheel_speed, velocity.t, offset_s, offset_name, estimate),
         clock_warning(sensor, estimate, offset_s, offset_name),
         scale,
     ]
