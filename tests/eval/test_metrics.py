@@ -114,7 +114,40 @@ def test_cli_eval_table_states_its_segments_and_units(tmp_path, capsys, n, expec
     out = " ".join(capsys.readouterr().out.split())
     assert expected in out
     assert "rotation [deg/100 m]" in out and "length [m]" in out
-    assert "(sim3 alignment)" not in out and "independent of the alignment" in out
+    assert "(sim3 alignment)" not in out and "scaled by the sim3 alignment first" in out
+
+
+def test_cli_eval_text_gives_the_mean_segment_errors_and_how_the_alignment_bears_on_them(
+    tmp_path, capsys
+):
+    """Issue 30: the text output left out the mean KITTI errors (only the JSON had them), and
+    called the segment errors "independent of the alignment" while sim3 changes them."""
+    truth = straight(n=301, yaw_rate=0.002)
+    turned = Rotation.from_euler("z", 0.001 * truth.t[:, None])
+    estimate = Trajectory(truth.t, truth.positions * 1.05, turned * truth.orientations)
+    write_tum(tmp_path / "gt.tum", truth)
+    write_tum(tmp_path / "est.tum", estimate)
+    files = [str(tmp_path / "est.tum"), str(tmp_path / "gt.tum")]
+    said = {}
+    for align in ("start", "sim3"):
+        assert main(["eval", *files, "--align", align, "--json"]) == 0
+        figures = json.loads(capsys.readouterr().out)
+        assert main(["eval", *files, "--align", align]) == 0
+        out = " ".join(capsys.readouterr().out.split())
+        mean = f"mean of all │ {figures['mean_translation_pct']:.3f} │ "
+        assert mean + f"{figures['mean_rotation_deg_per_100m']:.4f}" in out
+        said[align] = (out, figures)
+    assert "unchanged by the rigid start alignment" in said["start"][0]
+    assert (
+        "scaled by the sim3 alignment first, which changes the translation errors"
+        in (said["sim3"][0])
+    )
+    # sim3's scale changes the translation errors, not the rotation errors
+    start, sim3 = said["start"][1], said["sim3"][1]
+    assert abs(start["mean_translation_pct"] - sim3["mean_translation_pct"]) > 1.0
+    assert sim3["mean_rotation_deg_per_100m"] == pytest.approx(
+        start["mean_rotation_deg_per_100m"], rel=1e-6
+    )
 
 
 def strict_json(text: str):

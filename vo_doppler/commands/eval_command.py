@@ -99,7 +99,8 @@ def register(subparsers, summary: str) -> None:
         choices=ALIGNMENTS,
         default="start",
         help="how the estimate is aligned to the ground truth before the final error, end yaw "
-        "error and ATE (segment errors are relative and do not depend on it)",
+        "error and ATE (segment errors are relative: a rigid alignment leaves them as they are, "
+        "sim3 scales the estimate and so changes the translation errors)",
     )
     parser.add_argument(
         "--up",
@@ -152,7 +153,7 @@ def print_errors(errors: TrajectoryErrors) -> None:
             f"Segment errors: none, {segment_lengths_note(lengths, errors.path_length_m)}"
         )
     table = Table(
-        title="Segment errors (KITTI devkit: relative poses, independent of the alignment)",
+        title=f"Segment errors (KITTI devkit: relative poses; {segment_alignment_note(errors)})",
         caption=segment_lengths_note(lengths, errors.path_length_m),
     )
     for column in ("length [m]", "translation [%]", "rotation [deg/100 m]"):
@@ -164,7 +165,14 @@ def print_errors(errors: TrajectoryErrors) -> None:
             f"{s.translation_pct:.3f}",
             f"{s.rotation_deg_per_100m:.4f}",
             str(s.count),
+            end_section=s is errors.segments[-1],
         )
+    table.add_row(
+        "mean of all",
+        number_or_dash(errors.mean_translation_pct, "{:.3f}"),
+        number_or_dash(errors.mean_rotation_deg_per_100m, "{:.4f}"),
+        str(sum(s.count for s in errors.segments)),
+    )
     if lengths:
         console.print(table)
     evaluated = ""
@@ -180,6 +188,18 @@ def print_errors(errors: TrajectoryErrors) -> None:
         f"{number_or_dash(errors.end_yaw_error_deg, '{:.3f}')} deg | ATE RMSE "
         f"{number_or_dash(errors.ate_rmse_m, '{:.3f}')} m{evaluated}"
     )
+
+
+def segment_alignment_note(errors: TrajectoryErrors) -> str:
+    """How the alignment bears on the segment errors: a rigid one (``none``, ``start``,
+    ``se2``) leaves relative poses as they are; ``sim3`` scales the estimate first, which
+    changes the translation errors (not the rotation errors)."""
+    if errors.alignment == "sim3":
+        return (
+            "the estimate scaled by the sim3 alignment first, which changes the translation "
+            "errors, not the rotation errors"
+        )
+    return f"unchanged by the rigid {errors.alignment} alignment"
 
 
 def origin_value(text: str) -> tuple[float, float, float]:
