@@ -161,3 +161,19 @@ def test_ground_truth_is_read_before_the_vo(problem, tmp_path, monkeypatch, caps
     expected = "No such file or directory" if problem == "missing" else "4 poses but 3 timestamps"
     assert f"{truth}: " in err and expected in err
     assert not out.exists()
+
+
+def test_a_calibration_for_another_image_size_is_refused_before_any_work(tmp_path, capsys):
+    """Issue 30: exit 1 naming both sizes, nothing written."""
+    import cv2
+
+    images = tmp_path / "image_0"
+    images.mkdir()
+    for k in range(3):
+        cv2.imwrite(str(images / f"{k:06d}.png"), np.full((376, 1241), 40 * k, np.uint8))
+    calib = REPO_ROOT / "calib" / "kitti_odometry_04-12.yaml"
+    out = tmp_path / "out"
+    code = main(["vo", str(images), "--calib", str(calib), "--fps", "10", "-o", str(out)])
+    assert code == 1 and not out.exists()
+    err = capsys.readouterr().err
+    assert "1241×376 px but the camera calibration is for 1226×370 px" in err

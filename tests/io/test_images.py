@@ -8,8 +8,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.conftest import REPO_ROOT
 from vo_doppler.errors import InputError
+from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import (
+    check_image_size,
     list_images,
     prefetch_images,
     read_image,
@@ -85,3 +88,22 @@ def test_prefetch_stops_when_the_consumer_does(tmp_path):
         next(images)
     with pytest.raises(ValueError, match="depth"):
         next(prefetch_images(list_images(tmp_path), depth=0))
+
+
+def test_a_calibration_for_another_image_size_is_an_error_naming_both(tmp_path):
+    """Issue 30: the calibration of KITTI's 1226×370 sequences on 1241×376 images passed
+    silently (its principal point and focal lengths are wrong there)."""
+    calib = REPO_ROOT / "calib" / "kitti_odometry_04-12.yaml"
+    camera = read_camera(calib)
+    (tmp_path / "000000.png").write_bytes(b"not a png")  # skipped: the next one decodes
+    cv2.imwrite(str(tmp_path / "000001.png"), np.zeros((376, 1241), np.uint8))
+    images = list_images(tmp_path)
+    with pytest.raises(InputError) as found:
+        check_image_size(camera, images, calib)
+    message = str(found.value)
+    assert "the images are 1241×376 px but the camera calibration is for 1226×370 px" in message
+    assert "kitti_odometry_04-12.yaml" in message and "000001.png" in message
+    check_image_size(read_camera(REPO_ROOT / "calib" / "kitti_odometry_00-02.yaml"), images, "c")
+    camera.width = camera.height = 0  # a calibration without a size (KITTI calib.txt)
+    check_image_size(camera, images, calib)
+    assert camera.size_mismatch(1241, 376) is None

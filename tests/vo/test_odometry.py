@@ -7,6 +7,7 @@ import pytest
 
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import evaluate
+from vo_doppler.model.camera import Camera
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.vo_sequence import simulate_vo
 from vo_doppler.vo.baseline import FrameToFrameVO
@@ -55,6 +56,15 @@ def test_streaming_rejects_times_that_do_not_increase(drive):
     with pytest.raises(InputError, match="frame 1: time nan"):
         vo.process(drive.images[1], float("nan"))
     assert vo.process(drive.images[1], 1.1).index == 1
+
+
+def test_a_frame_of_another_size_than_the_calibration_is_an_error():
+    """The VO checks every frame's size against the calibration's (issue 30: 1241×376 images
+    with a 1226×370 calibration passed silently)."""
+    odometry = VisualOdometry(Camera(707.0, 707.0, 601.9, 183.1, 1226, 370))
+    image = np.zeros((376, 1241), np.uint8)
+    with pytest.raises(InputError, match=r"frame 0: the images are 1241×376 px but the camera"):
+        odometry.process(image, 0.0)
 
 
 def test_frame_to_frame_baseline_follows_a_straight_stretch(drive):

@@ -14,6 +14,7 @@ from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import NO_MATCH, evaluate_by_time
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.images import (
+    check_image_size,
     find_times_file,
     list_images,
     prefetch_images,
@@ -75,6 +76,7 @@ def run(args: argparse.Namespace) -> int:
     )
     files = list_images(args.images)
     camera = read_camera(args.calib)
+    check_image_size(camera, files, args.calib)
     if args.fps is not None:
         times = times_from_fps(args.fps, len(files))
     else:

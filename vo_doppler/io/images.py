@@ -15,6 +15,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.textfile import read_text
+from vo_doppler.model.camera import Camera
 
 log = logging.getLogger(__name__)
 
@@ -64,6 +65,30 @@ def read_image(path: Path) -> np.ndarray | None:
     if image is None:
         log.warning("%s: cannot decode image; the frame is flagged and bridged", path)
     return image
+
+
+def check_image_size(camera: Camera, images: list[Path], calibration: str | Path) -> None:
+    """Raise an :class:`InputError` naming the ``calibration`` file, the first image and both
+    sizes when the images are not of the size the calibration states
+    (:meth:`~vo_doppler.model.camera.Camera.size_mismatch`): checked on the first image that
+    decodes, before any work; the VO checks every frame again."""
+    if not (camera.width and camera.height):
+        return
+    import cv2  # loaded here as by read_image: only a recording with a camera needs it
+
+    for path in images[:MAX_SIZE_PROBES]:
+        image = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+        if image is None:
+            continue
+        mismatch = camera.size_mismatch(image.shape[1], image.shape[0])
+        if mismatch:
+            raise InputError(f"{mismatch} (first image {path})", calibration)
+        return
+
+
+MAX_SIZE_PROBES = 5
+"""Images tried, from the first, for one that decodes to check its size (an unreadable one is
+flagged later by the VO)."""
 
 
 def prefetch_images(paths: Iterable[Path], depth: int = 4) -> Iterator[np.ndarray | None]:

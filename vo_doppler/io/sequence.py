@@ -23,7 +23,7 @@ from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.can import CanDecodeReport, SignalError, read_can_motion
 from vo_doppler.io.doppler_sigma import read_doppler_sigma
-from vo_doppler.io.images import list_images, read_times
+from vo_doppler.io.images import check_image_size, list_images, read_times
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.satellite_states import read_satellite_states
 from vo_doppler.io.sensor_csv import (
@@ -245,6 +245,7 @@ def read_sequence_with_report(
                 "(the sum loses their spacing to rounding)",
             )
         camera = read_camera(m.file("camera", "calib"))
+        check_image_size(camera, images, m.file("camera", "calib"))
     obs, nav, sigma, lever_arm = None, None, None, (0.0, 0.0, 0.0)
     if "gnss" in m.data:  # a recording without GNSS (a KITTI raw drive) runs VO and DR only
         obs, nav, sigma = _gnss(m)

@@ -36,6 +36,20 @@ class Camera:
     def K(self) -> np.ndarray:
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
 
+    def size_mismatch(self, width: int, height: int) -> str | None:
+        """Why images of ``width`` × ``height`` px cannot be used with this calibration: its
+        intrinsics hold for the image size it states, and on images of another size (KITTI's
+        1241×376 sequences with the 1226×370 ones' calibration) the principal point and the
+        focal lengths in pixels are wrong with nothing to show it. None when the sizes agree or
+        the calibration states none (a KITTI ``calib.txt``)."""
+        if not (self.width and self.height) or (width, height) == (self.width, self.height):
+            return None
+        return (
+            f"the images are {width}×{height} px but the camera calibration is for "
+            f"{self.width}×{self.height} px: use the calibration of these images (its "
+            "intrinsics hold only for the size it states)"
+        )
+
     @property
     def has_distortion(self) -> bool:
         return bool(np.any(np.asarray(self.distortion) != 0.0))

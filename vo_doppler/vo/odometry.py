@@ -140,6 +140,10 @@ class VisualOdometry:
         last = self._window[-1].t if self._window else None
         if not np.isfinite(t) or (last is not None and t <= last):
             raise InputError(f"frame {index}: time {t!r} is not after the previous frame's {last}")
+        if image is not None:
+            mismatch = self.camera.size_mismatch(image.shape[1], image.shape[0])
+            if mismatch:
+                raise InputError(f"frame {index}: {mismatch}")
         self._frames_seen += 1
         frame = _Frame(index, float(t), self._predict(), TrackedFeatures.empty(), False)
         problem = self._image_problem(image)
