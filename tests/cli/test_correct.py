@@ -4,6 +4,7 @@ any work), and a warning when the trajectory's world is probably not the --world
 from __future__ import annotations
 
 import json
+import logging
 
 import numpy as np
 import pytest
@@ -57,6 +58,19 @@ def test_times_with_a_kitti_trajectory_are_its_times(drive, capsys):
     argv += ["--times", str(drive / "times.txt"), "--world", "level", "-o", str(drive / "c.tum")]
     assert main(argv) == 0
     np.testing.assert_allclose(read_tum(drive / "c.tum").t, level_turn().t, atol=1e-9)
+
+
+def test_the_summary_is_printed_once(drive, capsys, caplog):
+    """Issue 30: correct printed its JSON twice (logged at INFO, the default level, and
+    printed)."""
+    caplog.set_level(logging.INFO)
+    argv = ["correct", str(drive / "track.tum"), "--heading", str(drive / "heading.csv")]
+    assert main([*argv, "--world", "level", "-o", str(drive / "c.tum")]) == 0
+    captured = capsys.readouterr()
+    said = captured.out + captured.err + caplog.text
+    assert said.count('"poses_with_absolute_heading"') == 1
+    [line] = captured.out.strip().splitlines()
+    assert json.loads(line)["poses"] == len(level_turn())
 
 
 @pytest.mark.parametrize(("world", "warned"), [("first_camera", True), ("level", False)])

@@ -248,6 +248,5 @@ def run(args: argparse.Namespace) -> int:
         summary["heading_sigma_scale"] = result.noise.scale
         summary["outlier_fraction"] = result.noise.outlier_fraction
         summary["correlation_floor_s"] = result.noise.correlation_floor_s
-    log.info("correct: %s", json_text(summary))
-    print(json_text(summary))
+    print(json_text(summary))  # once, on stdout (the warnings in it were logged above)
     return 0
