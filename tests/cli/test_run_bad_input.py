@@ -318,6 +318,7 @@ def tree(folder: Path) -> dict[str, bytes]:
         ("par/seq", ".", "par/seq: the output folder is the input par/seq"),
         ("par", ".", "par: the output folder contains the input par/seq"),
         ("par/seq/gnss", ".", "par/seq/gnss: the output folder contains the input par/seq/gnss"),
+        ("par/seq/out", ".", "par/seq/out: the output folder is inside the input folder par/seq"),
         ("orbits", ".", "orbits: the output folder contains the input par/seq/../../orbits/x.sp3"),
         (
             "other",
@@ -333,7 +334,8 @@ def test_run_refuses_its_inputs_the_current_directory_and_a_folder_it_did_not_wr
     tmp_path, capsys, monkeypatch, output, cwd, message
 ):
     """The QA report's cases (`run selfrun -o selfrun`, `run par/seq -o par`, `-o other` with
-    notes in it, `-o .`) and the manifest's inputs, refused before any reading with nothing
+    notes in it, `-o .`), the manifest's inputs and a folder inside the sequence's (issue 30:
+    `run par/seq -o par/seq/out` was accepted), refused before any reading with nothing
     touched."""
     sequence = tmp_path / "par" / "seq"
     (sequence / "gnss").mkdir(parents=True)

@@ -229,7 +229,10 @@ def test_the_inputs_and_what_holds_them_are_refused(tmp_path):
             check_output_folder(output, RUN, inputs)
     with pytest.raises(OutputError, match=r"contains the input .*rover\.obs"):
         check_output_folder(recording / "gnss", RUN, [obs])
-    assert check_output_folder(recording / "out", RUN, inputs) == recording / "out"
+    with pytest.raises(OutputError, match=r"out: the output folder is inside the input folder"):
+        check_output_folder(recording / "out", RUN, inputs)
+    assert check_output_folder(tmp_path / "out", RUN, inputs) == tmp_path / "out"
+    assert check_output_folder(recording / "gnss" / "out", RUN, [obs]) == recording / "gnss" / "out"
     link = tmp_path / "link"
     link.symlink_to(recording, target_is_directory=True)
     with pytest.raises(OutputError, match="the output folder is the input"):

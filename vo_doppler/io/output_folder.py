@@ -2,7 +2,8 @@
 write.
 
 A command's ``-o`` folder must be new, empty or written by an earlier run of the same command
-(:func:`written_by`), must not be or contain one of the command's inputs, and, when the command
+(:func:`written_by`), must not be or contain one of the command's inputs nor lie inside an input
+folder (a sequence folder, an image folder), and, when the command
 replaces the whole folder (``run``; ``batch`` for each recording's folder), must not be the
 current directory or hold it. ``vo-doppler run`` and each recording of ``vo-doppler batch`` fill
 a temporary folder beside the output and swap it in only when complete (:func:`staged_output`;
@@ -208,11 +209,21 @@ def check_output_folder(
             f"folder itself ({path.resolve()})"
         )
     resolved = path.resolve()
-    for item in filter(None, inputs):
-        if _holds(resolved, Path(item).resolve()):
-            relation = "is" if Path(item).resolve() == resolved else "contains"
+    given = [item for item in inputs if item]
+    for item in given:
+        source = Path(item).resolve()
+        if _holds(resolved, source):
+            relation = "is" if source == resolved else "contains"
             raise OutputError(
                 f"{path}: the output folder {relation} the input {item}; choose another folder"
+            )
+    for item in given:
+        source = Path(item).resolve()
+        if source.is_dir() and resolved.is_relative_to(source):
+            raise OutputError(
+                f"{path}: the output folder is inside the input folder {item}, which would then "
+                "hold results beside its data (and, for a sequence, a later run read them as "
+                "part of it); choose a folder outside it"
             )
     if replace and _holds(resolved, Path.cwd().resolve()):
         raise OutputError(
