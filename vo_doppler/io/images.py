@@ -39,7 +39,17 @@ def list_images(folder: str | Path) -> list[Path]:
 
 
 def read_image(path: Path) -> np.ndarray | None:
-    """Grey uint8 image, or ``None`` (with a warning) when the file cannot be read or decoded.
+    """Grey uint8 image, or ``None`` (with a warning) when the file cannot be read or decoded
+    (:func:`decode_image`)."""
+    image, problem = decode_image(path)
+    if image is None:
+        log.warning("%s: %s; the frame is flagged and bridged", path, problem)
+    return image
+
+
+def decode_image(path: Path) -> tuple[np.ndarray | None, str]:
+    """The grey uint8 image of ``path``, or None and why not (a file larger than
+    ``IMAGE_MAX_BYTES``, unreadable, or not an image OpenCV decodes).
 
     The file is read by Python and decoded from memory: ``cv2.imread`` encodes the path as
     UTF-8, and a name that is not (bytes ``\\xff``, held as a lone surrogate) crashes OpenCV
@@ -49,35 +59,24 @@ def read_image(path: Path) -> np.ndarray | None:
     try:
         size = Path(path).stat().st_size
         if size > IMAGE_MAX_BYTES:
-            log.warning(
-                "%s: image of %d bytes, more than %d MiB: not read; the frame is flagged and "
-                "bridged",
-                path,
-                size,
-                IMAGE_MAX_BYTES >> 20,
-            )
-            return None
+            return None, f"image of {size} bytes, more than {IMAGE_MAX_BYTES >> 20} MiB: not read"
         data = np.fromfile(path, dtype=np.uint8)
     except OSError as exc:
-        log.warning("%s: cannot read image (%s); the frame is flagged and bridged", path, exc)
-        return None
+        return None, f"cannot read image ({exc})"
     image = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE) if data.size else None
-    if image is None:
-        log.warning("%s: cannot decode image; the frame is flagged and bridged", path)
-    return image
+    return image, "" if image is not None else "cannot decode image"
 
 
 def check_image_size(camera: Camera, images: list[Path], calibration: str | Path) -> None:
     """Raise an :class:`InputError` naming the ``calibration`` file, the first image and both
     sizes when the images are not of the size the calibration states
     (:meth:`~vo_doppler.model.camera.Camera.size_mismatch`): checked on the first image that
-    decodes, before any work; the VO checks every frame again."""
+    decodes (of the first :data:`MAX_SIZE_PROBES`), before any work; the VO checks every frame
+    again."""
     if not (camera.width and camera.height):
         return
-    import cv2  # loaded here as by read_image: only a recording with a camera needs it
-
     for path in images[:MAX_SIZE_PROBES]:
-        image = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+        image, _ = decode_image(path)  # an unreadable one is the VO's to flag
         if image is None:
             continue
         mismatch = camera.size_mismatch(image.shape[1], image.shape[0])
