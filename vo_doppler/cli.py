@@ -20,6 +20,7 @@ from vo_doppler.errors import (
     EXIT_INTERNAL,
     EXIT_OK,
     EXIT_USAGE,
+    UsageError,
     VoDopplerError,
     shown,
     storage_refused,
@@ -58,7 +59,8 @@ log = logging.getLogger("vo_doppler")
 EXIT_CODES_EPILOG = f"""exit codes:
   {EXIT_OK}  success
   {EXIT_FAILURE}  bad input or failed processing (the message names the file and line, epoch or key)
-  {EXIT_USAGE}  usage error (unknown command or option, bad option value)
+  {EXIT_USAGE}  usage error (unknown command or option, bad option value, a --start/--end outside
+     the recording)
   {EXIT_INTERNAL}  internal error (a bug: rerun with --debug and report the traceback)
 """
 
@@ -102,6 +104,9 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     try:
         return int(args.func(args) or EXIT_OK)
+    except UsageError as exc:
+        _report(args, f"usage error: {exc}")
+        return EXIT_USAGE
     except VoDopplerError as exc:
         _report(args, f"error: {exc}")
         return EXIT_FAILURE

@@ -5,7 +5,8 @@ Exit codes of the ``vo-doppler`` command (the one error contract):
 * ``EXIT_OK`` (0): success;
 * ``EXIT_FAILURE`` (1): bad input or failed processing — a :class:`VoDopplerError`, whose
   message names the file and line, epoch or key;
-* ``EXIT_USAGE`` (2): the command line itself is wrong (argparse);
+* ``EXIT_USAGE`` (2): the command line itself is wrong (argparse), or an option contradicts
+  the data it applies to (a :class:`UsageError`, e.g. a ``--start`` after the recording's end);
 * ``EXIT_INTERNAL`` (3): anything unexpected, i.e. a bug (``--debug`` shows the traceback).
 """
 
@@ -88,3 +89,8 @@ def shown(text: str | os.PathLike[str]) -> str:
         return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
     except UnicodeEncodeError:  # a surrogate no file name decodes to ('\\ud800')
         return text.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+class UsageError(VoDopplerError):
+    """An option's value that contradicts the data it applies to, which only reading them shows
+    (a ``--start`` / ``--end`` outside the recording): a usage error, exit 2, as argparse's."""

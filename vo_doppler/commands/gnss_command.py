@@ -28,6 +28,7 @@ from vo_doppler.commands.satellite_options import (
     satellite_inputs,
     satellite_states,
 )
+from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError, VoDopplerError, shown
 from vo_doppler.gnss.doppler_velocity import doppler_codes
 from vo_doppler.gnss.ephemeris import GLONASS_MAX_AGE_S, KEPLER_MAX_AGE_S
@@ -41,6 +42,7 @@ from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.precise_orbits import PreciseOrbits
+from vo_doppler.model.time_span import trim
 from vo_doppler.report.gnss import spp_figure, velocity_figure
 
 log = logging.getLogger(__name__)
@@ -57,6 +59,7 @@ def _common(parser: argparse.ArgumentParser) -> None:
     add_selection_options(parser)
     parser.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
+    add_span_options(parser, "first observation epoch")
 
 
 def register(subparsers, summary: str) -> None:
@@ -279,6 +282,9 @@ def run(args: argparse.Namespace) -> int:
         {"output": args.output, "figure": figure}, [args.obs, *satellite_inputs(args)]
     )
     obs, embedded = read_observation_file(args.obs)
+    span = time_span(args)
+    if not span.whole:
+        obs = trim(obs, span.resolve(obs.epoch_time, "observation epochs"))
     range_rate = getattr(args, "range_rate", "doppler")
     if args.gnss_command == "velocity":
         _check_range_rates(obs, args.systems, args.bands, range_rate)

@@ -24,6 +24,7 @@ from vo_doppler.commands.satellite_options import (
     satellite_inputs,
     satellite_states,
 )
+from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
@@ -35,6 +36,7 @@ from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.time_span import trim
 from vo_doppler.model.vehicle_source import VehicleSignalSource
 from vo_doppler.report.heading_figure import heading_figure
 from vo_doppler.report.json_text import json_text
@@ -131,6 +133,7 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--gt", type=Path, help="ground truth TUM (GPS time, z-up world)")
     parser.add_argument("-o", "--output", type=Path, required=True, help="heading CSV")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
+    add_span_options(parser, "first observation epoch")
     parser.add_check(sensor_options_problem)
     defaults = {option: parser.get_default(_dest(option)) for option in CAN_ONLY_OPTIONS}
     parser.add_check(lambda args: can_only_options_problem(args, defaults))
@@ -267,6 +270,11 @@ def run(args: argparse.Namespace) -> int:
     )
     speed, yaw_rate, yaw_rate_unit = _sensors(args)
     obs = read_obs(args.obs)
+    truth = read_trajectory(args.gt) if args.gt else None
+    span = time_span(args)
+    if not span.whole:
+        interval = span.resolve(obs.epoch_time, "observation epochs")
+        obs, speed, yaw_rate, truth = (trim(x, interval) for x in (obs, speed, yaw_rate, truth))
     nav = satellite_states(args)
     systems, mask = args.systems, np.radians(args.elev_mask)
     if args.max_sats is None:
@@ -301,8 +309,8 @@ def run(args: argparse.Namespace) -> int:
     for path in (args.output, figure):
         path.parent.mkdir(parents=True, exist_ok=True)
     write_heading_csv(args.output, table)
-    truth = read_trajectory(args.gt).yaw_at(table.t) if args.gt else None
-    heading_figure(figure, table, truth, args.obs.name)
+    truth_yaw = truth.yaw_at(table.t) if truth is not None else None
+    heading_figure(figure, table, truth_yaw, args.obs.name)
     final = final_calibration(table)
     summary = {
         "epochs": len(table),

@@ -10,6 +10,7 @@ import numpy as np
 from rich.progress import Progress
 
 from vo_doppler.commands.arg_types import frame_rate, window_size
+from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import NO_MATCH, evaluate_by_time
 from vo_doppler.io.calibration import read_camera
@@ -24,10 +25,10 @@ from vo_doppler.io.images import (
 from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, read_sensor_csv
 from vo_doppler.io.trajectory import read_trajectory, write_kitti, write_tum
+from vo_doppler.model.time_span import trim
 from vo_doppler.report.json_text import json_text
 from vo_doppler.report.plots import plot_top_view
 from vo_doppler.report.run_report import number_or_dash
-from vo_doppler.time_hints import span
 from vo_doppler.vo.batch import MIN_VO_FRAMES, run_visual_odometry
 from vo_doppler.vo.config import VoConfig
 
@@ -67,6 +68,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("--gt", type=Path, help="ground truth (KITTI poses or TUM) to evaluate")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    add_span_options(parser, "first image (a GPS time: in the image times' time base)")
     parser.set_defaults(func=run)
 
 
@@ -88,9 +90,16 @@ def run(args: argparse.Namespace) -> int:
         times = read_times(times_path, len(files))
     # Read before the VO (the long part): a missing or bad file stops the command first.
     truth = None if args.gt is None else read_trajectory(args.gt, times=times)
-    speed = None
+    speed = series = None
     if args.speed is not None:
         series = read_sensor_csv(args.speed, SPEED_COLUMN)
+    span = time_span(args)
+    if not span.whole:
+        interval = span.resolve(times, "images")
+        inside = interval.mask(times)
+        files = [file for file, keep in zip(files, inside, strict=True) if keep]
+        times, truth, series = times[inside], trim(truth, interval), trim(series, interval)
+    if series is not None:
         if len(series) < 2:
             raise InputError("speed CSV needs at least two samples", args.speed)
         speed = (series.t, series.value)
