@@ -17,6 +17,8 @@ Stages (docs/design.md, "The main job"):
 All trajectories are vehicle poses (x forward, y left, z up) in the sequence's ENU frame, on GPS
 time. A recording without a camera runs every pipeline that needs none; one without GNSS (an
 imported KITTI raw drive) runs the VO and the dead reckoning alone (:func:`run_without_gnss`).
+An absolute heading from elsewhere (:class:`GivenHeading`, ``run --heading FILE``) replaces
+stage 2's, on a recording with or without GNSS (:func:`run_with_given_heading`).
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from vo_doppler.checks import check_vehicle_overlap, check_yaw_rate_unit, origin
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.correction import (
     CorrectionConfig,
+    absolute_heading,
     conventional_absolute_heading,
     correct,
     tight_absolute_heading,
@@ -119,6 +122,9 @@ class RunResult:
     """What the checks found doubtful in the inputs and the calibration (each also logged):
     the origin against the RINEX approximate position, then the heading stage's
     (``heading.warnings``)."""
+    heading_source: str = ""
+    """Where ``heading`` came from, in words, when it was given (:class:`GivenHeading`);
+    empty when the heading stage computed it from GNSS."""
 
 
 @dataclass(frozen=True)
@@ -233,22 +239,31 @@ def correct_all(
     speed: SensorSeries,
     antenna: AntennaTrack,
     config: RunConfig,
+    yaw_rate: SensorSeries | None = None,
+    tight_source: str = "tc",
 ) -> dict[Pipeline, Trajectory]:
     """The VO and the wheel + gyro dead reckoning, each alone and corrected by the conventional
     and by the tightly coupled heading (vehicle poses, ENU).
 
     Every trajectory is turned to the absolute headings of its first seconds
     (:func:`initial_yaw_offset`) and placed by the antenna track (:func:`level_with_yaw`). Only
-    usable tightly coupled headings correct.
+    usable tightly coupled headings correct the tightly coupled pipelines (``tight_source``
+    "tc"; "tc+conv" for a table without them, the conventional ones). The dead reckoning
+    integrates ``yaw_rate`` (default: the sequence's, less the table's gyro bias).
     """
-    yaw_rate = table.calibrated_yaw_rate(sequence.yaw_rate)
+    if yaw_rate is None:
+        yaw_rate = table.calibrated_yaw_rate(sequence.yaw_rate)
     begin, end = max(speed.t[0], yaw_rate.t[0]), min(speed.t[-1], yaw_rate.t[-1])
     if vo_vehicle is not None:
         begin, end = max(begin, vo_vehicle.t[0]), min(end, vo_vehicle.t[-1])
     t_dr = np.arange(begin, end, 1.0 / config.dead_reckoning_rate_hz)
     dr = wheel_gyro_track(speed, yaw_rate, t_dr) if len(t_dr) > 1 else None
     usable = usable_tight_heading(table, config.correction.tc_max_sigma)
-    tight = tight_absolute_heading(table, config.correction)
+    tight = (
+        tight_absolute_heading(table, config.correction)
+        if tight_source == "tc"
+        else absolute_heading(table, tight_source, config.correction)
+    )
     conventional = conventional_absolute_heading(table)
     lever = sequence.antenna_lever_arm_m
     trajectories: dict[Pipeline, Trajectory] = {}
@@ -328,6 +343,23 @@ def sequence_vo(
     )
 
 
+def vehicle_vo(
+    sequence: Sequence,
+    config: VoConfig,
+    speed: SensorSeries,
+    on_frame: Callable[[int], None] | None = None,
+    images: Iterable[np.ndarray] | None = None,
+) -> tuple[VoOutput | None, Trajectory | None]:
+    """:func:`sequence_vo` and its camera poses as vehicle poses, (None, None) for a recording
+    without a camera."""
+    if not sequence.has_camera:
+        return None, None
+    vo = sequence_vo(sequence, config, speed, on_frame, images)
+    vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
+    release_free_heap()
+    return vo, vo_vehicle
+
+
 @functools.cache
 def _malloc_trim() -> Callable[[int], int] | None:
     return getattr(ctypes.CDLL(None), "malloc_trim", None)
@@ -348,9 +380,12 @@ def run_sequence(
     config: RunConfig | None = None,
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
+    given: GivenHeading | None = None,
 ) -> RunResult:
     """Run every stage on a recording. ``images`` replaces reading ``sequence.image_paths``
-    (e.g. frames already in memory); ``on_frame`` is called after each VO frame.
+    (e.g. frames already in memory); ``on_frame`` is called after each VO frame; ``given``,
+    an absolute heading from elsewhere, replaces the heading stage
+    (:func:`run_with_given_heading`).
 
     The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`):
     vehicle signals whose times miss the GNSS epochs, a yaw rate too large for a car (before
@@ -358,6 +393,8 @@ def run_sequence(
     course (after the heading stage, before the VO) raises :class:`InputError`; the rest are
     warnings, logged and returned in ``RunResult.warnings``."""
     config = config or RunConfig()
+    if given is not None:
+        return run_with_given_heading(sequence, given, config, on_frame, images)
     if not sequence.has_gnss:
         return run_without_gnss(sequence, config, on_frame, images)
     obs = sequence.observations
@@ -373,13 +410,8 @@ def run_sequence(
     table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
     release_free_heap()
     speed = table.calibrated_speed(sequence.wheel_speed)
-    vo = None
-    vo_vehicle = None
-    if sequence.has_camera:
-        vo = sequence_vo(sequence, config.vo, speed, on_frame, images)
-        vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
-        release_free_heap()
-    else:
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images)
+    if vo is None:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
     antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
     trajectories = correct_all(sequence, table, vo_vehicle, speed, antenna, config)
@@ -411,10 +443,7 @@ def run_without_gnss(
     note = NO_GNSS.format(name=sequence.name)
     log.warning("%s", note)
     speed, yaw_rate = sequence.wheel_speed, sequence.yaw_rate
-    vo = vo_vehicle = None
-    if sequence.has_camera:
-        vo = sequence_vo(sequence, config.vo, speed, on_frame, images)
-        vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images)
     begin, end = max(speed.t[0], yaw_rate.t[0]), min(speed.t[-1], yaw_rate.t[-1])
     if vo_vehicle is not None:
         begin, end = max(begin, vo_vehicle.t[0]), min(end, vo_vehicle.t[-1])
@@ -429,3 +458,111 @@ def run_without_gnss(
         if track is not None
     }
     return RunResult(None, None, vo, speed, trajectories, origin, np.zeros(0, dtype=bool), [note])
+
+
+@dataclass(frozen=True)
+class GivenHeading:
+    """An absolute heading from elsewhere (a dual-antenna receiver, an INS, an earlier run's
+    ``heading.csv``) that ``run`` uses instead of computing the tightly coupled heading from
+    GNSS: ``table`` as :func:`vo_doppler.io.heading_csv.read_heading_csv` reads it,
+    ``source`` (e.g. the file) names it in the summary."""
+
+    table: HeadingTable
+    source: str
+
+    @property
+    def has_tight(self) -> bool:
+        """The table holds a tightly coupled heading (a ``heading.csv``; a minimal heading CSV
+        holds its heading as the conventional one)."""
+        return bool(self.table.tc_available.any())
+
+    @property
+    def has_calibration(self) -> bool:
+        """The table holds a wheel scale and gyro bias at every row (a ``heading.csv``)."""
+        table = self.table
+        return bool(np.isfinite(table.wheel_scale).all() and np.isfinite(table.gyro_bias).all())
+
+    def describe(self) -> str:
+        """The summary's ``heading_source``."""
+        what = (
+            "its tightly coupled heading corrects the tightly coupled pipelines, its "
+            "conventional heading the conventional ones"
+            if self.has_tight
+            else "its heading corrects the tightly coupled pipelines (there are no conventional "
+            "ones)"
+        )
+        calibration = (
+            "its wheel scale and gyro bias calibrate the vehicle signals"
+            if self.has_calibration
+            else "the wheel speed and yaw rate are used as recorded (no calibration)"
+        )
+        return f"given: {self.source}, not computed from GNSS; {what}; {calibration}"
+
+
+NO_GNSS_GIVEN = (
+    "{name} has no GNSS: the trajectories start at the ENU origin (no fix places them), turned "
+    "and corrected by the given heading"
+)
+
+
+def run_with_given_heading(
+    sequence: Sequence,
+    given: GivenHeading,
+    config: RunConfig,
+    on_frame: Callable[[int], None] | None = None,
+    images: Iterable[np.ndarray] | None = None,
+) -> RunResult:
+    """:func:`run_sequence` with the absolute heading ``given`` instead of the heading stage.
+
+    The GNSS stage still runs when the recording has GNSS (its fixes place the trajectories);
+    without GNSS they start at the ENU origin. The vehicle signals are calibrated by the
+    table's wheel scale and gyro bias when it has them (a ``heading.csv``), else used as
+    recorded. The tightly coupled pipelines are corrected by the table's usable tightly coupled
+    heading, or for a table without one (a minimal heading CSV) by its heading, and then the
+    conventional pipelines, which would repeat them, are left out. Raises
+    :class:`InputError` when no valid heading of the table lies within the recording."""
+    table = given.table
+    check_yaw_rate_unit(sequence.yaw_rate, sequence.wheel_speed, sequence.vehicle_source)
+    tight_source = "tc" if given.has_tight else "tc+conv"
+    usable = absolute_heading(table, tight_source, config.correction).valid
+    times = np.concatenate([sequence.image_times, sequence.wheel_speed.t])
+    if sequence.has_gnss:
+        times = np.concatenate([times, sequence.observations.epoch_time])
+    begin, end = float(np.min(times)), float(np.max(times))
+    inside = (table.t >= begin) & (table.t <= end)
+    if not (usable & inside).any():
+        raise InputError(
+            f"{given.source}: no valid heading within the recording's times (GPS {begin:.3f} "
+            f"to {end:.3f} s; the file's rows run {table.t[0]:.3f} to {table.t[-1]:.3f} s, "
+            f"{int(usable.sum())} of them valid): is it of this recording, on GPS time?"
+        )
+    warnings: list[str] = []
+    gnss = None
+    antenna = AntennaTrack(np.zeros(0), np.zeros((1, 3)))
+    if sequence.has_gnss:
+        obs = sequence.observations
+        check_vehicle_overlap(
+            sequence.wheel_speed, sequence.yaw_rate, obs.epoch_time, sequence.vehicle_source
+        )
+        origin = origin_warning(sequence.enu, obs.header.approx_position)
+        warnings += [origin] if origin else []
+        gnss = sequence_gnss(sequence, config)
+        antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
+        release_free_heap()
+    else:
+        warnings.append(NO_GNSS_GIVEN.format(name=sequence.name))
+    for text in warnings:
+        log.warning("%s", text)
+    speed, yaw_rate = sequence.wheel_speed, sequence.yaw_rate
+    if given.has_calibration:
+        speed, yaw_rate = table.calibrated_speed(speed), table.calibrated_yaw_rate(yaw_rate)
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images)
+    trajectories = correct_all(
+        sequence, table, vo_vehicle, speed, antenna, config, yaw_rate, tight_source
+    )
+    if not given.has_tight:
+        for name in (Pipeline.VO_GPS_CONV, Pipeline.DR_GPS_CONV):
+            trajectories.pop(name, None)
+    return RunResult(
+        gnss, table, vo, speed, trajectories, antenna, usable, warnings, given.describe()
+    )

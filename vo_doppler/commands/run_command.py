@@ -16,12 +16,19 @@ from rich.table import Table
 
 from vo_doppler.commands.arg_types import window_size
 from vo_doppler.commands.correction_options import add_correction_options, correction_config
-from vo_doppler.commands.heading_method import add_heading_method_option, heading_method_config
+from vo_doppler.commands.heading_method import (
+    HeadingMethod,
+    add_heading_method_option,
+    heading_method_config,
+)
 from vo_doppler.commands.satellite_options import add_selection_options
+from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError, shown
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
+from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.output_folder import RUN, check_output_folder, staged_output, untouched
 from vo_doppler.io.sequence import manifest_inputs, read_manifest, read_sequence_with_report
+from vo_doppler.model.time_span import reference_times, trim_sequence
 from vo_doppler.report.run_outputs import (
     input_warnings,
     require_tight_heading,
@@ -29,7 +36,7 @@ from vo_doppler.report.run_outputs import (
     write_run_outputs,
 )
 from vo_doppler.report.run_report import TABLE_COLUMNS, table_cell
-from vo_doppler.run import RunConfig, RunResult, run_sequence
+from vo_doppler.run import GivenHeading, RunConfig, RunResult, run_sequence
 from vo_doppler.vo.config import VoConfig
 
 log = logging.getLogger(__name__)
@@ -52,7 +59,34 @@ def register(subparsers, summary: str) -> None:
         action="store_true",
         help="accept manifest paths outside the sequence folder (absolute or ../)",
     )
+    parser.add_argument(
+        "--heading",
+        type=Path,
+        metavar="FILE",
+        help="an absolute heading of your own (dual-antenna receiver, INS, an earlier run's "
+        "heading.csv) used instead of computing the tightly coupled heading from GNSS: a "
+        "heading.csv, or a minimal CSV gps_time_s, heading_deg or course_deg, sigma_deg[, "
+        "valid] (docs/formats.md); the corrected pipelines then run on a recording without "
+        "GNSS too",
+    )
+    add_span_options(
+        parser,
+        "recording's first GNSS epoch (without GNSS: its first image, else its first "
+        "yaw-rate sample)",
+    )
+    parser.add_check(heading_method_problem)
     parser.set_defaults(func=run)
+
+
+def heading_method_problem(args: argparse.Namespace) -> str | None:
+    """``--heading-method`` chooses how the tight heading is computed: with ``--heading FILE``
+    none is computed, and a method other than the default would be ignored."""
+    if args.heading is not None and args.heading_method != HeadingMethod.SNOOPING.value:
+        return (
+            f"--heading-method {args.heading_method} has no effect with --heading: the heading "
+            "is the file's, not computed from GNSS (drop one of them)"
+        )
+    return None
 
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:
@@ -80,7 +114,8 @@ def run_config(args: argparse.Namespace) -> RunConfig:
 
 
 def run(args: argparse.Namespace) -> int:
-    check_output_folder(args.output, RUN, sequence_inputs(args.sequence), replace=True)
+    inputs = sequence_inputs(args.sequence) + ([args.heading] if args.heading else [])
+    check_output_folder(args.output, RUN, inputs, replace=True)
     try:
         result = run_and_write(args)
     except BaseException:
@@ -104,6 +139,14 @@ def sequence_inputs(sequence: Path) -> list[Path]:
 def run_and_write(args: argparse.Namespace) -> RunResult:
     """Read, check, run and write the outputs in place (all or nothing)."""
     inputs, report = read_sequence_with_report(args.sequence, args.allow_outside_paths)
+    span = None
+    if not time_span(args).whole:
+        first = float(reference_times(inputs)[0][0])
+        inputs, interval = trim_sequence(inputs, time_span(args))
+        span = interval.to_dict(first)
+    given = None
+    if args.heading is not None:
+        given = GivenHeading(read_heading_csv(args.heading), str(args.heading))
     warnings = input_warnings(inputs, report)
     for text in warnings:
         log.warning("%s", text)
@@ -120,12 +163,13 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
     gc.freeze()
     with Progress(console=console, transient=True) as progress:
         task = progress.add_task("visual odometry", total=len(inputs.image_paths))
-        result = run_sequence(inputs, config, lambda _: progress.advance(task))
+        result = run_sequence(inputs, config, lambda _: progress.advance(task), given=given)
     gc.freeze()
     checks = result_checks(inputs, report, result, warnings)
-    with staged_output(args.output, RUN, sequence_inputs(args.sequence)) as out:
+    inputs_kept = sequence_inputs(args.sequence) + ([args.heading] if args.heading else [])
+    with staged_output(args.output, RUN, inputs_kept) as out:
         summary = write_run_outputs(
-            inputs, result, config, out, checks, read_manifest(args.sequence)
+            inputs, result, config, out, checks, read_manifest(args.sequence), span=span
         )
     if result.vo is None:
         console.print(f"{inputs.name} has no camera: only the non-visual pipelines ran")
@@ -145,7 +189,13 @@ def print_summary(console: Console, summary: dict) -> None:
         if "vo_frames" in summary
         else "no camera"
     )
-    if "gnss" in summary:  # no GNSS: the heading figures do not exist
+    if "heading_source" in summary:
+        console.print(
+            f"absolute heading {summary['heading_source']}; used by the tightly coupled "
+            f"correction at {summary['tight_heading_used']:.0%} of its rows; "
+            f"{summary['gnss_epochs']} GNSS epochs; {vo}"
+        )
+    elif "gnss" in summary:  # no GNSS: the heading figures do not exist
         console.print(f"GNSS {summary['gnss']}; {vo}")
     else:
         console.print(

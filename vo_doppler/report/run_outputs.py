@@ -86,6 +86,7 @@ FACT_FORMATS = {
     "camera": ("camera", "{}"),
     "heading_correction": ("heading correction", "{}"),
     "gnss": ("GNSS", "{}"),
+    "heading_source": ("absolute heading", "{}"),
     "can_clock_residual_offset_s": (
         "wheel-speed clock offset left (CAN/vehicle signals against the GNSS Doppler speed)",
         "{:+.3f} s",
@@ -103,6 +104,7 @@ NOT_FACTS = (
     "warnings",
     "doppler_noise",
     "calibration",
+    "span",
 )
 """Summary keys that are not scalars: the report shows them as tables or a list of their own,
 or (``time_order``, ``doppler_noise``) leaves them to summary.json."""
@@ -119,7 +121,9 @@ def summarise(result: RunResult, vehicle_span: tuple[float, float] | None = None
     GNSS only the VO figures and ``gnss``, saying that the GNSS pipelines were not run.
     ``vehicle_span``: the span both vehicle signals cover (``Sequence.vehicle_span``), outside
     which no tightly coupled heading can be used (``vehicle_signal_epochs``, and the share of
-    them used, ``tight_heading_used_with_vehicle_signals``; None: every epoch)."""
+    them used, ``tight_heading_used_with_vehicle_signals``; None: every epoch). A run on a
+    given heading (``result.heading_source``) says so in ``heading_source``; its figures are
+    those of the given table, and ``gnss_epochs`` counts the recording's own epochs."""
     table = result.heading
     if table is None:
         summary: dict = {
@@ -146,8 +150,14 @@ def summarise(result: RunResult, vehicle_span: tuple[float, float] | None = None
         "grade_prior_sigma_median": _finite_median(table.grade_prior_sigma),
         **final_calibration(table),
         "calibration": None if table.calibration is None else table.calibration.to_dict(),
-        "doppler_noise": doppler_noise_summary(result),
     }
+    if result.gnss is not None:
+        summary["doppler_noise"] = doppler_noise_summary(result)
+    if result.heading_source:
+        summary["heading_source"] = result.heading_source
+        summary["gnss_epochs"] = 0 if result.gnss is None else len(result.gnss.spp.t)
+        if result.gnss is None:
+            summary["gnss"] = "none: the trajectories start at the ENU origin"
     _vo_summary(summary, result)
     return summary
 
@@ -273,6 +283,7 @@ def write_run_outputs(
     checks: dict | None = None,
     manifest: dict | None = None,
     command: str | None = None,
+    span: dict | None = None,
 ) -> dict:
     """Write a run's outputs into ``out`` (created if missing) and return its summary.
 
@@ -281,7 +292,9 @@ def write_run_outputs(
     and, when the recording has ground truth, ``evaluation``: per pipeline the errors of
     :func:`vo_doppler.eval.pipelines.evaluate_pipelines` as dictionaries.
     ``manifest`` (the parsed ``sequence.yaml``) tells the report whether the drive is simulated;
-    ``command`` is the command line it shows (default: this process's).
+    ``command`` is the command line it shows (default: this process's); ``span`` (the part of
+    the recording run, :meth:`vo_doppler.model.time_span.GpsInterval.to_dict`) goes to the
+    summary as it is.
     """
     out.mkdir(parents=True, exist_ok=True)
     for name, trajectory in result.trajectories.items():
@@ -294,6 +307,8 @@ def write_run_outputs(
     summary = summarise(result, sequence.vehicle_span)
     summary["heading_correction"] = correction_label(config)
     summary.update(checks or {})
+    if span is not None:
+        summary["span"] = span
     table, truth = result.heading, sequence.truth
     report = RunReport(
         title=f"vo-doppler run: {sequence.name}",
@@ -406,8 +421,9 @@ def require_tight_heading(result: RunResult, folder: Path, out: Path) -> None:
     project's error naming the recording (after its outputs were written to ``out``, to show
     why). A heading is a direction of travel: when the vehicle never moved (:func:`standstill`)
     the message says so rather than blame the heading. A recording without GNSS has no heading
-    to require."""
-    if result.heading is None or result.heading.tc_available.any():
+    to require, nor has a run on a given heading (``result.heading_source``: the library
+    required a valid one)."""
+    if result.heading is None or result.heading_source or result.heading.tc_available.any():
         return
     kept = f"(the other results are in {out})"
     still = standstill(result)
