@@ -186,8 +186,8 @@ def test_a_minimal_heading_csv_gives_what_the_full_heading_csv_gives(
     drive, correction, source, capsys
 ):
     """Issue 31: your own heading as gps_time_s, course_deg (or heading_deg), sigma_deg and
-    valid gives the very file and summary of a heading.csv holding the same headings as its
-    conventional heading (no tight heading)."""
+    valid, or in three columns without valid, gives the very file and summary of a heading.csv
+    holding the same headings as its conventional heading (no tight heading)."""
     track = level_turn()
     t = np.arange(0.0, track.t[-1] + 0.05, 0.2)
     course, sigma, valid = _own_headings(t, np.interp(t, track.t, np.unwrap(track.yaw())))
@@ -211,18 +211,24 @@ def test_a_minimal_heading_csv_gives_what_the_full_heading_csv_gives(
     )
     (drive / "own.csv").write_text("gps_time_s,course_deg,sigma_deg,valid\n" + rows)
     (drive / "own_heading.csv").write_text("gps_time_s,heading_deg,sigma_deg,valid\n" + rows)
+    three = "".join(  # three columns: an invalid heading left empty
+        f"{ti:.3f},{f'{c:.4f}' if v else ''},{s:.4f}\n"
+        for ti, c, s, v in zip(t, course, sigma, valid, strict=True)
+    )
+    (drive / "own3.csv").write_text("gps_time_s,course_deg,sigma_deg\n" + three)
     summaries = {}
-    for name in ("full", "own", "own_heading"):
+    for name in ("full", "own", "own_heading", "own3"):
         argv = ["correct", str(drive / "track.tum"), "--heading", str(drive / f"{name}.csv")]
         argv += ["--world", "level", "--correction", correction, "--source", source]
         assert main([*argv, "-o", str(drive / f"{name}.tum")]) == 0
         summaries[name] = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
         del summaries[name]["output"]
-    assert summaries["own"] == summaries["full"] == summaries["own_heading"]
+    assert summaries["own"] == summaries["full"] == summaries["own_heading"] == summaries["own3"]
     assert summaries["own"]["poses_with_absolute_heading"] > 0.9 * len(track)
     written = (drive / "full.tum").read_bytes()
     assert (drive / "own.tum").read_bytes() == written
     assert (drive / "own_heading.tum").read_bytes() == written
+    assert (drive / "own3.tum").read_bytes() == written
 
 
 def test_a_minimal_heading_csv_has_no_tight_heading_for_source_tc(drive, capsys):

@@ -1,0 +1,133 @@
+"""``run --heading FILE``: an absolute heading from elsewhere replaces the tight heading computed
+from GNSS. An earlier run's heading.csv reproduces that run's corrected figures; a minimal
+heading CSV runs the corrected pipelines on a recording without GNSS."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+import yaml
+
+from vo_doppler.cli import main
+from vo_doppler.io.trajectory import read_tum
+
+CORRECTED = ("vo_gps_conv", "vo_gps_tc", "dr_gps_conv", "dr_gps_tc")
+
+
+@pytest.fixture(scope="module")
+def first_run(span_drive, tmp_path_factory):
+    """``run`` on the 8-s cut drive: its outputs, heading.csv among them."""
+    out = tmp_path_factory.mktemp("first") / "out"
+    assert main(["-q", "run", str(span_drive.cut), "-o", str(out)]) == 0
+    return out
+
+
+def _summary(folder) -> dict:
+    return json.loads((folder / "summary.json").read_text())
+
+
+def test_run_with_an_earlier_runs_heading_csv_reproduces_its_corrected_figures(
+    span_drive, first_run, tmp_path, capsys
+):
+    heading = tmp_path / "heading.csv"
+    shutil.copy(first_run / "heading.csv", heading)
+    out = tmp_path / "again"
+    argv = ["run", str(span_drive.cut), "-o", str(out), "--heading", str(heading)]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert f"absolute heading given: {heading}, not computed from GNSS" in printed.replace("\n", "")
+    before, after = _summary(first_run), _summary(out)
+    assert after["heading_source"].startswith(f"given: {heading}, not computed from GNSS")
+    assert "heading_source" not in before
+    assert set(after["evaluation"]) == set(before["evaluation"])
+    for name, errors in before["evaluation"].items():
+        for key in ("error_per_100m_m", "kitti_translation_pct", "final_position_error_m"):
+            assert after["evaluation"][name][key] == pytest.approx(errors[key], abs=1e-3), (
+                name,
+                key,
+            )
+        assert after["evaluation"][name]["heading_rmse_deg"] == pytest.approx(
+            errors["heading_rmse_deg"], abs=1e-3
+        )
+    for key in ("gnss_epochs", "tight_heading_used", "conventional_heading_availability"):
+        assert after[key] == before[key], key
+    # the heading file's precision: 6 decimals of the wheel scale, 5 of the gyro bias (deg/s)
+    assert after["final_wheel_scale"] == pytest.approx(before["final_wheel_scale"], abs=1e-6)
+    assert after["final_gyro_bias_dps"] == pytest.approx(before["final_gyro_bias_dps"], abs=1e-5)
+    report = (out / "report.html").read_text()
+    assert "absolute heading" in report and "not computed from GNSS" in report
+
+
+@pytest.fixture(scope="module")
+def no_gnss(span_drive, tmp_path_factory):
+    """The cut drive without its gnss section, as an imported KITTI raw drive has none, and a
+    minimal heading CSV (gps_time_s, course_deg, sigma_deg) of its true heading at 10 Hz
+    with 0.3° of noise."""
+    folder = tmp_path_factory.mktemp("no_gnss") / "drive"
+    shutil.copytree(span_drive.cut, folder)
+    manifest = yaml.safe_load((folder / "sequence.yaml").read_text())
+    del manifest["gnss"]
+    (folder / "sequence.yaml").write_text(yaml.safe_dump(manifest, sort_keys=False))
+    truth = read_tum(folder / "ground_truth.tum")
+    t = np.arange(truth.t[0], truth.t[-1], 0.1)
+    course = (90.0 - np.degrees(truth.yaw_at(t))) % 360.0
+    course += 0.3 * np.random.default_rng(5).standard_normal(len(t))
+    rows = "".join(f"{ti:.3f},{c:.4f},0.3\n" for ti, c in zip(t, course, strict=True))
+    heading = folder.parent / "ins_heading.csv"
+    heading.write_text("gps_time_s,course_deg,sigma_deg\n" + rows)
+    return folder, heading
+
+
+def test_run_with_a_minimal_heading_corrects_a_recording_without_gnss(no_gnss, tmp_path, capsys):
+    folder, heading = no_gnss
+    out = tmp_path / "out"
+    assert main(["-q", "run", str(folder), "-o", str(out), "--heading", str(heading)]) == 0
+    summary = _summary(out)
+    assert summary["gnss_epochs"] == 0
+    assert "its heading corrects the tightly coupled pipelines" in summary["heading_source"]
+    assert "used as recorded (no calibration)" in summary["heading_source"]
+    assert summary["tight_heading_used"] == 1.0
+    assert set(summary["evaluation"]) == {"vo", "vo_gps_tc", "dr", "dr_gps_tc"}
+    errors = summary["evaluation"]  # uncalibrated: the wheels read 2 % fast, the gyro 0.3°/s
+    for alone, corrected in (("vo", "vo_gps_tc"), ("dr", "dr_gps_tc")):
+        assert errors[corrected]["error_per_100m_m"] < errors[alone]["error_per_100m_m"]
+    assert errors["dr_gps_tc"]["heading_rmse_deg"] < 0.3 < errors["dr"]["heading_rmse_deg"]
+    assert (out / "heading.csv").is_file() and (out / "trajectory_corrected.tum").is_file()
+    assert not (out / "trajectory_vo_gps_conv.tum").exists()
+    without = tmp_path / "without"
+    assert main(["-q", "run", str(folder), "-o", str(without)]) == 0
+    assert set(_summary(without)["evaluation"]) == {"vo", "dr"}
+
+
+def test_a_heading_of_another_time_is_refused(no_gnss, tmp_path, capsys):
+    folder, _ = no_gnss
+    other = tmp_path / "other.csv"
+    other.write_text("gps_time_s,heading_deg,sigma_deg\n1000.0,90,1\n1001.0,91,1\n")
+    out = tmp_path / "out"
+    assert main(["run", str(folder), "-o", str(out), "--heading", str(other)]) == 1
+    err = capsys.readouterr().err
+    assert "other.csv: no valid heading within the recording's times" in err
+    assert "the file's rows run 1000.000 to 1001.000 s, 2 of them valid" in err
+    assert not out.exists()
+
+
+def test_a_heading_method_with_a_given_heading_is_a_usage_error(tmp_path, capsys):
+    argv = ["run", str(tmp_path), "-o", str(tmp_path / "out"), "--heading", "h.csv"]
+    with pytest.raises(SystemExit) as exit_info:
+        main([*argv, "--heading-method", "robust"])
+    assert exit_info.value.code == 2
+    assert "--heading-method robust has no effect with --heading" in capsys.readouterr().err
+
+
+def test_the_heading_file_is_not_overwritten_by_the_run(span_drive, first_run, capsys):
+    """An earlier run's heading.csv given back to a run into the same folder is an input the
+    output would replace: refused before anything is written."""
+    heading = first_run / "heading.csv"
+    before = heading.read_bytes()
+    argv = ["run", str(span_drive.cut), "-o", str(first_run), "--heading", str(heading)]
+    assert main(argv) == 1
+    assert heading.read_bytes() == before
+    assert "heading.csv" in capsys.readouterr().err
