@@ -16,8 +16,11 @@ def span_bound(text: str) -> SpanBound:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def add_span_options(parser: argparse.ArgumentParser, first: str = "first GNSS epoch") -> None:
-    """Add ``--start`` and ``--end``; ``first`` names what the seconds count from."""
+def add_span_options(
+    parser: argparse.ArgumentParser, first: str = "first GNSS epoch", gps_base: str = ""
+) -> None:
+    """Add ``--start`` and ``--end``; ``first`` names what the seconds count from, ``gps_base``
+    (if any) the time base a ``gps:`` time is read in."""
     group = parser.add_argument_group(
         "part of the recording (both bounds inclusive; default: all of it)"
     )
@@ -25,8 +28,9 @@ def add_span_options(parser: argparse.ArgumentParser, first: str = "first GNSS e
         "--start",
         type=span_bound,
         metavar="T",
-        help=f"process from T on: seconds from the {first} (e.g. 30), or a GPS time written "
-        f"{GPS_PREFIX}SECONDS (e.g. {GPS_PREFIX}1425953430.5); must lie inside the recording",
+        help=f"process from T on: seconds (e.g. 30) from the {first}, or a GPS time written "
+        f"{GPS_PREFIX}SECONDS (e.g. {GPS_PREFIX}1425953430.5){gps_base}; must lie inside the "
+        "recording",
     )
     group.add_argument(
         "--end",

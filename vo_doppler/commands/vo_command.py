@@ -68,7 +68,7 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument("--gt", type=Path, help="ground truth (KITTI poses or TUM) to evaluate")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
-    add_span_options(parser, "first image (a GPS time: in the image times' time base)")
+    add_span_options(parser, "first image", " in the image times' time base")
     parser.set_defaults(func=run)
 
 

@@ -29,6 +29,8 @@ EXPORTS: dict[str, str] = {
     "SatelliteTable": "satellite_table",
     "Sequence": "sequence",
     "SensorSeries": "series",
+    "SpanBound": "time_span",
+    "TimeSpan": "time_span",
     "Trajectory": "trajectory",
 }
 """Public dataclass → the module of this package that defines it."""
@@ -49,7 +51,9 @@ __all__ = [
     "SatelliteTable",
     "SensorSeries",
     "Sequence",
+    "SpanBound",
     "SppSolution",
+    "TimeSpan",
     "Trajectory",
     "VelocitySolution",
 ]
@@ -69,6 +73,7 @@ if TYPE_CHECKING:
     from vo_doppler.model.satellite_table import SatelliteTable
     from vo_doppler.model.sequence import Sequence
     from vo_doppler.model.series import SensorSeries
+    from vo_doppler.model.time_span import SpanBound, TimeSpan
     from vo_doppler.model.trajectory import Trajectory
 
 
