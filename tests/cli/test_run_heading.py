@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
+from tests.conftest import require_shared
 from vo_doppler.cli import main
 from vo_doppler.io.trajectory import read_tum
 
@@ -131,3 +132,25 @@ def test_the_heading_file_is_not_overwritten_by_the_run(span_drive, first_run, c
     assert main(argv) == 1
     assert heading.read_bytes() == before
     assert "heading.csv" in capsys.readouterr().err
+
+
+@pytest.mark.shared_data
+def test_run_with_a_heading_on_an_imported_kitti_raw_drive(tmp_path, capsys):
+    """Issue 31: a KITTI raw drive has no GNSS; with the OXTS unit's heading as a minimal CSV
+    (an INS's heading, σ 0.2°) the corrected pipelines run on it."""
+    drive = require_shared("kitti_raw_mini/2011_09_26/2011_09_26_drive_0001_sync")
+    folder = tmp_path / "seq"
+    assert main(["-q", "import", "kitti-raw", str(drive), "-o", str(folder)]) == 0
+    truth = read_tum(folder / "ground_truth.tum")
+    course = (90.0 - np.degrees(truth.yaw())) % 360.0
+    rows = "".join(f"{t:.6f},{c:.4f},0.2\n" for t, c in zip(truth.t, course, strict=True))
+    heading = tmp_path / "oxts_heading.csv"
+    heading.write_text("gps_time_s,heading_deg,sigma_deg\n" + rows)
+    out = tmp_path / "out"
+    assert main(["-q", "run", str(folder), "-o", str(out), "--heading", str(heading)]) == 0
+    summary = _summary(out)
+    assert summary["gnss_epochs"] == 0 and "given: " in summary["heading_source"]
+    assert summary["tight_heading_used"] == 1.0
+    for name in ("trajectory_vo.tum", "trajectory_corrected.tum", "trajectory_dr_gps_tc.tum"):
+        assert (out / name).is_file(), name
+    assert "has no GNSS: the trajectories start at the ENU origin" in " ".join(summary["warnings"])
