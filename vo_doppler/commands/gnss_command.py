@@ -282,9 +282,9 @@ def run(args: argparse.Namespace) -> int:
         {"output": args.output, "figure": figure}, [args.obs, *satellite_inputs(args)]
     )
     obs, embedded = read_observation_file(args.obs)
-    span = time_span(args)
-    if not span.whole:
-        obs = trim(obs, span.resolve(obs.epoch_time, "observation epochs"))
+    part = time_span(args)
+    if not part.whole:
+        obs = trim(obs, part.resolve(obs.epoch_time, "observation epochs"))
     range_rate = getattr(args, "range_rate", "doppler")
     if args.gnss_command == "velocity":
         _check_range_rates(obs, args.systems, args.bands, range_rate)

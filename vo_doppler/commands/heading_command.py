@@ -271,9 +271,9 @@ def run(args: argparse.Namespace) -> int:
     speed, yaw_rate, yaw_rate_unit = _sensors(args)
     obs = read_obs(args.obs)
     truth = read_trajectory(args.gt) if args.gt else None
-    span = time_span(args)
-    if not span.whole:
-        interval = span.resolve(obs.epoch_time, "observation epochs")
+    part = time_span(args)
+    if not part.whole:
+        interval = part.resolve(obs.epoch_time, "observation epochs")
         obs, speed, yaw_rate, truth = (trim(x, interval) for x in (obs, speed, yaw_rate, truth))
     nav = satellite_states(args)
     systems, mask = args.systems, np.radians(args.elev_mask)

@@ -29,6 +29,7 @@ from vo_doppler.model.time_span import trim
 from vo_doppler.report.json_text import json_text
 from vo_doppler.report.plots import plot_top_view
 from vo_doppler.report.run_report import number_or_dash
+from vo_doppler.time_hints import span
 from vo_doppler.vo.batch import MIN_VO_FRAMES, run_visual_odometry
 from vo_doppler.vo.config import VoConfig
 
@@ -93,9 +94,9 @@ def run(args: argparse.Namespace) -> int:
     speed = series = None
     if args.speed is not None:
         series = read_sensor_csv(args.speed, SPEED_COLUMN)
-    span = time_span(args)
-    if not span.whole:
-        interval = span.resolve(times, "images")
+    part = time_span(args)
+    if not part.whole:
+        interval = part.resolve(times, "images")
         inside = interval.mask(times)
         files = [file for file, keep in zip(files, inside, strict=True) if keep]
         times, truth, series = times[inside], trim(truth, interval), trim(series, interval)
