@@ -59,9 +59,13 @@ def test_other_bounds_are_refused(text, message):
 def test_a_span_resolves_on_the_reference_times_both_ways():
     times = FIRST + np.arange(0.0, 20.01, 0.5)
     span = TimeSpan(SpanBound(2.0), SpanBound(FIRST + 7.0, gps=True))
-    assert span.resolve(times, "GNSS epochs") == GpsInterval(FIRST + 2.0, FIRST + 7.0)
-    assert TimeSpan(SpanBound(3.0)).resolve(times, "x") == GpsInterval(FIRST + 3.0, FIRST + 20)
-    assert TimeSpan(end=SpanBound(3.0)).resolve(times, "x") == GpsInterval(FIRST, FIRST + 3.0)
+    assert span.resolve(times, "GNSS epochs") == GpsInterval(FIRST + 2.0, FIRST + 7.0, FIRST)
+    assert TimeSpan(SpanBound(3.0)).resolve(times, "x") == GpsInterval(
+        FIRST + 3.0, FIRST + 20, FIRST
+    )
+    assert TimeSpan(end=SpanBound(3.0)).resolve(times, "x") == GpsInterval(
+        FIRST, FIRST + 3.0, FIRST
+    )
     assert TimeSpan().whole and not span.whole
 
 
@@ -99,7 +103,7 @@ def test_the_problem_seen_before_reading_compares_bounds_of_one_kind():
 
 
 def test_trim_keeps_each_kind_of_input_inside_the_span_bounds_included():
-    interval = GpsInterval(2.0, 4.0)
+    interval = GpsInterval(2.0, 4.0, 0.0)
     t = np.arange(0.0, 6.5, 0.5)
     series = trim(SensorSeries(t, t * 2, "speed", "m/s", 3), interval)
     assert series.t.tolist() == [2.0, 2.5, 3.0, 3.5, 4.0] and series.value[0] == 4.0
@@ -133,7 +137,8 @@ def test_a_sequence_without_gnss_is_cut_on_its_image_times():
     sequence = _sequence()
     assert reference_times(sequence)[1] == "images"
     cut, interval = trim_sequence(sequence, TimeSpan(SpanBound(2.5), SpanBound(6.0)))
-    assert interval == GpsInterval(FIRST + 2.5, FIRST + 6.0)
+    assert interval == GpsInterval(FIRST + 2.5, FIRST + 6.0, FIRST)
+    assert interval.to_dict()["start_from_first_epoch_s"] == 2.5
     assert [p.name for p in cut.image_paths] == ["003.png", "004.png", "005.png", "006.png"]
     assert cut.image_times.tolist() == (FIRST + np.arange(3.0, 7.0)).tolist()
     assert len(cut.yaw_rate) == len(cut.wheel_speed) == 36

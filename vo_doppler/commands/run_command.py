@@ -28,7 +28,7 @@ from vo_doppler.eval.pipelines import PIPELINE_LABELS
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.output_folder import RUN, check_output_folder, staged_output, untouched
 from vo_doppler.io.sequence import manifest_inputs, read_manifest, read_sequence_with_report
-from vo_doppler.model.time_span import reference_times, trim_sequence
+from vo_doppler.model.time_span import trim_sequence
 from vo_doppler.report.run_outputs import (
     input_warnings,
     require_tight_heading,
@@ -114,8 +114,7 @@ def run_config(args: argparse.Namespace) -> RunConfig:
 
 
 def run(args: argparse.Namespace) -> int:
-    inputs = sequence_inputs(args.sequence) + ([args.heading] if args.heading else [])
-    check_output_folder(args.output, RUN, inputs, replace=True)
+    check_output_folder(args.output, RUN, run_inputs(args), replace=True)
     try:
         result = run_and_write(args)
     except BaseException:
@@ -125,6 +124,11 @@ def run(args: argparse.Namespace) -> int:
         gc.unfreeze()
     require_tight_heading(result, args.sequence, args.output)
     return 0
+
+
+def run_inputs(args: argparse.Namespace) -> list[Path]:
+    """What the output must not hold: the sequence's inputs and the ``--heading`` file."""
+    return sequence_inputs(args.sequence) + ([args.heading] if args.heading else [])
 
 
 def sequence_inputs(sequence: Path) -> list[Path]:
@@ -139,11 +143,10 @@ def sequence_inputs(sequence: Path) -> list[Path]:
 def run_and_write(args: argparse.Namespace) -> RunResult:
     """Read, check, run and write the outputs in place (all or nothing)."""
     inputs, report = read_sequence_with_report(args.sequence, args.allow_outside_paths)
-    span = None
-    if not time_span(args).whole:
-        first = float(reference_times(inputs)[0][0])
-        inputs, interval = trim_sequence(inputs, time_span(args))
-        span = interval.to_dict(first)
+    span, part = None, time_span(args)
+    if not part.whole:
+        inputs, interval = trim_sequence(inputs, part)
+        span = interval.to_dict()
     given = None
     if args.heading is not None:
         given = GivenHeading(read_heading_csv(args.heading), str(args.heading))
@@ -166,8 +169,7 @@ def run_and_write(args: argparse.Namespace) -> RunResult:
         result = run_sequence(inputs, config, lambda _: progress.advance(task), given=given)
     gc.freeze()
     checks = result_checks(inputs, report, result, warnings)
-    inputs_kept = sequence_inputs(args.sequence) + ([args.heading] if args.heading else [])
-    with staged_output(args.output, RUN, inputs_kept) as out:
+    with staged_output(args.output, RUN, run_inputs(args)) as out:
         summary = write_run_outputs(
             inputs, result, config, out, checks, read_manifest(args.sequence), span=span
         )

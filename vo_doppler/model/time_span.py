@@ -74,23 +74,25 @@ class SpanBound:
 
 @dataclass(frozen=True)
 class GpsInterval:
-    """A resolved span: GPS times ``begin`` ≤ t ≤ ``end`` (s)."""
+    """A resolved span: GPS times ``begin`` ≤ t ≤ ``end`` (s) of a recording whose first epoch
+    (what seconds from the first epoch count from) is ``first``."""
 
     begin: float
     end: float
+    first: float
 
     def mask(self, t: np.ndarray) -> np.ndarray:
         """Which of the times ``t`` lie inside (bounds included)."""
         t = np.asarray(t, dtype=float)
         return (t >= self.begin) & (t <= self.end)
 
-    def to_dict(self, first: float) -> dict:
-        """The span for a summary: GPS seconds and seconds from the first epoch ``first``."""
+    def to_dict(self) -> dict:
+        """The span for a summary: GPS seconds and seconds from the first epoch."""
         return {
             "start_gps_s": self.begin,
             "end_gps_s": self.end,
-            "start_from_first_epoch_s": self.begin - first,
-            "end_from_first_epoch_s": self.end - first,
+            "start_from_first_epoch_s": self.begin - self.first,
+            "end_from_first_epoch_s": self.end - self.first,
         }
 
 
@@ -138,7 +140,7 @@ class TimeSpan:
                 f"--start {self.start or 'first epoch'} ({GPS_PREFIX}{begin:.3f}) is not before "
                 f"--end {self.end or 'last epoch'} ({GPS_PREFIX}{end:.3f}): {recording}"
             )
-        interval = GpsInterval(begin, end)
+        interval = GpsInterval(begin, end, first)
         if not interval.mask(times).any():
             raise no_data(what, interval)
         return interval
