@@ -1,16 +1,21 @@
 """``vo-doppler import comma2k19 SEGMENT --orbits SP3 -o SEQ``, ``vo-doppler import
-kitti-raw DRIVE -o SEQ`` and ``vo-doppler import smartloc CSV -o SEQ``: a recording in another
-layout → a standard sequence folder for ``vo-doppler run``."""
+kitti-raw DRIVE -o SEQ``, ``vo-doppler import smartloc CSV -o SEQ`` and ``vo-doppler import
+rosbag BAG -o SEQ``: a recording in another layout → a standard sequence folder for
+``vo-doppler run``."""
 
 from __future__ import annotations
 
 import argparse
 import logging
+import sys
 from pathlib import Path
 
+from vo_doppler.commands.arg_types import number_in
+from vo_doppler.commands.simulate_command import _origin as origin
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.kitti_raw_import import CAMERAS as KITTI_CAMERAS
 from vo_doppler.io.kitti_raw_import import import_kitti_raw
+from vo_doppler.io.rosbag_import import AXES, RosbagOptions, import_rosbag, list_topics
 from vo_doppler.io.smartloc_import import import_smartloc
 
 log = logging.getLogger(__name__)
@@ -84,6 +89,100 @@ def register(subparsers, summary: str) -> None:
     )
     smartloc.add_argument("-o", "--output", type=Path, required=True, help="sequence folder")
     smartloc.set_defaults(func=run_smartloc)
+    _register_rosbag(kinds)
+
+
+def _register_rosbag(kinds) -> None:
+    bag = kinds.add_parser(
+        "rosbag",
+        help="a ROS 1 .bag or a ROS 2 bag (sqlite3 or MCAP)",
+        description="Write the images (sensor_msgs/Image as PNG, CompressedImage as sent) with "
+        "their times, the calibration (CameraInfo, or --calib; the extrinsic from /tf_static), "
+        "the yaw rate (sensor_msgs/Imu: the axis given or estimated from gravity) and speed "
+        "(TwistStamped or Odometry linear.x), the forward acceleration, raw GNSS (gnss_comm "
+        "GnssMeasMsg + GnssEphemMsg, or ublox_msgs RxmRAWX + RxmSFRBX) as RINEX observations "
+        "and navigation, NavSatFix fixes (the origin), ground truth (--ground-truth) and "
+        "sequence.yaml. Topics are found by type (--list-topics shows which) or named. ROS "
+        "times go to GPS time by one offset (--clock); the GNSS epochs keep the receiver's "
+        "GPS time; what was chosen is written under 'rosbag:' in sequence.yaml.",
+    )
+    bag.add_argument("bag", type=Path, help=".bag file, ROS 2 bag folder, .db3 or .mcap file")
+    bag.add_argument("-o", "--output", type=Path, help="sequence folder")
+    bag.add_argument(
+        "--list-topics", action="store_true", help="list the topics and their use, then stop"
+    )
+    topics = bag.add_argument_group("topics (default: found by message type)")
+    for name, what in (
+        ("image", "sensor_msgs/Image or CompressedImage"),
+        ("camera-info", "sensor_msgs/CameraInfo"),
+        ("imu", "sensor_msgs/Imu"),
+        ("speed", "TwistStamped, TwistWithCovarianceStamped or Odometry (linear.x)"),
+        ("gnss", "gnss_comm/GnssMeasMsg or ublox_msgs/RxmRAWX"),
+        ("iono", "gnss_comm/StampedFloat64Array (Klobuchar α, β)"),
+        ("fix", "sensor_msgs/NavSatFix"),
+        ("tf", "tf2_msgs/TFMessage (default /tf_static)"),
+    ):
+        topics.add_argument(f"--{name}-topic", metavar="TOPIC", help=what)
+    topics.add_argument(
+        "--ephemeris-topic",
+        action="append",
+        metavar="TOPIC",
+        help="GnssEphemMsg / GnssGloEphemMsg / RxmSFRBX (repeatable; default: those of the "
+        "GNSS topic's interface)",
+    )
+    topics.add_argument(
+        "--ground-truth",
+        metavar="TOPIC",
+        help="Odometry / PoseStamped (poses in the ENU frame of the origin) or NavSatFix: "
+        "written as ground_truth.tum (never taken by default)",
+    )
+    timing = bag.add_argument_group("time")
+    timing.add_argument(
+        "--stamps",
+        choices=("header", "receive"),
+        default="header",
+        help="message time: header.stamp, or the time the bag recorded it",
+    )
+    timing.add_argument(
+        "--clock",
+        choices=("utc", "gnss"),
+        default="utc",
+        help="ROS time → GPS time: utc (ROS time is Unix UTC time, leap seconds added) or "
+        "gnss (estimated from the raw GNSS messages' times)",
+    )
+    timing.add_argument(
+        "--clock-offset",
+        type=number_in(unit="s"),
+        metavar="S",
+        help="GPS − ROS time in seconds, instead of --clock",
+    )
+    frames = bag.add_argument_group("axes and frames")
+    frames.add_argument(
+        "--imu-yaw-axis",
+        choices=("auto", *AXES),
+        default="auto",
+        help="the gyro axis pointing up (-z for a z-down IMU; auto: from gravity)",
+    )
+    frames.add_argument(
+        "--imu-forward-axis",
+        choices=("auto", "none", *AXES),
+        default="auto",
+        help="accelerometer axis along the vehicle's forward direction (auto: from the speed's "
+        "change)",
+    )
+    frames.add_argument(
+        "--origin",
+        type=origin,
+        help="LAT,LON,H of the ENU frame (default: the first NavSatFix fix)",
+    )
+    frames.add_argument(
+        "--calib", type=Path, help="camera calibration file (instead of CameraInfo)"
+    )
+    frames.add_argument("--vehicle-frame", default="base_link", help="tf frame of the vehicle")
+    frames.add_argument(
+        "--gnss-frame", help="tf frame of the GNSS antenna (default: the NavSatFix frame_id)"
+    )
+    bag.set_defaults(func=run_rosbag, parser=bag)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -142,4 +241,52 @@ def run_smartloc(args: argparse.Namespace) -> int:
     )
     for problem in summary.problems:
         log.warning("%s", problem)
+    return 0
+
+
+def run_rosbag(args: argparse.Namespace) -> int:
+    options = RosbagOptions(
+        image_topic=args.image_topic,
+        camera_info_topic=args.camera_info_topic,
+        imu_topic=args.imu_topic,
+        speed_topic=args.speed_topic,
+        gnss_topic=args.gnss_topic,
+        ephemeris_topics=tuple(args.ephemeris_topic) if args.ephemeris_topic else None,
+        iono_topic=args.iono_topic,
+        fix_topic=args.fix_topic,
+        ground_truth_topic=args.ground_truth,
+        tf_topic=args.tf_topic,
+        stamps=args.stamps,
+        clock=args.clock,
+        clock_offset_s=args.clock_offset,
+        imu_yaw_axis=args.imu_yaw_axis,
+        imu_forward_axis=args.imu_forward_axis,
+        origin=args.origin,
+        calib=args.calib,
+        vehicle_frame=args.vehicle_frame,
+        gnss_frame=args.gnss_frame,
+    )
+    if args.list_topics:
+        sys.stdout.write("\n".join(list_topics(args.bag, options)) + "\n")
+        return 0
+    if args.output is None:
+        args.parser.error("-o/--output is required (unless --list-topics)")
+    summary = import_rosbag(args.bag, args.output, options)
+    log.info(
+        "wrote %s: %d images, %d GNSS epochs, %d ephemerides, %d IMU samples (yaw rate: %s), "
+        "%d speed samples, %d ground-truth poses; times: %s stamps, %s (GPS − ROS = %.3f s); "
+        "camera extrinsic: %s",
+        summary.folder,
+        summary.images,
+        summary.gnss_epochs,
+        summary.ephemerides,
+        summary.imu_samples,
+        summary.yaw_axis,
+        summary.speed_samples,
+        summary.ground_truth_poses,
+        summary.stamps,
+        summary.clock,
+        summary.gps_minus_ros_s,
+        summary.extrinsic_from,
+    )
     return 0
