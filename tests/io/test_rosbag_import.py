@@ -214,6 +214,15 @@ def test_cli_lists_topics_and_imports(imported, tmp_path, capsys):
     assert code == 0
     yaw = read_sequence(tmp_path / "s").yaw_rate
     assert np.allclose(yaw.value, -read_sequence(imported["mcap"][0]).yaw_rate.value)
+    args = ["import", "rosbag", str(bag), "-o", str(tmp_path / "r"), "--stamps", "receive"]
+    assert main(args) == 0
+    assert read_manifest(tmp_path / "r")["rosbag"]["times"]["/imu/data"] == "receive time"
+    np.testing.assert_array_equal(read_sequence(tmp_path / "r").yaw_rate.t, yaw.t)
+    assert main([*args[:4], str(tmp_path / "x"), "--imu-topic", "/gnss/meas"]) == 1
+    assert (
+        f"{bag}: topic /gnss/meas is gnss_comm/msg/GnssMeasMsg, not one of the imu types"
+        in capsys.readouterr().err
+    )
 
 
 def test_axis_estimates():

@@ -36,6 +36,7 @@ from rosbags.typesys import (
 from vo_doppler.errors import InputError
 from vo_doppler.io.rosbag_types import typestore as project_store
 
+KIND_NAMES = {"ros1": "ROS 1", "ros2": "ROS 2"}
 READABLE = "a ROS 1 .bag file, a ROS 2 bag folder (metadata.yaml), a .db3 or an .mcap file"
 _ERRORS = (
     ReaderError1,
@@ -102,7 +103,7 @@ class Bag:
             reader.open()
         except _ERRORS as exc:
             raise InputError(
-                f"cannot open the {self.kind.upper()} bag: {_text(exc)}", self.path
+                f"cannot open the {KIND_NAMES[self.kind]} bag: {_text(exc)}", self.path
             ) from exc
         self._reader = reader
         try:

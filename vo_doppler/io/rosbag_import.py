@@ -61,7 +61,7 @@ from vo_doppler.io.calibration import checked_camera, read_camera, write_camera_
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.rinex_write import ObsEpochs, write_nav, write_obs
-from vo_doppler.io.rosbag_bag import Bag, Topic
+from vo_doppler.io.rosbag_bag import KIND_NAMES, Bag, Topic
 from vo_doppler.io.rosbag_gnss import BagGnss, read_gnss_comm, read_ublox
 from vo_doppler.io.rosbag_types import field as get
 from vo_doppler.io.sensor_csv import (
@@ -185,8 +185,11 @@ class RosbagImportSummary:
     warnings: list[str] = field(default_factory=list)
 
 
-def discover(topics: list[Topic], options: RosbagOptions) -> dict[str, str | list[str]]:
-    """The topic of each kind: given by an option (checked against its type) or found by type."""
+def discover(
+    topics: list[Topic], options: RosbagOptions, path: Path | None = None
+) -> dict[str, str | list[str]]:
+    """The topic of each kind: given by an option (checked against its type) or found by type;
+    ``path`` (the bag) is named in the errors."""
     by_name = {t.name: t for t in topics}
     chosen: dict[str, str | list[str]] = {}
     given = {
@@ -212,17 +215,20 @@ def discover(topics: list[Topic], options: RosbagOptions) -> dict[str, str | lis
                     chosen[kind] = found[0]
             continue
         if name not in by_name:
-            raise InputError(f"no topic {name} ({kind}) in the bag: see --list-topics")
+            raise InputError(f"no topic {name} ({kind}) in the bag: see --list-topics", path)
         if by_name[name].msgtype not in KINDS[kind]:
             raise InputError(
-                f"topic {name} is {by_name[name].msgtype}, not a {kind} type "
-                f"({', '.join(KINDS[kind])})"
+                f"topic {name} is {by_name[name].msgtype}, not one of the {kind} types "
+                f"({', '.join(KINDS[kind])})",
+                path,
             )
         chosen[kind] = name
     if options.ephemeris_topics is not None:
         for name in options.ephemeris_topics:
             if name not in by_name or by_name[name].msgtype not in KINDS["ephemeris"]:
-                raise InputError(f"{name} is not an ephemeris topic in the bag: see --list-topics")
+                raise InputError(
+                    f"{name} is not an ephemeris topic in the bag: see --list-topics", path
+                )
         chosen["ephemeris"] = list(options.ephemeris_topics)
     elif "gnss" in chosen:
         interface = by_name[str(chosen["gnss"])].msgtype.split("/")[0]
@@ -238,13 +244,13 @@ def list_topics(bag_path: str | Path, options: RosbagOptions | None = None) -> l
     """One line per topic: name, type, message count and what the import would use it for."""
     with Bag(bag_path) as bag:
         topics = bag.topics()
-        chosen = discover(topics, options or RosbagOptions())
+        chosen = discover(topics, options or RosbagOptions(), Path(bag_path))
     roles: dict[str, list[str]] = {}
     for kind, value in chosen.items():
         for name in [value] if isinstance(value, str) else value:
             roles.setdefault(name, []).append(kind)
     width = max((len(t.name) for t in topics), default=5)
-    lines = [f"{bag_path} ({'ROS 1' if Bag(bag_path).kind == 'ros1' else 'ROS 2'}):"]
+    lines = [f"{bag_path} ({KIND_NAMES[Bag(bag_path).kind]}):"]
     for t in topics:
         role = ", ".join(roles.get(t.name, [])) or "-"
         lines.append(f"  {t.name:<{width}}  {t.msgtype:<45} {t.count:>7}  {role}")
@@ -593,14 +599,14 @@ def _raw_image(bag: Bag, topic: str, index: int, m) -> np.ndarray:
 
 
 def clock_offset(
-    options: RosbagOptions, start_ros_s: float, gnss_pairs: np.ndarray | None
+    options: RosbagOptions, start_ros_s: float, gnss_pairs: np.ndarray | None, path: Path
 ) -> tuple[float, str]:
-    """GPS − ROS time (s) and how it was found."""
+    """GPS − ROS time (s) and how it was found (``path``, the bag, named in an error)."""
     if options.clock_offset_s is not None:
         return float(options.clock_offset_s), "given (--clock-offset)"
     if options.clock == "gnss":
         if gnss_pairs is None or not len(gnss_pairs):
-            raise InputError("--clock gnss needs a raw GNSS topic (its epochs and ROS times)")
+            raise InputError("--clock gnss needs a raw GNSS topic (its epochs and ROS times)", path)
         offset = float(np.median(gnss_pairs[:, 0] - gnss_pairs[:, 1]))
         return offset, (
             f"estimated from {len(gnss_pairs)} GNSS epochs (median GPS epoch − ROS time; the "
@@ -639,7 +645,7 @@ def import_rosbag(
     timing = _Timing(options.stamps)
     with Bag(bag_path) as bag:
         topics = bag.topics()
-        chosen = discover(topics, options)
+        chosen = discover(topics, options, bag_path)
         if "imu" not in chosen or "speed" not in chosen:
             raise InputError(
                 "the sequence needs a yaw rate and a speed: the bag has "
@@ -652,7 +658,7 @@ def import_rosbag(
         pairs = None
         if "gnss" in chosen and options.clock == "gnss" and options.clock_offset_s is None:
             pairs = _gnss_pairs(bag, str(chosen["gnss"]), timing)
-        offset, clock_text = clock_offset(options, start, pairs)
+        offset, clock_text = clock_offset(options, start, pairs, bag_path)
         timing.offset = offset
         imu_t, gyro, accel = _read_imu(bag, str(chosen["imu"]), timing)
         speed = _read_speed(bag, str(chosen["speed"]), timing)
