@@ -19,6 +19,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+import apsw
 from rosbags.interfaces import MessageDefinitionFormat
 from rosbags.rosbag1 import Reader as Reader1
 from rosbags.rosbag1 import ReaderError as ReaderError1
@@ -57,6 +58,7 @@ _ERRORS = (
     UnicodeError,
     struct.error,
     sqlite3.Error,
+    apsw.Error,
     zlib.error,
     lzma.LZMAError,
 )

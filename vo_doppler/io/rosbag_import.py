@@ -293,7 +293,13 @@ def _vector(message, name: str) -> np.ndarray:
     )
 
 
-def _increasing(bag: Bag, topic: str, t: np.ndarray) -> None:
+def _increasing(bag: Bag, topic: str, t: np.ndarray, at_least: int = 0) -> None:
+    """Times strictly increasing (and at least ``at_least`` of them), else an error naming the
+    message."""
+    if t.size < at_least:
+        raise bag.error(
+            topic, int(t.size), f"only {t.size} messages could be read, {at_least} needed"
+        )
     bad = np.flatnonzero(np.diff(t) <= 0.0)
     if bad.size:
         k = int(bad[0]) + 1
@@ -314,7 +320,7 @@ def _read_imu(bag: Bag, topic: str, timing: _Timing):
         gyro.append(_vector(m, "angular_velocity"))
         accel.append(_vector(m, "linear_acceleration"))
     t_arr = np.array(t)
-    _increasing(bag, topic, t_arr)
+    _increasing(bag, topic, t_arr, 2)
     gyro_arr, accel_arr = np.array(gyro).reshape(-1, 3), np.array(accel).reshape(-1, 3)
     bad = ~np.all(np.isfinite(gyro_arr), axis=1)
     if np.any(bad):
@@ -401,7 +407,7 @@ def _read_speed(bag: Bag, topic: str, timing: _Timing) -> SensorSeries:
         t.append(timing.time(topic, receive_ns, m))
         v.append(value)
     t_arr = np.array(t)
-    _increasing(bag, topic, t_arr)
+    _increasing(bag, topic, t_arr, 2)
     return SensorSeries(t_arr, np.array(v))
 
 
@@ -423,7 +429,7 @@ def _read_fixes(bag: Bag, topic: str, timing: _Timing) -> np.ndarray:
 def _read_ground_truth(bag: Bag, topic: str, timing: _Timing, enu: EnuFrame) -> Trajectory:
     if bag.msgtype(topic) == "sensor_msgs/msg/NavSatFix":
         fixes = _read_fixes(bag, topic, timing)
-        _increasing(bag, topic, fixes[:, 0])
+        _increasing(bag, topic, fixes[:, 0], 2)
         positions = enu.geodetic_to_enu(
             np.radians(fixes[:, 1]), np.radians(fixes[:, 2]), fixes[:, 3]
         ).reshape(-1, 3)
@@ -444,7 +450,7 @@ def _read_ground_truth(bag: Bag, topic: str, timing: _Timing, enu: EnuFrame) -> 
         positions.append(xyz)
         quats.append(quat)
     t_arr = np.array(t)
-    _increasing(bag, topic, t_arr)
+    _increasing(bag, topic, t_arr, 2)
     rotations = (
         Rotation.from_quat(np.array(quats).reshape(-1, 4)) if quats else Rotation.identity(0)
     )
@@ -570,7 +576,7 @@ def _write_images(bag: Bag, topic: str, folder: Path, timing: _Timing) -> tuple[
             cv2.imwrite(str(folder / (name + ".png")), _raw_image(bag, topic, index, m))
         times.append(timing.time(topic, receive_ns, m))
     t = np.array(times)
-    _increasing(bag, topic, t)
+    _increasing(bag, topic, t, 2)
     return t, warnings
 
 
