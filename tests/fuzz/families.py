@@ -22,6 +22,7 @@ from tests.fuzz.bound_families import register_bounds
 from tests.fuzz.gnss_families import register_gnss
 from tests.fuzz.import_families import register_imports
 from tests.fuzz.mutators import SHRINKING
+from tests.fuzz.rosbag_families import register_rosbag
 from tests.helpers.rinex_text import as_rinex4
 from tests.io.fuzz_families import register_all
 from vo_doppler.io.rinex_common import FIRST_YEAR, LAST_YEAR, PRN_RANGE
@@ -300,4 +301,5 @@ register(
 register_all(register, Family, Seed)  # CAN, DBC, CSV, NMEA, trajectory, calibration, manifest
 register_gnss(register, Family, Seed, check_observations, check_navigation)  # SP3 … raw_gnss
 register_imports(register, Family, Seed, check_observations, same_observations)  # smartLoc …
+register_rosbag(register, Family, Seed, check_observations)  # ROS 1 .bag, ROS 2 .mcap/.db3
 register_bounds(FAMILIES, register, Family, Seed, check_observations, check_navigation)

@@ -1,0 +1,137 @@
+"""Fuzz families of the ROS bag importer (``vo-doppler import rosbag``): a ROS 1 ``.bag`` and
+a ROS 2 bag as one ``.mcap`` or ``.db3`` file, written with rosbags' writers from a slice of
+the repository's sample sequence (3 images, 2 s of IMU and speed, 10 GNSS epochs with every
+ephemeris, the ground truth's fixes and poses), once with gnss_comm and once with ublox_msgs
+raw GNSS. ``read`` imports the mutated bag into a temporary folder and reads that folder back
+as ``run`` would, so whatever the importer accepts must also be a readable sequence. Registered
+by ``families.py`` with::
+
+    register_rosbag(register, Family, Seed, check_observations)
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import replace
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from tests.conftest import REPO_ROOT
+from tests.helpers.rosbag_writer import write_sequence_bag
+from vo_doppler.io.rosbag_import import RosbagOptions, import_rosbag
+from vo_doppler.io.sequence import read_manifest, read_sequence
+from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.trajectory import Trajectory
+
+SAMPLE = REPO_ROOT / "sample_sequences" / "urban_canyon_small"
+SPAN_S = 2.0
+
+
+@cache
+def _slice():
+    """The first seconds of the sample sequence."""
+    seq = read_sequence(SAMPLE)
+    start = float(seq.image_times[0])
+    end = start + SPAN_S
+
+    def series(s: SensorSeries | None) -> SensorSeries | None:
+        if s is None:
+            return None
+        keep = (s.t >= start) & (s.t <= end)
+        return SensorSeries(s.t[keep], s.value[keep])
+
+    obs = seq.observations
+    epochs = obs.epoch_time[(obs.epoch_time >= start) & (obs.epoch_time <= end)][:10]
+    rows = np.isin(obs.time, epochs)
+    observations = replace(
+        obs.subset(rows), epoch_time=epochs, epoch_flag=np.zeros(epochs.size, np.int8)
+    )
+    truth = seq.truth
+    keep = np.flatnonzero((truth.t >= start) & (truth.t <= end))
+    return replace(
+        seq,
+        image_paths=seq.image_paths[:3],
+        image_times=seq.image_times[:3],
+        yaw_rate=series(seq.yaw_rate),
+        wheel_speed=series(seq.wheel_speed),
+        forward_acceleration=series(seq.forward_acceleration),
+        observations=observations,
+        truth=Trajectory(truth.t[keep], truth.positions[keep], truth.orientations[keep]),
+    )
+
+
+def _bag_bytes(flavour: str, gnss: str, compressed: bool) -> bytes:
+    with tempfile.TemporaryDirectory() as folder:
+        target = Path(folder) / ("seed.bag" if flavour == "ros1" else "seed")
+        write_sequence_bag(_slice(), target, flavour, gnss, compressed)
+        if flavour == "ros1":
+            return target.read_bytes()
+        return next(p for p in target.iterdir() if p.suffix in (".mcap", ".db3")).read_bytes()
+
+
+def read_bag(path: Path):
+    """Import the bag and read the sequence back: (summary, sequence)."""
+    origin = read_manifest(SAMPLE)["origin"]
+    options = RosbagOptions(
+        origin=(origin["lat_deg"], origin["lon_deg"], origin["height_m"]),
+        ground_truth_topic="/ground_truth",
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        summary = import_rosbag(path, Path(folder) / "seq", options)
+        return summary, read_sequence(Path(folder) / "seq")
+
+
+def make_check(check_observations):
+    def check(result, path: Path) -> list[str]:
+        summary, seq = result
+        bad = []
+        for name in ("yaw_rate", "wheel_speed", "forward_acceleration"):
+            series = getattr(seq, name)
+            if series is not None and len(series) and not np.all(np.diff(series.t) > 0):
+                bad.append(f"{name}: times not increasing")
+        if seq.image_times.size and not np.all(np.diff(seq.image_times) > 0):
+            bad.append("image times not increasing")
+        if seq.image_times.size != len(seq.image_paths):
+            bad.append(f"{seq.image_times.size} times for {len(seq.image_paths)} images")
+        if seq.observations is not None:
+            bad += check_observations(seq.observations, path)
+        if summary.images != len(seq.image_paths):
+            bad.append(
+                f"summary says {summary.images} images, the folder has {len(seq.image_paths)}"
+            )
+        return bad
+
+    return check
+
+
+def register_rosbag(register, family_cls, seed_cls, check_observations) -> None:
+    """The ROS 1 and ROS 2 families (the sample sequence is in the repository)."""
+    check = make_check(check_observations)
+    register(
+        family_cls(
+            "rosbag1",
+            lambda: [
+                seed_cls(
+                    "gnss_comm.bag", lambda: _bag_bytes("ros1", "gnss_comm", False), suffix=".bag"
+                ),
+                seed_cls("ublox.bag", lambda: _bag_bytes("ros1", "ublox", True), suffix=".bag"),
+            ],
+            read_bag,
+            check,
+        )
+    )
+    register(
+        family_cls(
+            "rosbag2",
+            lambda: [
+                seed_cls(
+                    "gnss_comm.mcap", lambda: _bag_bytes("mcap", "gnss_comm", True), suffix=".mcap"
+                ),
+                seed_cls("ublox.db3", lambda: _bag_bytes("sqlite3", "ublox", False), suffix=".db3"),
+            ],
+            read_bag,
+            check,
+        )
+    )
