@@ -239,23 +239,45 @@ def test_axis_estimates():
     assert yaw_axis(gyro * [1, 1, 5], np.full((500, 3), np.nan), "auto")[0] == "z"
 
 
-def _rewrite(source: Path, target: Path, edit) -> Path:
-    """A ROS 1 copy of ``source`` with ``edit(topic, message)`` applied to each message."""
+def _rewrite(source: Path, target: Path, edit, topics: set[str] | None = None) -> Path:
+    """A ROS 1 copy of ``source`` (of ``topics`` only, when given) with ``edit(topic,
+    message)`` applied to each message."""
     from rosbags.rosbag1 import Reader, Writer
 
     store = typestore(False)
     with Reader(source) as reader, Writer(target) as writer:
+        kept = [c for c in reader.connections if topics is None or c.topic in topics]
         connections = {}
-        for connection in reader.connections:
+        for connection in kept:
             connections[connection.id] = writer.add_connection(
                 connection.topic, connection.msgtype, typestore=store
             )
-        for connection, t, raw in reader.messages():
+        for connection, t, raw in reader.messages(connections=kept):
             message = store.deserialize_ros1(raw, connection.msgtype)
             message = edit(connection.topic, message)
             raw = store.serialize_ros1(message, connection.msgtype)
             writer.write(connections[connection.id], t, raw)
     return target
+
+
+def test_a_bag_without_camera_or_raw_gnss(drive, imported, tmp_path):
+    """IMU, speed and fixes only: the origin from the first fix, no camera, no GNSS section;
+    run reads the folder."""
+    bag = _rewrite(
+        imported["ros1"][1],
+        tmp_path / "few.bag",
+        lambda t, m: m,
+        {"/imu/data", "/vehicle/twist", "/fix"},
+    )
+    summary = import_rosbag(bag, tmp_path / "seq")
+    seq = read_sequence(tmp_path / "seq")
+    assert not seq.has_camera and not seq.has_gnss and summary.images == 0
+    first_fix = read_manifest(tmp_path / "seq")["origin"]
+    assert first_fix["lat_deg"] == pytest.approx(
+        read_manifest(drive)["origin"]["lat_deg"], abs=1e-3
+    )
+    assert (tmp_path / "seq" / "gnss" / "fixes.csv").is_file()
+    np.testing.assert_array_equal(seq.yaw_rate.value, read_sequence(drive).yaw_rate.value)
 
 
 def test_bad_bags_name_bag_topic_and_index(imported, origin, tmp_path, capsys):

@@ -689,8 +689,13 @@ def import_rosbag(
             camera, extrinsic_from = _camera(bag, chosen, options, frames, warnings)
         lever_arm, lever_arm_from = _lever_arm(bag, chosen, options, frames)
         open_output_folder(output, "import")
-        for sub in ("vehicle", "imu", "gnss"):
-            (output / sub).mkdir(exist_ok=True)
+        for sub in (
+            "vehicle",
+            "imu" if acceleration is not None else None,
+            "gnss" if gnss else None,
+        ):
+            if sub:
+                (output / sub).mkdir(exist_ok=True)
         image_times = np.zeros(0)
         if camera is not None:
             (output / IMAGES).mkdir(exist_ok=True)
@@ -698,8 +703,6 @@ def import_rosbag(
                 bag, str(chosen["image"]), output / IMAGES, timing
             )
             warnings += image_warnings
-    for text in warnings:
-        log.warning(text)
     manifest = _manifest(bag_path, output, origin, camera is not None, acceleration)
     if camera is not None:
         np.savetxt(output / TIMES, image_times, fmt="%.9f")
@@ -709,6 +712,7 @@ def import_rosbag(
     if acceleration is not None:
         write_sensor_csv(output / ACCELERATION_CSV, acceleration, FORWARD_ACCELERATION_COLUMN)
     if fixes is not None:
+        (output / FIXES).parent.mkdir(exist_ok=True)
         np.savetxt(
             output / FIXES,
             fixes,
@@ -728,6 +732,8 @@ def import_rosbag(
         gnss_epochs = _write_gnss(output, gnss, approx, lever_arm, bag_path, manifest, warnings)
         if "gnss" in manifest:
             manifest["gnss"]["antenna_lever_arm_m"] = lever_arm
+    for text in warnings:
+        log.warning(text)
     manifest["rosbag"] = {
         "bag": str(bag_path),
         "topics": {k: v for k, v in chosen.items()},
