@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.io.rinex_nav import KEPLER_FIELDS
+from vo_doppler.model.observations import Observations
 
 GPS_EPOCH = dt.datetime(1980, 1, 6)
 PROGRAM = "vo-doppler sim"
@@ -122,6 +123,33 @@ class ObsEpochs:
     satellite: np.ndarray
     values: np.ndarray
     codes: tuple[str, ...]
+
+
+KIND_ORDER = "CLDS"
+"""Order of the observable kinds within one signal in the written files."""
+
+
+def observation_epochs(obs: Observations) -> ObsEpochs:
+    """Columnar observations as RINEX epoch rows: one row per (epoch, satellite) holding the
+    value of each code (NaN where none), the codes ordered by signal, then C, L, D, S, the same
+    for every system; the epochs of ``obs.epoch_time`` (one without a row is written empty)."""
+    codes = tuple(sorted(obs.codes, key=lambda c: (c[1:], KIND_ORDER.find(c[0]))))
+    column = {code: codes.index(code) for code in obs.codes}
+    lines: dict[tuple[int, str], np.ndarray] = {}
+    epochs = np.searchsorted(obs.epoch_time, obs.time)
+    for epoch, sat, code, value in zip(
+        epochs.tolist(), obs.satellites().tolist(), obs.code.tolist(), obs.value, strict=True
+    ):
+        values = lines.setdefault((epoch, sat), np.full(len(codes), np.nan))
+        values[column[obs.codes[code]]] = value
+    keys = list(lines)
+    return ObsEpochs(
+        obs.epoch_time,
+        np.array([k[0] for k in keys], dtype=int),
+        np.array([k[1] for k in keys], dtype="U3"),
+        np.array([lines[k] for k in keys]).reshape(len(keys), len(codes)),
+        codes,
+    )
 
 
 def signal_strength_digit(cn0_dbhz: np.ndarray) -> np.ndarray:

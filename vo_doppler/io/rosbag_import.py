@@ -60,7 +60,7 @@ from vo_doppler.geo import EnuFrame, geodetic_to_ecef
 from vo_doppler.io.calibration import checked_camera, read_camera, write_camera_yaml
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.output_folder import check_output_folder, open_output_folder
-from vo_doppler.io.rinex_write import ObsEpochs, write_nav, write_obs
+from vo_doppler.io.rinex_write import observation_epochs, write_nav, write_obs
 from vo_doppler.io.rosbag_bag import KIND_NAMES, Bag, Topic
 from vo_doppler.io.rosbag_gnss import BagGnss, read_gnss_comm, read_ublox
 from vo_doppler.io.rosbag_types import field as get
@@ -829,24 +829,6 @@ def _camera(bag: Bag, chosen: dict, options: RosbagOptions, frames, warnings: li
     return checked_camera(replace(intrinsics, T_vehicle_camera=extrinsic), bag.path), source
 
 
-def obs_epochs(gnss: BagGnss) -> ObsEpochs:
-    """Observations as RINEX epoch rows: one row per (epoch, satellite), the same codes for
-    every system (ordered by signal, then C, L, D, S)."""
-    obs = gnss.observations
-    order = "CLDS"
-    codes = tuple(sorted(obs.codes, key=lambda c: (c[1:], order.index(c[0]))))
-    sats = obs.satellites()
-    keys = sorted({(t, s) for t, s in zip(obs.time.tolist(), sats.tolist(), strict=True)})
-    row_of = {key: k for k, key in enumerate(keys)}
-    values = np.full((len(keys), len(codes)), np.nan)
-    column = [codes.index(obs.codes[c]) for c in obs.code]
-    for r, (t, s) in enumerate(zip(obs.time.tolist(), sats.tolist(), strict=True)):
-        values[row_of[(t, s)], column[r]] = obs.value[r]
-    epoch_time = np.asarray(obs.epoch_time, dtype=float)
-    epoch = np.searchsorted(epoch_time, [t for t, _ in keys])
-    return ObsEpochs(epoch_time, epoch, np.array([s for _, s in keys]), values, codes)
-
-
 def _write_gnss(
     output: Path, gnss: BagGnss, approx, lever_arm, bag_path: Path, manifest, warnings
 ) -> int:
@@ -855,7 +837,7 @@ def _write_gnss(
     if not len(obs):
         warnings.append(f"{bag_path}: the GNSS topic holds no measurement: no gnss section")
         return 0
-    epochs = obs_epochs(gnss)
+    epochs = observation_epochs(obs)
     interval = float(np.median(np.diff(epochs.epoch_time))) if epochs.epoch_time.size > 1 else 0.0
     write_obs(
         output / OBS,
@@ -864,6 +846,9 @@ def _write_gnss(
         interval,
         marker_name=bag_path.stem or "ROSBAG",
         receiver=gnss.source.split(" ")[0],
+        program="vo-doppler import",
+        observer="ROS bag",
+        antenna="UNKNOWN",
         antenna_height_m=lever_arm[2],
         glonass_channels=obs.header.glonass_channels,
     )

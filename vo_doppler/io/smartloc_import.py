@@ -44,7 +44,7 @@ from scipy.spatial.transform import Rotation
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.output_folder import check_output_folder, open_output_folder
-from vo_doppler.io.rinex_write import ObsEpochs, write_obs
+from vo_doppler.io.rinex_write import observation_epochs, write_obs
 from vo_doppler.io.satellite_states import read_satellite_states
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, YAW_RATE_COLUMN, write_sensor_csv
 from vo_doppler.io.sequence import FORMAT, MANIFEST
@@ -71,7 +71,6 @@ NLOS_HEADER = (
     "cn0_dbhz",
     "nlos",
 )
-_KIND_ORDER = "CLDS"
 
 
 @dataclass(frozen=True)
@@ -191,26 +190,10 @@ def _labels(recording: SmartLocRecording) -> np.ndarray:
 def _write_rinex(path: Path, recording: SmartLocRecording, approx_ecef: np.ndarray) -> None:
     """The observations as RINEX 3.04, one line per (epoch, satellite)."""
     obs = recording.observations
-    codes = tuple(sorted(obs.codes, key=lambda c: (c[1:], _KIND_ORDER.find(c[0]))))
-    column = {code: codes.index(code) for code in obs.codes}
-    lines: dict[tuple[int, str], np.ndarray] = {}
-    epochs = np.searchsorted(obs.epoch_time, obs.time)
-    for epoch, sat, code, value in zip(
-        epochs.tolist(), obs.satellites().tolist(), obs.code.tolist(), obs.value, strict=True
-    ):
-        values = lines.setdefault((epoch, sat), np.full(len(codes), np.nan))
-        values[column[obs.codes[code]]] = value
-    keys = list(lines)
     interval = float(np.median(np.diff(obs.epoch_time))) if obs.epoch_time.size > 1 else 0.0
     write_obs(
         path,
-        ObsEpochs(
-            obs.epoch_time,
-            np.array([k[0] for k in keys], dtype=int),
-            np.array([k[1] for k in keys], dtype="U3"),
-            np.array([lines[k] for k in keys]).reshape(len(keys), len(codes)),
-            codes,
-        ),
+        observation_epochs(obs),
         approx_ecef,
         interval,
         marker_name="SMARTLOC",
