@@ -106,32 +106,27 @@ def make_check(check_observations):
     return check
 
 
+SEEDS = {  # family → (seed file, bag flavour, GNSS interface, compressed images)
+    "rosbag1": (
+        ("gnss_comm.bag", "ros1", "gnss_comm", False),
+        ("ublox.bag", "ros1", "ublox", True),
+    ),
+    "rosbag2": (
+        ("gnss_comm.mcap", "mcap", "gnss_comm", True),
+        ("ublox.db3", "sqlite3", "ublox", False),
+    ),
+}
+
+
 def register_rosbag(register, family_cls, seed_cls, check_observations) -> None:
     """The ROS 1 and ROS 2 families (the sample sequence is in the repository)."""
     check = make_check(check_observations)
-    register(
-        family_cls(
-            "rosbag1",
-            lambda: [
-                seed_cls(
-                    "gnss_comm.bag", lambda: _bag_bytes("ros1", "gnss_comm", False), suffix=".bag"
-                ),
-                seed_cls("ublox.bag", lambda: _bag_bytes("ros1", "ublox", True), suffix=".bag"),
-            ],
-            read_bag,
-            check,
-        )
-    )
-    register(
-        family_cls(
-            "rosbag2",
-            lambda: [
-                seed_cls(
-                    "gnss_comm.mcap", lambda: _bag_bytes("mcap", "gnss_comm", True), suffix=".mcap"
-                ),
-                seed_cls("ublox.db3", lambda: _bag_bytes("sqlite3", "ublox", False), suffix=".db3"),
-            ],
-            read_bag,
-            check,
-        )
-    )
+
+    def seed(name: str, flavour: str, gnss: str, compressed: bool):
+        def load() -> bytes:
+            return _bag_bytes(flavour, gnss, compressed)
+
+        return seed_cls(name, load, suffix=Path(name).suffix)
+
+    for family, seeds in SEEDS.items():
+        register(family_cls(family, lambda seeds=seeds: [seed(*s) for s in seeds], read_bag, check))
