@@ -349,3 +349,12 @@ def test_ros2_bag_without_definitions_uses_the_project_types(tmp_path):
     assert rows == {"C1C": 2.2e7, "D1C": -850.25, "S1C": 45.0}
     assert obs.satellites().tolist() == ["E03"] * 3
     assert gnss.doppler_sigma.sigma_mps[0] == pytest.approx(0.1 * 299792458.0 / 1575.42e6)
+
+
+def test_a_repeated_measurement_keeps_one_sigma():
+    """A measurement repeated in the bag (the observations keep the first) leaves one σ row,
+    or doppler_sigma.csv would be refused (make fuzz: rosbag1 case 476, swap_lines)."""
+    from vo_doppler.io.rosbag_gnss import _sigma
+
+    sigma = _sigma([(1.0, "G01", "D1C", 0.1), (1.0, "G01", "D1C", 0.2), (1.2, "G01", "D1C", 0.3)])
+    assert sigma.sigma_mps.tolist() == [0.1, 0.3]

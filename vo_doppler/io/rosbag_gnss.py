@@ -202,9 +202,14 @@ class _Rows(_RawxRows):
 
 
 def _sigma(rows: list[tuple[float, str, str, float]]) -> ReportedSigma | None:
-    if not rows:
+    """The σ rows, the first of each (epoch, satellite, code) kept as the observations keep
+    the first of a repeated measurement."""
+    first: dict[tuple[float, str, str], float] = {}
+    for t, sat, code, sigma in rows:
+        first.setdefault((t, sat, code), sigma)
+    if not first:
         return None
-    t, sat, code, sigma = zip(*rows, strict=True)
+    t, sat, code, sigma = zip(*((*key, value) for key, value in first.items()), strict=True)
     return ReportedSigma(np.array(t), np.array(sat), np.array(code), np.array(sigma))
 
 
