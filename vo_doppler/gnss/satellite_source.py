@@ -9,7 +9,8 @@ source once with :func:`satellite_source`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, fields
 from typing import Protocol
 
 import numpy as np
@@ -19,6 +20,12 @@ from vo_doppler.gnss.ephemeris import SatelliteStates, rotate_earth, satellite_s
 from vo_doppler.gnss.precise_orbits import LAGRANGE_POINTS, precise_states
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.precise_orbits import PreciseOrbits
+
+STATES_CHUNK = 8192
+"""Rows of satellite states computed at once. Each row gathers its ephemeris' parameters and
+their intermediate results (about 100 numbers), so the states of a whole drive in one call
+grew with its duration (a 30-min drive's 200,000 Doppler rows: about 130 MB at once); in
+chunks the GNSS stage's peak memory stays flat in the duration, with the same results."""
 
 _GROUP_DELAY_FIELD = {("G", "1"): "tgd", ("J", "1"): "tgd", ("E", "1"): "iodc", ("C", "2"): "tgd"}
 
@@ -54,7 +61,7 @@ class BroadcastSource:
         return self.nav.klobuchar
 
     def states(self, system, prn, t) -> SatelliteStates:
-        return satellite_states(self.nav, system, prn, t)
+        return states_in_chunks(lambda *rows: satellite_states(self.nav, *rows), system, prn, t)
 
     def group_delay_s(
         self, system: np.ndarray, states: SatelliteStates, codes: dict[str, str]
@@ -85,7 +92,9 @@ class PreciseSource:
         return None
 
     def states(self, system, prn, t) -> SatelliteStates:
-        return precise_states(self.orbits, system, prn, t, self.n_points)
+        return states_in_chunks(
+            lambda *rows: precise_states(self.orbits, *rows, self.n_points), system, prn, t
+        )
 
     def group_delay_s(
         self, system: np.ndarray, states: SatelliteStates, codes: dict[str, str]
@@ -97,6 +106,26 @@ class PreciseSource:
 
 
 StateSource = Navigation | PreciseOrbits | SatelliteSource
+
+
+def states_in_chunks(
+    states: Callable[[np.ndarray, np.ndarray, np.ndarray], SatelliteStates], system, prn, t
+) -> SatelliteStates:
+    """``states(system, prn, t)`` (flat arrays, one row each; the row results independent of
+    the others) computed :data:`STATES_CHUNK` rows at a time and joined, arrays broadcast
+    and flattened as ``ephemeris.satellite_states`` does."""
+    system, prn, t = (
+        np.ravel(a)
+        for a in np.broadcast_arrays(np.asarray(system), np.asarray(prn), np.asarray(t, float))
+    )
+    if t.size <= STATES_CHUNK:
+        return states(system, prn, t)
+    parts = [
+        states(system[k : k + STATES_CHUNK], prn[k : k + STATES_CHUNK], t[k : k + STATES_CHUNK])
+        for k in range(0, t.size, STATES_CHUNK)
+    ]
+    joined = (np.concatenate([getattr(part, f.name) for part in parts]) for f in fields(parts[0]))
+    return SatelliteStates(*joined)
 
 
 def satellite_source(source: StateSource) -> SatelliteSource:
