@@ -102,6 +102,7 @@ def read_obs(path: str | Path) -> Observations:
     problems: list[str] = []
     text = read_rinex_bytes(path, problems)
     header_lines, body = split_header(path, text)
+    del text  # the body lines hold what is read: not the file's text too while they are decoded
     header = _parse_header(path, header_lines, problems)
     typesets = [dict(header.obs_types)]
     if header.version < 3:
