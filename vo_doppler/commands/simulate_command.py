@@ -154,7 +154,7 @@ def register(subparsers, summary: str) -> None:
         "--duration",
         type=number_in(0.0, MAX_DURATION_S, low_open=True, unit="s"),
         default=defaults.duration_s,
-        help=f"seconds (at most {MAX_DURATION_S:g}: the drive is held in memory, about 1 MB/s)",
+        help=f"seconds (at most {MAX_DURATION_S:g}: the drive is held in memory, about 0.25 MB/s)",
     )
     parser.add_argument("--seed", type=int, default=0, help="random seed (same seed, same data)")
     parser.add_argument("-o", "--output", required=True, help="sequence folder to write")
