@@ -28,3 +28,16 @@ def require_shared(relative: str) -> Path:
     if not path.exists():
         pytest.skip(f"real recording {relative} not found under {shared_data_dir()}")
     return path
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Captured output as text the xdist workers can send: a test on file names that are not
+    UTF-8 logs them as surrogate escapes, which execnet refuses to serialise (the whole run then
+    stops with an internal error); they are shown as backslash escapes instead."""
+    outcome = yield
+    report = outcome.get_result()
+    report.sections = [
+        (title, text.encode("utf-8", "backslashreplace").decode("utf-8"))
+        for title, text in report.sections
+    ]

@@ -111,7 +111,8 @@ def test_corrected_trajectory_is_finite_and_covers_every_image(sequence, run_out
 
 
 def test_missing_manifest_is_a_clear_error(tmp_path, capsys):
-    assert main(["run", str(tmp_path), "-o", str(tmp_path / "out")]) == 1
+    (tmp_path / "seq").mkdir()
+    assert main(["run", str(tmp_path / "seq"), "-o", str(tmp_path / "out")]) == 1
     assert "sequence.yaml" in capsys.readouterr().err
 
 

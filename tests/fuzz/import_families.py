@@ -173,8 +173,8 @@ MAX_FILES = 2000
 
 def kitti_raw_seed() -> bytes:
     """The kitti_raw_mini drive: the calibration and timestamp files as they are, the image
-    file names (their content is replaced by one tiny PNG: the importer copies images), and one
-    line per OXTS data file."""
+    file names (their content is replaced by one blank PNG of the calibration's size: the
+    importer copies images and checks their size), and one line per OXTS data file."""
     day = _shared(KITTI_DAY)
     parts = []
     for name in DRIVE_FILES:
@@ -187,26 +187,28 @@ def kitti_raw_seed() -> bytes:
     return b"\n".join(parts) + b"\n"
 
 
-def _tiny_png() -> bytes:
-    """An 8 × 8 grey PNG (no image library needed)."""
+def _blank_png(width: int, height: int) -> bytes:
+    """A black grey-scale PNG of ``width`` × ``height`` (no image library needed)."""
 
     def chunk(kind: bytes, data: bytes) -> bytes:
         body = kind + data
         return len(data).to_bytes(4, "big") + body + zlib.crc32(body).to_bytes(4, "big")
 
-    header = (8).to_bytes(4, "big") * 2 + bytes([8, 0, 0, 0, 0])
-    pixels = zlib.compress(b"".join(b"\0" + bytes(range(0, 256, 32)) for _ in range(8)))
+    header = width.to_bytes(4, "big") + height.to_bytes(4, "big") + bytes([8, 0, 0, 0, 0])
+    pixels = zlib.compress(bytes(height * (width + 1)))
     return (
         b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", pixels) + chunk(b"IEND", b"")
     )
 
 
-TINY_PNG = _tiny_png()
+KITTI_SIZE = (1242, 375)
+"""The rectified size kitti_raw_mini's calib_cam_to_cam.txt states (S_rect_00)."""
+BLANK_PNG = _blank_png(*KITTI_SIZE)
 
 
 def _unpack_drive(path: Path) -> Path:
     """The one-text drive laid out as ``<path>.d/<day>/``: each ``=== NAME`` section becomes the
-    file NAME (the image list: one tiny PNG per safe name; the OXTS section: one data file per
+    file NAME (the image list: one blank PNG per safe name; the OXTS section: one data file per
     line, numbered from 0). Returns the drive folder."""
     day = Path(f"{path}.d") / "2011_09_26"
     shutil.rmtree(day.parent, ignore_errors=True)
@@ -226,7 +228,7 @@ def _unpack_drive(path: Path) -> Path:
             (day / name).write_bytes(b"\n".join(sections[name]) + b"\n")
     for name in sections.get(IMAGE_LIST, [])[:MAX_FILES]:
         if _SAFE_NAME.match(name):
-            (day / IMAGE_LIST / name.decode()).write_bytes(TINY_PNG)
+            (day / IMAGE_LIST / name.decode()).write_bytes(BLANK_PNG)
     for k, line in enumerate(sections.get(OXTS_DATA, [])[:MAX_FILES]):
         if line:
             (day / OXTS_DATA / f"{k:010d}.txt").write_bytes(line + b"\n")
