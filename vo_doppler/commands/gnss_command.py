@@ -32,10 +32,9 @@ from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError, VoDopplerError, shown
 from vo_doppler.gnss.doppler_velocity import doppler_codes
 from vo_doppler.gnss.ephemeris import GLONASS_MAX_AGE_S, KEPLER_MAX_AGE_S
-from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_velocity
+from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_position, gnss_velocity
 from vo_doppler.gnss.satellite_source import satellite_source
 from vo_doppler.gnss.signals import carrier_frequency
-from vo_doppler.gnss.spp import solve_spp
 from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
 from vo_doppler.io.receiver_file import read_observation_file
 from vo_doppler.io.satellite_states import state_problems
@@ -304,7 +303,7 @@ def run(args: argparse.Namespace) -> int:
     used = _glonass_dropped(obs, nav, args.systems, bands)
     title = f"{shown(args.obs.name)} ({used})"
     if args.gnss_command == "spp":
-        solution = solve_spp(obs, nav, args.systems, mask)
+        solution = gnss_position(obs, nav, args.systems, mask)
         valid = solution.valid
         outputs = [
             (args.output, lambda path: write_spp_csv(path, solution)),

@@ -174,5 +174,6 @@ def minimal_detectable_shift(
     noncentrality = detectable_noncentrality(dof, alpha, power)
     with np.errstate(divide="ignore"):
         bias = np.sqrt(noncentrality / np.where(controlled > 1e-12 * own, controlled, 0.0))
-    shift = (covariance @ H.T @ weighted).T * bias[:, None]
+    with np.errstate(invalid="ignore"):  # 0 · inf where a bias cannot show: replaced below
+        shift = (covariance @ H.T @ weighted).T * bias[:, None]
     return np.where(np.isfinite(bias)[:, None], shift, np.inf)

@@ -58,15 +58,9 @@ class NoiseModel:
 
     def sigma(self, cn0: np.ndarray, elevation: np.ndarray) -> np.ndarray:
         """σ (m/s) of rows of this signal; a missing C/N0 reads as the reference."""
-        cn0 = np.where(np.isfinite(cn0), cn0, CN0_REFERENCE_DBHZ)
-        cn0 = np.clip(cn0, *self.cn0_range_dbhz)
-        elevation = np.clip(elevation, *self.elevation_range_rad)
-        log_sigma = (
-            np.log10(self.sigma_ref_mps)
-            - self.cn0_slope * (cn0 - CN0_REFERENCE_DBHZ) / 20.0
-            - self.elevation_exponent * np.log10(np.sin(elevation))
-        )
-        return np.maximum(10.0**log_sigma, FLOOR_MPS)
+        law = (self.sigma_ref_mps, self.cn0_slope, self.elevation_exponent)
+        ranges = (self.cn0_range_dbhz, self.elevation_range_rad)
+        return sigma_law(law, ranges, cn0, elevation, FLOOR_MPS)
 
     def to_dict(self) -> dict:
         """JSON-ready fields, the elevation range in degrees (for the run summary)."""
@@ -74,6 +68,28 @@ class NoiseModel:
         out["elevation_range_deg"] = [float(np.degrees(v)) for v in out.pop("elevation_range_rad")]
         out["cn0_range_dbhz"] = [float(v) for v in out["cn0_range_dbhz"]]
         return out
+
+
+def sigma_law(
+    law: tuple[float, float, float],
+    ranges: tuple[tuple[float, float], tuple[float, float]],
+    cn0: np.ndarray,
+    elevation: np.ndarray,
+    floor: float,
+) -> np.ndarray:
+    """σ of the module docstring's law, ``law`` = (10^a, b, c), at C/N0 ``cn0`` (dB-Hz; missing:
+    the reference) and ``elevation`` (rad), each clamped to its fitted range of ``ranges``
+    (C/N0, elevation), never below ``floor`` (any unit: that of 10^a)."""
+    sigma_ref, slope, exponent = law
+    cn0 = np.where(np.isfinite(cn0), cn0, CN0_REFERENCE_DBHZ)
+    cn0 = np.clip(cn0, *ranges[0])
+    elevation = np.clip(elevation, *ranges[1])
+    log_sigma = (
+        np.log10(sigma_ref)
+        - slope * (cn0 - CN0_REFERENCE_DBHZ) / 20.0
+        - exponent * np.log10(np.sin(elevation))
+    )
+    return np.maximum(10.0**log_sigma, floor)
 
 
 def normalised_residuals(rows: DopplerRows, solution: VelocitySolution) -> np.ndarray:
@@ -95,7 +111,7 @@ def fit_noise_models(
     signals = {(str(s), str(c)) for s, c in zip(rows.system, rows.code, strict=True)}
     for system, code in sorted(signals):
         members = usable & (rows.system == system) & (rows.code == code)
-        model = _fit_signal(
+        model = fit_sigma_law(
             residual[members], rows.cn0[members], rows.elevation[members], min_bin_rows
         )
         if model is not None:
@@ -125,8 +141,12 @@ def modelled_sigma(
     return sigma
 
 
-def _fit_signal(residual, cn0, elevation, min_bin_rows):
-    """(σ_ref, b, c, C/N0 range, elevation range, bins) or None without two C/N0 bins."""
+def fit_sigma_law(
+    residual: np.ndarray, cn0: np.ndarray, elevation: np.ndarray, min_bin_rows: int = MIN_BIN_ROWS
+) -> tuple | None:
+    """(σ_ref, b, c, C/N0 range, elevation range, bins) of the module docstring's law fitted
+    to normalised residuals (any unit; σ_ref in it) of one signal at C/N0 ``cn0`` (dB-Hz) and
+    ``elevation`` (rad), all finite; None without two C/N0 bins of ``min_bin_rows`` rows."""
     cn0_bin = np.floor(cn0 / CN0_BIN_DBHZ)
     elevation_bin = np.floor(elevation / ELEVATION_BIN_RAD)
     keys, inverse = np.unique(

@@ -19,6 +19,7 @@ from vo_doppler.gnss.doppler_velocity import (
 from vo_doppler.gnss.moving_noise import MovingNoiseModel, moving_noise_weights
 from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models
 from vo_doppler.gnss.phase_rate import carrier_phase_doppler
+from vo_doppler.gnss.position_check import doppler_consistency
 from vo_doppler.gnss.receiver_track import smoothed_track
 from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.signals import bands_problem
@@ -190,4 +191,22 @@ def gnss_velocity(
         rows, moving = moving_noise_weights(rows, velocity)
         if not moving.identity:
             velocity = solve_velocity(rows, obs.epoch_time)
+    spp = doppler_consistency(spp, velocity)
     return GnssVelocityResult(velocity, rows, spp, np.asarray(position), models, fit_noise, moving)
+
+
+def gnss_position(
+    obs: Observations,
+    source: StateSource,
+    systems: str = "GREJC",
+    elevation_mask_rad: float = np.deg2rad(10.0),
+) -> SppSolution:
+    """Single-point fixes (:func:`~vo_doppler.gnss.spp.solve_spp`: fitted pseudorange σ,
+    chi-square test, protection levels) checked against each other along the Doppler
+    velocities of :func:`gnss_velocity` where the file has Doppler of ``systems``
+    (:mod:`~vo_doppler.gnss.position_check`: a fix inconsistent with its neighbours is not
+    valid, the σ scaled to the scatter); without Doppler, the fixes' own tests alone."""
+    check_elevation_mask(elevation_mask_rad)
+    if not doppler_codes(obs, systems):
+        return solve_spp(obs, source, systems, elevation_mask_rad)
+    return gnss_velocity(obs, source, systems, elevation_mask_rad).spp

@@ -11,7 +11,7 @@ without the excluded rows.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -19,11 +19,22 @@ from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
 from vo_doppler.gnss.ephemeris import rotate_earth
-from vo_doppler.gnss.lsq import lsq_with_exclusion, weighted_lsq
+from vo_doppler.gnss.lsq import (
+    DEFAULT_ALPHA,
+    lsq_with_exclusion,
+    minimal_detectable_shift,
+    weighted_lsq,
+)
+from vo_doppler.gnss.pseudorange_noise import (
+    SIGMA_PRIOR_M,
+    PseudorangeNoiseModel,
+    fit_pseudorange_noise,
+    prior_sigma,
+)
 from vo_doppler.gnss.satellite_source import StateSource, satellite_source
-from vo_doppler.gnss.signals import wavelengths
+from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.model.gnss_solutions import SppSolution
-from vo_doppler.model.observations import Observations
+from vo_doppler.model.observations import Observations, lookup, row_keys
 
 log = logging.getLogger(__name__)
 
@@ -36,8 +47,13 @@ PSEUDORANGE_PRIORITY = {
     "S": ("C1C", "C1"),
     "I": ("C5A", "C9A"),
 }
-SIGMA_PSEUDORANGE_M = 3.0
 EARTH_SURFACE_M = 6.0e6
+SIGNAL_IN_SPACE_SIGMA_M = {"G": 0.6, "E": 0.4, "C": 1.0, "J": 0.6, "R": 1.8, "I": 2.0, "S": 2.0}
+"""σ (m) of the broadcast orbit and clock along the line of sight per system (the signal-in-
+space range errors of O. Montenbruck et al., "Multi-GNSS signal-in-space range error
+assessment", GPS Solutions 22, 2018, rounded up; 2 m where not assessed)."""
+IONOSPHERE_FRACTION = 0.5
+TROPOSPHERE_SIGMA_M = 0.3
 
 
 def pseudorange_codes(obs: Observations, systems: str) -> dict[str, str]:
@@ -84,9 +100,21 @@ def solve_spp(
     source: StateSource,
     systems: str = "GREJC",
     elevation_mask_rad: float = np.deg2rad(10.0),
+    fit_noise: bool = True,
+    alpha: float = DEFAULT_ALPHA,
 ) -> SppSolution:
     """Single-point position per data epoch of ``obs`` (invalid epochs NaN, never guessed),
-    satellite states from ``source`` (broadcast or precise, ``satellite_source``)."""
+    satellite states from ``source`` (broadcast or precise, ``satellite_source``).
+
+    Integrity (as the Doppler velocity's, ``doppler_velocity.solve_velocity``): unless
+    ``fit_noise`` is False, a first solution with the a-priori σ (``pseudorange_noise``) gives
+    the residuals that fit each signal's σ(C/N0, elevation), and every epoch is solved again
+    with those σ; an epoch is valid when it has redundancy and its weighted residuals pass the
+    chi-square test at ``alpha`` (after at most a third of its rows excluded). Its σ
+    (horizontal √(σ_e² + σ_n²), vertical σ_u) come from the weighted covariance, its
+    protection levels from Baarda's minimal detectable bias (``lsq.minimal_detectable_shift``):
+    the largest horizontal and vertical shifts a bias on one satellite could cause while the
+    test would miss it more than once in five."""
     codes = pseudorange_codes(obs, systems)
     if not codes:
         raise InputError(no_system_message(obs, systems), obs.header.path)
@@ -104,62 +132,87 @@ def solve_spp(
     n_no_ephemeris = int((~states.valid).sum())
     channels = {**source.glonass_channels(), **obs.header.glonass_channels}
     frequency = np.full(len(sel), L1_HZ)
+    cn0 = np.full(len(sel), np.nan)
     for system, code in codes.items():
         hit = sel.system == system
         lam = wavelengths(sel.system[hit], sel.prn[hit], code, channels, obs.header.version)
         frequency[hit] = np.nan_to_num(SPEED_OF_LIGHT / lam, nan=L1_HZ)
+        cn0[hit] = _signal_strength(obs, sel.subset(hit), strength_code(code))
     epoch = np.searchsorted(obs.epoch_time, sel.time)
     bounds = np.searchsorted(epoch, np.arange(obs.epoch_time.size + 1))
     start = obs.header.approx_position
     if start is None or np.linalg.norm(start) < EARTH_SURFACE_M:
         start = np.zeros(3)
-    model = _Model(sorted(codes), elevation_mask_rad, source.klobuchar)
-    n_epochs = obs.epoch_time.size
-    position = np.full((n_epochs, 3), np.nan)
-    clocks = {s: np.full(n_epochs, np.nan) for s in model.systems}
-    n_sat = np.zeros(n_epochs, dtype=np.int64)
-    rms = np.full(n_epochs, np.nan)
-    pdop = np.full(n_epochs, np.nan)
-    quality = np.full((n_epochs, 2), np.nan)
-    valid = np.zeros(n_epochs, dtype=bool)
-    verified = np.zeros(n_epochs, dtype=bool)
-    for k in range(n_epochs):
+    data = []
+    for k in range(obs.epoch_time.size):
         r = np.arange(bounds[k], bounds[k + 1])
         r = r[states.valid[r]]
-        data = _EpochData(
-            obs.epoch_time[k],
-            states.position[r],
-            sel.value[r] + satellite_clock_m[r],
-            sel.system[r],
-            sel.prn[r],
-            frequency[r],
+        data.append(
+            _EpochData(
+                obs.epoch_time[k],
+                states.position[r],
+                sel.value[r] + satellite_clock_m[r],
+                sel.system[r],
+                sel.prn[r],
+                frequency[r],
+                cn0[r],
+            )
         )
-        result = _solve_epoch(data, model, start)
-        if result is None:
+    model = _Model(sorted(codes), elevation_mask_rad, source.klobuchar, {}, alpha)
+    fits = _solve_all(data, model, start)
+    noise_models = {}
+    if fit_noise:
+        noise_models = fit_pseudorange_noise(*_residual_table(data, fits, codes))
+        model = replace(
+            model,
+            noise={s: noise_models[(s, c)] for s, c in codes.items() if (s, c) in noise_models},
+        )
+        fits = _solve_all(data, model, start, [f.x if f is not None else None for f in fits])
+    return _solution(obs.epoch_time, fits, model.systems, n_no_ephemeris, noise_models, alpha)
+
+
+def _solution(t, fits, systems, n_no_ephemeris, noise_models, alpha) -> SppSolution:
+    """The per-epoch fits as an :class:`SppSolution` (unsolved epochs NaN, not valid)."""
+    n_epochs = t.size
+    position = np.full((n_epochs, 3), np.nan)
+    clocks = {s: np.full(n_epochs, np.nan) for s in systems}
+    n_sat = np.zeros(n_epochs, dtype=np.int64)
+    figures = np.full((n_epochs, 7), np.nan)
+    valid = np.zeros(n_epochs, dtype=bool)
+    for k, fit in enumerate(fits):
+        if fit is None:
             continue
-        x, clock, used, residuals, dop, fit = result
-        valid[k] = verified[k] = fit.passed
-        quality[k] = _horizontal_quality(x, fit.design, fit.covariance[:3, :3])
-        position[k] = x
-        for s, value in clock.items():
+        valid[k] = fit.passed
+        position[k] = fit.x
+        for s, value in fit.clock.items():
             clocks[s][k] = value
-        n_sat[k] = used
-        rms[k] = residuals
-        pdop[k] = dop
-        start = x
+        n_sat[k] = fit.n_used
+        figures[k] = (fit.rms, fit.pdop, *_quality(fit, alpha))
     return SppSolution(
-        obs.epoch_time,
+        t,
         position,
         clocks,
         n_sat,
-        rms,
-        pdop,
+        figures[:, 0],
+        figures[:, 1],
         valid,
         n_no_ephemeris,
-        verified=verified,
-        hdop=quality[:, 0],
-        horizontal_sigma_m=quality[:, 1],
+        verified=valid.copy(),
+        hdop=figures[:, 2],
+        horizontal_sigma_m=figures[:, 3],
+        vertical_sigma_m=figures[:, 4],
+        horizontal_protection_m=figures[:, 5],
+        vertical_protection_m=figures[:, 6],
+        noise_models=noise_models,
     )
+
+
+def _signal_strength(obs: Observations, sel: Observations, code: str) -> np.ndarray:
+    """C/N0 (dB-Hz) of the rows ``sel`` from the same satellite's ``code`` observable at the
+    same epoch (NaN where the file has none)."""
+    strength = obs.select(code=code)
+    keys = row_keys(obs.epoch_time, strength.time, strength.system, strength.prn)
+    return lookup(keys, strength.value, row_keys(obs.epoch_time, sel.time, sel.system, sel.prn))
 
 
 @dataclass(frozen=True)
@@ -172,6 +225,7 @@ class _EpochData:
     system: np.ndarray
     prn: np.ndarray
     frequency: np.ndarray
+    cn0: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -179,16 +233,75 @@ class _Model:
     systems: list[str]
     mask: float
     klobuchar: np.ndarray | None
+    noise: dict[str, PseudorangeNoiseModel]
+    """The fitted σ law per system (its pseudorange code); absent: the a-priori law."""
+    alpha: float
 
 
-def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray):
+@dataclass(frozen=True)
+class _EpochFit:
+    """One epoch's solution and what the integrity figures and the noise fit need of it:
+    ``rows`` the data rows above the mask, their post-fit ``residual`` (m), ``spread`` the
+    standard deviation of each residual in units of its σ (√r_i for a kept row, r_i its
+    redundancy number; √(1 + h_ii) for an excluded one, predicted by the others) and
+    ``elevation`` (rad); ``design``, ``sigma`` and ``groups`` of the kept rows."""
+
+    x: np.ndarray
+    clock: dict[str, float]
+    n_used: int
+    rms: float
+    pdop: float
+    passed: bool
+    dof: int
+    covariance: np.ndarray
+    design: np.ndarray
+    sigma: np.ndarray
+    groups: np.ndarray
+    rows: np.ndarray
+    residual: np.ndarray
+    spread: np.ndarray
+    elevation: np.ndarray
+
+
+def _solve_all(data, model, start, starts=None) -> list[_EpochFit | None]:
+    """Every epoch, each started from ``starts[k]`` where given, else the last solution."""
+    fits = []
+    x = start
+    for k, epoch in enumerate(data):
+        here = starts[k] if starts is not None and starts[k] is not None else x
+        fit = _solve_epoch(epoch, model, here)
+        fits.append(fit)
+        if fit is not None:
+            x = fit.x
+    return fits
+
+
+def _residual_table(data, fits, codes):
+    """(residual / spread, system, code, C/N0, elevation) of every row of the solved epochs:
+    the normalised residuals that fit the noise models."""
+    parts = [
+        (f.residual / f.spread, d.system[f.rows], d.cn0[f.rows], f.elevation)
+        for d, f in zip(data, fits, strict=True)
+        if f is not None
+    ]
+    if not parts:
+        empty = np.zeros(0)
+        return empty, empty.astype(str), empty.astype(str), empty, empty
+    residual, system, cn0, elevation = (np.concatenate(p) for p in zip(*parts, strict=True))
+    code = np.array([codes[s] for s in system], dtype="U3")
+    return residual, system, code, cn0, elevation
+
+
+def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray) -> _EpochFit | None:
     """Gauss–Newton with elevation mask and FDE; None when fewer than 3 + n_clock satellites."""
     keep = np.ones(data.corrected_range.size, dtype=bool)
     x = np.asarray(start, dtype=float).copy()
     clocks = np.zeros(len(model.systems))
     for _ in range(2):
         for _ in range(12):
-            H, residual, sigma, keep_now, present = _linearise(data, model, x, clocks, keep)
+            H, residual, sigma, keep_now, present, elevation = _linearise(
+                data, model, x, clocks, keep
+            )
             if keep_now.sum() < 3 + present.sum():
                 return None
             H = H[keep_now][:, np.r_[True, True, True, present]]
@@ -199,7 +312,7 @@ def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray):
                 break
         groups = np.char.add(data.system[keep_now], data.prn[keep_now].astype(str))
         result = lsq_with_exclusion(
-            H, residual[keep_now], sigma[keep_now], groups, 3 + int(present.sum())
+            H, residual[keep_now], sigma[keep_now], groups, 3 + int(present.sum()), model.alpha
         )
         if not result.valid:
             return None
@@ -208,32 +321,70 @@ def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray):
         keep[np.flatnonzero(keep_now)[~result.used]] = False
     if np.linalg.norm(x) < EARTH_SURFACE_M:
         return None
-    used = keep_now.sum()
-    rms_value = float(np.sqrt(np.mean(result.residuals[result.used] ** 2)))
+    used = result.used
+    rms_value = float(np.sqrt(np.mean(result.residuals[used] ** 2)))
     pdop = float(np.sqrt(np.trace(np.linalg.inv(H.T @ H)[:3, :3])))
     clock = {s: clocks[i] for i, s in enumerate(model.systems) if present[i]}
-    fit = _Fit(result.passed, result.dof, result.covariance, H[result.used])
-    return x, clock, int(used - (~result.used).sum()), rms_value, pdop, fit
+    s = sigma[keep_now]
+    leverage = np.einsum("ij,jk,ik->i", H, result.covariance, H) / s**2
+    spread = np.sqrt(np.where(used, np.clip(1.0 - leverage, 1e-6, 1.0), 1.0 + leverage))
+    return _EpochFit(
+        x,
+        clock,
+        int(used.sum()),
+        rms_value,
+        pdop,
+        result.passed,
+        result.dof,
+        result.covariance,
+        H[used],
+        s[used],
+        groups[used],
+        np.flatnonzero(keep_now),
+        result.residuals,
+        spread,
+        elevation[keep_now],
+    )
 
 
-@dataclass(frozen=True)
-class _Fit:
-    """What the integrity figures need from an epoch's final least squares."""
-
-    passed: bool
-    dof: int
-    covariance: np.ndarray
-    design: np.ndarray
-
-
-def _horizontal_quality(x: np.ndarray, design: np.ndarray, covariance: np.ndarray):
-    """HDOP (unweighted geometry) and √(σ_e² + σ_n²) (weighted covariance) at position x."""
-    lat, lon, _ = ecef_to_geodetic(x)
+def _quality(fit: _EpochFit, alpha: float) -> tuple[float, float, float, float, float]:
+    """HDOP (unweighted geometry), √(σ_e² + σ_n²) and σ_u (weighted covariance), and the
+    horizontal and vertical protection levels (module docstring of ``lsq``) at the fix."""
+    lat, lon, _ = ecef_to_geodetic(fit.x)
     rotation = ecef_to_enu_rotation(float(lat), float(lon))
-    geometry = np.linalg.inv(design.T @ design)[:3, :3]
-    horizontal = (rotation @ geometry @ rotation.T)[:2, :2]
-    weighted = (rotation @ covariance @ rotation.T)[:2, :2]
-    return np.sqrt(np.trace(horizontal)), np.sqrt(np.trace(weighted))
+    geometry = np.linalg.inv(fit.design.T @ fit.design)[:3, :3]
+    hdop = np.sqrt(np.trace((rotation @ geometry @ rotation.T)[:2, :2]))
+    weighted = rotation @ fit.covariance[:3, :3] @ rotation.T
+    shift = minimal_detectable_shift(
+        fit.design, fit.sigma, fit.groups, fit.covariance, fit.dof, alpha
+    )[:, :3]
+    if np.all(np.isfinite(shift)):
+        enu = shift @ rotation.T
+        horizontal = float(np.max(np.hypot(enu[:, 0], enu[:, 1])))
+        vertical = float(np.max(np.abs(enu[:, 2])))
+    else:
+        horizontal = vertical = float("inf")
+    return (
+        float(hdop),
+        float(np.sqrt(np.trace(weighted[:2, :2]))),
+        float(np.sqrt(weighted[2, 2])),
+        horizontal,
+        vertical,
+    )
+
+
+def model_error_sigma(
+    system: np.ndarray, elevation: np.ndarray, ionosphere_m: np.ndarray
+) -> np.ndarray:
+    """σ (m) of the errors of the models behind a pseudorange that its epoch's residuals do not
+    show (common to the satellites, slowly varying), added to the fitted noise in quadrature:
+    the broadcast orbit and clock (``SIGNAL_IN_SPACE_SIGMA_M`` per system), half of the
+    broadcast ionospheric delay (the Klobuchar model corrects about half of it, IS-GPS-200
+    sec. 20.3.3.5.2.5) and the troposphere's residual 0.3 m / (sin el + 0.1) (the budget of
+    RTKLIB's ``pntpos``, T. Takasu, RTKLIB 2.4.2 manual, appendix E.6)."""
+    orbit_clock = np.array([SIGNAL_IN_SPACE_SIGMA_M.get(str(s), 2.0) for s in system])
+    troposphere = TROPOSPHERE_SIGMA_M / (np.sin(elevation) + 0.1)
+    return np.sqrt(orbit_clock**2 + (IONOSPHERE_FRACTION * ionosphere_m) ** 2 + troposphere**2)
 
 
 def _linearise(data: _EpochData, model: _Model, x, clocks, keep):
@@ -242,23 +393,31 @@ def _linearise(data: _EpochData, model: _Model, x, clocks, keep):
     rho = np.linalg.norm(vector, axis=1)
     los = vector / rho[:, None]
     keep_now = keep.copy()
-    sigma = np.full(rho.size, SIGMA_PSEUDORANGE_M)
+    sigma = np.full(rho.size, SIGMA_PRIOR_M)
     atmosphere = np.zeros(rho.size)
+    elevation = np.full(rho.size, np.pi / 2)
     if np.linalg.norm(x) > EARTH_SURFACE_M:
         lat, lon, height = (float(v) for v in ecef_to_geodetic(x))
         elevation, azimuth = elevation_azimuth(x, los, (lat, lon))
         keep_now &= elevation >= model.mask
-        sigma = SIGMA_PSEUDORANGE_M / np.sin(np.maximum(elevation, np.deg2rad(5.0)))
-        atmosphere = troposphere_delay(lat, height, elevation)
+        sigma = prior_sigma(elevation)
+        for system, noise in model.noise.items():
+            hit = data.system == system
+            sigma[hit] = noise.sigma(data.cn0[hit], elevation[hit])
+        troposphere = troposphere_delay(lat, height, elevation)
+        ionosphere = np.zeros(rho.size)
         if model.klobuchar is not None:
-            atmosphere = atmosphere + klobuchar_delay(
+            ionosphere = klobuchar_delay(
                 model.klobuchar, lat, lon, elevation, azimuth, data.t, data.frequency
             )
+        atmosphere = troposphere + ionosphere
+        if model.noise:
+            sigma = np.hypot(sigma, model_error_sigma(data.system, elevation, ionosphere))
     one_hot = np.stack([data.system == s for s in model.systems], axis=1).astype(float)
     present = one_hot[keep_now].any(axis=0)
     predicted = rho + one_hot @ clocks + atmosphere
     H = np.hstack([-los, one_hot])
-    return H, data.corrected_range - predicted, sigma, keep_now, present
+    return H, data.corrected_range - predicted, sigma, keep_now, present, elevation
 
 
 def receiver_positions(solution: SppSolution, fallback: np.ndarray | None) -> np.ndarray:

@@ -46,6 +46,9 @@ SPP_COLUMNS = (
     "verified",
     "hdop",
     "horizontal_sigma_m",
+    "vertical_sigma_m",
+    "hpl_m",
+    "vpl_m",
 )
 
 
@@ -126,9 +129,12 @@ def write_spp_csv(path: str | Path, solution: SppSolution) -> None:
             solution.verified.astype(int),
             solution.hdop,
             solution.horizontal_sigma_m,
+            _or_nan(solution.vertical_sigma_m, len(solution.t)),
+            _or_nan(solution.horizontal_protection_m, len(solution.t)),
+            _or_nan(solution.vertical_protection_m, len(solution.t)),
         ],
         ["{:.3f}", "{:.9f}", "{:.9f}"]
         + ["{:.3f}"] * 7
         + ["{:d}", "{:.3f}", "{:.2f}", "{:d}"]
-        + ["{:d}", "{:.2f}", "{:.2f}"],
+        + ["{:d}", "{:.2f}", "{:.2f}", "{:.2f}", "{:.2f}", "{:.2f}"],
     )

@@ -98,4 +98,7 @@ def read_position_csv(path: str | Path) -> SppSolution:
         verified=_flag(table, "verified", path) if "verified" in table.columns else valid.copy(),
         hdop=_column(table, "hdop"),
         horizontal_sigma_m=_column(table, "horizontal_sigma_m"),
+        vertical_sigma_m=_column(table, "vertical_sigma_m"),
+        horizontal_protection_m=_column(table, "hpl_m"),
+        vertical_protection_m=_column(table, "vpl_m"),
     )

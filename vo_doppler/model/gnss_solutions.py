@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -20,12 +20,33 @@ class SppSolution:
     valid: np.ndarray
     n_no_ephemeris: int
     verified: np.ndarray | None = None
-    """Redundant and passing the chi-square test, the same as ``valid`` (a solved epoch without
-    redundancy, or still failing the test after the allowed exclusions, keeps its position but
-    is not valid)."""
+    """Redundant and passing the chi-square test with the fitted pseudorange σ (a solved epoch
+    without redundancy, or still failing the test after the allowed exclusions, keeps its
+    position but is not verified); ``valid`` is the same unless the fixes were also checked
+    against their Doppler-carried neighbours (``consistency_tested``)."""
     hdop: np.ndarray | None = None
     horizontal_sigma_m: np.ndarray | None = None
     """√(σ_e² + σ_n²) of the position from the weighted covariance (m)."""
+    vertical_sigma_m: np.ndarray | None = None
+    """σ_u of the position from the weighted covariance (m)."""
+    horizontal_protection_m: np.ndarray | None = None
+    """The largest horizontal position error (m) that a bias on one satellite's pseudorange
+    could cause while the chi-square test would catch it less than four times in five
+    (Baarda's minimal detectable bias, :func:`vo_doppler.gnss.lsq.minimal_detectable_shift`):
+    what the σ does not cover when one satellite is reflected. Infinite without redundancy,
+    NaN where unsolved."""
+    vertical_protection_m: np.ndarray | None = None
+    """The same for the vertical (m)."""
+    consistency_scale: tuple[float, float] | None = None
+    """(λ_h, λ_u): how much the fixes' scatter about their Doppler-carried neighbours exceeds
+    their formal σ, by which the σ and protection levels were multiplied
+    (:mod:`vo_doppler.gnss.position_check`); None: not checked."""
+    consistency_tested: np.ndarray | None = None
+    """Fixes the neighbour check could judge (None: not run); ``verified`` is each epoch's own
+    test, ``valid`` adds the check."""
+    noise_models: dict = field(default_factory=dict)
+    """(system, pseudorange code) → the σ(C/N0, elevation) law fitted to the residuals
+    (:class:`vo_doppler.gnss.pseudorange_noise.PseudorangeNoiseModel`); empty: the a-priori σ."""
 
 
 @dataclass(frozen=True)
