@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from tests.helpers.velocity import velocity_solution
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, wrap_angle
@@ -20,6 +21,7 @@ from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.run import (
+    PLACEMENT_VERTICAL_SIGMA_M,
     AntennaTrack,
     RunConfig,
     _malloc_trim,
@@ -330,6 +332,46 @@ def test_fixes_only_seconds_later_are_carried_back_along_the_trajectory():
     placed = level_with_yaw(own, 0.4, AntennaTrack(t[fixes], antenna), LEVER)
     assert np.all(np.abs(placed.positions[0] - truth[0]) < 1.5)
     np.testing.assert_allclose(placed.positions - placed.positions[0], truth - truth[0], atol=1e-9)
+
+
+def _canyon_heights(height_sigma):
+    """A straight drive 3 m above the origin, placed by fixes exact horizontally whose heights
+    are 46 m too high (σ_u 12 m, the sample's street canyon) except the ones of ``height_sigma``
+    at most 5 m, which are right."""
+    t = np.arange(0.0, 20.0, 0.1)
+    truth = np.column_stack([12.0 * t, np.zeros(t.size), np.full(t.size, 3.0)])
+    own = Trajectory(t, truth - truth[0], Rotation.identity(t.size))
+    fixes = np.arange(0, t.size, 10)
+    antenna = truth[fixes] + np.array(LEVER)
+    antenna[:, 2] += np.where(height_sigma <= PLACEMENT_VERTICAL_SIGMA_M, 0.0, 46.0)
+    track = AntennaTrack(t[fixes], antenna, height_sigma, "test")
+    return level_with_yaw(own, 0.0, track, LEVER), truth
+
+
+def test_heights_come_from_the_fixes_with_a_small_vertical_sigma_or_the_origin():
+    """Before: every trajectory 46 m above the road, the height of the canyon's fixes."""
+    sigma = np.full(20, 12.0)
+    placed, truth = _canyon_heights(sigma)
+    np.testing.assert_allclose(placed.positions[:, :2], truth[:, :2], atol=1e-9)
+    np.testing.assert_allclose(placed.positions[:, 2], 0.0, atol=1e-9)  # the origin's height
+    sigma[[3, 8, 15]] = [2.0, 4.0, 1.5]  # three good heights (beyond the first 5 s: carried)
+    placed, truth = _canyon_heights(sigma)
+    np.testing.assert_allclose(placed.positions, truth, atol=1e-9)
+
+
+def test_the_antenna_track_says_what_placed_the_heights():
+    t = np.arange(10.0)
+    position = np.tile(EnuFrame(0.6, 2.4, 50.0).origin_ecef, (10, 1))
+    spp = SppSolution(t, position, {}, np.full(10, 8), t, t, np.ones(10, bool), 0)
+    velocity = velocity_solution(t, np.zeros((10, 3)))
+    frame = EnuFrame(0.6, 2.4, 0.0)
+    poor = replace(spp, horizontal_sigma_m=np.ones(10), vertical_sigma_m=np.full(10, 9.0))
+    assert "the sequence origin" in antenna_track(poor, velocity, None, frame).height_source
+    sigma = np.where(t < 4, 3.0, 9.0)
+    good = replace(poor, vertical_sigma_m=sigma)
+    track = antenna_track(good, velocity, None, frame)
+    assert track.height_source.startswith("the valid fixes with a vertical σ of at most 5 m (4 of")
+    np.testing.assert_array_equal(track.height_rows, np.arange(4))
 
 
 def test_a_trajectory_without_a_gnss_epoch_is_placed_by_the_nearest_one_with_a_warning(caplog):

@@ -131,10 +131,51 @@ class RunResult:
 class AntennaTrack:
     """Where the trajectories are placed: the GNSS antenna's ENU positions ``position`` (N, 3, m)
     at the GPS times ``t`` (N,) of the valid SPP fixes; ``t`` empty with one untimed position
-    (no fix: the RINEX approximate position or the origin)."""
+    (no fix: the RINEX approximate position or the origin). Heights come only from the positions
+    whose ``height_sigma`` (N,, m; None: all) is at most ``PLACEMENT_VERTICAL_SIGMA_M``; without
+    any, from the sequence origin (the first pose at up 0). ``height_source`` says which, in
+    words, for the report."""
 
     t: np.ndarray
     position: np.ndarray
+    height_sigma: np.ndarray | None = None
+    height_source: str = "the antenna positions"
+
+    @property
+    def height_rows(self) -> np.ndarray:
+        """Indices of the positions whose heights may place a trajectory."""
+        if self.height_sigma is None:
+            return np.arange(len(self.position))
+        return np.flatnonzero(
+            np.nan_to_num(self.height_sigma, nan=np.inf) <= PLACEMENT_VERTICAL_SIGMA_M
+        )
+
+
+PLACEMENT_VERTICAL_SIGMA_M = 5.0
+"""Largest vertical σ (m) of a valid fix whose height may place the trajectories. A street
+canyon's fixes are worst in height (the satellites left are high, their reflections all
+delays): the sample's valid fixes lay 46 m above the road, the Hong Kong drive's 14 m at the
+median with σ_u 14 m; a fix this good is a better height than the origin's guess, a worse one
+is not."""
+ORIGIN_HEIGHT = (
+    "the sequence origin (no valid fix with a vertical σ of at most {limit:g} m): the first "
+    "pose at its height"
+)
+
+
+def _height_sigma(spp: SppSolution, rows: np.ndarray) -> tuple[np.ndarray, str]:
+    """σ_u (m) of the fixes ``rows`` (inf where unknown) and what places the heights."""
+    sigma = np.full(rows.size, np.inf)
+    if spp.vertical_sigma_m is not None:
+        sigma = np.nan_to_num(spp.vertical_sigma_m[rows], nan=np.inf)
+    good = sigma <= PLACEMENT_VERTICAL_SIGMA_M
+    if not good.any():
+        return sigma, ORIGIN_HEIGHT.format(limit=PLACEMENT_VERTICAL_SIGMA_M)
+    return sigma, (
+        f"the valid fixes with a vertical σ of at most {PLACEMENT_VERTICAL_SIGMA_M:g} m "
+        f"({good.sum()} of {rows.size}; median σ_u {np.median(sigma[good]):.1f} m), their "
+        "inverse-variance weighted median"
+    )
 
 
 def antenna_track(
@@ -164,15 +205,20 @@ def antenna_track(
             spp.t, fixes, spp.horizontal_sigma_m, velocity.velocity_ecef, velocity.covariance, known
         )
         if track is not None:
-            return AntennaTrack(spp.t[valid], enu.ecef_to_enu(track[valid]))
+            sigma, source = _height_sigma(spp, valid)
+            return AntennaTrack(spp.t[valid], enu.ecef_to_enu(track[valid]), sigma, source)
     if valid.size:
-        return AntennaTrack(spp.t[valid], enu.ecef_to_enu(spp.position_ecef[valid]))
+        sigma, source = _height_sigma(spp, valid)
+        return AntennaTrack(spp.t[valid], enu.ecef_to_enu(spp.position_ecef[valid]), sigma, source)
+    origin = ORIGIN_HEIGHT.format(limit=PLACEMENT_VERTICAL_SIGMA_M)
     approx = np.asarray(approx_position if approx_position is not None else np.nan, dtype=float)
     if np.all(np.isfinite(approx)) and np.linalg.norm(approx) > EARTH_SURFACE_M:
         log.warning("no SPP fix: the trajectories start at the RINEX approximate position")
-        return AntennaTrack(np.zeros(0), enu.ecef_to_enu(approx.reshape(1, 3)))
+        return AntennaTrack(
+            np.zeros(0), enu.ecef_to_enu(approx.reshape(1, 3)), np.full(1, np.inf), origin
+        )
     log.warning("no SPP fix and no approximate position: the trajectories start at the origin")
-    return AntennaTrack(np.zeros(0), np.zeros((1, 3)))
+    return AntennaTrack(np.zeros(0), np.zeros((1, 3)), np.full(1, np.inf), origin)
 
 
 PLACEMENT_SPAN_S = 60.0
@@ -197,7 +243,10 @@ def level_with_yaw(
     positions of the first ``PLACEMENT_SPAN_S`` seconds inside the trajectory's times (at least
     ``PLACEMENT_MIN_FIXES``): each fix is carried back to the start along the trajectory
     itself, the vehicle placed where it was then, not where it was seconds later, and one bad
-    fix cannot move it. The trajectory's antenna at a fix's time: its position interpolated
+    fix cannot move it. The height likewise, from the positions whose heights are good
+    (``AntennaTrack.height_rows``: valid fixes with a small vertical σ), their inverse-variance
+    weighted median; without any, the first pose at the sequence origin's height (up 0). The
+    trajectory's antenna at a fix's time: its position interpolated
     there plus the lever arm (``lever_arm_m`` from the vehicle's origin, x forward, y left,
     z up) turned by its pose nearest in time. Without an antenna position inside, the one
     nearest in time places the trajectory's nearest end (with a warning); an untimed one, the
@@ -208,28 +257,65 @@ def level_with_yaw(
     out = rotation @ trajectory.matrices
     t = trajectory.t
     if not antenna.t.size:
-        out[:, :3, 3] += antenna.position[0] - out[0, :3, 3]
+        shift = antenna.position[0] - out[0, :3, 3]
+        if not antenna.height_rows.size:
+            shift[2] = -out[0, 2, 3]
+        out[:, :3, 3] += shift
         return Trajectory.from_matrices(t, out)
-    outside_s = np.maximum(t[0] - antenna.t, antenna.t - t[-1])
-    rows = np.flatnonzero(outside_s <= 0.0)
-    if rows.size:
-        span = antenna.t[rows] <= antenna.t[rows[0]] + PLACEMENT_SPAN_S
-        rows = rows[: max(int(span.sum()), PLACEMENT_MIN_FIXES)]
+    lever = np.asarray(lever_arm_m, dtype=float)
+    rows = _placing_rows(antenna.t, np.arange(antenna.t.size), t, warn=True)
+    shift = np.median(antenna.position[rows] - _carried(out, t, antenna.t[rows], lever), axis=0)
+    heights = antenna.height_rows
+    if heights.size:
+        rows = _placing_rows(antenna.t, heights, t, warn=False)
+        carried = _carried(out, t, antenna.t[rows], lever)[:, 2]
+        weight = np.ones(rows.size)
+        if antenna.height_sigma is not None:
+            weight = np.maximum(antenna.height_sigma[rows], 1e-3) ** -2.0
+        shift[2] = weighted_median(antenna.position[rows, 2] - carried, weight)
     else:
-        rows = np.array([int(np.argmin(outside_s))])
+        shift[2] = -out[0, 2, 3]
+    out[:, :3, 3] += shift
+    return Trajectory.from_matrices(t, out)
+
+
+def _placing_rows(t_fix: np.ndarray, rows: np.ndarray, t: np.ndarray, warn: bool) -> np.ndarray:
+    """Of the antenna positions ``rows`` (times ``t_fix[rows]``), those of the first
+    ``PLACEMENT_SPAN_S`` seconds inside the trajectory's times ``t`` (at least
+    ``PLACEMENT_MIN_FIXES``); without any inside, the nearest in time (with a warning if
+    ``warn``)."""
+    outside_s = np.maximum(t[0] - t_fix[rows], t_fix[rows] - t[-1])
+    inside = rows[outside_s <= 0.0]
+    if inside.size:
+        span = t_fix[inside] <= t_fix[inside[0]] + PLACEMENT_SPAN_S
+        return inside[: max(int(span.sum()), PLACEMENT_MIN_FIXES)]
+    nearest = int(np.argmin(outside_s))
+    if warn:
         log.warning(
             "no GNSS fix within the trajectory from %.1f to %.1f s: it is placed by the antenna "
             "position %.1f s outside it",
             t[0],
             t[-1],
-            outside_s[rows[0]],
+            outside_s[nearest],
         )
-    t_fix = np.clip(antenna.t[rows], t[0], t[-1])
-    carried = np.column_stack([np.interp(t_fix, t, out[:, axis, 3]) for axis in range(3)])
-    nearest = nearest_time(t, t_fix)
-    carried += out[nearest, :3, :3] @ np.asarray(lever_arm_m, dtype=float)
-    out[:, :3, 3] += np.median(antenna.position[rows] - carried, axis=0)
-    return Trajectory.from_matrices(t, out)
+    return rows[[nearest]]
+
+
+def _carried(poses: np.ndarray, t: np.ndarray, t_fix: np.ndarray, lever: np.ndarray):
+    """The trajectory's antenna (position interpolated at ``t_fix`` plus the lever arm turned
+    by the pose nearest in time), (M, 3)."""
+    t_fix = np.clip(t_fix, t[0], t[-1])
+    carried = np.column_stack([np.interp(t_fix, t, poses[:, axis, 3]) for axis in range(3)])
+    return carried + poses[nearest_time(t, t_fix), :3, :3] @ lever
+
+
+def weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
+    """The value at which the cumulative weight of the sorted ``values`` reaches half of the
+    total (the lower one on a tie): the median when the weights are equal and unmoved by values
+    holding less than half of the weight, however far off."""
+    order = np.argsort(values, kind="stable")
+    cumulative = np.cumsum(weights[order])
+    return float(values[order][np.searchsorted(cumulative, 0.5 * cumulative[-1])])
 
 
 def correct_all(
@@ -269,7 +355,10 @@ def correct_all(
     trajectories: dict[Pipeline, Trajectory] = {}
     if vo_vehicle is not None:
         vo_level = level_with_yaw(
-            vo_vehicle, initial_yaw_offset(table, usable, vo_vehicle), antenna, lever
+            vo_vehicle,
+            initial_yaw_offset(table, usable, vo_vehicle),
+            antenna,
+            lever,
         )
         trajectories[Pipeline.VO] = vo_level
         trajectories[Pipeline.VO_GPS_CONV] = correct(
@@ -448,7 +537,7 @@ def run_without_gnss(
     if vo_vehicle is not None:
         begin, end = max(begin, vo_vehicle.t[0]), min(end, vo_vehicle.t[-1])
     t_dr = np.arange(begin, end, 1.0 / config.dead_reckoning_rate_hz)
-    origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)))
+    origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)), None, "the sequence origin (no GNSS)")
     tracks = {Pipeline.VO: vo_vehicle}
     if len(t_dr) > 1:
         tracks[Pipeline.DR] = wheel_gyro_track(speed, yaw_rate, t_dr)

@@ -306,6 +306,7 @@ def write_run_outputs(
         write_heading_csv(out / "heading.csv", result.heading)
     summary = summarise(result, sequence.vehicle_span)
     summary["heading_correction"] = correction_label(config)
+    summary["placement_heights"] = result.antenna.height_source
     summary.update(checks or {})
     if span is not None:
         summary["span"] = span
@@ -324,6 +325,7 @@ def write_run_outputs(
         heading_figure="",
         warnings=list(summary.get("warnings", [])),
         definitions=glossary(sequence.has_camera, sequence.has_gnss),
+        placement_heights=result.antenna.height_source,
     )
     truth_yaw = truth.yaw_at(table.t) if truth is not None and table is not None else None
     if truth is not None:

@@ -432,6 +432,8 @@ class RunReport:
     not do (ground truth covering part of the drive), shown under the data."""
     definitions: list[tuple[str, str]] = field(default_factory=glossary)
     """The definitions shown (:func:`glossary`: only those of what ran)."""
+    placement_heights: str = ""
+    """What placed the trajectories' heights (``AntennaTrack.height_source``)."""
 
 
 STYLE = (
@@ -562,7 +564,13 @@ def render(report: RunReport) -> str:
             "by the GNSS single-point positions), against the ground truth at the same time: "
             "horizontal distance and height difference (absolute) at its first and last pose "
             "inside the truth's time span, and the medians over all of them. The table above "
-            "moves each trajectory to the truth first and so leaves this offset out.</p>",
+            "moves each trajectory to the truth first and so leaves this offset out."
+            + (
+                f" Heights placed by {html.escape(report.placement_heights)}."
+                if report.placement_heights
+                else ""
+            )
+            + "</p>",
             _absolute_table(report.absolute),
         ]
     parts += [
