@@ -352,11 +352,12 @@ def correct_all(
     )
     conventional = conventional_absolute_heading(table)
     lever = sequence.antenna_lever_arm_m
+    reference = config.correction.reference
     trajectories: dict[Pipeline, Trajectory] = {}
     if vo_vehicle is not None:
         vo_level = level_with_yaw(
             vo_vehicle,
-            initial_yaw_offset(table, usable, vo_vehicle),
+            initial_yaw_offset(table, usable, vo_vehicle, reference=reference),
             antenna,
             lever,
         )
@@ -366,7 +367,9 @@ def correct_all(
         ).vehicle
         trajectories[Pipeline.VO_GPS_TC] = correct(vo_level, tight, config.correction).vehicle
     if dr is not None:
-        dr_level = level_with_yaw(dr, initial_yaw_offset(table, usable, dr), antenna, lever)
+        dr_level = level_with_yaw(
+            dr, initial_yaw_offset(table, usable, dr, reference=reference), antenna, lever
+        )
         trajectories[Pipeline.DR] = dr_level
         trajectories[Pipeline.DR_GPS_CONV] = correct(
             dr_level, conventional, config.correction

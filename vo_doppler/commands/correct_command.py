@@ -208,7 +208,9 @@ def run(args: argparse.Namespace) -> int:
     # The starting heading as `run` sets it: before its first absolute heading (and through
     # the window method's first window) the trajectory would stay in the VO's own frame.
     usable = usable_tight_heading(table, config.tc_max_sigma)
-    start_turn = initial_yaw_offset(table, usable, vehicle, source=args.source)
+    start_turn = initial_yaw_offset(
+        table, usable, vehicle, source=args.source, reference=config.reference
+    )
     vehicle = turned_about_start(vehicle, start_turn)
     result = correct(vehicle, absolute_heading(table, args.source, config), config)
     if not result.has_absolute.any():

@@ -8,6 +8,8 @@ import logging
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.fusion.heading_blend import BlendConfig, relative_times, vo_direction
+from vo_doppler.fusion.heading_correction import headings_at
 from vo_doppler.geo import wrap_angle
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
@@ -26,10 +28,41 @@ START_SOURCES = {
 a trajectory, in order of preference (:func:`initial_yaw_offset`)."""
 
 
-def yaw_offset(trajectory: Trajectory, t: np.ndarray, yaw: np.ndarray) -> float:
-    """Circular median of the absolute headings ``yaw`` minus the trajectory's yaw at ``t``:
-    the rotation about z that best turns the trajectory into the absolute headings."""
-    differences = wrap_angle(yaw - trajectory.yaw_at(t))
+def yaw_offset(
+    trajectory: Trajectory,
+    t: np.ndarray,
+    yaw: np.ndarray,
+    reference: str = "course",
+    min_chord_m: float = BlendConfig.min_chord_m,
+    max_gap_s: float = BlendConfig.max_gap_s,
+) -> float:
+    """Circular median of the absolute headings ``yaw`` (at ``t``) minus the trajectory's
+    direction: the rotation about z that best turns the trajectory into the absolute headings.
+
+    The direction is the one the correction compares them with
+    (:func:`~vo_doppler.fusion.heading_blend.offset_measurements`): for ``reference``
+    "course", the course of the trajectory's chords of at least ``min_chord_m`` (its vehicle
+    origin's direction of travel, which the heading table's headings are: the heading stage
+    takes the antenna's lever arm out of them), at each chord's middle time, with the absolute
+    heading interpolated there across gaps of at most ``max_gap_s``; for "orientation", or
+    where the trajectory does not move that far within the headings' times, its yaw at ``t``.
+    In a sharp turn the two differ (a vehicle origin under the camera slips sideways: 7.7° on
+    a simulated drive), and a start from the yaw would leave that difference in the whole
+    trajectory. Times relative to the trajectory's start: no dependence on the time origin."""
+    origin = float(trajectory.t[0]) if len(trajectory.t) else 0.0
+    t = relative_times(np.asarray(t, dtype=float), origin)
+    yaw = np.asarray(yaw, dtype=float)
+    differences = np.zeros(0)
+    if reference == "course":
+        poses = trajectory.matrices
+        positions = poses[:, :3, 3] - poses[0, :3, 3]
+        t_direction, yaw_direction = vo_direction(
+            relative_times(trajectory.t, origin), positions, poses[:, :3, :3], "course", min_chord_m
+        )
+        absolute, inside = headings_at(t_direction, t, yaw, None, max_gap_s)
+        differences = wrap_angle(absolute[inside] - yaw_direction[inside])
+    if not differences.size:
+        differences = wrap_angle(yaw - trajectory.yaw_at(t + origin))
     return float(differences[0] + np.median(wrap_angle(differences - differences[0])))
 
 
@@ -39,6 +72,7 @@ def initial_yaw_offset(
     trajectory: Trajectory,
     span_s: float = INITIAL_HEADING_SPAN_S,
     source: str = "tc+conv",
+    reference: str = "course",
 ) -> float:
     """Rotation about z that starts a trajectory with the absolute heading.
 
@@ -49,7 +83,9 @@ def initial_yaw_offset(
     correct (a canyon from the start: two satellites, an uncalibrated wheel scale); without
     those, the trajectory starts facing east (with a warning). ``source`` keeps the headings
     of one kind only (:data:`START_SOURCES`: "tc" without the conventional ones, "conv" the
-    conventional ones alone).
+    conventional ones alone). ``reference``: what the headings are compared with, as the
+    correction compares them (:func:`yaw_offset`: the trajectory's 'course' or its
+    'orientation' yaw); ``run`` and ``correct`` pass their correction's.
     """
     if source not in START_SOURCES:
         raise ValueError(f"unknown heading source {source!r} ({', '.join(START_SOURCES)})")
@@ -64,7 +100,7 @@ def initial_yaw_offset(
         rows = np.flatnonzero(valid & inside & np.isfinite(yaw))
         if rows.size:
             rows = rows[table.t[rows] <= table.t[rows[0]] + span_s]
-            return yaw_offset(trajectory, table.t[rows], yaw[rows])
+            return yaw_offset(trajectory, table.t[rows], yaw[rows], reference)
     log.warning(
         "no absolute heading during the %.0f s of a trajectory: it starts facing east",
         trajectory.t[-1] - trajectory.t[0],
