@@ -185,6 +185,15 @@ def run(args: argparse.Namespace) -> int:
         f"h {np.degrees(model.h):.3g} deg/s; {window} "
         f"{result.prepared.standstill[0]:.2f}–{result.prepared.standstill[1]:.2f} s"
     )
+    start = result.initial_heading
+    if start is None:
+        console.print("initial heading: the first GPS course (too little track to fit one)")
+    else:
+        course = start.to_dict()
+        console.print(
+            f"initial heading: course {course['course_deg']:.2f} ± {course['sigma_deg']:.2f} deg "
+            f"(1σ), the path fitted to {start.fixes} GPS fixes of {start.t0:.2f}–{start.t1:.2f} s"
+        )
     skipped = gyro1.n_skipped + gyro2.n_skipped
     console.print(
         f"skipped input rows: gyros {skipped}, GPS {fixes.n_skipped}; GPS gaps "

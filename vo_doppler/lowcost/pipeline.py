@@ -173,6 +173,8 @@ class PreparedTrack:
     track_enu: np.ndarray
     standstill: tuple[float, float]
     standstills: list[tuple[float, float]]
+    raw_t: np.ndarray | None = None
+    """Times (s) of the cleaned fixes ``raw_enu``."""
 
 
 def _prepare_track(fixes, config: DeadReckonConfig, speed) -> PreparedTrack:
@@ -191,7 +193,14 @@ def _prepare_track(fixes, config: DeadReckonConfig, speed) -> PreparedTrack:
     knots = _standstill_knots(fix_t, standstills)
     track = reconstruct_track(fix_t, lat, lon, config.downsample, config.cluster_m, knots)
     return PreparedTrack(
-        report, frame, enu(lat, lon), track, enu(track.lat, track.lon), standstill, standstills
+        report,
+        frame,
+        enu(lat, lon),
+        track,
+        enu(track.lat, track.lon),
+        standstill,
+        standstills,
+        fix_t,
     )
 
 
@@ -239,6 +248,72 @@ def _bias_model(rates: AlignedRates, standstill, config: DeadReckonConfig) -> Bi
     return BiasModel(k_choices, k, combined, allan, tau, eps0, h)
 
 
+INITIAL_FIT_S = 10.0
+"""Seconds of moving track, from the first, whose shape fits the initial heading when no
+straight stretch is given (the gyro's drift over them is far below the fit's σ)."""
+MIN_FIT_PATH_M = 5.0
+"""Less track than this over the fit's span gives no direction: the first course instead."""
+
+
+@dataclass(frozen=True)
+class InitialHeading:
+    """The dead reckoning's initial yaw (rad, CCW from east) and its σ (rad; NaN when taken
+    from a single course), fitted over the GPS fixes of ``t0``–``t1`` (``fixes`` of them)."""
+
+    yaw: float
+    sigma: float
+    t0: float
+    t1: float
+    fixes: int
+
+    def to_dict(self) -> dict:
+        """Degrees, course clockwise from north, for people."""
+        return {
+            "course_deg": float(np.mod(90.0 - np.degrees(self.yaw), 360.0)),
+            "sigma_deg": float(np.degrees(self.sigma)),
+            "t0_s": self.t0,
+            "t1_s": self.t1,
+            "fixes": self.fixes,
+        }
+
+
+def fit_initial_heading(
+    t: np.ndarray, track: np.ndarray, shape: np.ndarray, span: tuple[float, float]
+) -> InitialHeading | None:
+    """The rotation about the vertical that best lays the dead-reckoned path ``shape`` (N, 2,
+    east/north, started facing east: yaw 0) onto the GPS ``track`` (N, 2) over the epochs
+    ``t`` inside ``span``: the least-squares rotation of the centred points (2-D Procrustes),
+
+        ψ₀ = atan2(Σ d_i × g_i, Σ d_i · g_i),    σ_ψ² = s² / Σ |d_i|²,
+        s² = Σ |g_i − R(ψ₀) d_i|² / (2n − 3)
+
+    (d, g the centred shape and track points, s² the fixes' scatter per axis about the fitted
+    path, 2n − 3 its degrees of freedom after the translation and the angle), Σ |d_i|² counted
+    once per second (a receiver's fixes share its position filter's errors over about a
+    second: ten 10-Hz fixes are one measurement, not ten). The path's own
+    turns enter through the gyro, so the span need not be straight; its length pins ψ₀: 0.1 m
+    of scatter over 50 m of path is 0.1°. None with fewer than three epochs or less than
+    ``MIN_FIT_PATH_M`` of path in the span."""
+    inside = (t >= span[0]) & (t <= span[1])
+    n = int(inside.sum())
+    if n < 3:
+        return None
+    d = shape[inside] - shape[inside].mean(axis=0)
+    g = track[inside] - track[inside].mean(axis=0)
+    if 2.0 * float(np.max(np.hypot(d[:, 0], d[:, 1]))) < MIN_FIT_PATH_M:
+        return None
+    spread = float(np.sum(d**2))
+    yaw = float(np.arctan2(np.sum(d[:, 0] * g[:, 1] - d[:, 1] * g[:, 0]), np.sum(d * g)))
+    c, s_ = np.cos(yaw), np.sin(yaw)
+    fitted = d @ np.array([[c, s_], [-s_, c]])
+    scatter = float(np.sum((g - fitted) ** 2)) / max(2 * n - 3, 1)
+    independent = min(n, max(int(t[inside][-1] - t[inside][0]), 1) + 1)
+    spread *= independent / n
+    return InitialHeading(
+        yaw, float(np.sqrt(scatter / spread)), float(t[inside][0]), float(t[inside][-1]), n
+    )
+
+
 @dataclass
 class DeadReckonResult:
     """Everything the chain computed, for tables, files and figures."""
@@ -251,6 +326,8 @@ class DeadReckonResult:
     trajectories: dict[str, DeadReckoning] = field(default_factory=dict)
     rows: list[DriftRow] = field(default_factory=list)
     selected: str = "combined + ε0 removed"
+    initial_heading: InitialHeading | None = None
+    """How the dead reckoning was started (None: from the first GPS course alone)."""
 
     @property
     def selected_trajectory(self) -> DeadReckoning:
@@ -286,8 +363,8 @@ def run_deadreckon(
         steps = np.where(inside[:-1] & inside[1:], 0.0, steps)
     epoch_enu = track_enu[in_gyro]
 
+    speed_at = smoothed_track_speed(track.t, track_enu[:, 0], track_enu[:, 1])[in_gyro]
     if reference is None:
-        speed_at = smoothed_track_speed(track.t, track_enu[:, 0], track_enu[:, 1])[in_gyro]
         reference_yaw = _gps_reference(epochs, epoch_enu, speed_at)
         source = "reconstructed GPS course"
     else:
@@ -296,7 +373,6 @@ def run_deadreckon(
     valid = np.isfinite(reference_yaw)
     if np.sum(valid) < 2:
         raise InputError(f"the {source} covers fewer than 2 dead-reckoning epochs")
-    yaw0 = float(reference_yaw[np.flatnonzero(valid)[0]])
 
     result = DeadReckonResult(rates, prepared, model, source, config)
     if config.threshold is not None:
@@ -305,6 +381,28 @@ def run_deadreckon(
     rates_by_variant = variant_rates(
         model.combined, rates.omega1, rates.omega2, model.eps0["combined"], model.h
     )
+    # The start comes from the GPS track, never from the reference (a ground truth scores the
+    # result; it must not start it): the rotation that lays the path's first seconds onto the
+    # fixes, over the straight stretch when one is given.
+    shape = dead_reckon(
+        epochs, steps, increments(rates.t, rates_by_variant[result.selected], epochs, "hold"), 0.0
+    )
+    moving = epochs[speed_at >= MOVING_SPEED_MPS]
+    span = (epochs[0], epochs[0])
+    if config.standstill is not None and not config.window_is_standstill:
+        span = config.standstill
+    elif moving.size:
+        span = (moving[0], moving[0] + INITIAL_FIT_S)
+    fix_t = prepared.raw_t
+    shape_en = np.column_stack([np.interp(fix_t, epochs, v) for v in (shape.east, shape.north)])
+    result.initial_heading = fit_initial_heading(fix_t, prepared.raw_enu, shape_en, span)
+    if result.initial_heading is not None:
+        yaw0 = result.initial_heading.yaw
+    else:
+        gps_yaw = (
+            reference_yaw if reference is None else _gps_reference(epochs, epoch_enu, speed_at)
+        )
+        yaw0 = float(gps_yaw[np.flatnonzero(np.isfinite(gps_yaw))[0]])
     for name, rate in rates_by_variant.items():
         dr = dead_reckon(
             epochs, steps, increments(rates.t, rate, epochs, outside="hold"), yaw0, start

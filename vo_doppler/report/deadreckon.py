@@ -91,6 +91,9 @@ def summary(result: DeadReckonResult) -> dict:
         "standstill_is_straight_driving": not result.config.window_is_standstill,
         "standstills": [list(iv) for iv in prepared.standstills],
         "reference": result.reference_source,
+        "initial_heading": (
+            None if result.initial_heading is None else result.initial_heading.to_dict()
+        ),
         "selected_variant": result.selected,
         "route_closes": bool(result.rows[0].gap.closed) if result.rows else None,
         "origin_lat_lon_deg": [
