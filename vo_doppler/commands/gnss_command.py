@@ -332,8 +332,13 @@ def run(args: argparse.Namespace) -> int:
         ]
     problems = len(obs.problems) + len(state_problems(nav))
     summary = (
-        f"{int(valid.sum())} of {valid.size} epochs valid (the others: too few satellites or "
-        "failing the residual test)"
+        f"{int(valid.sum())} of {valid.size} epochs valid (the others: too few satellites, "
+        "failing the residual test"
+        + (
+            " or inconsistent with their neighbours carried along the Doppler velocities)"
+            if args.gnss_command == "spp"
+            else ")"
+        )
         + (f"; {problems} input problems (warned above)" if problems else "")
     )
     if not valid.any():
