@@ -85,6 +85,7 @@ FACT_FORMATS = {
     "vo_fps": ("VO speed", "{:.1f} frames/s"),
     "camera": ("camera", "{}"),
     "heading_correction": ("heading correction", "{}"),
+    "placement_heights": ("heights placed by", "{}"),
     "gnss": ("GNSS", "{}"),
     "heading_source": ("absolute heading", "{}"),
     "can_clock_residual_offset_s": (
