@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vo_doppler.geo import EnuFrame, wrap_angle
-from vo_doppler.heading.conventional import course_from_velocity, heading_from_velocity
+from vo_doppler.heading.conventional import heading_from_velocity
 from vo_doppler.heading.tight_heading import TightHeadingConfig, tight_heading_series
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.sim.doppler_rows import simulate_doppler
@@ -228,9 +228,9 @@ def test_conventional_heading_from_velocity():
     yaw, ok = heading_from_velocity(v)
     np.testing.assert_allclose(yaw[:3], [0.0, np.pi / 2, -np.pi / 2])
     assert ok.tolist() == [True, True, True, False]
-    course, ok = course_from_velocity(v, valid=np.array([True, True, False, True]))
-    np.testing.assert_allclose(course[:2], [np.pi / 2, 0.0])
-    assert ok.tolist() == [True, True, False, False] and np.isnan(course[2:]).all()
+    yaw, ok = heading_from_velocity(v, valid=np.array([True, True, False, True]))
+    np.testing.assert_allclose(yaw[:2], [0.0, np.pi / 2])
+    assert ok.tolist() == [True, True, False, False] and np.isnan(yaw[2:]).all()
 
 
 def test_no_epochs_no_rows_and_unmatched_rows_are_unavailable():

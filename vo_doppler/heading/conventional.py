@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vo_doppler.geo import wrap_angle, yaw_to_course
+from vo_doppler.geo import wrap_angle
 
 
 def heading_from_velocity(
@@ -23,14 +23,6 @@ def heading_from_velocity(
         ok &= np.asarray(valid, dtype=bool)
     yaw = np.where(ok, np.arctan2(v[..., 1], v[..., 0]), np.nan)
     return yaw, ok
-
-
-def course_from_velocity(
-    velocity_enu: np.ndarray, valid: np.ndarray | None = None, min_speed_mps: float = 0.5
-) -> tuple[np.ndarray, np.ndarray]:
-    """Course (rad, clockwise from north, [0, 2π)) of ENU velocities and its validity."""
-    yaw, ok = heading_from_velocity(velocity_enu, valid, min_speed_mps)
-    return np.where(ok, yaw_to_course(np.nan_to_num(yaw)), np.nan), ok
 
 
 def velocity_heading_sigma(
