@@ -13,7 +13,6 @@ from vo_doppler.time_hints import (
     UNIX_OFFSET_S,
     TimeBase,
     coverage,
-    frame_index_hint,
     looks_like_frame_numbers,
     offset_hint,
     overlap_error,
@@ -35,11 +34,6 @@ def test_a_unix_time_log_gets_the_gps_minus_unix_offset():
 
 def test_times_since_the_log_start_get_the_start_hint():
     assert "since the start of the log" in offset_hint(0.0, 1425953400.0, "--time-offset")
-
-
-def test_frame_numbers_suggest_times():
-    assert "--times" in frame_index_hint(np.arange(10.0))
-    assert frame_index_hint(0.1 * np.arange(10.0)) == ""
 
 
 def test_overlap_error_shows_plain_spans_without_numpy_brackets():

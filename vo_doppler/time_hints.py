@@ -61,13 +61,6 @@ def looks_like_frame_numbers(t: np.ndarray) -> bool:
     return bool(len(t) > 2 and np.all(np.abs(np.diff(t) - 1.0) <= FRAME_STEP_TOLERANCE_S))
 
 
-def frame_index_hint(t: np.ndarray) -> str:
-    """For a trajectory whose times are 0, 1, 2, …: they are frame numbers, not times."""
-    if looks_like_frame_numbers(t):
-        return f"; its times are frame numbers 0, 1, 2, ...: {FRAME_NUMBER_FIX}"
-    return ""
-
-
 def coverage(t: np.ndarray, epochs: np.ndarray) -> float:
     """Share of the span of ``t`` inside the span of ``epochs`` (0 when they do not meet or
     either is empty; for a single time, 1 when it lies inside)."""
