@@ -45,8 +45,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from vo_doppler.geo import SPEED_OF_LIGHT
-
 if TYPE_CHECKING:
     from vo_doppler.sim.gnss_observations import Boxes, GnssSimConfig
 
@@ -248,8 +246,3 @@ def thermal_sigma_mps(config: GnssSimConfig, cn0_dbhz: np.ndarray) -> np.ndarray
     loop = config.sigma_range_rate_mps * 10.0 ** ((CN0_NOISE_REFERENCE_DBHZ - cn0_dbhz) / 20.0)
     floor = config.canyon.doppler_floor_mps if config.canyon is not None else 0.0
     return np.hypot(loop, floor)
-
-
-def clock_drift_steps_mps(drift: np.ndarray) -> np.ndarray:
-    """Epoch-to-epoch changes of a receiver clock drift (s/s) as range rates (m/s)."""
-    return np.diff(np.asarray(drift) * SPEED_OF_LIGHT)
