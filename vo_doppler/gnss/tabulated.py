@@ -1,12 +1,13 @@
 """Satellite states from a provider's table (GSDC ``device_gnss.csv``) instead of ephemerides.
 
-The same contract as :func:`vo_doppler.gnss.ephemeris.transmit_states`: states at signal
+The same contract as :func:`vo_doppler.gnss.satellite_source.transmit_states`: states at signal
 transmission in the ECEF frame of the reception epoch, plus the travel times. The table's
 states are already at transmission, in the frame of that instant; they are rotated by the Earth
 rotation during the travel time (IS-GPS-200 sec. 20.3.3.4.3.4), the geometric one when the
 receiver position is given, else the table's own. Queries without a table row at the same epoch
-(within 1 ms) are ``valid = False``. A hook for a state-source choice in the GNSS stage; the
-stage itself still takes a :class:`Navigation`.
+(within 1 ms) are ``valid = False``. For a solution of your own: the GNSS stage does not take
+the table, it queries a state source (navigation file or precise orbits) at transmission times
+(docs/formats.md, GSDC).
 """
 
 from __future__ import annotations

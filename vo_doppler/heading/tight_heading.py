@@ -1,7 +1,7 @@
 """Tightly coupled time-series heading from Doppler, gyro and wheel speed ([TK18] sec. 3.5).
 
 For the window of epochs t ∈ (t_k − W, t_k] ending at epoch k, every Doppler row (see
-:mod:`vo_doppler.heading.rows`) gives one equation in three unknowns:
+:mod:`vo_doppler.model.doppler`) gives one equation in three unknowns:
 
     y = −G·v_t + ρ_t,    v_t = s_t · [cos θ_t, sin θ_t, g],
     θ_t = θ₀ + Φ_t − Φ_k,    ρ_t = ρ₀ − α · (t − t_k)

@@ -1,6 +1,6 @@
 """Synthetic Doppler rows for a land vehicle, exact by construction (for tests and benchmarks).
 
-The truth follows the conventions of :mod:`vo_doppler.heading.rows`: ṙ = G·(v_s − v) + ρ − ρ_s,
+The truth follows the conventions of :mod:`vo_doppler.model.doppler`: ṙ = G·(v_s − v) + ρ − ρ_s,
 yaw counter-clockwise from east, velocity horizontal.
 """
 
