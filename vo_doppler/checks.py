@@ -4,7 +4,9 @@ Pure functions over model types and numpy (no file I/O, no stage): the library's
 call them (``run_sequence`` and ``heading_from_gnss``: errors raised before the work they
 would spoil, warnings logged and returned), and so every command. The messages name the
 signals as a :class:`~vo_doppler.model.vehicle_source.VehicleSignalSource` says (a file, a
-CAN signal and its DBC, an option). Each check states its threshold:
+CAN signal and its DBC, an option). Where the checks sit: docs/design.md, "Packages"; the
+measurements behind their thresholds: docs/benchmarks.md, "Plausibility checks". Each check
+states its threshold:
 
 * yaw rate against its DBC unit: while the wheels turn faster than 2 m/s, a median |yaw rate|
   above 0.2 rad/s (11.5 °/s) or a median lateral acceleration |yaw rate × speed| above
@@ -13,9 +15,8 @@ CAN signal and its DBC, an option). Each check states its threshold:
 * the yaw rate's sign against the GNSS Doppler course (:func:`yaw_rate_sign_agreement`): over
   the turns between two straights, the course change of the conventional heading (GNSS tests
   alone, at the wheel speed) and the integrated raw yaw rate must agree in sign; a summed
-  course change of 30° or more at an agreement of −0.5 or less is an error (simulated canyon
-  drives: +1.00 right, −1.00 with the sign flipped, on every one of 15 with a turn), less
-  turning is no verdict;
+  course change of 30° or more at an agreement of −0.5 or less is an error, less turning is no
+  verdict;
 * the calibrated gyro bias: beyond ±4 °/s (a car yaw-rate sensor's specified offset) it is a
   warning;
 * the CAN clock against the GNSS speed: the lag (±5 s, or a quarter of a shorter record) at
@@ -23,33 +24,26 @@ CAN signal and its DBC, an option). Each check states its threshold:
   epochs, by the median absolute difference (robust to the reflected epochs that pass the
   velocity's own tests, up to half of them), is the residual clock offset; beyond 0.2 s, or
   beyond 1 m along the track at the drive's median moving speed, it is a warning reporting the
-  estimate next to the manifest's ``time_offset_s`` (comma2k19 at 17.7 m/s: DR + GPS 0.15 m per
-  100 m with the offset found, 0.27 m with the vehicle signals shifted by 0.1 s, 0.54 m by
-  0.2 s: ``CLOCK_TOLERANCE_M``). The lag is only a lag when the agreement has a clear interior
-  minimum: aligned, the two speeds differ by their noise alone (≈ 0.05 m/s on comma2k19, a tenth
-  of the median difference over the lags), while misaligned by τ they differ by about
-  |acceleration|·τ. A best difference above half the median over the lags (no shift matches: an
-  offset beyond the range, or a speed too featureless), a best lag at the edge of the range (the
-  agreement still improves beyond it) or a best difference above twice the GNSS speed's noise
-  (aligned, the median difference is 0.56-0.82 times that noise on comma2k19 and simulated
-  drives; a wrong shift leaves more) is "no lag found", a warning naming why, and no number
-  (comma2k19 with its CAN clock 30 s off: 0.47 m/s at +2.2 s against a median of 0.62 m/s). A
-  drive steady more than half the time (a highway cruise) matches at every shift to the noise;
-  without a clear minimum, the search is made again over the epochs where the wheel speed
-  changes, |dv/dt| over ±0.5 s above five times its noise (at least 0.05 m/s²), with stricter
-  guards: a best difference below a quarter of the median over the shifts and below twice the
-  GNSS speed's noise, changes spread over more than twice the searched range (a single change
-  can match another). A drive without speed changes then gets "no lag found" (the speed hardly
-  changes); 120-s cruises with three speed changes get their lag (117 of 120 within 0.1 s; of
-  160 shifted by 6-60 s, 2 get a wrong lag, 7 before the first search compared its best
-  difference with the noise);
+  estimate next to the manifest's ``time_offset_s`` (``CLOCK_TOLERANCE_M``). The lag is only a
+  lag when the agreement has a clear interior minimum: aligned, the two speeds differ by their
+  noise alone, while misaligned by τ they differ by about |acceleration|·τ. A best difference
+  above half the median over the lags (no shift matches: an offset beyond the range, or a speed
+  too featureless), a best lag at the edge of the range (the agreement still improves beyond it)
+  or a best difference above twice the GNSS speed's noise (aligned, the median difference is
+  below that noise; a wrong shift leaves more) is "no lag found", a warning naming why, and no
+  number. A drive steady more than half the time (a highway cruise) matches at every shift to
+  the noise; without a clear minimum, the search is made again over the epochs where the wheel
+  speed changes, |dv/dt| over ±0.5 s above five times its noise (at least 0.05 m/s²), with
+  stricter guards: a best difference below a quarter of the median over the shifts and below
+  twice the GNSS speed's noise, changes spread over more than twice the searched range (a single
+  change can match another). A drive without speed changes then gets "no lag found" (the speed
+  hardly changes);
 * the wheel-speed times against the GNSS epochs: when more than 10 % of the epochs lie outside
   the wheel speed's time span, it is a warning, since those epochs get no tightly coupled
   heading. It tells why: vehicle signals whose clock the GNSS Doppler speed confirms where
   they overlap, or recorded over less than 90 % of the GNSS span, cover part of the drive; a
   wheel speed recorded as long but shifted is a clock offset wrong by more than the ±5 s
-  searched (comma2k19 with its CAN clock 30 s off: half the epochs), and the warning names the
-  setting;
+  searched, and the warning names the setting;
 * the calibrated wheel scale: beyond 1 ± 0.10 it is a warning, since a tyre's rolling radius
   changes by a few per cent with wear and pressure, and a scale far from 1 means a speed in
   other units (km/h: 0.28, mph: 0.45) or a wheel speed that is not this drive's; so is the
