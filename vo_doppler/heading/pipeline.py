@@ -87,10 +87,9 @@ class HeadingPipelineConfig:
     """Spread of an uncalibrated wheel scale about one."""
     backfill_bias_sigma: float = float(np.radians(0.05))
     """The gyro bias's first estimates with a larger σ (rad/s) give way to the drive's median
-    (:func:`backfill_start`): 0.05 °/s held for 10 s turns the dead reckoning by 0.5°, for good.
-    On the simulated clean drive seed 0 the first estimate, 0.02 ± 0.12 °/s for a true
-    0.30 °/s, held 4 s until the next samples and cost its open-sky dead reckoning alone 2.6 m
-    per 100 m."""
+    (:func:`backfill_start`): 0.05 °/s held for 10 s turns the dead reckoning by 0.5°, for good
+    (docs/design.md, "Sensor calibration"; measured in docs/benchmarks.md, "Error per 100 m on
+    the simulator's drives")."""
     tight_calibration: bool = True
     """Where the conventional calibration has no gyro bias estimate, take it from the tightly
     coupled headings of a first pass and solve them again (:func:`tight_gyro_bias`)."""
@@ -98,28 +97,25 @@ class HeadingPipelineConfig:
     """Tightly coupled headings with a larger σ (rad) do not calibrate. Where nothing has
     calibrated, a two-satellite heading's σ is 3–4°, most of it the prior's 3 % wheel-scale σ:
     an offset that changes only with the satellite geometry, which hardly tilts the bias's
-    slope over the drive. With 2° the comma2k19 minute in a canyon from its start
-    (``benchmarks/real_heading.py``) kept the prior's zero bias for a true −0.41 °/s, and its
-    two-satellite windows settled on the mirror root, 59° off; with 5° the bias is −0.39 °/s
-    and the headings 1.2° off at the median."""
+    slope over the drive, so the gate lies above that σ; below it nothing calibrates in a canyon
+    from the start, and an uncalibrated bias can tip two-satellite windows to their mirror root
+    (docs/design.md, "Sensor calibration"; measured in docs/benchmarks.md, "A street canyon
+    from the start")."""
     tight_scale_max_sigma: float = 0.005
     """Where nothing else calibrated the wheel scale, the Doppler rows given the tight headings
     do (:func:`tight_wheel_scale`) only when they pin it to this σ (relative), a sixth of the
     prior's 3 %: a scale error δ shifts a two-satellite heading by about δ rad, and that shift
-    is shared by every window, which the correction cannot average away. On the simulator's
-    drives in a canyon from the start the rows give σ 0.18–0.20 % (scale within 0.04–0.26 % of
-    the truth); on the comma2k19 highway minute, at an even speed, 1.45 % (the grade, which the
-    two highest satellites see instead of the horizontal speed), and the scale stays at the
-    prior."""
+    is shared by every window, which the correction cannot average away. At an even speed the
+    rows hardly tell the scale from the grade, and the scale stays at the prior (docs/design.md,
+    "Sensor calibration"; measured in docs/benchmarks.md, "A street canyon from the start")."""
     fixed_gyro_bias: float | None = None
     fixed_wheel_scale: float | None = None
 
     @classmethod
     def robust(cls) -> HeadingPipelineConfig:
         """``--heading-method robust``: :meth:`TightHeadingConfig.robust` and calibration fits
-        over the last 600 s (a canyon's Doppler
-        speeds scatter by metres per second; over 60 s the Hong Kong drive's wheel scale was
-        1 % off, over 600 s 0.1 %)."""
+        over the last 600 s, since a canyon's Doppler speeds scatter by metres per second
+        (docs/design.md, "The robust heading method for any rate")."""
         return cls(
             tight=TightHeadingConfig.robust(),
             gate=GateConfig(window_s=600.0),
