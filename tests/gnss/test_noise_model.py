@@ -15,6 +15,7 @@ from vo_doppler.gnss.noise_model import (
     FLOOR_MPS,
     NoiseModel,
     fit_noise_models,
+    fit_sigma_law,
     modelled_sigma,
 )
 from vo_doppler.io.rinex_nav import read_nav
@@ -120,3 +121,19 @@ def test_signals_without_enough_data_keep_their_prior(noisy):
     assert models == {}  # a single C/N0 bin: no slope to fit
     fallback = np.full(len(one_bin), 0.123)
     np.testing.assert_array_equal(modelled_sigma(models, one_bin, fallback), fallback)
+
+
+def test_nearly_exact_rows_fit_no_law():
+    """A simulator's noise-free pseudoranges leave residuals of 1e-13 with a few real ones: the
+    fit's slope came out near 3,900 and its σ_ref overflowed (a singular SPP, exit 3 on a
+    generated drive); such a law describes no noise and none is returned, nor for bins whose
+    residuals are exactly zero."""
+    rng = np.random.default_rng(0)
+    cn0 = np.repeat([36.0, 42.0, 48.0], 80)
+    elevation = np.radians(np.tile(np.linspace(41.0, 48.0, 80), 3))
+    residual = rng.normal(0.0, 1e-13, cn0.size) * 10.0 ** (-(cn0 - 40.0))
+    assert fit_sigma_law(residual, cn0, elevation) is None
+    assert fit_sigma_law(np.zeros(cn0.size), cn0, elevation) is None
+    honest = rng.normal(0.0, 1.0, cn0.size) * 10.0 ** (-(cn0 - 45.0) / 20.0)
+    law = fit_sigma_law(honest, cn0, elevation)
+    assert law is not None and law[1] == pytest.approx(1.0, abs=0.5)

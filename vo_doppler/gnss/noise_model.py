@@ -37,6 +37,11 @@ ELEVATION_BIN_RAD = np.deg2rad(10.0)
 MIN_BIN_ROWS = 30
 FLOOR_MPS = 0.01
 MIN_ELEVATION_RAD = np.deg2rad(5.0)
+SLOPE_BOUNDS = (-2.0, 5.0)
+"""The C/N0 slope b and elevation exponent c a receiver's noise can have (thermal noise: b = 1;
+measured 0.2–1.5 and 0.2–1.9): a fit beyond them (bins of nearly exact rows, e.g. a
+simulator's noise-free pseudoranges, gave b ≈ 3,900) describes no noise and is not used."""
+MAX_LOG_SIGMA_REF = 6.0
 
 
 @dataclass(frozen=True)
@@ -146,7 +151,10 @@ def fit_sigma_law(
 ) -> tuple | None:
     """(σ_ref, b, c, C/N0 range, elevation range, bins) of the module docstring's law fitted
     to normalised residuals (any unit; σ_ref in it) of one signal at C/N0 ``cn0`` (dB-Hz) and
-    ``elevation`` (rad), all finite; None without two C/N0 bins of ``min_bin_rows`` rows."""
+    ``elevation`` (rad), all finite; None without two C/N0 bins of ``min_bin_rows`` rows whose
+    residuals spread (a bin of exact rows, e.g. a simulator's noise-free pseudoranges, has no
+    scale to fit: its logarithm would be −∞ and the law's σ 0 or ∞); None also for a law
+    beyond ``SLOPE_BOUNDS`` or whose σ_ref is beyond 10^±``MAX_LOG_SIGMA_REF``."""
     cn0_bin = np.floor(cn0 / CN0_BIN_DBHZ)
     elevation_bin = np.floor(elevation / ELEVATION_BIN_RAD)
     keys, inverse = np.unique(
@@ -155,11 +163,11 @@ def fit_sigma_law(
     inverse = inverse.reshape(-1)
     count = np.bincount(inverse, minlength=len(keys))
     bins = np.flatnonzero(count >= min_bin_rows)
+    spread = np.array([MAD_TO_SIGMA * np.median(np.abs(residual[inverse == k])) for k in bins])
+    bins, spread = bins[spread > 0.0], spread[spread > 0.0]  # exact rows: no noise to fit
     if np.unique(keys[bins, 0]).size < 2:
         return None
-    log_sigma = np.array(
-        [np.log10(MAD_TO_SIGMA * np.median(np.abs(residual[inverse == k]))) for k in bins]
-    )
+    log_sigma = np.log10(spread)
     centre_cn0 = np.array([np.mean(cn0[inverse == k]) for k in bins])
     centre_el = np.array([np.mean(elevation[inverse == k]) for k in bins])
     columns = [np.ones(bins.size), -(centre_cn0 - CN0_REFERENCE_DBHZ) / 20.0]
@@ -170,6 +178,12 @@ def fit_sigma_law(
     solution = np.linalg.lstsq(design * weight[:, None], log_sigma * weight, rcond=None)[0]
     a, b = solution[0], solution[1]
     c = solution[2] if solution.size > 2 else 0.0
+    if not (
+        abs(a) < MAX_LOG_SIGMA_REF
+        and SLOPE_BOUNDS[0] <= b <= SLOPE_BOUNDS[1]
+        and SLOPE_BOUNDS[0] <= c <= SLOPE_BOUNDS[1]
+    ):
+        return None
     inside = np.isin(inverse, bins)
     return (
         float(10.0**a),
