@@ -22,6 +22,20 @@ def shared_data() -> Path:
     return path
 
 
+@pytest.fixture(scope="session")
+def turning_drive_folder(tmp_path_factory) -> Path:
+    """The 20-s simulated canyon drive without images, with one left turn of 90° (13–16 s), as
+    ``vo-doppler simulate --duration 20 --seed 1 --no-images`` writes it (the QA report's ``s1``):
+    gyro bias 0.3 °/s, wheel scale 1/1.02, the yaw rate counter-clockwise positive. Built once per
+    test process and shared: a test that changes the recording works on a copy."""
+    from vo_doppler.cli import main
+
+    folder = tmp_path_factory.mktemp("turning") / "s1"
+    argv = ["-q", "simulate", "--duration", "20", "--seed", "1", "--no-images", "-o", str(folder)]
+    assert main(argv) == 0
+    return folder
+
+
 def require_shared(relative: str) -> Path:
     """Path of one recording inside the shared data folder, or skip the test."""
     path = shared_data_dir() / relative

@@ -136,6 +136,7 @@ def test_a_marker_counts_only_with_its_fingerprint_and_outputs(tmp_path):
     assert finished(job) is None
 
 
+@pytest.mark.slow
 def test_failures_stay_with_their_recording(tmp_path):
     """A worker that dies fails only its own recording (the others lost with the pool run
     again alone); a plain exception is an internal error; bad input an input error."""
@@ -157,6 +158,7 @@ def test_failures_stay_with_their_recording(tmp_path):
     assert not any((tmp_path / "out" / s.name / MARKER).exists() for s in sources)
 
 
+@pytest.mark.slow
 def test_a_rerun_leaves_no_stale_output_beside_the_new_ones(tmp_path):
     source = tmp_path / "bug"
     source.mkdir()
@@ -204,6 +206,7 @@ def test_a_batch_never_replaces_a_recording_or_a_folder_it_did_not_write(tmp_pat
     assert sorted(p.name for p in out.iterdir()) == [OUTPUT_MARKER, "drive"]
 
 
+@pytest.mark.slow
 def test_a_rerun_that_fails_before_its_outputs_keeps_the_earlier_results(tmp_path):
     """A recording that succeeded, then fails (its RINEX cut short): the failure is listed, the
     earlier results stay as they were with the failed run's log beside them, and no staging
@@ -278,6 +281,7 @@ def _start_batch(drives, out, block_dir) -> subprocess.Popen:
     )
 
 
+@pytest.mark.slow
 def test_killed_batch_resumes_without_recomputing_finished_recordings(
     tmp_path_factory, tmp_path, monkeypatch
 ):
@@ -308,6 +312,7 @@ def test_killed_batch_resumes_without_recomputing_finished_recordings(
     assert result.rows[0]["gnss_epochs"] == result.rows[1]["gnss_epochs"] > 0
 
 
+@pytest.mark.slow
 def test_terminated_batch_ends_its_workers(tmp_path):
     """SIGTERM to the batch (not its workers): it exits and its worker does not live on."""
     source, block_dir = tmp_path / "rec", tmp_path / "block"
@@ -337,6 +342,7 @@ def _alive(pid: int) -> bool:
     return not Path(f"/proc/{pid}/stat").read_text().split(") ")[-1].startswith("Z")
 
 
+@pytest.mark.slow
 def test_ray_executor_gives_the_local_aggregate(tmp_path_factory, tmp_path):
     drives = [tiny_drive(tmp_path_factory, seed) for seed in (1, 2)]
     local = run_batch(drives, tmp_path / "local", workers=2)
@@ -357,6 +363,7 @@ def test_opencv_threads_share_out_the_cores(monkeypatch, cores, workers, threads
     assert opencv_threads(workers) == threads
 
 
+@pytest.mark.slow
 def test_pool_workers_run_opencv_with_their_share_of_threads():
     with _pool(2) as pool:
         counts = set(pool.map(opencv_thread_count, range(4)))

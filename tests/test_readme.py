@@ -15,6 +15,7 @@ def test_the_readme_has_library_snippets():
     assert len(SNIPPETS) >= 2
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("code", SNIPPETS, ids=[f"snippet{i}" for i in range(len(SNIPPETS))])
 def test_snippet_runs_as_written(code, monkeypatch, capsys):
     monkeypatch.chdir(REPO_ROOT)

@@ -49,6 +49,7 @@ def run_output(sequence, tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_run_writes_every_output(run_output):
     for name in (
         "trajectory_vo.tum",
@@ -73,6 +74,7 @@ def test_run_writes_every_output(run_output):
     assert f"<th>tightly coupled heading available</th><td class='text'>{available}</td>" in report
 
 
+@pytest.mark.slow
 def test_run_recovers_calibration_and_heading(sequence, run_output):
     summary = json.loads((run_output / "summary.json").read_text())
     assert summary["tight_heading_availability"] >= summary["conventional_heading_availability"]
@@ -92,6 +94,7 @@ def test_run_recovers_calibration_and_heading(sequence, run_output):
     assert tc["error_per_100m_m"] < 2.0
 
 
+@pytest.mark.slow
 def test_every_trajectory_starts_where_the_vehicle_was(sequence, run_output):
     """The canyon's first valid fixes come 21 s into the drive: carried back along each
     trajectory they put its first pose 0.3-0.7 m from the truth's horizontally and 1.2-1.9 m
@@ -105,6 +108,7 @@ def test_every_trajectory_starts_where_the_vehicle_was(sequence, run_output):
         assert np.linalg.norm(error[:2]) < 1.5 and abs(error[2]) < 2.5, path.name
 
 
+@pytest.mark.slow
 def test_corrected_trajectory_is_finite_and_covers_every_image(sequence, run_output):
     corrected = read_tum(run_output / "trajectory_corrected.tum")
     images = list((sequence / "image_0").iterdir())
@@ -403,15 +407,12 @@ def test_run_config_refuses_values_out_of_their_domain(arguments, message):
 
 
 @pytest.fixture(scope="module")
-def turning_drive(tmp_path_factory):
-    """The 20-s simulated canyon drive with one left turn of 90° (13–16 s), without images:
-    gyro bias 0.3 °/s, wheel scale 1/1.02, the yaw rate counter-clockwise positive."""
-    folder = tmp_path_factory.mktemp("turn") / "seq"
-    argv = ["-q", "simulate", "--duration", "20", "--seed", "1", "--no-images", "-o", str(folder)]
-    assert main(argv) == 0
-    return read_sequence(folder)
+def turning_drive(turning_drive_folder):
+    """The 20-s simulated canyon drive with one left turn of 90° (13–16 s), read."""
+    return read_sequence(turning_drive_folder)
 
 
+@pytest.mark.slow
 def test_the_library_run_checks_the_inputs_and_returns_its_warnings(turning_drive):
     result = run_sequence(turning_drive)
     assert result.warnings == [] and result.heading.warnings == []
@@ -425,6 +426,7 @@ def test_the_library_run_checks_the_inputs_and_returns_its_warnings(turning_driv
     assert any("its sign could not be checked" in w for w in warnings)
 
 
+@pytest.mark.slow
 def test_the_library_run_refuses_a_yaw_rate_of_the_wrong_sign_or_in_deg_per_s(turning_drive):
     negated = replace(turning_drive, yaw_rate=_scaled(turning_drive.yaw_rate, -1.0))
     with pytest.raises(InputError, match=r"wrong sign: over 1 turn\(s\) totalling 9") as info:

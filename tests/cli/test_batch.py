@@ -39,6 +39,7 @@ def read_rows(out):
         return list(csv.DictReader(stream))
 
 
+@pytest.mark.slow
 def test_every_recording_is_listed_with_failures_categorised(batch_run):
     _, out, _, listing = batch_run
     rows = read_rows(out)
@@ -52,6 +53,7 @@ def test_every_recording_is_listed_with_failures_categorised(batch_run):
     assert "drive1/report.html" in page and "does not exist" in page
 
 
+@pytest.mark.slow
 def test_rows_hold_each_runs_summary_and_the_overall_weights(batch_run):
     _, out, _, _ = batch_run
     rows = read_rows(out)
@@ -71,6 +73,7 @@ def test_rows_hold_each_runs_summary_and_the_overall_weights(batch_run):
     assert float(rows[3]["tight_heading_availability"]) == pytest.approx(expected, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_rows_and_the_terminal_table_carry_each_runs_warnings(batch_run):
     _, out, _, _ = batch_run
     rows = read_rows(out)
@@ -87,6 +90,7 @@ def test_rows_and_the_terminal_table_carry_each_runs_warnings(batch_run):
     assert "│ kmh       │ done, 1 warning │" in text and "│ clean     │ done            │" in text
 
 
+@pytest.mark.slow
 def test_parquet_holds_the_csv_table(batch_run):
     _, out, _, _ = batch_run
     table = pq.read_table(out / "batch_summary.parquet").to_pylist()
@@ -99,6 +103,7 @@ def test_parquet_holds_the_csv_table(batch_run):
         assert from_parquet["final_wheel_scale"] == (float(scale) if scale else None)
 
 
+@pytest.mark.slow
 def test_outputs_are_those_of_vo_doppler_run(batch_run, tmp_path):
     drives, out, _, _ = batch_run
     alone = tmp_path / "run"
@@ -110,6 +115,7 @@ def test_outputs_are_those_of_vo_doppler_run(batch_run, tmp_path):
     assert ours == theirs
 
 
+@pytest.mark.slow
 def test_resume_skips_finished_recordings(batch_run):
     drives, out, command, _ = batch_run
     markers = {d.name: (out / d.name / MARKER).stat().st_mtime_ns for d in drives}
@@ -133,6 +139,7 @@ def test_no_recordings_is_a_usage_error_and_an_empty_list_bad_input(tmp_path, ca
     assert not out.exists()
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_raw_comma2k19_segments_are_imported_then_run(tmp_path):
     segment = require_shared("comma2k19_example1")

@@ -40,6 +40,7 @@ def _args(paths, out, *extra):
     ]
 
 
+@pytest.mark.slow
 def test_cli_writes_every_output(inputs, tmp_path, capsys):
     record, paths = inputs
     t0, t1 = record.standstill
@@ -94,6 +95,7 @@ def test_cli_bad_input_exit_codes(inputs, tmp_path, capsys):
         assert info.value.code == 2
 
 
+@pytest.mark.slow
 def test_standstill_interval_that_moves_is_exit_1_with_the_speed(inputs, tmp_path, capsys):
     record, paths = inputs
     _, t1 = record.standstill
@@ -120,6 +122,7 @@ def test_an_output_folder_holding_an_input_or_someone_elses_files_is_refused(
     assert [p.name for p in other.iterdir()] == ["notes.txt"]
 
 
+@pytest.mark.slow
 def test_an_open_route_gets_the_end_error_and_no_loop_gap(inputs, tmp_path, capsys):
     """The QA case: a start-to-end "gap" reported on a route that is no loop (here the first
     60 s of the loop's drive)."""

@@ -50,6 +50,7 @@ def test_bad_input_is_1_with_one_line_naming_the_file(tmp_path, capsys):
     assert "missing.tum" in err and "Traceback" not in err and len(err.splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_usage_is_2_as_a_process():
     result = cli("run")
     assert result.returncode == EXIT_USAGE
@@ -90,6 +91,7 @@ def test_an_os_error_without_a_file_stays_internal(tum, monkeypatch, capsys):
     assert "internal error: OSError" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_bad_input_as_a_process_exits_1_and_debug_shows_the_traceback(tmp_path):
     png = tmp_path / "picture.png"
     png.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(64))

@@ -53,6 +53,7 @@ def first_run(drive, tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_run_with_names_that_are_not_utf8_writes_its_report(first_run):
     report = (first_run / "report.html").read_text(encoding="utf-8")
     assert shown(NOT_UTF8) == "caf\\xe9-\\xff"
@@ -60,6 +61,7 @@ def test_run_with_names_that_are_not_utf8_writes_its_report(first_run):
     assert (first_run / "trajectories.png").stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_run_on_a_full_disk_is_exit_1_naming_the_folder_and_keeps_the_results(
     drive, first_run, monkeypatch, capsys, caplog
 ):
@@ -75,6 +77,7 @@ def test_run_on_a_full_disk_is_exit_1_naming_the_folder_and_keeps_the_results(
     assert leftovers == []
 
 
+@pytest.mark.slow
 def test_gnss_velocity_on_a_full_disk_is_exit_1_naming_the_output(drive, tmp_path, capsys):
     obs = tmp_path / f"rover-{NOT_UTF8}.obs"  # a file name that is not UTF-8: in the title
     shutil.copy(drive / "gnss" / "rover.obs", obs)

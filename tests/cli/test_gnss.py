@@ -23,6 +23,7 @@ def _read(path):
     return rows[0], rows[1:]
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_velocity_and_spp_commands(tmp_path):
     obs = require_shared("yamatogawa_ublox_walk/yamatogawa_rover.obs")
@@ -48,6 +49,7 @@ def test_velocity_and_spp_commands(tmp_path):
     assert np.array(rows, dtype=float)[:, -1].all()
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_the_summary_line_counts_the_input_problems_the_reader_warned(tmp_path, caplog):
     """A time system the RINEX version lacks is read as GPS and warned: a problem, not a
@@ -115,6 +117,7 @@ def _without_doppler(tmp_path):
     return obs
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_a_file_without_doppler_is_solved_from_its_carrier_phase(tmp_path, capsys):
     """A RINEX 2 with carrier phase but no Doppler: the refusal names --range-rate phase, and
@@ -211,6 +214,7 @@ def test_precise_orbits_or_clocks_of_another_time_are_named(tmp_path, capsys, ca
     )
 
 
+@pytest.mark.slow
 def test_glonass_rows_without_a_frequency_channel_are_said_once(tmp_path, caplog):
     """GLONASS Doppler without a channel (no GLONASS SLOT / FRQ # entry, no GLONASS record in
     the navigation file): one warning with the count and the satellites (they were dropped

@@ -38,6 +38,7 @@ def _heading(folder, offset_s: float, out, capsys, caplog) -> dict:
     return summary
 
 
+@pytest.mark.slow
 def test_a_wheel_scale_far_from_one_is_a_warning(kmh_drive, tmp_path, capsys, caplog):
     summary = _heading(kmh_drive, GPS_MINUS_UNIX_S, tmp_path / "h.csv", capsys, caplog)
     assert summary["wheel_scale"] == pytest.approx(1 / 3.6, abs=0.02)
@@ -45,6 +46,7 @@ def test_a_wheel_scale_far_from_one_is_a_warning(kmh_drive, tmp_path, capsys, ca
     assert f"wheel scale: the calibration gives {summary['wheel_scale']:.3f}" in warning
 
 
+@pytest.mark.slow
 def test_a_can_clock_2_s_off_is_a_warning_with_the_right_offset(
     kmh_drive, tmp_path, capsys, caplog
 ):

@@ -52,6 +52,7 @@ def test_import_writes_a_sequence_folder(imported):
     assert tum.shape == (1200, 8)
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_gnss_commands_with_orbits(imported, tmp_path):
     obs = imported / "gnss/raw_gnss_ublox.obs"
@@ -88,6 +89,7 @@ def test_nav_and_orbits_are_exclusive():
     assert stop.value.code == 2
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_run_without_camera(imported, tmp_path, capsys):
     out = tmp_path / "run"

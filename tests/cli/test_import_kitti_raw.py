@@ -40,6 +40,7 @@ def test_import_writes_a_sequence_without_gnss(imported):
     np.testing.assert_allclose(tum[0, 1:4], 0.0, atol=1e-9)  # the origin is the first fix
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_run_on_the_imported_drive_runs_vo_and_dead_reckoning(imported, tmp_path, capsys):
     out = tmp_path / "out"

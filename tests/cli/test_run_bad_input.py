@@ -74,6 +74,7 @@ def epoch_seconds(header: str) -> float:
     return datetime(year, month, day, hour, minute).timestamp() + second
 
 
+@pytest.mark.slow
 def test_truncated_rinex_keeps_the_epochs_before_the_cut(clean, clean_run, tmp_path, caplog):
     folder = damaged_copy(clean, tmp_path)
     obs = folder / "gnss" / "rover.obs"
@@ -91,6 +92,7 @@ def test_truncated_rinex_keeps_the_epochs_before_the_cut(clean, clean_run, tmp_p
     np.testing.assert_array_equal(table.t, clean_table.t[: len(table)])
 
 
+@pytest.mark.slow
 def test_gnss_outage_leaves_a_gap_without_heading(clean, tmp_path, caplog):
     folder = damaged_copy(clean, tmp_path)
     obs = folder / "gnss" / "rover.obs"
@@ -110,6 +112,7 @@ def test_gnss_outage_leaves_a_gap_without_heading(clean, tmp_path, caplog):
     assert not np.any(table.tc_available[gap])
 
 
+@pytest.mark.slow
 def test_short_can_frames_are_skipped_and_named(clean, tmp_path, caplog):
     folder = damaged_copy(clean, tmp_path)
     log_path = folder / "can" / "vehicle.log"
@@ -126,6 +129,7 @@ def test_short_can_frames_are_skipped_and_named(clean, tmp_path, caplog):
     assert "id 0x1A0, 4 of 8 bytes" in caplog.text
 
 
+@pytest.mark.slow
 def test_unreadable_image_is_flagged_and_bridged(clean, clean_run, tmp_path, caplog):
     folder = damaged_copy(clean, tmp_path)
     image = sorted((folder / "image_0").iterdir())[40]
@@ -139,6 +143,7 @@ def test_unreadable_image_is_flagged_and_bridged(clean, clean_run, tmp_path, cap
     assert summary["vo_flagged_frames"] > clean_summary["vo_flagged_frames"]
 
 
+@pytest.mark.slow
 def test_navigation_without_ephemerides_keeps_the_vo_and_fails(clean, tmp_path, caplog, capsys):
     folder = damaged_copy(clean, tmp_path)
     nav = folder / "gnss" / "brdc.nav"
@@ -152,6 +157,7 @@ def test_navigation_without_ephemerides_keeps_the_vo_and_fails(clean, tmp_path, 
     assert len(vo) == n_images(folder) and np.all(np.isfinite(vo.positions))
 
 
+@pytest.mark.slow
 def test_can_log_ending_early_keeps_the_vo_scale(clean, clean_run, tmp_path, caplog):
     folder = damaged_copy(clean, tmp_path)
     log_path = folder / "can" / "vehicle.log"
@@ -359,6 +365,7 @@ def test_run_refuses_its_inputs_the_current_directory_and_a_folder_it_did_not_wr
     assert sorted(p.name for p in (tmp_path / "empty").iterdir()) == []
 
 
+@pytest.mark.slow
 def test_failed_run_keeps_the_previous_results_and_says_so(clean, clean_run, tmp_path, caplog):
     folder = damaged_copy(clean, tmp_path)
     edit_manifest(folder, "can", "time_offset_s", float("inf"))
@@ -372,6 +379,7 @@ def test_failed_run_keeps_the_previous_results_and_says_so(clean, clean_run, tmp
     assert not [p for p in tmp_path.iterdir() if ".partial-" in p.name]
 
 
+@pytest.mark.slow
 def test_duplicated_can_frames_and_a_distant_origin_are_warned_and_stale_files_go(
     clean, clean_run, tmp_path, caplog
 ):
@@ -453,6 +461,7 @@ def _garbage_glonass_slot(header, blocks):
     return header[:at] + line + header[at:] + "".join(blocks)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("damage", "warning"),
     [
@@ -501,6 +510,7 @@ def test_can_times_missing_the_gnss_epochs_are_an_error_before_any_work(clean, t
     assert "do not overlap the GNSS epochs" in err and "the manifest's time_offset_s" in err
 
 
+@pytest.mark.slow
 def test_can_clock_off_by_most_of_a_second_is_warned_with_the_fix(tmp_path, caplog):
     folder = tmp_path / "drive"
     simulate = ["simulate", "--duration", "30", "--seed", "1", "--no-images", "-o", str(folder)]
@@ -517,14 +527,13 @@ def test_can_clock_off_by_most_of_a_second_is_warned_with_the_fix(tmp_path, capl
 
 
 @pytest.fixture(scope="module")
-def turning(tmp_path_factory) -> Path:
-    """20 s without images, with one left turn of 90° (the QA report's ``s1``)."""
-    folder = tmp_path_factory.mktemp("turning") / "s1"
-    argv = ["-q", "simulate", "--duration", "20", "--seed", "1", "--no-images", "-o", str(folder)]
-    assert main(argv) == 0
-    return folder
+def turning(turning_drive_folder) -> Path:
+    """20 s without images, with one left turn of 90° (the QA report's ``s1``); tests damage a
+    copy."""
+    return turning_drive_folder
 
 
+@pytest.mark.slow
 def test_a_yaw_rate_sign_flipped_in_the_manifest_is_an_error_naming_the_setting(
     turning, tmp_path, capsys
 ):

@@ -6,10 +6,14 @@ from __future__ import annotations
 
 import gc
 
+import pytest
+
 from vo_doppler.cli import main
 from vo_doppler.commands import run_command
 from vo_doppler.errors import EXIT_INTERNAL
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+
+pytestmark = pytest.mark.slow
 
 
 def test_the_collector_is_frozen_during_the_stages_and_unfrozen_after(tmp_path, monkeypatch):

@@ -30,6 +30,7 @@ def _summary(folder) -> dict:
     return json.loads((folder / "summary.json").read_text())
 
 
+@pytest.mark.slow
 def test_run_with_an_earlier_runs_heading_csv_reproduces_its_corrected_figures(
     span_drive, first_run, tmp_path, capsys
 ):
@@ -82,6 +83,7 @@ def no_gnss(span_drive, tmp_path_factory):
     return folder, heading
 
 
+@pytest.mark.slow
 def test_run_with_a_minimal_heading_corrects_a_recording_without_gnss(no_gnss, tmp_path, capsys):
     folder, heading = no_gnss
     out = tmp_path / "out"
@@ -103,6 +105,7 @@ def test_run_with_a_minimal_heading_corrects_a_recording_without_gnss(no_gnss, t
     assert set(_summary(without)["evaluation"]) == {"vo", "dr"}
 
 
+@pytest.mark.slow
 def test_a_heading_of_another_time_is_refused(no_gnss, tmp_path, capsys):
     folder, _ = no_gnss
     other = tmp_path / "other.csv"
@@ -123,6 +126,7 @@ def test_a_heading_method_with_a_given_heading_is_a_usage_error(tmp_path, capsys
     assert "--heading-method robust has no effect with --heading" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_heading_file_is_not_overwritten_by_the_run(span_drive, first_run, capsys):
     """An earlier run's heading.csv given back to a run into the same folder is an input the
     output would replace: refused before anything is written."""

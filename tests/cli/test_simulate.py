@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import pytest
+
 from vo_doppler.cli import main
+
+pytestmark = pytest.mark.slow
 
 
 def test_without_images_the_summary_says_no_frame_was_rendered(tmp_path, capsys):

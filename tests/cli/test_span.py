@@ -38,6 +38,7 @@ def run_outputs(span_drive, tmp_path_factory):
     return out / "span", out / "cut"
 
 
+@pytest.mark.slow
 def test_run_on_a_span_gives_the_run_on_the_recording_cut_to_it(run_outputs):
     span, cut = run_outputs
     for name in TRAJECTORIES:
@@ -71,6 +72,7 @@ def _heading_argv(folder, output, *extra):
     ]
 
 
+@pytest.mark.slow
 def test_heading_on_a_span_gives_the_heading_of_the_cut_recording(span_drive, tmp_path, capsys):
     assert main(_heading_argv(span_drive.full, tmp_path / "span.csv", *_span(span_drive))) == 0
     assert main(_heading_argv(span_drive.cut, tmp_path / "cut.csv")) == 0
@@ -93,6 +95,7 @@ def test_gnss_on_a_span_gives_the_solutions_of_the_cut_recording(span_drive, tmp
     assert (tmp_path / "span.csv").read_bytes() == (tmp_path / "cut.csv").read_bytes()
 
 
+@pytest.mark.slow
 def test_vo_on_a_span_gives_the_vo_of_the_cut_recording(span_drive, tmp_path):
     """``vo`` counts from its first image and reads GPS times in the image times' own base
     (times.txt from 0 s, 20 ms after the first GNSS epoch: no image between the two spans)."""

@@ -490,6 +490,7 @@ def test_reflected_bursts_do_not_make_the_vo_follow_the_headings(burst_deg):
     assert _yaw_rmse(result, yaw) < np.radians(0.1)
 
 
+@pytest.mark.slow
 def test_persisting_faults_raise_the_correlation_floor_until_the_innovations_are_white():
     vo, t_heading, headings, yaw = _burst_headings(0, 145.0)
     whitened = blend_heading(vo, t_heading, headings, np.radians(1.0))

@@ -43,6 +43,7 @@ def walk():
     return measurements, clock, grid
 
 
+@pytest.mark.slow
 def test_the_likelihood_of_every_grid_point_does_not_depend_on_the_chunks(walk):
     """Chunks of one point (on the first 100 measurements: a Python step per measurement and
     chunk), of a few points and of many give the side-by-side values bit for bit."""
@@ -60,6 +61,7 @@ def test_the_likelihood_of_every_grid_point_does_not_depend_on_the_chunks(walk):
             assert np.array_equal(chunked, whole), budget
 
 
+@pytest.mark.slow
 def test_the_fit_is_the_same_and_its_memory_follows_the_budget(walk):
     """2,000 measurements × 2,560 points side by side hold about 235 MiB; in chunks of 8 MiB
     the fit's traced peak stays near the budget, and the chosen noise is the same."""

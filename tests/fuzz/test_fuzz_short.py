@@ -14,6 +14,7 @@ from vo_doppler.errors import InputError
 SHORT_CASES = 20
 
 
+@pytest.mark.slow
 def test_short_fuzz_of_every_reader_family():
     """20 mutated files of every registered family (500 with the shared data, 340 without the
     families seeded from it): each read plausibly or refused with the project's error naming

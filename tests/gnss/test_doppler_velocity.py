@@ -222,6 +222,7 @@ def septentrio():
     return obs, nav, receiver_positions(spp, obs.header.approx_position)
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 @pytest.mark.parametrize("systems", ["GREJC", "G"])
 def test_static_septentrio_speed(septentrio, systems):

@@ -78,6 +78,7 @@ def _with_noise(rows, sigma_of, outliers, seed=1):
     return replace(rows, range_rate=measured), sats, sigma
 
 
+@pytest.mark.slow
 def test_fitted_sigma_recovers_each_satellite(static_rows):
     obs, rows = static_rows
     noisy = {"G13", "E12"}

@@ -83,6 +83,7 @@ def test_known_law_is_recovered(geometry):
         assert np.median(np.abs(fitted / sigma[members] - 1.0)) < 0.065
 
 
+@pytest.mark.slow
 def test_fitted_weights_from_a_wrong_prior(noisy):
     """Starting from one σ for every row (0.1 m/s), the fitted σ (model × per-satellite scale)
     land within 15 % of the true ones for most rows (measured median 13 %), and the speeds of

@@ -15,6 +15,7 @@ from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_a_satellite_without_ephemeris_is_warned_once(caplog):
     """Septentrio's R02 has no healthy ephemeris: the rows are computed twice (SPP fixes, then

@@ -203,6 +203,7 @@ def test_glonass_that_cannot_be_solved_is_an_input_error_not_an_internal_one(tmp
     assert not out.exists() and not out.with_suffix(".png").exists()
 
 
+@pytest.mark.slow
 def test_the_gnss_stage_in_a_simulated_two_satellite_canyon(tmp_path):
     """Through ``gnss_velocity``: a simulated 1 Hz drive circling at 8 m/s, two satellites
     (the highest) after 60 s for 21 min. The lines of sight's receiver positions were 9 km off

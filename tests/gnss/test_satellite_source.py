@@ -80,6 +80,7 @@ def test_precise_states_reproduce_the_broadcast_orbit(nav):
     assert drift_error.max() < 1e-3  # m/s
 
 
+@pytest.mark.slow
 def test_same_doppler_velocity_from_either_source(nav):
     obs = read_obs(require_shared("septentrio_static/rover.obs"))
     orbits = tabulated(nav)

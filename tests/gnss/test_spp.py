@@ -63,6 +63,7 @@ def test_static_septentrio_spp(systems):
     assert np.all(np.std(enu, axis=0) < 1.0)
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_spp_without_redundancy_is_solved_but_not_valid():
     """Four GPS satellites: the position is computed (no redundancy, nothing to test) and not

@@ -153,6 +153,7 @@ def test_variation_gate_keeps_neighbours_of_a_spike():
     np.testing.assert_array_equal(keep, [True, True, False, True, True, True])
 
 
+@pytest.mark.slow
 def test_streaming_least_squares_follows_a_change_after_one_window():
     config = GateConfig(window_s=20.0)
     t, speed, yaw_rate, yaw = _drive(n=800)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import heading_from_gnss
@@ -13,14 +12,13 @@ from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.series import SensorSeries
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
-def drive(tmp_path_factory):
-    """A 20-s simulated canyon drive with one left turn of 90°, its GNSS stage run."""
-    folder = tmp_path_factory.mktemp("turn") / "seq"
-    argv = ["-q", "simulate", "--duration", "20", "--seed", "1", "--no-images", "-o", str(folder)]
-    assert main(argv) == 0
-    sequence = read_sequence(folder)
+def drive(turning_drive_folder):
+    """The 20-s simulated canyon drive with one left turn of 90°, its GNSS stage run."""
+    sequence = read_sequence(turning_drive_folder)
     return sequence, gnss_velocity(sequence.observations, sequence.navigation, "GE")
 
 

@@ -73,6 +73,7 @@ def _drive():
     return t, yaw, rows, wheel, SensorSeries(t_gyro, rate)
 
 
+@pytest.mark.slow
 def test_reflections_that_pass_the_chi_square_fail_the_gyro_test():
     t, yaw, rows, wheel, gyro = _drive()
     velocity = solve_velocity(rows, t)

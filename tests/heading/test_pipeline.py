@@ -134,6 +134,7 @@ def test_pipeline_calibrates_the_gyro_from_tight_headings_without_conventional_v
     assert np.percentile(error[used], 95) < 0.5 * np.percentile(single_error[single_used], 95)
 
 
+@pytest.mark.slow
 def test_tight_calibration_leaves_the_conventionally_calibrated_epochs():
     t, scenario, velocity, wheel, gyro, bias = _biased_drive()
     conv = velocity + np.random.default_rng(5).normal(0.0, 0.03, velocity.shape)
@@ -184,6 +185,7 @@ def test_causal_calibration_holds_and_overrides():
     assert abs(bias[-1] - 0.01) < 1e-3 and abs(scale[-1] - 1.1) < 1e-3
 
 
+@pytest.mark.slow
 def test_conventional_speeds_far_from_the_wheel_speed_do_not_calibrate():
     t, scenario, velocity = _drive()
     rng = np.random.default_rng(6)
@@ -226,6 +228,7 @@ def _with_accelerometer(t, scenario, velocity, wheel, gyro, acceleration):
     )
 
 
+@pytest.mark.slow
 def test_the_table_records_where_the_grade_prior_came_from():
     t, scenario, velocity = _drive(noise=0.0)
     wheel = SensorSeries(t, scenario.speed)
@@ -243,6 +246,7 @@ def test_the_table_records_where_the_grade_prior_came_from():
     np.testing.assert_array_equal(table.grade_prior_sigma[~fitted], config.tight.grade_sigma)
 
 
+@pytest.mark.slow
 def test_the_grade_prior_differentiates_the_calibrated_wheel_speed(monkeypatch):
     """A level road driven at 10 ± 6 m/s (up to 1.8 m/s² of acceleration) with wheels reading
     3 % fast: dv/dt of the raw wheel speed would put 0.55 % of grade where there is none."""

@@ -257,6 +257,7 @@ def test_window_constant_satellite_errors_are_noise_not_reflections(correlated_d
     assert np.median(error) < 0.5
 
 
+@pytest.mark.slow
 def test_reflection_is_still_rejected_amid_correlated_noise(correlated_drive):
     scenario, rows = correlated_drive
     reflected = (rows.sat_id == "G03") & (rows.t >= 60.0) & (rows.t < 61.5)

@@ -7,11 +7,14 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.run import RunConfig, sequence_heading
+
+pytestmark = pytest.mark.slow
 
 SAMPLE = Path(__file__).resolve().parents[2] / "sample_sequences" / "urban_canyon_small"
 

@@ -54,6 +54,7 @@ def heading(inputs, chunk_bytes: int):
     return heading_from_gnss(*args, config, lever)
 
 
+@pytest.mark.slow
 def test_chunking_does_not_change_the_headings(heading_inputs):
     whole = heading(heading_inputs, 1 << 40)
     assert np.count_nonzero(whole.rejected_rows) > 0, "the drive should exercise data snooping"
@@ -100,6 +101,7 @@ def peak_bytes(inputs, chunk_bytes: int) -> int:
         tracemalloc.stop()
 
 
+@pytest.mark.slow
 def test_budget_bounds_the_transient_memory(series_inputs):
     """The peak above the floor of small chunks stays within the budget, and all windows at
     once need several times more (so the budget is what bounds it)."""

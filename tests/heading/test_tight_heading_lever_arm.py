@@ -102,6 +102,7 @@ def test_vehicle_heading_from_antenna_inverts_the_antenna_velocity(yaw, speed, o
     assert abs(vehicle_speed[0] - speed) < 1e-12
 
 
+@pytest.mark.slow
 def test_heading_cli_on_a_simulated_drive_with_an_offset_antenna(tmp_path):
     """20 s through a 9-m-radius corner, antenna 1.5 m ahead of the rear axle: with
     --antenna-lever-arm the tight heading in the turn is within a degree of the truth, without

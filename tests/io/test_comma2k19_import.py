@@ -72,6 +72,7 @@ def segment_without_dbc(tmp_path):
     return segment
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_a_segment_without_a_dbc_takes_the_decoded_wheel_speeds_and_the_gyro(tmp_path):
     segment = segment_without_dbc(tmp_path)

@@ -89,6 +89,7 @@ def test_an_undecodable_video_is_named(tmp_path):
     assert "decode" in str(caught.value) or "open" in str(caught.value)
 
 
+@pytest.mark.slow
 @pytest.mark.shared_data
 def test_imported_segment_with_a_video_has_a_camera_on_gps_time(tmp_path):
     source = require_shared("comma2k19_example1")

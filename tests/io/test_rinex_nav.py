@@ -63,6 +63,7 @@ def _matches(reference, sat, toc_calendar, expected: dict[str, float], rtol: flo
     return False
 
 
+@pytest.mark.slow
 def test_kepler_parameters_equal_georinex(both):
     nav, reference = both
     k = nav.kepler
@@ -74,6 +75,7 @@ def test_kepler_parameters_equal_georinex(both):
         assert _matches(reference, sat, toc, expected, rtol=0.0), (sat, k.line[i])
 
 
+@pytest.mark.slow
 def test_glonass_parameters_equal_georinex(both):
     nav, reference = both
     g = nav.glonass

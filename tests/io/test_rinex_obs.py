@@ -65,6 +65,7 @@ def epochs(draw):
     return records
 
 
+@pytest.mark.slow
 @settings(
     max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )

@@ -67,6 +67,7 @@ def imported(drive, origin, tmp_path_factory) -> dict[str, tuple[Path, Path, obj
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["ros1", "sqlite3", "mcap"])
 def test_gnss_comm_observations_and_ephemerides_identical(drive, imported, name):
     folder = imported[name][0]
@@ -82,6 +83,7 @@ def test_gnss_comm_observations_and_ephemerides_identical(drive, imported, name)
     np.testing.assert_array_equal(nav_back.klobuchar, nav.klobuchar)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["ros1", "mcap", "ublox_ros1"])
 def test_raw_images_bitwise(drive, imported, name):
     folder = imported[name][0]
@@ -94,6 +96,7 @@ def test_raw_images_bitwise(drive, imported, name):
         )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["sqlite3", "ublox_mcap"])
 def test_compressed_images_as_sent_and_decodable(drive, imported, name):
     original = sorted((drive / "image_0").iterdir())
@@ -104,6 +107,7 @@ def test_compressed_images_as_sent_and_decodable(drive, imported, name):
     assert cv2.imread(str(back[-1])) is not None
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(BAGS))
 def test_vehicle_signals_camera_and_truth(drive, imported, name):
     seq, back = read_sequence(drive), read_sequence(imported[name][0])
@@ -135,6 +139,7 @@ def test_vehicle_signals_camera_and_truth(drive, imported, name):
     np.testing.assert_allclose(back.antenna_lever_arm_m, seq.antenna_lever_arm_m, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_manifest_states_times_and_axes(drive, imported):
     manifest = read_manifest(imported["ros1"][0])
     has_acceleration = read_sequence(drive).forward_acceleration is not None
@@ -153,6 +158,7 @@ def _rows(obs, code: str) -> dict[tuple[float, str], float]:
     return dict(zip(zip(rows.time, rows.satellites(), strict=True), rows.value, strict=True))
 
 
+@pytest.mark.slow
 def test_ublox_observations_at_message_precision(drive, imported):
     """RxmRAWX carries the Doppler as float32 and C/N0 as whole dB-Hz; GPS ephemerides come
     back as LNAV subframes carry them."""
@@ -178,6 +184,7 @@ def test_ublox_observations_at_message_precision(drive, imported):
         assert (imported[name][0] / "gnss/doppler_sigma.csv").is_file()
 
 
+@pytest.mark.slow
 def test_run_gives_the_same_error_per_100m(drive, imported):
     """Acceptance: `run` on the imported sequence within 1 % of the original per pipeline."""
     errors = {}
@@ -193,6 +200,7 @@ def test_run_gives_the_same_error_per_100m(drive, imported):
         assert errors["imported"][pipeline] == pytest.approx(value, rel=0.01), pipeline
 
 
+@pytest.mark.slow
 def test_list_topics_and_clock_from_gnss(imported, origin, tmp_path):
     bag = imported["ros1"][1]
     lines = list_topics(bag)
@@ -204,6 +212,7 @@ def test_list_topics_and_clock_from_gnss(imported, origin, tmp_path):
     assert "estimated from" in summary.clock
 
 
+@pytest.mark.slow
 def test_cli_lists_topics_and_imports(imported, tmp_path, capsys):
     bag = imported["mcap"][1]
     assert main(["import", "rosbag", str(bag), "--list-topics"]) == 0
@@ -260,6 +269,7 @@ def _rewrite(source: Path, target: Path, edit, topics: set[str] | None = None) -
     return target
 
 
+@pytest.mark.slow
 def test_a_bag_without_camera_or_raw_gnss(drive, imported, tmp_path):
     """IMU, speed and fixes only: the origin from the first fix, no camera, no GNSS section;
     run reads the folder."""
@@ -280,6 +290,7 @@ def test_a_bag_without_camera_or_raw_gnss(drive, imported, tmp_path):
     np.testing.assert_array_equal(seq.yaw_rate.value, read_sequence(drive).yaw_rate.value)
 
 
+@pytest.mark.slow
 def test_bad_bags_name_bag_topic_and_index(imported, origin, tmp_path, capsys):
     bag = imported["ros1"][1]
     options = RosbagOptions(origin=origin)

@@ -79,6 +79,7 @@ def test_missing_section_and_key_are_named(tmp_path):
         read_sequence(tmp_path)
 
 
+@pytest.mark.slow
 def test_antenna_lever_arm_is_read_and_defaults_to_zero(tmp_path):
     config = UrbanCanyonConfig(
         duration_s=1.0, seed=1, image_size=(64, 36), antenna_lever_arm_m=(1.2, -0.3, 1.5)
@@ -107,6 +108,7 @@ def test_antenna_lever_arm_is_read_and_defaults_to_zero(tmp_path):
     )
 
 
+@pytest.mark.slow
 def test_a_ground_truth_file_named_but_absent_is_an_error_naming_the_key(tmp_path):
     simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=1.0, seed=1, image_size=(64, 36)))
     assert read_sequence(tmp_path).truth is not None
@@ -121,6 +123,7 @@ def test_a_ground_truth_file_named_but_absent_is_an_error_naming_the_key(tmp_pat
     assert read_sequence(tmp_path).truth is None
 
 
+@pytest.mark.slow
 def test_forward_acceleration_from_the_can_bus_or_a_csv_but_not_both(tmp_path):
     simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
     sequence = read_sequence(tmp_path)
@@ -155,6 +158,7 @@ def test_forward_acceleration_from_the_can_bus_or_a_csv_but_not_both(tmp_path):
         read_sequence(tmp_path)
 
 
+@pytest.mark.slow
 def test_vehicle_signals_from_sensor_csvs_instead_of_a_can_log(tmp_path):
     simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
     from_can = read_sequence(tmp_path)
@@ -213,6 +217,7 @@ def test_vehicle_signals_from_sensor_csvs_instead_of_a_can_log(tmp_path):
         read_sequence(tmp_path)
 
 
+@pytest.mark.slow
 def test_vehicle_rows_skipped_by_the_readers_are_warnings_of_the_run(tmp_path):
     simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
     from_can = read_sequence(tmp_path)

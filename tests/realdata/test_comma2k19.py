@@ -22,7 +22,7 @@ from vo_doppler.io.comma2k19 import read_vehicle_poses
 from vo_doppler.model.timeseries import sample
 from vo_doppler.run import RunConfig, antenna_track, correct_all, sequence_heading
 
-pytestmark = pytest.mark.shared_data
+pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
 
 
 @pytest.fixture(scope="module")

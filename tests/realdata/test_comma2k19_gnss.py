@@ -13,7 +13,7 @@ from tests.helpers.comma2k19 import checked_conventional_figures, imported_comma
 from vo_doppler.report.run_outputs import doppler_noise_summary
 from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
 
-pytestmark = pytest.mark.shared_data
+pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
 
 
 @pytest.fixture(scope="module")

@@ -18,7 +18,7 @@ from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.timeseries import integral_at, sample
 from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
 
-pytestmark = pytest.mark.shared_data
+pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
 
 
 @pytest.fixture(scope="module")

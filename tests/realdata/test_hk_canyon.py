@@ -20,6 +20,8 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import sample
 from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def canyon(tmp_path_factory):

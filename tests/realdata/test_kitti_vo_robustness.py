@@ -12,6 +12,8 @@ from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.trajectory import read_kitti
 from vo_doppler.vo.batch import run_visual_odometry
 
+pytestmark = pytest.mark.slow
+
 N_FRAMES = 24
 GLITCH = 10
 

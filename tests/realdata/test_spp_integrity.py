@@ -16,7 +16,7 @@ from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.model.gnss_solutions import SppSolution
 
-pytestmark = pytest.mark.shared_data
+pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
 
 HK = "hk_tst_canyon_drive/"
 STATIC = "hk_tst_static_f9p/"

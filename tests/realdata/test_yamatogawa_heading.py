@@ -37,7 +37,7 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.doppler_rows import gyro_from_heading
 
-pytestmark = pytest.mark.shared_data
+pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
 
 FOLDER = "yamatogawa_ublox_walk"
 BIAS = np.radians(0.5)

@@ -97,6 +97,7 @@ def _write(drive_run, out: Path, truth: Trajectory | None) -> dict:
     return summary
 
 
+@pytest.mark.slow
 def test_a_ground_truth_starting_late_is_evaluated_over_the_overlap(drive_run, tmp_path):
     truth = drive_run[0].truth
     late = truth.subset(np.flatnonzero(truth.t >= truth.t[0] + 0.46))
@@ -110,6 +111,7 @@ def test_a_ground_truth_starting_late_is_evaluated_over_the_overlap(drive_run, t
     assert html.escape(warning) in (tmp_path / "report.html").read_text()
 
 
+@pytest.mark.slow
 def test_a_ground_truth_from_another_time_skips_the_evaluation_and_keeps_the_rest(
     drive_run, tmp_path
 ):
@@ -121,6 +123,7 @@ def test_a_ground_truth_from_another_time_skips_the_evaluation_and_keeps_the_res
     assert "The ground truth could not be used" in (tmp_path / "report.html").read_text()
 
 
+@pytest.mark.slow
 def test_a_static_ground_truth_has_no_figure_per_distance(drive_run, tmp_path):
     truth = drive_run[0].truth
     still = Trajectory(truth.t, np.repeat(truth.positions[:1], len(truth), 0), truth.orientations)
@@ -132,6 +135,7 @@ def test_a_static_ground_truth_has_no_figure_per_distance(drive_run, tmp_path):
     assert "too short for errors per distance" in report and "<td>—</td>" in report
 
 
+@pytest.mark.slow
 def test_a_failing_evaluation_becomes_a_warning(drive_run, tmp_path, monkeypatch):
     def broken(*_):
         raise RuntimeError("boom")
@@ -145,6 +149,7 @@ def test_a_failing_evaluation_becomes_a_warning(drive_run, tmp_path, monkeypatch
     )
 
 
+@pytest.mark.slow
 def test_geojson_and_map_show_the_trajectories_as_written(drive_run, tmp_path):
     sequence, _ = drive_run
     summary = _write(drive_run, tmp_path, sequence.truth)
@@ -190,6 +195,7 @@ def test_geojson_and_map_show_the_trajectories_as_written(drive_run, tmp_path):
     assert "trajectories.png" in page
 
 
+@pytest.mark.slow
 def test_the_report_of_a_drive_without_camera_names_no_vo_setting(drive_run, tmp_path):
     """Issue 30: "VO window 20 frames" and the VO's definitions on a drive without camera."""
     assert not drive_run[0].has_camera
@@ -200,6 +206,7 @@ def test_the_report_of_a_drive_without_camera_names_no_vo_setting(drive_run, tmp
     assert "dead-reckoning heading compared as" in page
 
 
+@pytest.mark.slow
 def test_heading_use_is_a_share_of_the_epochs_with_vehicle_signals(drive_run, tmp_path):
     """Issue 30: the share of GNSS epochs whose tightly coupled heading was used counted the
     epochs without vehicle signals. Vehicle signals kept over the middle of the drive only."""
@@ -237,6 +244,7 @@ def test_heading_use_is_a_share_of_the_epochs_with_vehicle_signals(drive_run, tm
         )
 
 
+@pytest.mark.slow
 def test_every_summary_key_has_a_label_and_units(drive_run, tmp_path):
     """Every key a run's summary can hold, with and without a camera: a new key without a
     label in ``FACT_FORMATS`` would show in the report as its raw name."""
@@ -286,6 +294,7 @@ def _without_heading(result, wheel_factor: float, gnss_factor: float):
     )
 
 
+@pytest.mark.slow
 def test_a_parked_car_fails_saying_it_never_moved(drive_run, tmp_path):
     _, result = drive_run
     peak_gnss = np.nanmax(np.hypot(*result.gnss.velocity.velocity_enu[:, :2].T))
@@ -301,6 +310,7 @@ def test_a_parked_car_fails_saying_it_never_moved(drive_run, tmp_path):
     )
 
 
+@pytest.mark.slow
 def test_wheels_still_while_gnss_moves_and_a_moving_drive_keep_their_own_messages(
     drive_run, tmp_path
 ):

@@ -57,6 +57,7 @@ REAL_BINS = [
 """C/N0 bin (dB-Hz), the real drive's MAD (m/s) and the range accepted here."""
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("low", "high", "real_mad", "lowest", "highest"), REAL_BINS)
 def test_doppler_error_per_cn0_bin_is_the_real_drives(drive, low, high, real_mad, lowest, highest):
     """Moving rows: MAD 2.0 / 1.1 / 0.28 / 0.13–0.17 m/s on the real drive."""
@@ -67,6 +68,7 @@ def test_doppler_error_per_cn0_bin_is_the_real_drives(drive, low, high, real_mad
     assert lowest <= mad <= highest, f"MAD {mad:.2f} m/s, real {real_mad:g}"
 
 
+@pytest.mark.slow
 def test_weak_rows_are_heavy_tailed_and_strong_ones_are_not(drive):
     """Real: 22 % of the rows below 25 dB-Hz beyond 3 m/s; none of the strong ones."""
     _, error, cn0, speed = drive
@@ -76,6 +78,7 @@ def test_weak_rows_are_heavy_tailed_and_strong_ones_are_not(drive):
     assert beyond[moving & (cn0 >= 35.0)].mean() < 0.01
 
 
+@pytest.mark.slow
 def test_weak_signal_error_grows_with_speed(drive):
     """Real rows below 30 dB-Hz: MAD 0.18 m/s at standstill, 1.6 m/s at 3–10 m/s."""
     _, error, cn0, speed = drive
@@ -87,6 +90,7 @@ def test_weak_signal_error_grows_with_speed(drive):
     assert 1.0 <= _mad(error[driving]) <= 2.4
 
 
+@pytest.mark.slow
 def test_speed_coefficient_falls_about_tenfold_per_ten_db(drive):
     """k(C/N0) of σ² = σ_th² + (k·speed)²: 0.22 at 25 dB-Hz, 0.023 at 35 on the real drive.
     Here k from the moving rows' robust σ of error/speed within ±2 dB."""
@@ -101,6 +105,7 @@ def test_speed_coefficient_falls_about_tenfold_per_ten_db(drive):
     assert 4.0 <= k(25.0) / k(35.0) <= 25.0
 
 
+@pytest.mark.slow
 def test_the_cn0_mix_is_weak_while_moving(drive):
     """Real: 37 % of the moving rows below 30 dB-Hz, most between 25 and 35. With GPS + Galileo
     the simulated sky has half the real GPS + BeiDou satellites, so fewer strong ones."""
@@ -111,6 +116,7 @@ def test_the_cn0_mix_is_weak_while_moving(drive):
     assert cn0.min() >= 22.0 - 5.0
 
 
+@pytest.mark.slow
 def test_three_to_seven_satellites_are_biased_per_five_second_window(drive):
     """A satellite is biased in a window when its median error exceeds 3 σ_th of its rows."""
     sim, error, cn0, speed = drive
@@ -135,6 +141,7 @@ def test_three_to_seven_satellites_are_biased_per_five_second_window(drive):
     assert np.mean((np.array(counts) >= 3) & (np.array(counts) <= 7)) > 0.6
 
 
+@pytest.mark.slow
 def test_clock_drift_jumps_about_0_17_mps_per_epoch(drive):
     sim, error, _, _ = drive
     steps = np.diff(SPEED_OF_LIGHT * sim.gnss.clock.drift)  # as range rates (m/s)
@@ -155,6 +162,7 @@ def test_knife_edge_loss_is_itu_r_p526():
     assert loss[3] == pytest.approx(20.4, abs=0.2)
 
 
+@pytest.mark.slow
 def test_a_1_hz_realistic_canyon_from_the_command_line_is_a_sequence_run_reads(tmp_path):
     seq, out = tmp_path / "seq", tmp_path / "out"
     argv = ["-q", "simulate", "--duration", "40", "--seed", "1", "--gnss-rate", "1"]
@@ -170,6 +178,7 @@ def test_a_1_hz_realistic_canyon_from_the_command_line_is_a_sequence_run_reads(t
     assert summary["gnss_epochs"] == 41
 
 
+@pytest.mark.slow
 def test_without_the_option_the_manifest_has_no_canyon_settings(tmp_path):
     assert main(["-q", "simulate", "--duration", "3", "--no-images", "-o", str(tmp_path)]) == 0
     manifest = yaml.safe_load((tmp_path / "sequence.yaml").read_text())

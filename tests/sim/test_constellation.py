@@ -90,6 +90,7 @@ def test_facade_reflection_extra_path_and_rate():
     assert not facade_reflections(ANTENNA[None], low[None], velocity, boxes).found[0]
 
 
+@pytest.mark.slow
 def test_narrow_street_leaves_fewer_than_four_satellites(tmp_path):
     config = UrbanCanyonConfig(
         duration_s=20.0,

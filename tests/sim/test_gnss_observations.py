@@ -77,6 +77,7 @@ def test_orbits_are_gps_and_galileo_like():
     assert np.all(np.abs(incl[gps] - 55.0) < 4.0) and np.all(np.abs(incl[~gps] - 56.0) < 2.0)
 
 
+@pytest.mark.slow
 def test_observation_file_reads_back_to_the_generating_values(open_sky):
     out, sim = open_sky
     gnss = sim.gnss
@@ -98,6 +99,7 @@ def test_observation_file_reads_back_to_the_generating_values(open_sky):
     assert ssi.min() >= 5 and ssi.max() <= 8
 
 
+@pytest.mark.slow
 def test_doppler_is_minus_range_rate_over_wavelength(open_sky):
     _, sim = open_sky
     gnss = sim.gnss
@@ -128,6 +130,7 @@ def test_analytic_range_rate_matches_finite_difference_to_a_millimetre_per_secon
     assert np.max(np.abs(centre.range_rate_mps - first_order)) > 100.0  # satellites move
 
 
+@pytest.mark.slow
 def test_doppler_of_an_offset_antenna_is_its_analytic_range_rate_in_a_turn(tmp_path):
     """Antenna 1.5 m ahead of and 0.7 m right of the rear axle: noise-free Doppler equals the
     analytic range rate of that point. Its velocity is the rear axle's (speed along the yaw)
@@ -179,6 +182,7 @@ def test_doppler_of_an_offset_antenna_is_its_analytic_range_rate_in_a_turn(tmp_p
     assert manifest["gnss"]["antenna_lever_arm_m"] == [1.5, -0.7, 1.6]
 
 
+@pytest.mark.slow
 def test_gnss_solvers_recover_the_simulated_truth(open_sky):
     out, sim = open_sky
     obs = read_obs(out / "gnss" / "rover.obs")
@@ -198,6 +202,7 @@ def test_gnss_solvers_recover_the_simulated_truth(open_sky):
     assert np.median(np.linalg.norm(position - expected, axis=1)) < 0.05
 
 
+@pytest.mark.slow
 def test_noise_scales_with_cn0(tmp_path):
     config = UrbanCanyonConfig(
         duration_s=6.0, seed=2, render=False, city=CityConfig(height_range_m=(0.5, 1.0))
@@ -209,6 +214,7 @@ def test_noise_scales_with_cn0(tmp_path):
     assert 0.9 < np.std(normalised) < 1.1
 
 
+@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::FutureWarning")
 def test_an_independent_reader_agrees(tmp_path):
     """georinex (test-only) reads the written files to the same values."""

@@ -39,6 +39,7 @@ def sequence(tmp_path_factory):
     return out, simulate_urban_canyon(out, config)
 
 
+@pytest.mark.slow
 def test_manifest_paths_and_time_offsets(sequence):
     out, sim = sequence
     manifest = yaml.safe_load((out / "sequence.yaml").read_text())
@@ -91,6 +92,7 @@ def test_manifest_paths_and_time_offsets(sequence):
     assert manifest["stats"]["epochs"] == 121
 
 
+@pytest.mark.slow
 def test_same_seed_same_files_other_seed_differs(sequence, tmp_path):
     out, sim = sequence
     simulate_urban_canyon(tmp_path / "again", sim.config)
@@ -106,6 +108,7 @@ def test_same_seed_same_files_other_seed_differs(sequence, tmp_path):
     assert other["can/vehicle.log"] != first["can/vehicle.log"]
 
 
+@pytest.mark.slow
 def test_cli_writes_a_sequence(tmp_path, capsys):
     out = tmp_path / "cli"
     code = main(
@@ -176,6 +179,7 @@ def test_the_least_fps_and_duration_named_give_two_frames(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
+@pytest.mark.slow
 def test_route_has_turns_stops_and_a_speed_limit(tmp_path):
     config = UrbanCanyonConfig(
         duration_s=40.0,
@@ -203,6 +207,7 @@ def _manifest(out: Path, *options: str) -> dict:
     return yaml.safe_load((out / "sequence.yaml").read_text())
 
 
+@pytest.mark.slow
 def test_cli_effects_switch_off_one_by_one_and_clean_restores_the_old_camera(tmp_path):
     default = _manifest(tmp_path / "default")
     effects = default["truth"]["camera"]["effects"]
@@ -239,6 +244,7 @@ def test_cli_effects_switch_off_one_by_one_and_clean_restores_the_old_camera(tmp
     assert "--clean" in clean["command"]
 
 
+@pytest.mark.slow
 def test_cli_receives_reflections_unless_told_not_to(tmp_path):
     default = _manifest(tmp_path / "default")
     assert default["truth"]["gnss"]["nlos"] is True
@@ -248,6 +254,7 @@ def test_cli_receives_reflections_unless_told_not_to(tmp_path):
     assert "--no-nlos" in direct["command"].split()
 
 
+@pytest.mark.slow
 def test_cli_writes_only_into_a_new_empty_or_earlier_simulated_folder(tmp_path, capsys):
     """A second simulation into its own folder is fine; a folder with someone else's files is
     refused before any work, untouched."""
@@ -262,6 +269,7 @@ def test_cli_writes_only_into_a_new_empty_or_earlier_simulated_folder(tmp_path, 
     assert [p.name for p in other.iterdir()] == ["sequence.yaml"]
 
 
+@pytest.mark.slow
 def test_a_shorter_simulation_into_its_own_folder_leaves_no_stale_frames(tmp_path):
     """Frames of an earlier, longer simulation (or of its other image format) used to stay, and
     the new sequence's times no longer matched its images."""

@@ -68,6 +68,7 @@ def test_speed_profile_limits_and_kinematics():
     assert motion.yaw[-1] == pytest.approx(np.pi / 2 * round(motion.yaw[-1] / (np.pi / 2)))
 
 
+@pytest.mark.slow
 @settings(max_examples=15, deadline=None)
 @given(
     max_speed=st.floats(3.0, 16.0),
@@ -131,6 +132,7 @@ def test_simulation_is_deterministic_per_seed(small_scene):
     assert not np.array_equal(a.images, c.images)  # same poses, other noise
 
 
+@pytest.mark.slow
 def test_generated_files_read_back(tmp_path, small_scene):
     plan = generate_vo_sequence(tmp_path, 0.5, 10.0, seed=2, scene=small_scene, t0=100.0)
     images = sorted((tmp_path / "image_0").glob("*.png"))

@@ -24,6 +24,7 @@ def drive():
     return simulate_vo(duration_s=14.0, fps=10.0, seed=3)
 
 
+@pytest.mark.slow
 def test_metric_vo_follows_a_rendered_drive(drive):
     plan = drive.plan
     truth = Trajectory.from_matrices(plan.times, plan.T_first_camera)
@@ -39,6 +40,7 @@ def test_metric_vo_follows_a_rendered_drive(drive):
     assert abs(errors.end_yaw_error_deg) < 0.5
 
 
+@pytest.mark.slow
 def test_unscaled_vo_is_declared_and_similar_up_to_scale(drive):
     plan = drive.plan
     truth = Trajectory.from_matrices(plan.times, plan.T_first_camera)
@@ -48,6 +50,7 @@ def test_unscaled_vo_is_declared_and_similar_up_to_scale(drive):
     assert aligned.ate_rmse_m < 0.01 * truth.subset(slice(0, 40)).path_length
 
 
+@pytest.mark.slow
 def test_streaming_rejects_times_that_do_not_increase(drive):
     vo = VisualOdometry(drive.plan.camera)
     vo.process(drive.images[0], 1.0)
@@ -67,6 +70,7 @@ def test_a_frame_of_another_size_than_the_calibration_is_an_error():
         odometry.process(image, 0.0)
 
 
+@pytest.mark.slow
 def test_frame_to_frame_baseline_follows_a_straight_stretch(drive):
     plan = drive.plan
     truth = Trajectory.from_matrices(plan.times, plan.T_first_camera).subset(slice(0, 30))
@@ -83,6 +87,7 @@ def short_drive():
     return simulate_vo(duration_s=9.0, fps=10.0, seed=5)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("every", [1, 3])
 def test_window_is_adjusted_at_every_nth_keyframe(short_drive, every):
     plan = short_drive.plan
