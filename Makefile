@@ -4,7 +4,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 
-.PHONY: demo test lint bench fuzz clean browser
+.PHONY: demo test test-fast lint bench fuzz clean browser
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -35,6 +35,11 @@ browser:
 # The suite runs on two workers (pytest-xdist): about 6 min on 2 cores, 13 min on one.
 test: $(TEST_STAMP) browser
 	$(BIN)/python -m pytest -q -n 2
+
+# The suite without the tests marked slow (generated drives, whole runs, real recordings):
+# under 2 min on 2 cores, for the edit-test loop; `make test` still runs everything.
+test-fast: $(TEST_STAMP) browser
+	$(BIN)/python -m pytest -q -n 2 -m "not slow"
 
 lint: $(TEST_STAMP)
 	$(BIN)/ruff check . && $(BIN)/ruff format --check .
