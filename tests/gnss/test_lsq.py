@@ -7,13 +7,7 @@ import pytest
 from scipy.special import chdtri, chndtr, chndtrinc
 from scipy.stats import chi2
 
-from vo_doppler.gnss.lsq import (
-    Constraint,
-    constrained,
-    lsq_with_exclusion,
-    minimal_detectable_shift,
-    weighted_lsq,
-)
+from vo_doppler.gnss.lsq import lsq_with_exclusion, minimal_detectable_shift, weighted_lsq
 
 X_TRUE = np.array([1.5, -2.0, 0.25, 3.0])
 
@@ -110,35 +104,3 @@ def test_without_redundancy_no_bias_is_detectable():
     _, covariance5, _ = weighted_lsq(flat, flat @ X_TRUE, sigma5)
     shift = minimal_detectable_shift(flat, sigma5, np.arange(5), covariance5, 1)
     assert np.isinf(shift[4]).all() and np.isfinite(shift[:4]).all()
-
-
-def test_a_constraint_joins_the_kept_rows_without_changing_the_verdict():
-    """A prior on the third unknown added after the exclusion: one more degree of freedom, the
-    same rows and verdict; consistent it changes nothing but the covariance, contradicted it
-    enters Ω and pulls the solution."""
-    H = _geometry(7, seed=4)
-    y = H @ X_TRUE
-    y[3] += 2.0
-    sigma = np.full(7, 0.1)
-    agreeing = Constraint(np.array([[0.0, 0.0, 1.0, 0.0]]), np.array([X_TRUE[2]]), np.array([0.2]))
-    free = lsq_with_exclusion(H, y, sigma, np.arange(7), 4)
-    held = constrained(free, H, y, sigma, agreeing)
-    assert held.dof == free.dof + 1 and held.used.tolist() == free.used.tolist()
-    assert held.passed == free.passed and not held.used[3]
-    np.testing.assert_allclose(held.x, X_TRUE, atol=1e-12)
-    assert held.chi_square == pytest.approx(0.0, abs=1e-20)
-    used = held.used
-    W = np.diag(np.r_[sigma[used], 0.2] ** -2.0)
-    stacked = np.vstack([H[used], agreeing.H])
-    np.testing.assert_allclose(held.covariance, np.linalg.inv(stacked.T @ W @ stacked), rtol=1e-9)
-    assert held.covariance[2, 2] < free.covariance[2, 2]
-    contradicting = Constraint(agreeing.H, agreeing.y + 1.0, agreeing.sigma)
-    pulled = constrained(free, H, y, sigma, contradicting)
-    assert pulled.chi_square > 1.0 and pulled.x[2] > X_TRUE[2] + 0.01
-
-
-def test_an_unavailable_solution_stays_unavailable_under_a_constraint():
-    H = _geometry(3)
-    short = lsq_with_exclusion(H, H @ X_TRUE, np.full(3, 0.1), np.arange(3), 4)
-    prior = Constraint(np.array([[0.0, 0.0, 1.0, 0.0]]), np.zeros(1), np.ones(1))
-    assert constrained(short, H, H @ X_TRUE, np.full(3, 0.1), prior) is short

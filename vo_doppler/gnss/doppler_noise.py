@@ -19,9 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
-from vo_doppler.gnss.grade_prior import grade_prior
-
 WINDOW_S = 60.0
 MIN_ROWS = 20
 FLOOR_MPS = 0.02
@@ -41,7 +38,7 @@ def fitted_sigma(
     satellites with too few residuals keep ``prior_sigma``)."""
     state = np.column_stack([solution.velocity_ecef, solution.clock_drift_mps])[rows.epoch]
     predicted = -np.einsum("ij,ij->i", rows.los, state[:, :3]) + state[:, 3]
-    redundancy = redundancy_numbers(rows, rows.sigma(), solution)
+    redundancy = redundancy_numbers(rows, rows.sigma())
     reference = np.broadcast_to(np.asarray(reference_sigma, dtype=float), (len(rows),))
     residual = (rows.reduced() - predicted) / np.sqrt(redundancy) / reference
     sigma = np.asarray(prior_sigma, dtype=float).copy()
@@ -60,10 +57,9 @@ def fitted_sigma(
     return sigma
 
 
-def redundancy_numbers(rows, sigma: np.ndarray, solution=None) -> np.ndarray:
-    """r_i = 1 − h_ii per row with all of its epoch's rows in the design and, where
-    ``solution`` is given, the road's grade prior at its velocity (the solutions are solved with it:
-    :mod:`vo_doppler.gnss.grade_prior`); NaN without redundancy."""
+def redundancy_numbers(rows, sigma: np.ndarray) -> np.ndarray:
+    """r_i = 1 − h_ii per row with all of its epoch's rows in the design (NaN without
+    redundancy)."""
     out = np.full(len(rows), np.nan)
     order = np.argsort(rows.epoch, kind="stable")
     bounds = np.flatnonzero(np.diff(rows.epoch[order])) + 1
@@ -73,16 +69,6 @@ def redundancy_numbers(rows, sigma: np.ndarray, solution=None) -> np.ndarray:
             continue
         weight = sigma[members] ** -2.0
         normal = (H * weight[:, None]).T @ H
-        if solution is not None and members.size:
-            normal += _prior_information(rows, solution, members[0])
         hat = np.einsum("ij,jk,ik->i", H, np.linalg.pinv(normal), H) * weight
         out[members] = np.clip(1.0 - hat, 1e-6, 1.0)
     return out
-
-
-def _prior_information(rows, solution, row: int) -> np.ndarray:
-    """HᵀWH of the grade prior at the epoch of ``row`` (``solution``'s velocity there)."""
-    lat, lon, _ = ecef_to_geodetic(rows.receiver_ecef[row])
-    rotation = ecef_to_enu_rotation(float(lat), float(lon))
-    h = grade_prior(rotation, solution.velocity_ecef[rows.epoch[row]]).constraint
-    return (h.H / h.sigma[:, None] ** 2).T @ h.H

@@ -11,11 +11,8 @@ clock drift b = c·δṫ_r (m/s) and satellite clock drift c·δṫ_s (m/s):
 
 Weights: σ_i = σ₀ · 10^((C/N0_ref − C/N0_i)/20) / sin(elevation_i), or the receiver's own σ
 where it reports one, or σ fitted to the residuals (``doppler_noise``). Fault detection and
-exclusion: chi-square test, iterated (``lsq.lsq_with_exclusion``). The rows kept are then
-solved again with the road's grade as a pseudo-observation (:mod:`vo_doppler.gnss.grade_prior`:
-v_u = 0 with σ_g = √((0.1·s)² + 0.1²) at the horizontal speed s; ``lsq.constrained``). Fewer
-than four satellites (after mask and exclusion) → the epoch is unavailable (NaN), never
-guessed. ``valid`` only where
+exclusion: chi-square test, iterated (``lsq.lsq_with_exclusion``). Fewer than four satellites
+(after mask and exclusion) → the epoch is unavailable (NaN), never guessed. ``valid`` only where
 the solution could be tested and passed: at least five satellites left after the exclusion
 (redundancy), the chi-square test accepting them, and a vertical velocity that a land vehicle
 can have (:func:`vertical_velocity_plausible`) — these make it ``verified`` — and a course
@@ -23,14 +20,11 @@ continuous with the neighbouring epochs' (:mod:`vo_doppler.gnss.continuity`); a 
 solution is given, with its σ, but not valid (``untestable``: the heading stage's calibration
 tests it against the wheels and the gyro instead).
 
-The grade prior and its test add the one fact about a car that the GNSS-only solution leaves
-out: it climbs no steeper than its road. Reflected (NLOS) Doppler from several satellites at
-once can be fitted by a wrong velocity that passes the chi-square test (with five or six
-satellites it has one or two degrees of freedom), but the wrong velocity then rarely stays
-horizontal (docs/design.md (2a): measured on simulated canyons and the real recordings). In a
-street canyon the satellites left see the vertical poorly and it is correlated with the
-horizontal: the prior, not only the test, then holds the course (docs/design.md (2a);
-figures in docs/benchmarks.md).
+The vertical test adds the one fact about a car that the GNSS-only solution leaves out: it
+climbs no steeper than its road. Reflected (NLOS) Doppler from several satellites at once can
+be fitted by a wrong velocity that passes the chi-square test (with five or six satellites it
+has one or two degrees of freedom), but the wrong velocity then rarely stays horizontal
+(docs/design.md (2a): measured on simulated canyons and the real recordings).
 """
 
 from __future__ import annotations
@@ -43,13 +37,7 @@ import numpy as np
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.continuity import continuity_checked
 from vo_doppler.gnss.doppler_noise import fitted_sigma
-from vo_doppler.gnss.grade_prior import grade_prior
-from vo_doppler.gnss.lsq import (
-    DEFAULT_ALPHA,
-    constrained,
-    lsq_with_exclusion,
-    minimal_detectable_shift,
-)
+from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion, minimal_detectable_shift
 from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models, modelled_sigma
 from vo_doppler.gnss.satellite_source import StateSource, satellite_source, transmit_states
 from vo_doppler.gnss.signals import strength_code, wavelengths
@@ -66,9 +54,12 @@ CN0_REFERENCE_DBHZ = 45.0
 CN0_DEFAULT_DBHZ = 40.0
 MIN_SATELLITES = 4
 NOISE_PASSES = 3
+GRADE_SIGMA = 0.1
+"""σ of a land vehicle's vertical over its horizontal speed: a road's grade of 10 %, so that
+the 3σ gate is a 30 % grade, steeper than public roads (the steepest streets are 30–35 %)."""
+VERTICAL_FLOOR_MPS = 0.1
+"""σ of the vertical velocity at any speed: suspension, a walker's gait, a phone in a hand."""
 VERTICAL_GATE = 3.0
-PRIOR_GROUP = "~grade"
-"""The grade prior's label among the satellites' (never a satellite's name)."""
 
 
 def range_rate_sigma(cn0: np.ndarray, elevation: np.ndarray, sigma0: float) -> np.ndarray:
@@ -248,11 +239,7 @@ def solve_velocity(
             n_sat[k] = np.unique(satellite[r]).size
             continue
         H = np.hstack([-rows.los[r], np.ones((r.size, 1))])
-        lat, lon, _ = ecef_to_geodetic(rows.receiver_ecef[r[0]])
-        rotation = ecef_to_enu_rotation(float(lat), float(lon))
         result = lsq_with_exclusion(H, y_all[r], sigma_all[r], satellite[r], MIN_SATELLITES, alpha)
-        prior = grade_prior(rotation, result.x[:3]).constraint
-        result = constrained(result, H, y_all[r], sigma_all[r], prior)
         n_sat[k] = np.unique(satellite[r][result.used]).size if result.valid else 0
         if not result.valid:
             continue
@@ -262,26 +249,19 @@ def solve_velocity(
         n_obs[k] = int(result.used.sum())
         n_excluded[k] = int((~result.used).sum())
         rms[k] = float(np.sqrt(np.mean(result.residuals[result.used] ** 2)))
+        lat, lon, _ = ecef_to_geodetic(rows.receiver_ecef[r[0]])
+        rotation = ecef_to_enu_rotation(float(lat), float(lon))
         velocity_enu[k] = rotation @ result.x[:3]
         covariance_enu = rotation @ result.covariance[:3, :3] @ rotation.T
         dop[k] = _dop(H[result.used], rotation)
         horizontal_sigma[k] = speed_course_sigma(velocity_enu[k], covariance_enu)
         vertical_sigma[k] = np.sqrt(covariance_enu[2, 2])
         kept = result.used
-        groups = np.append(satellite[r][kept], PRIOR_GROUP)
         shift = minimal_detectable_shift(
-            np.vstack([H[kept], prior.H]),
-            np.r_[sigma_all[r][kept], prior.sigma],
-            groups,
-            result.covariance,
-            result.dof,
-            alpha,
+            H[kept], sigma_all[r][kept], satellite[r][kept], result.covariance, result.dof, alpha
         )
-        satellites_only = np.unique(groups) != PRIOR_GROUP
-        protection[k] = _horizontal_protection(shift[satellites_only, :3], rotation)
-        plausible = vertical_velocity_plausible(
-            velocity_enu[k], covariance_enu, float(prior.sigma[0])
-        )
+        protection[k] = _horizontal_protection(shift[:, :3], rotation)
+        plausible = vertical_velocity_plausible(velocity_enu[k], covariance_enu)
         verified[k] = result.passed and n_sat[k] > MIN_SATELLITES and plausible
         untestable[k] = (
             n_sat[k] == MIN_SATELLITES and (result.dof == 0 or result.passed) and plausible
@@ -319,20 +299,17 @@ def _horizontal_protection(shift_ecef: np.ndarray, rotation: np.ndarray) -> floa
     return float(np.max(np.hypot(horizontal[:, 0], horizontal[:, 1])))
 
 
-def vertical_velocity_plausible(
-    velocity_enu: np.ndarray, covariance_enu: np.ndarray, prior_sigma: float
-) -> bool:
-    """Whether the grade prior passes its own test (Baarda's w-test of the prior row): the
-    solution's vertical velocity v_u against the prior's residual σ, |v_u| ≤ 3·√(σ_g² − P_uu),
-    with σ_g = ``prior_sigma`` (:mod:`vo_doppler.gnss.grade_prior`) and P_uu the solution's
-    vertical variance with the prior. For the one prior row this is the test of the solution
-    without it, |v_u'| ≤ 3·√(P_uu' + σ_g²): a land vehicle climbs no steeper than its road,
-    however uncertain the satellites leave the vertical. (Capping P_uu' at 0.3 m/s was tried for
-    issue 29: on the Hong Kong canyon drive no valid course was then beyond 15° (one at 20°
-    without), but the calibration lost good epochs elsewhere: comma2k19's dead reckoning alone
-    0.36 → 0.54 m per 100 m, the sample's VO + GPS (tightly coupled) 0.05 → 0.10 m.)"""
-    residual_variance = max(prior_sigma**2 - covariance_enu[2, 2], 1e-12 * prior_sigma**2)
-    return bool(abs(velocity_enu[2]) <= VERTICAL_GATE * np.sqrt(residual_variance))
+def vertical_velocity_plausible(velocity_enu: np.ndarray, covariance_enu: np.ndarray) -> bool:
+    """Whether the vertical velocity v_u is one a land vehicle can have:
+    |v_u| ≤ 3·√(P_uu + σ_g²), σ_g = √((g·s)² + f²) with s the horizontal speed, g
+    ``GRADE_SIGMA`` and f ``VERTICAL_FLOOR_MPS``; P_uu the solution's own vertical variance.
+    (Capping P_uu's share at 0.3 m/s was tried for issue 29: on the Hong Kong canyon drive no
+    valid course was then beyond 15° (one at 20° without), but the calibration lost good epochs
+    elsewhere: comma2k19's dead reckoning alone 0.36 → 0.54 m per 100 m, the sample's VO + GPS
+    (tightly coupled) 0.05 → 0.10 m.)"""
+    speed = np.hypot(velocity_enu[0], velocity_enu[1])
+    prior = (GRADE_SIGMA * speed) ** 2 + VERTICAL_FLOOR_MPS**2
+    return bool(abs(velocity_enu[2]) <= VERTICAL_GATE * np.sqrt(covariance_enu[2, 2] + prior))
 
 
 def speed_course_sigma(velocity_enu: np.ndarray, covariance_enu: np.ndarray) -> np.ndarray:

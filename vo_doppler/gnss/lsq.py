@@ -5,10 +5,6 @@ u unknowns follows χ²(n − u); when Ω exceeds the (1 − α) quantile, the r
 normalised residual |r_i| / √(Q_vv,ii), Q_vv = W⁻¹ − H (HᵀWH)⁻¹ Hᵀ (Baarda's w-test), is
 excluded and the solution repeated, while enough distinct satellites remain.
 
-Constraints: pseudo-observations (a prior on part of the state) added to the rows the exclusion
-kept (:func:`constrained`). They take no part in the exclusion: a prior that the faulty rows
-contradict would otherwise have good rows excluded until the faulty ones agree with it.
-
 What the test cannot see (external reliability, :func:`minimal_detectable_shift`): the shift of
 the solution that the smallest bias on one satellite the test still detects with probability
 ``DETECTION_POWER`` would cause.
@@ -17,7 +13,7 @@ the solution that the smallest bias on one satellite the test still detects with
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import chdtri, chndtrinc
@@ -57,15 +53,6 @@ def weighted_lsq(H: np.ndarray, y: np.ndarray, sigma: np.ndarray):
     return x, covariance, y - H @ x
 
 
-@dataclass(frozen=True)
-class Constraint:
-    """Pseudo-observation rows ``H x = y`` with σ ``sigma`` (a prior on part of the state)."""
-
-    H: np.ndarray
-    y: np.ndarray
-    sigma: np.ndarray
-
-
 def lsq_with_exclusion(
     H: np.ndarray,
     y: np.ndarray,
@@ -103,34 +90,6 @@ def lsq_with_exclusion(
         normalised = np.abs(residuals[used]) / np.sqrt(np.maximum(q_vv, 1e-30))
         worst = np.flatnonzero(used)[int(np.argmax(normalised))]
         used[worst] = False
-
-
-def constrained(
-    result: LsqResult, H: np.ndarray, y: np.ndarray, sigma: np.ndarray, constraint: Constraint
-) -> LsqResult:
-    """``result`` solved again with the ``constraint`` rows added to the rows it kept: the
-    solution, its covariance, every row's residual, Ω (the constraint's share included) and
-    the degrees of freedom change; which rows are used and the test's verdict do not (module
-    docstring). An unavailable result is returned as it is."""
-    if not result.valid:
-        return result
-    used = result.used
-    x, covariance, _ = weighted_lsq(
-        np.vstack([H[used], constraint.H]),
-        np.r_[y[used], constraint.y],
-        np.r_[sigma[used], constraint.sigma],
-    )
-    residuals = y - H @ x
-    omega = float(np.sum((residuals[used] / sigma[used]) ** 2))
-    omega += float(np.sum(((constraint.y - constraint.H @ x) / constraint.sigma) ** 2))
-    return replace(
-        result,
-        x=x,
-        covariance=covariance,
-        residuals=residuals,
-        chi_square=omega,
-        dof=result.dof + constraint.y.size,
-    )
 
 
 @functools.lru_cache(maxsize=256)

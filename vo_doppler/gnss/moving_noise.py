@@ -15,9 +15,8 @@ the chi-square test. The model per row i is
     σ_i² = (f · σ_prior,i)² + (k(C/N0_i) · s_i)²,    log₁₀ k(C) = κ₀ + κ₁ · (C − C_ref) / 10 dB,
 
 with s_i the horizontal speed of the row's epoch (a first solution's). f and (κ₀, κ₁) are fitted
-to the residuals of the conventional solutions that passed their tests (``verified``), each
-divided by √r_i (r_i its redundancy number, so that its variance is σ_i²;
-``noise_model.normalised_residuals``): f is the
+to the residuals of the conventional solutions, each divided by √r_i (r_i its redundancy
+number, so that its variance is σ_i²; ``noise_model.normalised_residuals``): f is the
 normalised MAD of r_i / σ_prior,i over the rows of epochs at rest; the rows of moving epochs
 (any motion: a walker's gait noise enters k as a car's multipath does; fitted on the car's
 speeds alone, the Yamatogawa walker kept f·σ_prior and got rows four times too confident)
@@ -147,18 +146,14 @@ def fit_moving_noise(
 def moving_noise_weights(
     rows: DopplerRows, solution: VelocitySolution
 ) -> tuple[DopplerRows, MovingNoiseModel]:
-    """The model fitted to the residuals of ``solution``'s verified epochs and the rows
-    re-weighted by it (the speed of each row: its epoch's horizontal speed in ``solution``).
-    An epoch that failed its tests was solved by a wrong velocity: its residuals are that
-    velocity's error, not noise (on the sample's simulated canyon they took k from 0.01 to
-    0.56 m/s per m/s, and every test then passed wrong velocities)."""
+    """The model fitted to ``solution``'s residuals and the rows re-weighted by it (the speed
+    of each row: its epoch's horizontal speed in ``solution``)."""
     if not len(rows) or rows.epoch is None:
         return rows, MovingNoiseModel()
     cn0 = rows.cn0 if rows.cn0 is not None else np.full(len(rows), np.nan)
     solved = np.hypot(solution.velocity_enu[:, 0], solution.velocity_enu[:, 1])
     prior = rows.sigma()
-    residual = np.where(solution.verified[rows.epoch], normalised_residuals(rows, solution), np.nan)
-    model = fit_moving_noise(residual, prior, cn0, solved[rows.epoch])
+    model = fit_moving_noise(normalised_residuals(rows, solution), prior, cn0, solved[rows.epoch])
     if model.identity:
         return rows, model
     speed = epoch_speed(solution.t, solved)[rows.epoch]

@@ -102,8 +102,7 @@ def normalised_residuals(rows: DopplerRows, solution: VelocitySolution) -> np.nd
     no redundancy)."""
     state = np.column_stack([solution.velocity_ecef, solution.clock_drift_mps])[rows.epoch]
     predicted = -np.einsum("ij,ij->i", rows.los, state[:, :3]) + state[:, 3]
-    redundancy = redundancy_numbers(rows, rows.sigma(), solution)
-    return (rows.reduced() - predicted) / np.sqrt(redundancy)
+    return (rows.reduced() - predicted) / np.sqrt(redundancy_numbers(rows, rows.sigma()))
 
 
 def fit_noise_models(
