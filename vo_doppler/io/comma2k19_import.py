@@ -32,7 +32,7 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.errors import InputError
-from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.geo import SPEED_OF_LIGHT, EnuFrame, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.io.can import check_dbc
 from vo_doppler.io.comma2k19 import (
     RAW_GNSS,
@@ -58,7 +58,7 @@ from vo_doppler.io.sensor_csv import (
     YAW_RATE_COLUMN,
     write_sensor_csv,
 )
-from vo_doppler.io.sequence import FORMAT, MANIFEST
+from vo_doppler.io.sequence import FORMAT, MANIFEST, origin_entry
 from vo_doppler.io.sp3 import read_sp3
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.io.vehicle_limits import GPS_TIME
@@ -204,11 +204,7 @@ def import_comma2k19(
         "format": FORMAT,
         "name": segment.name,
         "source": f"comma2k19 segment {segment} (vo-doppler import comma2k19)",
-        "origin": {
-            "lat_deg": float(np.degrees(lat)),
-            "lon_deg": float(np.degrees(lon)),
-            "height_m": height,
-        },
+        "origin": origin_entry(EnuFrame(lat, lon, height)),
         **({"camera": camera} if camera else {}),
         "gnss": gnss,
         **vehicle,

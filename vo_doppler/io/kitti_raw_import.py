@@ -51,7 +51,7 @@ from vo_doppler.io.calibration import checked_camera, write_camera_yaml
 from vo_doppler.io.kitti_oxts import match_frame_files, read_oxts, read_timestamps
 from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, YAW_RATE_COLUMN, write_sensor_csv
-from vo_doppler.io.sequence import FORMAT, MANIFEST
+from vo_doppler.io.sequence import FORMAT, MANIFEST, origin_entry
 from vo_doppler.io.textfile import SMALL_MAX_BYTES, read_text
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD, Camera
@@ -142,11 +142,7 @@ def import_kitti_raw(
         "format": FORMAT,
         "name": drive.name,
         "source": f"KITTI raw drive {drive} (vo-doppler import kitti-raw)",
-        "origin": {
-            "lat_deg": float(np.degrees(origin.lat_rad)),
-            "lon_deg": float(np.degrees(origin.lon_rad)),
-            "height_m": float(origin.height_m),
-        },
+        "origin": origin_entry(origin),
         "camera": {"images": camera, "times": TIMES, "calib": CALIB, "time_offset_s": 0.0},
         "vehicle": {"yaw_rate": YAW_RATE_CSV, "wheel_speed": SPEED_CSV, "time_offset_s": 0.0},
         "ground_truth": {"trajectory": GROUND_TRUTH},

@@ -72,6 +72,16 @@ class InputReport:
         return self.skipped + order
 
 
+def origin_entry(frame: EnuFrame) -> dict[str, float]:
+    """The manifest's ``origin`` entry (degrees, metres) of an ENU frame: what
+    :func:`read_sequence` reads back into the frame."""
+    return {
+        "lat_deg": float(np.degrees(frame.lat_rad)),
+        "lon_deg": float(np.degrees(frame.lon_rad)),
+        "height_m": float(frame.height_m),
+    }
+
+
 def read_manifest(folder: str | Path) -> dict[str, Any]:
     """The parsed ``sequence.yaml`` of a folder (or the file itself), checked for its format."""
     path = Path(folder)

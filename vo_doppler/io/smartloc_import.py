@@ -47,7 +47,7 @@ from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.rinex_write import observation_epochs, write_obs
 from vo_doppler.io.satellite_states import read_satellite_states
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, YAW_RATE_COLUMN, write_sensor_csv
-from vo_doppler.io.sequence import FORMAT, MANIFEST
+from vo_doppler.io.sequence import FORMAT, MANIFEST, origin_entry
 from vo_doppler.io.smartloc import SmartLocRecording, read_smartloc
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.series import SensorSeries
@@ -133,11 +133,7 @@ def import_smartloc(
         "format": FORMAT,
         "name": source.stem,
         "source": f"smartLoc raw CSV {source} (vo-doppler import smartloc)",
-        "origin": {
-            "lat_deg": float(np.degrees(frame.lat_rad)),
-            "lon_deg": float(np.degrees(frame.lon_rad)),
-            "height_m": float(frame.height_m),
-        },
+        "origin": origin_entry(frame),
         **({"gnss": gnss} if nav else {}),
         "vehicle": {"yaw_rate": YAW_RATE_CSV, "wheel_speed": SPEED_CSV, "time_offset_s": 0.0},
         "ground_truth": {"trajectory": GROUND_TRUTH},
