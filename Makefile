@@ -32,7 +32,7 @@ browser:
 	           || echo "chromium could not be installed: the browser tests will skip"; \
 	       else echo "no chromium and no root apt-get: the browser tests will skip"; fi; }
 
-# The suite runs on two workers (pytest-xdist): about 6 min on 2 cores, 13 min on one.
+# The suite runs on two workers (pytest-xdist): about 8 min on 2 cores, 13 min on one.
 test: $(TEST_STAMP) browser
 	$(BIN)/python -m pytest -q -n 2
 
