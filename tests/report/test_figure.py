@@ -1,25 +1,27 @@
-"""Figure helpers: a new figure is on an Agg canvas whose renderer the tight layout and the PNG
-share; the tight layout leaves no layout engine, so saving draws the figure once, into the same
-pixels as matplotlib's own ``tight_layout``."""
+"""Figure helpers, seen through matplotlib's public interfaces: a new figure is on an Agg canvas
+whose renderer the tight layout and the PNG share; the tight layout leaves no layout engine, so
+saving draws the figure once (one ``draw_event``), into the same pixels as matplotlib's own
+``tight_layout``; integer ticks are whole numbers."""
 
 from __future__ import annotations
 
 import io
 
 import numpy as np
+from matplotlib.image import imread
 
-from vo_doppler.report.figure import new_figure, tight_layout
+from vo_doppler.report.figure import integer_ticks, new_figure, tight_layout
 
 
 def _figure():
     fig = new_figure(figsize=(6, 3))
     ax = fig.subplots()
-    (line,) = ax.plot(np.arange(50.0), np.sin(np.arange(50.0) / 5.0), label="a sine")
+    ax.plot(np.arange(50.0), np.sin(np.arange(50.0) / 5.0), label="a sine")
     ax.set_xlabel("time since first GNSS epoch [s]")
     ax.set_ylabel("heading error\n(estimate − truth) [deg]")
     ax.legend(fontsize=8)
     ax.set_title("a title")
-    return fig, line
+    return fig
 
 
 def _png(fig) -> bytes:
@@ -28,34 +30,62 @@ def _png(fig) -> bytes:
     return buffer.getvalue()
 
 
+def _drawn_with(fig) -> list:
+    """The renderer of every ``draw_event`` the figure sends from now on."""
+    renderers = []
+    fig.canvas.mpl_connect("draw_event", lambda event: renderers.append(event.renderer))
+    return renderers
+
+
 def test_tight_layout_leaves_no_layout_engine_and_saving_draws_once():
-    fig, line = _figure()
+    fig = _figure()
     tight_layout(fig)
-    draws = []
-    draw = line.draw
-    line.draw = lambda renderer: (draws.append(renderer), draw(renderer))
+    draws = _drawn_with(fig)
     _png(fig)
     assert fig.get_layout_engine() is None
     assert len(draws) == 1
+    # matplotlib's own tight layout leaves an engine that draws the figure once more
+    theirs = _figure()
+    theirs.tight_layout()
+    their_draws = _drawn_with(theirs)
+    _png(theirs)
+    assert len(their_draws) == 2
 
 
 def test_tight_layout_gives_the_layout_and_pixels_of_matplotlibs():
-    ours, _ = _figure()
+    ours = _figure()
     tight_layout(ours)
-    theirs, _ = _figure()
+    theirs = _figure()
     theirs.tight_layout()
     params = ("left", "right", "bottom", "top")
     assert [getattr(ours.subplotpars, p) for p in params] == [
         getattr(theirs.subplotpars, p) for p in params
     ]
     assert ours.subplotpars.left > 0.1
-    assert _png(ours) == _png(theirs)
+    png = _png(ours)
+    assert png == _png(theirs)
+    pixels = imread(io.BytesIO(png), format="png")
+    assert pixels.shape == (300, 600, 4)  # 6 x 3 in at 100 dpi, RGBA
+    assert len(np.unique(pixels.reshape(-1, 4), axis=0)) > 10  # drawn, not blank
 
 
 def test_the_layout_and_the_png_share_the_canvas_renderer():
-    fig, _ = _figure()
+    fig = _figure()
+    layout_renderer = fig.canvas.get_renderer()
     tight_layout(fig)
-    layout_renderer = fig.canvas.renderer
-    png = _png(fig)
-    assert png.startswith(b"\x89PNG")
-    assert fig.canvas.renderer is layout_renderer
+    draws = _drawn_with(fig)
+    assert _png(fig).startswith(b"\x89PNG")
+    assert draws == [layout_renderer]
+    assert fig.canvas.get_renderer() is layout_renderer
+
+
+def test_integer_ticks_are_whole_numbers():
+    fig = new_figure(figsize=(4, 3))
+    ax = fig.subplots()
+    ax.plot([0.0, 1.0], [0.0, 2.6])
+    integer_ticks(ax.yaxis)
+    ticks = ax.yaxis.get_ticklocs()
+    assert len(ticks) >= 2
+    np.testing.assert_array_equal(ticks, np.round(ticks))
+    # without it, the same axis gets fractional ticks
+    assert np.any(ax.xaxis.get_ticklocs() != np.round(ax.xaxis.get_ticklocs()))
