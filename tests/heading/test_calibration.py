@@ -18,7 +18,6 @@ from vo_doppler.heading.calibration import (
     estimate_gyro_bias,
     estimate_wheel_scale,
     huber_line,
-    median_of_finite,
     variation_gate,
 )
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, causal_calibration
@@ -51,17 +50,6 @@ def test_exact_wheel_scale_and_spikes_rejected():
     assert estimate.value == pytest.approx(1.0123, abs=1e-12)
     assert estimate.n_rejected == 3 and estimate.n_used == len(t) - 3
     assert estimate.sigma < 1e-10
-
-
-def test_median_of_finite_values_is_numpys_median_to_the_bit():
-    assert median_of_finite(np.array([3.0, -1.0, 2.0])) == 2.0
-    assert median_of_finite(np.array([4.0, 1.0, 2.0, 3.0])) == 2.5
-    assert median_of_finite(np.array([7.0])) == 7.0
-    rng = np.random.default_rng(5)
-    for n in (2, 3, 30, 31, 760, 761):
-        for _ in range(50):
-            values = rng.standard_normal(n) * 10.0 ** rng.uniform(-8, 8) + rng.normal(0, 1e3)
-            assert median_of_finite(values) == float(np.median(values))
 
 
 def test_huber_line_is_least_squares_on_clean_data_and_ignores_a_coherent_burst():

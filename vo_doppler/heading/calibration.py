@@ -37,6 +37,7 @@ import numpy as np
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
+from vo_doppler.robust import median_of_finite
 
 PRIOR_WHEEL_SCALE = 1.0
 PRIOR_WHEEL_SCALE_SIGMA = 0.03
@@ -139,18 +140,6 @@ def _centred(
     for index in members:
         out[index] -= weights[index] @ values[index] / weights[index].sum()
     return out
-
-
-def median_of_finite(values: np.ndarray) -> float:
-    """``np.median`` of a 1-D array of finite values, to the bit: the middle order statistic,
-    or half the sum of the two middle ones (as ``np.median`` takes their mean), found by one
-    partition without ``np.median``'s generic axis and NaN handling (the IRLS of
-    :func:`huber_line` takes two medians per iteration and epoch)."""
-    half = values.size // 2
-    if values.size % 2:
-        return float(np.partition(values, half)[half])
-    middle = np.partition(values, (half - 1, half))
-    return float((middle[half - 1] + middle[half]) / 2.0)
 
 
 def _robust_scale(residual: np.ndarray) -> float:
