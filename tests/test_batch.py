@@ -41,6 +41,7 @@ from vo_doppler.batch import (
 from vo_doppler.errors import InputError, OutputError
 from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
 from vo_doppler.io.output_folder import RUN, mark_output, open_output_folder, written_by
+from vo_doppler.model.time_span import SpanBound, TimeSpan
 from vo_doppler.run import RunConfig
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 from vo_doppler.vo.config import VoConfig
@@ -114,6 +115,11 @@ def test_fingerprint_follows_files_and_config(tmp_path):
     assert fingerprint(tmp_path, RunConfig(), None) == first
     assert fingerprint(tmp_path, replace(config, vo=VoConfig(window_size=10)), None) != first
     assert fingerprint(tmp_path, config, die_or_fail) != first
+    assert fingerprint(tmp_path, config, None, TimeSpan()) == first
+    span = TimeSpan(SpanBound(2.0), SpanBound(9.0))
+    assert fingerprint(tmp_path, config, None, span) != first
+    later = TimeSpan(SpanBound(2.0), SpanBound(9.5))
+    assert fingerprint(tmp_path, config, None, later) != fingerprint(tmp_path, config, None, span)
     data.write_text("22")
     assert fingerprint(tmp_path, config, None) != first
 

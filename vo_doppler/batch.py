@@ -25,11 +25,11 @@ were and adds its log beside them as :data:`FAILED_LOG`; a folder without earlie
 replaced by the failed run's (its ``run.log``). A recording that does not exist fails without
 any folder, its message naming the list's file and line when it came from a list.
 
-The fingerprint hashes the package version, the configuration, the ``prepare`` step's name
-(or, for a callable object, its ``repr``: e.g. the orbits an importer uses) and, for every file
-under ``SOURCE``, its relative path, size and modification time (the quick
-check of rsync and make: touching or replacing a file re-runs the recording; files outside
-``SOURCE`` that a manifest points to are not followed).
+The fingerprint hashes the package version, the configuration, the span (``--start`` /
+``--end``), the ``prepare`` step's name (or, for a callable object, its ``repr``: e.g. the
+orbits an importer uses) and, for every file under ``SOURCE``, its relative path, size and
+modification time (the quick check of rsync and make: touching or replacing a file re-runs the
+recording; files outside ``SOURCE`` that a manifest points to are not followed).
 
 ``prepare``: a picklable function ``prepare(source, work_dir) -> sequence_folder`` run in the
 worker before the job, for recordings that need importing first (e.g. a raw comma2k19 segment
@@ -63,7 +63,7 @@ from enum import StrEnum
 from pathlib import Path
 
 from vo_doppler import __version__
-from vo_doppler.errors import InputError, VoDopplerError, storage_refused
+from vo_doppler.errors import InputError, UsageError, VoDopplerError, storage_refused
 from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
 from vo_doppler.io.output_folder import (
     RUN,
@@ -77,6 +77,7 @@ from vo_doppler.io.output_folder import (
 )
 from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
 from vo_doppler.io.tables import write_csv_and_parquet
+from vo_doppler.model.time_span import TimeSpan, trim_sequence
 from vo_doppler.report.batch_summary import (
     COLUMNS,
     overall_row,
@@ -103,6 +104,8 @@ PREPARED = "prepared"
 EXECUTORS = ("local", "ray")
 TABLE_NAME = "batch_summary"
 PARENT_POLL_S = 0.5
+WHOLE = TimeSpan()
+"""No ``--start`` / ``--end``: each recording whole."""
 
 Prepare = Callable[[Path, Path], Path]
 """``prepare(source, work_dir) -> sequence folder``: imports a raw recording (module docstring)."""
@@ -120,6 +123,9 @@ class Failure(StrEnum):
 
     INPUT = "input-error"
     """The toolkit's own error (:class:`~vo_doppler.errors.VoDopplerError`): unusable input."""
+    USAGE = "usage-error"
+    """An option that contradicts the recording (:class:`~vo_doppler.errors.UsageError`: a
+    ``--start`` / ``--end`` outside it), what makes ``vo-doppler run`` exit 2."""
     INTERNAL = "internal-error"
     """Any other exception: a bug; the traceback is in the recording's ``run.log``."""
     WORKER_LOST = "worker-lost"
@@ -145,6 +151,8 @@ class RecordingJob:
     prepare: Prepare | None = None
     listed: Listing | None = None
     """Where a list named the recording (for its messages), None when given directly."""
+    span: TimeSpan = WHOLE
+    """The part of the recording to run on (``--start`` / ``--end``; default all of it)."""
 
     @property
     def name(self) -> str:
@@ -178,7 +186,10 @@ class BatchResult:
 
     @property
     def exit_code(self) -> int:
-        """1 when any recording failed, else 0 (the command's exit status)."""
+        """The command's exit status: 2 when a recording failed on a usage error (a span
+        outside it, as ``run`` exits 2), else 1 when any failed, else 0."""
+        if any(o.category is Failure.USAGE for o in self.failed):
+            return 2
         return 1 if self.failed else 0
 
 
@@ -224,14 +235,17 @@ def output_names(sources: list[Path]) -> list[str]:
     raise InputError("two recordings resolve to the same path")
 
 
-def fingerprint(source: Path, config: RunConfig, prepare: Prepare | None) -> str:
-    """SHA-256 of the version, configuration, prepare step and input files (module docstring)."""
+def fingerprint(
+    source: Path, config: RunConfig, prepare: Prepare | None, span: TimeSpan = WHOLE
+) -> str:
+    """SHA-256 of the version, configuration, span, prepare step and input files (module
+    docstring)."""
     digest = hashlib.sha256()
     step = None
     if prepare is not None:
         name = getattr(prepare, "__qualname__", None)
         step = f"{prepare.__module__}.{name}" if name else repr(prepare)
-    digest.update(repr((__version__, config, step)).encode())
+    digest.update(repr((__version__, config, span, step)).encode())
     files = sorted(p for p in source.rglob("*") if p.is_file()) if source.is_dir() else [source]
     for path in files:
         try:
@@ -278,13 +292,22 @@ def _run_job(job: RecordingJob, staging: Path) -> dict:
     else:
         folder, shown = job.prepare(job.source, staging / PREPARED), job.out / PREPARED
     sequence, report = read_sequence_with_report(folder)
+    interval = None
+    if not job.span.whole:
+        sequence, interval = trim_sequence(sequence, job.span)
     warnings = input_warnings(sequence, report)
     for text in warnings:
         log.warning("%s", text)
     result = run_sequence(sequence, job.config)
     checks = result_checks(sequence, report, result, warnings)
     summary = write_run_outputs(
-        sequence, result, job.config, staging, checks, read_manifest(folder)
+        sequence,
+        result,
+        job.config,
+        staging,
+        checks,
+        read_manifest(folder),
+        span=None if interval is None else interval.to_dict(),
     )
     require_tight_heading(result, shown, job.out)
     return summary
@@ -348,7 +371,8 @@ def _logged_run(job: RecordingJob, staging: Path, start: float) -> RecordingOutc
         summary = _run_job(job, staging)
     except VoDopplerError as exc:
         package_log.error("%s", exc)
-        return _failed(job, Failure.INPUT, str(exc), time.perf_counter() - start)
+        category = Failure.USAGE if isinstance(exc, UsageError) else Failure.INPUT
+        return _failed(job, category, str(exc), time.perf_counter() - start)
     except Exception as exc:
         if storage_refused(exc):  # a full disk: the environment, as for ``run``
             message = f"{job.out}: cannot write the results: {exc.strerror}"
@@ -512,10 +536,11 @@ def plan(
     config: RunConfig,
     prepare: Prepare | None = None,
     listings: Mapping[Path, Listing] | None = None,
+    span: TimeSpan = WHOLE,
 ) -> list[RecordingJob]:
     """One job per distinct recording (repeats dropped with a warning naming their spellings),
-    each with its output folder and, from ``listings`` (:func:`read_list`), where a list named
-    it."""
+    each with its output folder, the ``span`` to run on and, from ``listings``
+    (:func:`read_list`), where a list named it."""
     spellings: dict[Path, list[str]] = {}
     for source in sources:
         spellings.setdefault(Path(source).resolve(), []).append(str(source))
@@ -530,9 +555,10 @@ def plan(
             source,
             out / name,
             config,
-            fingerprint(source, config, prepare),
+            fingerprint(source, config, prepare, span),
             prepare,
             listed.get(source),
+            span,
         )
         for source, name in zip(unique, names, strict=True)
     ]
@@ -549,6 +575,7 @@ def run_batch(
     ray_address: str | None = None,
     on_outcome: Callable[[RecordingOutcome], None] | None = None,
     listings: Mapping[Path, Listing] | None = None,
+    span: TimeSpan = WHOLE,
 ) -> BatchResult:
     """Run the main job on every recording and write the aggregate into ``out``
     (``batch_summary.csv``, ``.parquet``, ``.html``).
@@ -557,7 +584,9 @@ def run_batch(
     finished by an earlier batch with the same fingerprint are skipped (their summaries still
     enter the aggregate). ``on_outcome`` is called in the calling process as each recording
     ends (skipped ones first). ``listings``: where a list named the recordings it named
-    (:func:`read_list`), for their messages.
+    (:func:`read_list`), for their messages. ``span`` (``--start`` / ``--end``) is resolved on
+    each recording as ``run`` resolves it: a recording it does not fit fails with the usage
+    error (category ``usage-error``, exit status 2), the others run.
     """
     if executor not in EXECUTORS:
         raise InputError(f"unknown executor {executor!r} (choose from {', '.join(EXECUTORS)})")
@@ -566,7 +595,7 @@ def run_batch(
     config = config or RunConfig()
     sources = [Path(folder) for folder in folders]
     check_output_folder(out, "batch", sources)
-    jobs = plan(sources, out, config, prepare, listings)
+    jobs = plan(sources, out, config, prepare, listings, span)
     for job in jobs:
         check_output_folder(job.out, RUN, sources, replace=True)
     open_output_folder(out, "batch")

@@ -1,9 +1,11 @@
-"""``--start`` / ``--end`` on ``run``, ``heading``, ``gnss`` and ``vo``: the results on a span are
-those on the recording cut to it (as text, :mod:`tests.helpers.cut_recording`); bounds outside
-the recording are usage errors (exit 2), a span without data a clear error (exit 1)."""
+"""``--start`` / ``--end`` on ``run``, ``batch``, ``heading``, ``gnss`` and ``vo``: the results on
+a span are those on the recording cut to it (as text, :mod:`tests.helpers.cut_recording`);
+bounds outside the recording are usage errors (exit 2; in a batch, of that recording only), a
+span without data a clear error (exit 1)."""
 
 from __future__ import annotations
 
+import csv
 import json
 
 import pytest
@@ -51,6 +53,28 @@ def test_run_on_a_span_gives_the_run_on_the_recording_cut_to_it(run_outputs):
     assert on_span["span"]["start_from_first_epoch_s"] == pytest.approx(SPAN_START_S)
     assert on_span["span"]["end_from_first_epoch_s"] == pytest.approx(SPAN_END_S)
     assert "span" not in on_cut
+
+
+@pytest.mark.slow
+def test_batch_runs_each_recording_on_the_span_as_run_does(span_drive, run_outputs, tmp_path):
+    """The whole drive gives run's outputs on the span; the cut drive, which ends before the
+    span's end, fails with run's usage error (category usage-error) and the batch exits 2."""
+    out = tmp_path / "batch"
+    argv = ["-q", "batch", str(span_drive.full), str(span_drive.cut), "-o", str(out)]
+    assert main([*argv, "--workers", "1", *_span(span_drive)]) == 2
+    span = run_outputs[0]
+    for name in TRAJECTORIES:
+        assert (out / "full" / name).read_bytes() == (span / name).read_bytes(), name
+    on_span, in_batch = (json.loads((o / "summary.json").read_text()) for o in (span, out / "full"))
+    assert in_batch["span"] == on_span["span"]
+    assert in_batch["evaluation"] == on_span["evaluation"]
+    with (out / "batch_summary.csv").open() as stream:
+        rows = {row["recording"]: row for row in csv.DictReader(stream)}
+    assert rows["full"]["status"] == "done"
+    assert rows["cut"]["status"] == "failed"
+    assert rows["cut"]["exit_category"] == "usage-error"
+    assert f"--end gps:{span_drive.end:.3f} lies outside the recording" in rows["cut"]["error"]
+    assert "the recording's GNSS epochs run from gps:" in rows["cut"]["error"]
 
 
 def _heading_argv(folder, output, *extra):
@@ -141,10 +165,11 @@ def test_a_span_outside_the_recording_is_a_usage_error(
         (["--end", "gps:nan"], "'gps:nan' is not a time"),
     ],
 )
-@pytest.mark.parametrize("command", ["run", "heading", "gnss", "vo"])
+@pytest.mark.parametrize("command", ["run", "batch", "heading", "gnss", "vo"])
 def test_bounds_wrong_alone_are_refused_before_reading(tmp_path, capsys, command, bounds, message):
     argv = {
         "run": ["run", str(tmp_path / "missing")],
+        "batch": ["batch", str(tmp_path / "missing")],
         "heading": [
             "heading",
             "x.obs",

@@ -14,6 +14,7 @@ from rich.table import Table
 from vo_doppler.batch import EXECUTORS, RecordingOutcome, Status, read_list, run_batch
 from vo_doppler.commands.arg_types import positive_int
 from vo_doppler.commands.run_command import add_run_options, run_config
+from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError
 from vo_doppler.io.comma2k19_import import Comma2k19Import
 from vo_doppler.report.batch_summary import summary_warnings, warnings_status
@@ -30,7 +31,9 @@ def register(subparsers, summary: str) -> None:
         "and the others go on (one that fails before its outputs keeps its earlier results in "
         "OUT/<name>/); the exit status is 1 when any failed. --resume skips the recordings an "
         "earlier batch finished with the same inputs and options, unless their last run "
-        "failed (a failed_run.log beside earlier results): those run again.",
+        "failed (a failed_run.log beside earlier results): those run again. --start/--end "
+        "run each recording on that part of it, as run does; a recording the span does not "
+        "fit fails with run's usage error, the others go on, and the exit status is 2.",
     )
     parser.add_argument(
         "sequences",
@@ -78,6 +81,11 @@ def register(subparsers, summary: str) -> None:
         "file, or a folder of SP3 files from which each segment takes the one around its time",
     )
     add_run_options(parser)
+    add_span_options(
+        parser,
+        "first GNSS epoch of each recording (without GNSS: its first image, else its first "
+        "yaw-rate sample)",
+    )
     parser.set_defaults(func=run, usage_error=parser.error)
 
 
@@ -119,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
             ray_address=args.ray_address,
             on_outcome=advance,
             listings=listed,
+            span=time_span(args),
         )
     console.print(outcome_table(result.outcomes))
     console.print(f"wrote {result.csv}, {result.parquet.name} and {result.html.name}")
