@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -24,15 +25,20 @@ def shared_data() -> Path:
 
 @pytest.fixture(scope="session")
 def turning_drive_folder(tmp_path_factory) -> Path:
-    """The 20-s simulated canyon drive without images, with one left turn of 90° (13–16 s), as
-    ``vo-doppler simulate --duration 20 --seed 1 --no-images`` writes it (the QA report's ``s1``):
-    gyro bias 0.3 °/s, wheel scale 1/1.02, the yaw rate counter-clockwise positive. Built once per
-    test process and shared: a test that changes the recording works on a copy."""
-    from vo_doppler.cli import main
+    """The 20-s simulated canyon drive without images, with one left turn of 90° (13–16 s), the
+    files ``vo-doppler simulate --duration 20 --seed 1 --no-images`` writes (the QA report's
+    ``s1``; its reflected signals on, as the command's default): gyro bias 0.3 °/s, wheel scale
+    1/1.02, the yaw rate counter-clockwise positive. Built once per test process by the
+    simulator's library function, so that stage tests do not depend on the command line; a
+    test that changes the recording works on a copy."""
+    from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
+    defaults = UrbanCanyonConfig()
+    config = UrbanCanyonConfig(
+        duration_s=20.0, seed=1, render=False, gnss=replace(defaults.gnss, nlos=True)
+    )
     folder = tmp_path_factory.mktemp("turning") / "s1"
-    argv = ["-q", "simulate", "--duration", "20", "--seed", "1", "--no-images", "-o", str(folder)]
-    assert main(argv) == 0
+    simulate_urban_canyon(folder, config)
     return folder
 
 
