@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import base64
+import io
 import json
+import re
 from dataclasses import replace
 
 import numpy as np
 import pytest
+from matplotlib.image import imread
 from scipy.spatial.transform import Rotation
 
 from tests.helpers.velocity import velocity_solution
@@ -14,6 +18,8 @@ from vo_doppler import run as run_module
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, wrap_angle
+from vo_doppler.io.heading_csv import COLUMNS as HEADING_COLUMNS
+from vo_doppler.io.heading_csv import OPTIONAL_COLUMNS as HEADING_OPTIONAL
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.io.trajectory import read_tum
@@ -21,6 +27,7 @@ from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.report.trajectory_map import lon_lat
 from vo_doppler.run import (
     PLACEMENT_VERTICAL_SIGMA_M,
     AntennaTrack,
@@ -50,27 +57,85 @@ def run_output(sequence, tmp_path_factory):
     return out
 
 
+CAMERA_TRAJECTORIES = {
+    "vo": "trajectory_vo.tum",
+    "vo_gps_conv": "trajectory_vo_gps_conv.tum",
+    "vo_gps_tc": "trajectory_corrected.tum",
+}
+DR_TRAJECTORIES = {
+    "dr": "trajectory_dr.tum",
+    "dr_gps_conv": "trajectory_dr_gps_conv.tum",
+    "dr_gps_tc": "trajectory_dr_gps_tc.tum",
+}
+FIGURES = ("trajectories.png", "heading.png", "error_per_100m.png", "heading_error.png")
+
+
 @pytest.mark.slow
-def test_run_writes_every_output(run_output):
-    for name in (
-        "trajectory_vo.tum",
-        "trajectory_corrected.tum",
-        "trajectory_vo_gps_conv.tum",
-        "trajectory_dr.tum",
-        "trajectory_dr_gps_conv.tum",
-        "trajectory_dr_gps_tc.tum",
-        "heading.csv",
-        "trajectories.png",
-        "heading.png",
-        "error_per_100m.png",
-        "report.html",
-        "summary.json",
-    ):
-        assert (run_output / name).stat().st_size > 0, name
-    report = (run_output / "report.html").read_text()
-    assert "VO + GPS (tightly coupled)" in report and "data:image/png;base64," in report
-    assert "synthetic data" in report and (run_output / "trajectories.geojson").is_file()
+def test_run_writes_every_output(sequence, run_output):
+    recording = read_sequence(sequence)
+    written = sorted(p.name for p in run_output.iterdir() if not p.name.startswith("."))
+    expected = [*CAMERA_TRAJECTORIES.values(), *DR_TRAJECTORIES.values(), *FIGURES]
+    expected += ["heading.csv", "report.html", "summary.json", "trajectories.geojson"]
+    assert written == sorted(expected)
+    manifest = json.loads((run_output / ".vo-doppler-output.json").read_text())
+    assert manifest["command"] == "run" and manifest["entries"] == written
     summary = json.loads((run_output / "summary.json").read_text())
+
+    # one pose per image, at the image times; one per vehicle-signal epoch for dead reckoning
+    trajectories = {n: read_tum(run_output / f) for n, f in CAMERA_TRAJECTORIES.items()}
+    for trajectory in trajectories.values():
+        np.testing.assert_allclose(trajectory.t, recording.image_times, rtol=0, atol=1e-6)
+    assert summary["vo_frames"] == len(recording.image_paths) == 375
+    dead_reckoning = {n: read_tum(run_output / f) for n, f in DR_TRAJECTORIES.items()}
+    dr_times = dead_reckoning["dr"].t
+    assert len(dr_times) == summary["vehicle_signal_epochs"] > 0.9 * 20 * 25  # 20 Hz for 25 s
+    assert np.all(np.diff(dr_times) > 0)
+    begin, end = recording.vehicle_span
+    assert begin <= dr_times[0] and dr_times[-1] <= end
+    trajectories |= dead_reckoning
+    truth = recording.truth
+    for name, trajectory in trajectories.items():
+        first = trajectories["vo" if name in CAMERA_TRAJECTORIES else "dr"]
+        np.testing.assert_array_equal(trajectory.t, first.t)
+        assert np.all(np.isfinite(trajectory.positions)), name
+        # every pose within 3 m of the truth horizontally (0.8-1.2 m at most at 356e1ed)
+        truth_xy = [np.interp(trajectory.t, truth.t, truth.positions[:, i]) for i in (0, 1)]
+        error = np.hypot(*(trajectory.positions[:, :2] - np.column_stack(truth_xy)).T)
+        assert error.max() < 3.0, name
+        # the evaluation's truth path over the same span, as long as the estimate's within 2 %
+        evaluation = summary["evaluation"][name]
+        assert trajectory.path_length == pytest.approx(evaluation["path_length_m"], rel=0.02)
+        assert evaluation["coverage"]["fraction"] == pytest.approx(1.0, abs=0.01)
+        assert summary["absolute_position_error"][name]["poses"] == len(trajectory)
+
+    # the heading table: one row per GNSS epoch, every column named
+    with open(run_output / "heading.csv") as handle:
+        assert handle.readline().strip().split(",") == [*HEADING_COLUMNS, *HEADING_OPTIONAL]
+    table = read_heading_csv(run_output / "heading.csv")
+    np.testing.assert_allclose(table.t, recording.observations.epoch_time, rtol=0, atol=5e-4)
+    assert summary["gnss_epochs"] == len(table.t) == 501  # 20 Hz for 25 s and the last epoch
+    assert summary["tight_heading_availability"] == pytest.approx(
+        np.mean(np.isfinite(table.yaw_tc)), abs=1e-12
+    )
+
+    # the tracks on the map are the trajectories written, in longitude and latitude
+    features = json.loads((run_output / "trajectories.geojson").read_text())["features"]
+    assert [f["properties"]["name"] for f in features] == ["truth", *trajectories]
+    for feature in features[1:]:
+        coordinates = np.array(feature["geometry"]["coordinates"])
+        positions = trajectories[feature["properties"]["name"]].positions
+        np.testing.assert_allclose(coordinates, lon_lat(recording.enu, positions), atol=1e-8)
+
+    # the figures: pictures, and the report embeds the very PNGs written beside it
+    report = (run_output / "report.html").read_text()
+    embedded = [base64.b64decode(b) for b in re.findall(r"data:image/png;base64,([^'\"]+)", report)]
+    for name in FIGURES:
+        png = (run_output / name).read_bytes()
+        pixels = imread(io.BytesIO(png), format="png")
+        assert pixels.shape[0] >= 300 and pixels.shape[1] >= 600, name
+        assert len(np.unique(pixels.reshape(-1, pixels.shape[2]), axis=0)) > 10, name
+        assert name == "trajectories.png" or png in embedded, name
+    assert "VO + GPS (tightly coupled)" in report and "synthetic data" in report
     available = f"{summary['tight_heading_availability']:.1%}"
     assert f"<th>tightly coupled heading available</th><td class='text'>{available}</td>" in report
 
