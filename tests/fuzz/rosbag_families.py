@@ -2,7 +2,9 @@
 a ROS 2 bag as one ``.mcap`` or ``.db3`` file, written with rosbags' writers from a slice of
 the repository's sample sequence (3 images, 2 s of IMU and speed, 10 GNSS epochs with every
 ephemeris, the ground truth's fixes and poses), once with gnss_comm and once with ublox_msgs
-raw GNSS. ``read`` imports the mutated bag into a temporary folder and reads that folder back
+raw GNSS; and ``rosbag_can``: the slice's IMU and its wheel speeds as ``can_msgs/Frame``
+frames of the simulator's DBC (a ROS 1 ``.bag`` and a ROS 2 ``.mcap``), imported with that DBC.
+``read`` imports the mutated bag into a temporary folder and reads that folder back
 as ``run`` would, so whatever the importer accepts must also be a readable sequence. Registered
 by ``families.py`` with::
 
@@ -16,14 +18,16 @@ from dataclasses import replace
 from functools import cache
 from pathlib import Path
 
+import cantools
 import numpy as np
 
 from tests.conftest import REPO_ROOT
-from tests.helpers.rosbag_writer import write_sequence_bag
+from tests.helpers.rosbag_writer import SmallBag, frame_fields, ros_ns, write_sequence_bag
 from vo_doppler.io.rosbag_import import RosbagOptions, import_rosbag
 from vo_doppler.io.sequence import read_manifest, read_sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.sim.can_bus import DBC_PATH, WHEEL_MESSAGE, WHEEL_SPEED_SIGNALS, WHEELS
 
 SAMPLE = REPO_ROOT / "sample_sequences" / "urban_canyon_small"
 SPAN_S = 2.0
@@ -71,16 +75,42 @@ def _bag_bytes(flavour: str, gnss: str, compressed: bool) -> bytes:
         return next(p for p in target.iterdir() if p.suffix in (".mcap", ".db3")).read_bytes()
 
 
-def read_bag(path: Path):
-    """Import the bag and read the sequence back: (summary, sequence)."""
+def _can_bag_bytes(flavour: str) -> bytes:
+    """The slice's IMU and its wheel speeds (km/h, every wheel alike) as WHEEL_SPEEDS frames."""
+    seq = _slice()
+    database = cantools.database.load_file(DBC_PATH)
+    message = database.get_message_by_name(WHEEL_MESSAGE)
+    with tempfile.TemporaryDirectory() as folder:
+        target = Path(folder) / ("seed.bag" if flavour == "ros1" else "seed")
+        with SmallBag(target, flavour) as bag:
+            bag.imu(seq.yaw_rate.t, seq.yaw_rate.value)
+            for t, v in zip(seq.wheel_speed.t, seq.wheel_speed.value, strict=True):
+                speeds = {f"WHEEL_SPEED_{w}": round(float(v) * 3.6, 2) for w in WHEELS}
+                data = database.encode_message(WHEEL_MESSAGE, speeds)
+                t_ns = ros_ns(float(t))
+                bag.can_frame("/can/rx", t_ns, frame_fields(bag, t_ns, message.frame_id, data))
+        if flavour == "ros1":
+            return target.read_bytes()
+        return next(p for p in target.iterdir() if p.suffix == ".mcap").read_bytes()
+
+
+def read_bag(path: Path, can: bool = False):
+    """Import the bag (its CAN topic's wheel speed decoded with the simulator's DBC when
+    ``can``) and read the sequence back: (summary, sequence)."""
     origin = read_manifest(SAMPLE)["origin"]
-    options = RosbagOptions(
-        origin=(origin["lat_deg"], origin["lon_deg"], origin["height_m"]),
-        ground_truth_topic="/ground_truth",
-    )
+    place = (origin["lat_deg"], origin["lon_deg"], origin["height_m"])
+    if can:
+        options = RosbagOptions(origin=place, dbc=DBC_PATH, wheel_speed=WHEEL_SPEED_SIGNALS)
+    else:
+        options = RosbagOptions(origin=place, ground_truth_topic="/ground_truth")
     with tempfile.TemporaryDirectory() as folder:
         summary = import_rosbag(path, Path(folder) / "seq", options)
         return summary, read_sequence(Path(folder) / "seq")
+
+
+def read_can_bag(path: Path):
+    """:func:`read_bag` of a ``rosbag_can`` bag."""
+    return read_bag(path, can=True)
 
 
 def make_check(check_observations):
@@ -130,3 +160,13 @@ def register_rosbag(register, family_cls, seed_cls, check_observations) -> None:
 
     for family, seeds in SEEDS.items():
         register(family_cls(family, lambda seeds=seeds: [seed(*s) for s in seeds], read_bag, check))
+
+    def can_seeds():
+        return [
+            seed_cls(
+                name, lambda flavour=flavour: _can_bag_bytes(flavour), suffix=Path(name).suffix
+            )
+            for name, flavour in (("can.bag", "ros1"), ("can.mcap", "mcap"))
+        ]
+
+    register(family_cls("rosbag_can", can_seeds, read_can_bag, check))

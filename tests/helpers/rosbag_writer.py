@@ -1,4 +1,6 @@
-"""A sequence folder → a ROS bag, with rosbags' writers: the test input of the ROS bag importer.
+"""A sequence folder → a ROS bag, with rosbags' writers: the test input of the ROS bag importer;
+and :class:`SmallBag`, the writer it uses, for tests that build their own topics (CAN frames,
+GLONASS ephemerides).
 
 Topics (ROS times are the GPS times as Unix UTC times: GPS − 315964800 s − the leap seconds):
 
@@ -41,22 +43,39 @@ GRAVITY = 9.80665
 UBX_GNSS_ID = {"G": 0, "S": 1, "E": 2, "C": 3, "J": 5, "R": 6}
 
 
-class _Out:
-    """One bag being written: connections by topic, messages by ROS time."""
+def ros_ns(gps: float) -> int:
+    """ROS time (Unix UTC, ns) of a GPS time, whole seconds added as integers (exact to 1 ns
+    of the float64 value)."""
+    whole = int(np.floor(gps))
+    seconds = whole + int(UNIX_TIME_AT_GPS_EPOCH_S) - int(gps_minus_utc(gps))
+    return seconds * 1_000_000_000 + round((gps - whole) * 1e9)
+
+
+def bag_path(folder: Path, flavour: str, name: str) -> Path:
+    """A ``.bag`` file for ROS 1, a bag folder for ``sqlite3`` / ``mcap``."""
+    return folder / (f"{name}.bag" if flavour == "ros1" else f"{name}_{flavour}")
+
+
+class SmallBag:
+    """One bag being written (a context manager); ``types`` are the message classes."""
 
     def __init__(self, path: Path, flavour: str) -> None:
         self.ros2 = flavour != "ros1"
         self.store = typestore(self.ros2)
-        if flavour == "ros1":
-            self.writer = Writer1(path)
-        else:
+        self.types = self.store.types
+        if self.ros2:
             plugin = StoragePlugin.MCAP if flavour == "mcap" else StoragePlugin.SQLITE3
             self.writer = Writer2(path, version=9, storage_plugin=plugin)
-        self.writer.open()
+        else:
+            self.writer = Writer1(path)
         self.connections: dict[str, object] = {}
 
-    def types(self, name: str):
-        return self.store.types[name]
+    def __enter__(self) -> SmallBag:
+        self.writer.open()
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.writer.close()
 
     def write(self, topic: str, msgtype: str, t_ns: int, message) -> None:
         if topic not in self.connections:
@@ -67,38 +86,75 @@ class _Out:
             raw = self.store.serialize_cdr(message, msgtype)
         else:
             raw = self.store.serialize_ros1(message, msgtype)
-        self.writer.write(self.connections[topic], int(t_ns), raw)
+        self.writer.write(self.connections[topic], t_ns, raw)
 
-    def close(self) -> None:
-        self.writer.close()
+    def header(self, t_ns: int, frame: str = ""):
+        stamp = self.types["builtin_interfaces/msg/Time"](
+            sec=t_ns // 1_000_000_000, nanosec=t_ns % 1_000_000_000
+        )
+        Header = self.types["std_msgs/msg/Header"]
+        if self.ros2:
+            return Header(stamp=stamp, frame_id=frame)
+        return Header(seq=0, stamp=stamp, frame_id=frame)
+
+    def imu(self, gps_times, yaw_rate, forward=0.0) -> None:
+        """``/imu/data`` at each GPS time: angular_velocity.z = the yaw rate, linear_acceleration
+        = (the forward acceleration, 0, +g): an IMU with z up and x forward."""
+        zeros = np.zeros(9)
+        still = np.array([0.0, 0.0, 0.0, 1.0])
+        n = len(gps_times)
+        for t_gps, rate, ahead in zip(
+            gps_times, np.broadcast_to(yaw_rate, n), np.broadcast_to(forward, n), strict=True
+        ):
+            t = ros_ns(float(t_gps))
+            message = self.types["sensor_msgs/msg/Imu"](
+                header=self.header(t, "imu"),
+                orientation=_quat(self, still),
+                orientation_covariance=np.r_[-1.0, zeros[1:]],
+                angular_velocity=_vec(self, 0.0, 0.0, rate),
+                angular_velocity_covariance=zeros,
+                linear_acceleration=_vec(self, ahead, 0.0, GRAVITY),
+                linear_acceleration_covariance=zeros,
+            )
+            self.write("/imu/data", "sensor_msgs/msg/Imu", t, message)
+
+    def twist(self, gps_times, speed) -> None:
+        """``/vehicle/twist`` (TwistStamped, linear.x = the speed) at each GPS time."""
+        for t_gps, v in zip(gps_times, np.broadcast_to(speed, len(gps_times)), strict=True):
+            t = ros_ns(float(t_gps))
+            twist = self.types["geometry_msgs/msg/Twist"](
+                linear=_vec(self, v, 0.0, 0.0), angular=_vec(self, 0.0, 0.0, 0.0)
+            )
+            message = self.types["geometry_msgs/msg/TwistStamped"](
+                header=self.header(t, "base_link"), twist=twist
+            )
+            self.write("/vehicle/twist", "geometry_msgs/msg/TwistStamped", t, message)
+
+    def can_frame(self, topic: str, t_ns: int, fields: dict) -> None:
+        """One ``can_msgs/Frame`` of :func:`frame_fields` (edited or not)."""
+        self.write(topic, "can_msgs/msg/Frame", t_ns, self.types["can_msgs/msg/Frame"](**fields))
 
 
-def ros_ns(gps: float) -> int:
-    """ROS time (Unix UTC, ns) of a GPS time, whole seconds added as integers (exact to 1 ns
-    of the float64 value)."""
-    whole = int(np.floor(gps))
-    seconds = whole + int(UNIX_TIME_AT_GPS_EPOCH_S) - int(gps_minus_utc(gps))
-    return seconds * 1_000_000_000 + round((gps - whole) * 1e9)
+def frame_fields(bag: SmallBag, t_ns: int, frame_id: int, data: bytes, **flags) -> dict:
+    """The fields of a ``can_msgs/Frame`` of ``data`` (dlc its length, zero-padded to 8);
+    ``flags``: ``is_extended``, ``is_rtr``, ``is_error`` (default false)."""
+    return {
+        "header": bag.header(t_ns),
+        "id": frame_id,
+        "is_rtr": flags.get("is_rtr", False),
+        "is_extended": flags.get("is_extended", False),
+        "is_error": flags.get("is_error", False),
+        "dlc": len(data),
+        "data": np.frombuffer(data.ljust(8, b"\0"), np.uint8).copy(),
+    }
 
 
-def _stamp(out: _Out, t_ns: int):
-    Time = out.types("builtin_interfaces/msg/Time")
-    return Time(sec=t_ns // 1_000_000_000, nanosec=t_ns % 1_000_000_000)
+def _vec(out: SmallBag, x: float, y: float, z: float):
+    return out.types["geometry_msgs/msg/Vector3"](x=float(x), y=float(y), z=float(z))
 
 
-def _header(out: _Out, t_ns: int, frame: str = ""):
-    Header = out.types("std_msgs/msg/Header")
-    if out.ros2:
-        return Header(stamp=_stamp(out, t_ns), frame_id=frame)
-    return Header(seq=0, stamp=_stamp(out, t_ns), frame_id=frame)
-
-
-def _vec(out: _Out, x: float, y: float, z: float):
-    return out.types("geometry_msgs/msg/Vector3")(x=float(x), y=float(y), z=float(z))
-
-
-def _quat(out: _Out, q: np.ndarray):
-    return out.types("geometry_msgs/msg/Quaternion")(x=q[0], y=q[1], z=q[2], w=q[3])
+def _quat(out: SmallBag, q: np.ndarray):
+    return out.types["geometry_msgs/msg/Quaternion"](x=q[0], y=q[1], z=q[2], w=q[3])
 
 
 def write_bag(
@@ -116,8 +172,7 @@ def write_sequence_bag(
     seq, bag: Path, flavour: str = "ros1", gnss: str = "gnss_comm", compressed: bool = False
 ) -> Path:
     """:func:`write_bag` of a :class:`~vo_doppler.model.sequence.Sequence` already read."""
-    out = _Out(bag, flavour)
-    try:
+    with SmallBag(bag, flavour) as out:
         _camera(out, seq, compressed)
         _vehicle(out, seq)
         if gnss == "gnss_comm":
@@ -125,17 +180,15 @@ def write_sequence_bag(
         else:
             _ublox(out, seq)
         _truth(out, seq)
-    finally:
-        out.close()
     return bag
 
 
-def _camera(out: _Out, seq, compressed: bool) -> None:
+def _camera(out: SmallBag, seq, compressed: bool) -> None:
     import cv2
 
     cam = seq.camera
-    info = out.types("sensor_msgs/msg/CameraInfo")
-    roi = out.types("sensor_msgs/msg/RegionOfInterest")(
+    info = out.types["sensor_msgs/msg/CameraInfo"]
+    roi = out.types["sensor_msgs/msg/RegionOfInterest"](
         x_offset=0, y_offset=0, height=0, width=0, do_rectify=False
     )
     K = np.array([cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1], dtype=float)
@@ -150,7 +203,7 @@ def _camera(out: _Out, seq, compressed: bool) -> None:
         "sensor_msgs/msg/CameraInfo",
         t0,
         info(
-            header=_header(out, t0, "camera"),
+            header=out.header(t0, "camera"),
             height=cam.height,
             width=cam.width,
             distortion_model="plumb_bob",
@@ -161,10 +214,10 @@ def _camera(out: _Out, seq, compressed: bool) -> None:
         ),
     )
     T = cam.T_vehicle_camera
-    TransformStamped = out.types("geometry_msgs/msg/TransformStamped")
-    Transform = out.types("geometry_msgs/msg/Transform")
+    TransformStamped = out.types["geometry_msgs/msg/TransformStamped"]
+    Transform = out.types["geometry_msgs/msg/Transform"]
     tf = TransformStamped(
-        header=_header(out, t0, "base_link"),
+        header=out.header(t0, "base_link"),
         child_frame_id="camera",
         transform=Transform(
             translation=_vec(out, *T[:3, 3]),
@@ -172,7 +225,7 @@ def _camera(out: _Out, seq, compressed: bool) -> None:
         ),
     )
     antenna = TransformStamped(
-        header=_header(out, t0, "base_link"),
+        header=out.header(t0, "base_link"),
         child_frame_id="gps",
         transform=Transform(
             translation=_vec(out, *seq.antenna_lever_arm_m),
@@ -183,20 +236,20 @@ def _camera(out: _Out, seq, compressed: bool) -> None:
         "/tf_static",
         "tf2_msgs/msg/TFMessage",
         t0,
-        out.types("tf2_msgs/msg/TFMessage")(transforms=[tf, antenna]),
+        out.types["tf2_msgs/msg/TFMessage"](transforms=[tf, antenna]),
     )
     for path, gps in zip(seq.image_paths, seq.image_times, strict=True):
         t = ros_ns(float(gps))
         if compressed:
             data = np.frombuffer(path.read_bytes(), np.uint8)
-            message = out.types("sensor_msgs/msg/CompressedImage")(
-                header=_header(out, t, "camera"), format=path.suffix.lstrip("."), data=data
+            message = out.types["sensor_msgs/msg/CompressedImage"](
+                header=out.header(t, "camera"), format=path.suffix.lstrip("."), data=data
             )
             out.write("/camera/image_raw/compressed", "sensor_msgs/msg/CompressedImage", t, message)
             continue
         pixels = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
-        message = out.types("sensor_msgs/msg/Image")(
-            header=_header(out, t, "camera"),
+        message = out.types["sensor_msgs/msg/Image"](
+            header=out.header(t, "camera"),
             height=pixels.shape[0],
             width=pixels.shape[1],
             encoding="mono8",
@@ -207,39 +260,12 @@ def _camera(out: _Out, seq, compressed: bool) -> None:
         out.write("/camera/image_raw", "sensor_msgs/msg/Image", t, message)
 
 
-def _vehicle(out: _Out, seq) -> None:
-    Imu = out.types("sensor_msgs/msg/Imu")
+def _vehicle(out: SmallBag, seq) -> None:
     yaw = seq.yaw_rate
     accel = seq.forward_acceleration
-    forward = np.interp(yaw.t, accel.t, accel.value) if accel is not None else np.zeros(len(yaw))
-    zeros = np.zeros(9)
-    for t_gps, rate, ahead in zip(yaw.t, yaw.value, forward, strict=True):
-        t = ros_ns(float(t_gps))
-        out.write(
-            "/imu/data",
-            "sensor_msgs/msg/Imu",
-            t,
-            Imu(
-                header=_header(out, t, "imu"),
-                orientation=_quat(out, np.array([0.0, 0.0, 0.0, 1.0])),
-                orientation_covariance=np.r_[-1.0, zeros[1:]],
-                angular_velocity=_vec(out, 0.0, 0.0, rate),
-                angular_velocity_covariance=zeros,
-                linear_acceleration=_vec(out, ahead, 0.0, GRAVITY),
-                linear_acceleration_covariance=zeros,
-            ),
-        )
-    TwistStamped = out.types("geometry_msgs/msg/TwistStamped")
-    Twist = out.types("geometry_msgs/msg/Twist")
-    for t_gps, v in zip(seq.wheel_speed.t, seq.wheel_speed.value, strict=True):
-        t = ros_ns(float(t_gps))
-        twist = Twist(linear=_vec(out, v, 0.0, 0.0), angular=_vec(out, 0.0, 0.0, 0.0))
-        out.write(
-            "/vehicle/twist",
-            "geometry_msgs/msg/TwistStamped",
-            t,
-            TwistStamped(header=_header(out, t, "base_link"), twist=twist),
-        )
+    forward = np.interp(yaw.t, accel.t, accel.value) if accel is not None else 0.0
+    out.imu(yaw.t, yaw.value, forward)
+    out.twist(seq.wheel_speed.t, seq.wheel_speed.value)
 
 
 def _epochs(obs):
@@ -253,14 +279,14 @@ def _epochs(obs):
         yield float(t), [(s[0], int(s[1:]), v) for s, v in sorted(per.items())]
 
 
-def _gnss_time(out: _Out, t: float):
+def _gnss_time(out: SmallBag, t: float):
     week = int(t // SECONDS_PER_WEEK)
-    return out.types("gnss_comm/msg/GnssTimeMsg")(week=week, tow=t - week * SECONDS_PER_WEEK)
+    return out.types["gnss_comm/msg/GnssTimeMsg"](week=week, tow=t - week * SECONDS_PER_WEEK)
 
 
-def _gnss_comm(out: _Out, seq) -> None:
-    GnssObsMsg = out.types("gnss_comm/msg/GnssObsMsg")
-    GnssMeasMsg = out.types("gnss_comm/msg/GnssMeasMsg")
+def _gnss_comm(out: SmallBag, seq) -> None:
+    GnssObsMsg = out.types["gnss_comm/msg/GnssObsMsg"]
+    GnssMeasMsg = out.types["gnss_comm/msg/GnssMeasMsg"]
     for t, sats in _epochs(seq.observations):
         meas = []
         for system, prn, values in sats:
@@ -301,8 +327,8 @@ def _gnss_comm(out: _Out, seq) -> None:
         _gnss_comm_ephemerides(out, nav)
 
 
-def _gnss_comm_ephemerides(out: _Out, nav) -> None:
-    Ephem = out.types("gnss_comm/msg/GnssEphemMsg")
+def _gnss_comm_ephemerides(out: SmallBag, nav) -> None:
+    Ephem = out.types["gnss_comm/msg/GnssEphemMsg"]
     kepler = nav.kepler
     for k in range(len(kepler)):
         system, prn = str(kepler.system[k]), int(kepler.prn[k])
@@ -346,20 +372,20 @@ def _gnss_comm_ephemerides(out: _Out, nav) -> None:
         )
         out.write("/gnss/ephem", "gnss_comm/msg/GnssEphemMsg", ros_ns(toc), ephem)
     if nav.klobuchar is not None:
-        Array = out.types("gnss_comm/msg/StampedFloat64Array")
+        Array = out.types["gnss_comm/msg/StampedFloat64Array"]
         t = ros_ns(float(kepler.toc.min()))
         out.write(
             "/gnss/iono",
             "gnss_comm/msg/StampedFloat64Array",
             t,
-            Array(header=_header(out, t), data=np.asarray(nav.klobuchar, float)),
+            Array(header=out.header(t), data=np.asarray(nav.klobuchar, float)),
         )
 
 
-def _ublox(out: _Out, seq) -> None:
+def _ublox(out: SmallBag, seq) -> None:
     ros2 = out.ros2
-    Meas = out.types("ublox_msgs/msg/RxmRAWXMeas" if ros2 else "ublox_msgs/msg/RxmRAWX_Meas")
-    Rawx = out.types("ublox_msgs/msg/RxmRAWX")
+    Meas = out.types["ublox_msgs/msg/RxmRAWXMeas" if ros2 else "ublox_msgs/msg/RxmRAWX_Meas"]
+    Rawx = out.types["ublox_msgs/msg/RxmRAWX"]
 
     def name(camel: str, snake: str) -> str:
         return snake if ros2 else camel
@@ -399,7 +425,7 @@ def _ublox(out: _Out, seq) -> None:
         }
         receive = ros_ns(t + GNSS_LATENCY_S)
         if ros2:
-            fields["header"] = _header(out, receive)
+            fields["header"] = out.header(receive)
         out.write("/ublox/rxmraw", "ublox_msgs/msg/RxmRAWX", receive, Rawx(**fields))
     _sfrbx(out, seq.navigation)
 
@@ -412,8 +438,8 @@ def lnav_dict(kepler, k: int) -> dict[str, float]:
     return p
 
 
-def _sfrbx(out: _Out, nav) -> None:
-    Sfrbx = out.types("ublox_msgs/msg/RxmSFRBX")
+def _sfrbx(out: SmallBag, nav) -> None:
+    Sfrbx = out.types["ublox_msgs/msg/RxmSFRBX"]
     kepler = nav.kepler
     for k in np.flatnonzero(kepler.system == "G"):
         t = float(kepler.toc[k])
@@ -427,20 +453,20 @@ def _sfrbx(out: _Out, nav) -> None:
             fields = dict(zip(names, (0, int(kepler.prn[k]), 0, 10), strict=True))
             fields.update(reserved0=0, chn=1, version=2, reserved1=0, dwrd=dwrd)
             if out.ros2:
-                fields["header"] = _header(out, ros_ns(t + n))
+                fields["header"] = out.header(ros_ns(t + n))
             out.write("/ublox/rxmsfrb", "ublox_msgs/msg/RxmSFRBX", ros_ns(t + n), Sfrbx(**fields))
 
 
-def _truth(out: _Out, seq) -> None:
+def _truth(out: SmallBag, seq) -> None:
     truth = seq.truth
-    Odometry = out.types("nav_msgs/msg/Odometry")
-    Pose = out.types("geometry_msgs/msg/Pose")
-    PoseCov = out.types("geometry_msgs/msg/PoseWithCovariance")
-    Twist = out.types("geometry_msgs/msg/Twist")
-    TwistCov = out.types("geometry_msgs/msg/TwistWithCovariance")
-    Point = out.types("geometry_msgs/msg/Point")
-    NavSatFix = out.types("sensor_msgs/msg/NavSatFix")
-    Status = out.types("sensor_msgs/msg/NavSatStatus")
+    Odometry = out.types["nav_msgs/msg/Odometry"]
+    Pose = out.types["geometry_msgs/msg/Pose"]
+    PoseCov = out.types["geometry_msgs/msg/PoseWithCovariance"]
+    Twist = out.types["geometry_msgs/msg/Twist"]
+    TwistCov = out.types["geometry_msgs/msg/TwistWithCovariance"]
+    Point = out.types["geometry_msgs/msg/Point"]
+    NavSatFix = out.types["sensor_msgs/msg/NavSatFix"]
+    Status = out.types["sensor_msgs/msg/NavSatStatus"]
     quats = truth.orientations.as_quat()
     antenna = truth.positions + truth.orientations.apply(np.array(seq.antenna_lever_arm_m))
     ecef = seq.enu.enu_to_ecef(antenna)
@@ -455,7 +481,7 @@ def _truth(out: _Out, seq) -> None:
             "nav_msgs/msg/Odometry",
             t,
             Odometry(
-                header=_header(out, t, "enu"),
+                header=out.header(t, "enu"),
                 child_frame_id="base_link",
                 pose=PoseCov(pose=pose, covariance=np.zeros(36)),
                 twist=TwistCov(twist=still, covariance=np.zeros(36)),
@@ -467,7 +493,7 @@ def _truth(out: _Out, seq) -> None:
                 "sensor_msgs/msg/NavSatFix",
                 t,
                 NavSatFix(
-                    header=_header(out, t, "gps"),
+                    header=out.header(t, "gps"),
                     status=Status(status=0, service=1),
                     latitude=float(np.degrees(lat[k])),
                     longitude=float(np.degrees(lon[k])),

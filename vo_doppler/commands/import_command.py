@@ -99,7 +99,8 @@ def _register_rosbag(kinds) -> None:
         description="Write the images (sensor_msgs/Image as PNG, CompressedImage as sent) with "
         "their times, the calibration (CameraInfo, or --calib; the extrinsic from /tf_static), "
         "the yaw rate (sensor_msgs/Imu: the axis given or estimated from gravity) and speed "
-        "(TwistStamped or Odometry linear.x), the forward acceleration, raw GNSS (gnss_comm "
+        "(TwistStamped or Odometry linear.x, or with --dbc the wheel-speed signals of a "
+        "can_msgs/Frame topic), the forward acceleration, raw GNSS (gnss_comm "
         "GnssMeasMsg + GnssEphemMsg, or ublox_msgs RxmRAWX + RxmSFRBX) as RINEX observations "
         "and navigation, NavSatFix fixes (the origin), ground truth (--ground-truth) and "
         "sequence.yaml. Topics are found by type (--list-topics shows which) or named. ROS "
@@ -117,6 +118,7 @@ def _register_rosbag(kinds) -> None:
         ("camera-info", "sensor_msgs/CameraInfo"),
         ("imu", "sensor_msgs/Imu"),
         ("speed", "TwistStamped, TwistWithCovarianceStamped or Odometry (linear.x)"),
+        ("can", "can_msgs/Frame, decoded with --dbc"),
         ("gnss", "gnss_comm/GnssMeasMsg or ublox_msgs/RxmRAWX"),
         ("iono", "gnss_comm/StampedFloat64Array (Klobuchar α, β)"),
         ("fix", "sensor_msgs/NavSatFix"),
@@ -135,6 +137,17 @@ def _register_rosbag(kinds) -> None:
         metavar="TOPIC",
         help="Odometry / PoseStamped (poses in the ENU frame of the origin) or NavSatFix: "
         "written as ground_truth.tum (never taken by default)",
+    )
+    can = bag.add_argument_group("wheel speed from a CAN topic (instead of a speed topic)")
+    can.add_argument(
+        "--dbc", type=Path, metavar="FILE", help="DBC (or other cantools database) of the bus"
+    )
+    can.add_argument(
+        "--wheel-speed",
+        metavar="MSG.SIG[,MSG.SIG]",
+        help="the DBC's wheel-speed signals, averaged (e.g. "
+        "WHEEL_SPEEDS.WHEEL_SPEED_RL,WHEEL_SPEEDS.WHEEL_SPEED_RR); the DBC unit is converted "
+        "to m/s",
     )
     timing = bag.add_argument_group("time")
     timing.add_argument(
@@ -182,6 +195,7 @@ def _register_rosbag(kinds) -> None:
     frames.add_argument(
         "--gnss-frame", help="tf frame of the GNSS antenna (default: the NavSatFix frame_id)"
     )
+    bag.add_check(lambda args: rosbag_options(args).problem())
     bag.set_defaults(func=run_rosbag, parser=bag)
 
 
@@ -244,12 +258,16 @@ def run_smartloc(args: argparse.Namespace) -> int:
     return 0
 
 
-def run_rosbag(args: argparse.Namespace) -> int:
-    options = RosbagOptions(
+def rosbag_options(args: argparse.Namespace) -> RosbagOptions:
+    """The :class:`RosbagOptions` of the parsed ``import rosbag`` options."""
+    return RosbagOptions(
         image_topic=args.image_topic,
         camera_info_topic=args.camera_info_topic,
         imu_topic=args.imu_topic,
         speed_topic=args.speed_topic,
+        can_topic=args.can_topic,
+        dbc=args.dbc,
+        wheel_speed=args.wheel_speed,
         gnss_topic=args.gnss_topic,
         ephemeris_topics=tuple(args.ephemeris_topic) if args.ephemeris_topic else None,
         iono_topic=args.iono_topic,
@@ -266,6 +284,10 @@ def run_rosbag(args: argparse.Namespace) -> int:
         vehicle_frame=args.vehicle_frame,
         gnss_frame=args.gnss_frame,
     )
+
+
+def run_rosbag(args: argparse.Namespace) -> int:
+    options = rosbag_options(args)
     if args.list_topics:
         sys.stdout.write("\n".join(list_topics(args.bag, options)) + "\n")
         return 0
@@ -274,8 +296,8 @@ def run_rosbag(args: argparse.Namespace) -> int:
     summary = import_rosbag(args.bag, args.output, options)
     log.info(
         "wrote %s: %d images, %d GNSS epochs, %d ephemerides, %d IMU samples (yaw rate: %s), "
-        "%d speed samples, %d ground-truth poses; times: %s stamps, %s (GPS − ROS = %.3f s); "
-        "camera extrinsic: %s",
+        "%d speed samples (%s), %d ground-truth poses; times: %s stamps, %s (GPS − ROS = %.3f "
+        "s); camera extrinsic: %s",
         summary.folder,
         summary.images,
         summary.gnss_epochs,
@@ -283,6 +305,7 @@ def run_rosbag(args: argparse.Namespace) -> int:
         summary.imu_samples,
         summary.yaw_axis,
         summary.speed_samples,
+        summary.speed_source,
         summary.ground_truth_poses,
         summary.stamps,
         summary.clock,

@@ -21,7 +21,9 @@ shows what would be used) or named by options:
   averaged over 1 s, best matches the speed's change over that second; none when even the best
   misses by half the RMS acceleration, e.g. a drive at constant speed);
 - ``geometry_msgs/TwistStamped`` / ``TwistWithCovarianceStamped`` / ``nav_msgs/Odometry`` →
-  ``vehicle/wheel_speed.csv`` (``linear.x``, m/s);
+  ``vehicle/wheel_speed.csv`` (``linear.x``, m/s); or, with a DBC (``--dbc FILE
+  --wheel-speed MSG.A,MSG.B``), the wheel-speed signals of a ``can_msgs/Frame`` topic
+  (:mod:`vo_doppler.io.rosbag_can`);
 - raw GNSS (:mod:`vo_doppler.io.rosbag_gnss`) → ``gnss/rover.obs`` (RINEX 3.04; its approximate
   position the first NavSatFix fix, else the origin), and
   ``gnss/brdc.nav`` when the bag holds ephemerides, ``gnss/doppler_sigma.csv`` when the
@@ -55,13 +57,14 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.errors import InputError
+from vo_doppler.errors import InputError, UsageError
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
 from vo_doppler.io.calibration import checked_camera, read_camera, write_camera_yaml
 from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.rinex_write import observation_epochs, write_nav, write_obs
 from vo_doppler.io.rosbag_bag import KIND_NAMES, Bag, Topic
+from vo_doppler.io.rosbag_can import read_can_speed
 from vo_doppler.io.rosbag_gnss import BagGnss, read_gnss_comm, read_ublox
 from vo_doppler.io.rosbag_types import field as get
 from vo_doppler.io.sensor_csv import (
@@ -99,6 +102,7 @@ KINDS: dict[str, tuple[str, ...]] = {
         "geometry_msgs/msg/TwistWithCovarianceStamped",
         "nav_msgs/msg/Odometry",
     ),
+    "can": ("can_msgs/msg/Frame",),
     "gnss": ("gnss_comm/msg/GnssMeasMsg", "ublox_msgs/msg/RxmRAWX"),
     "ephemeris": (
         "gnss_comm/msg/GnssEphemMsg",
@@ -115,9 +119,10 @@ KINDS: dict[str, tuple[str, ...]] = {
     ),
     "tf": ("tf2_msgs/msg/TFMessage",),
 }
-AUTO_KINDS = ("image", "camera_info", "imu", "speed", "gnss", "iono", "fix", "tf")
+AUTO_KINDS = ("image", "camera_info", "imu", "speed", "can", "gnss", "iono", "fix", "tf")
 """Kinds found without an option (ephemeris topics follow the GNSS interface; ground truth is
-only taken when named: an Odometry topic is as often a wheel odometry as a reference)."""
+only taken when named: an Odometry topic is as often a wheel odometry as a reference). The
+speed comes from a speed topic, or with a DBC from a CAN topic: only that one is looked for."""
 AXES = ("x", "y", "z", "-x", "-y", "-z")
 GRAVITY_MIN_MPS2 = 5.0
 FORWARD_MAX_MISFIT = 0.5
@@ -148,6 +153,11 @@ class RosbagOptions:
     camera_info_topic: str | None = None
     imu_topic: str | None = None
     speed_topic: str | None = None
+    can_topic: str | None = None
+    dbc: Path | None = None
+    wheel_speed: str | None = None
+    """``MSG.A,MSG.B``: the DBC's wheel-speed signals (averaged); the speed then comes from the
+    CAN topic."""
     gnss_topic: str | None = None
     ephemeris_topics: tuple[str, ...] | None = None
     iono_topic: str | None = None
@@ -164,6 +174,16 @@ class RosbagOptions:
     vehicle_frame: str = "base_link"
     gnss_frame: str | None = None
 
+    def problem(self) -> str | None:
+        """Options that contradict each other (a usage error), else None."""
+        if (self.dbc is None) != (self.wheel_speed is None):
+            return "--dbc FILE and --wheel-speed MSG.SIG[,MSG.SIG] go together"
+        if self.dbc is None and self.can_topic is not None:
+            return "--can-topic needs --dbc FILE and --wheel-speed (its wheel-speed signals)"
+        if self.dbc is not None and self.speed_topic is not None:
+            return "--speed-topic and --dbc both give the speed: keep one"
+        return None
+
 
 @dataclass
 class RosbagImportSummary:
@@ -175,6 +195,7 @@ class RosbagImportSummary:
     ephemerides: int
     imu_samples: int
     speed_samples: int
+    speed_source: str
     ground_truth_poses: int
     clock: str
     gps_minus_ros_s: float
@@ -197,15 +218,17 @@ def discover(
         "camera_info": options.camera_info_topic,
         "imu": options.imu_topic,
         "speed": options.speed_topic,
+        "can": options.can_topic,
         "gnss": options.gnss_topic,
         "iono": options.iono_topic,
         "fix": options.fix_topic,
         "ground_truth": options.ground_truth_topic,
         "tf": options.tf_topic,
     }
+    unused = "speed" if options.dbc is not None else "can"
     for kind, name in given.items():
         if name is None:
-            if kind in AUTO_KINDS:
+            if kind in AUTO_KINDS and kind != unused:
                 found = [t.name for t in topics if t.msgtype in KINDS[kind] and t.count]
                 if kind == "speed":  # a Twist topic before an Odometry one
                     found.sort(key=lambda n: by_name[n].msgtype == "nav_msgs/msg/Odometry")
@@ -645,20 +668,17 @@ def import_rosbag(
     """Write the sequence folder ``output`` from the bag (module docstring). Everything but the
     images is read and checked before the folder is opened; the images are then streamed."""
     options = options or RosbagOptions()
+    problem = options.problem()
+    if problem:
+        raise UsageError(problem)
     bag_path, output = Path(bag_path), Path(output)
-    check_output_folder(output, "import", [bag_path, options.calib])
+    check_output_folder(output, "import", [bag_path, options.calib, options.dbc])
     warnings: list[str] = []
     timing = _Timing(options.stamps)
     with Bag(bag_path) as bag:
         topics = bag.topics()
         chosen = discover(topics, options, bag_path)
-        if "imu" not in chosen or "speed" not in chosen:
-            raise InputError(
-                "the sequence needs a yaw rate and a speed: the bag has "
-                f"{'no IMU topic' if 'imu' not in chosen else 'no speed topic'} "
-                "(sensor_msgs/Imu; TwistStamped or Odometry; see --list-topics)",
-                bag_path,
-            )
+        _require_motion(topics, chosen, options, bag_path)
         start = bag.start_s()
         gnss = _gnss(bag, chosen)
         pairs = None
@@ -667,7 +687,15 @@ def import_rosbag(
         offset, clock_text = clock_offset(options, start, pairs, bag_path)
         timing.offset = offset
         imu_t, gyro, accel = _read_imu(bag, str(chosen["imu"]), timing)
-        speed = _read_speed(bag, str(chosen["speed"]), timing)
+        if options.dbc is not None:
+            can = read_can_speed(
+                bag, str(chosen["can"]), timing.time, options.dbc, str(options.wheel_speed)
+            )
+            speed, speed_source = can.speed, can.source
+            warnings += can.warnings
+        else:
+            speed = _read_speed(bag, str(chosen["speed"]), timing)
+            speed_source = f"topic {chosen['speed']}: twist linear.x"
         up, up_text = yaw_axis(gyro, accel, options.imu_yaw_axis)
         k, sign = _axis(up)
         yaw_rate = SensorSeries(imu_t, sign * gyro[:, k])
@@ -742,6 +770,7 @@ def import_rosbag(
         "gps_minus_ros_s": offset,
         "imu_yaw_axis": f"{up}: {up_text}",
         "imu_forward_axis": f"{ahead}: {ahead_text}",
+        "speed": speed_source,
         "camera_extrinsic": extrinsic_from,
         "antenna_lever_arm": lever_arm_from,
         "gnss": gnss.source if gnss else "none",
@@ -757,6 +786,7 @@ def import_rosbag(
         len(gnss.ephemerides) if gnss else 0,
         len(yaw_rate),
         len(speed),
+        speed_source,
         len(truth) if truth is not None else 0,
         clock_text,
         offset,
@@ -766,6 +796,33 @@ def import_rosbag(
         extrinsic_from,
         warnings,
     )
+
+
+def _require_motion(topics: list[Topic], chosen: dict, options: RosbagOptions, path: Path):
+    """An :class:`InputError` unless the bag gives a yaw rate (an IMU topic) and a speed (a
+    speed topic, or a CAN topic when a DBC is given), saying what is missing."""
+    if "imu" not in chosen:
+        raise InputError(
+            "the sequence needs a yaw rate: the bag has no sensor_msgs/Imu topic (see "
+            "--list-topics)",
+            path,
+        )
+    if options.dbc is not None and "can" not in chosen:
+        raise InputError(
+            "--dbc is given but the bag has no can_msgs/Frame topic (see --list-topics)", path
+        )
+    if options.dbc is None and "speed" not in chosen:
+        can = [t.name for t in topics if t.msgtype in KINDS["can"] and t.count]
+        hint = (
+            f"; its CAN topic {can[0]} gives one with --dbc FILE --wheel-speed MSG.SIG"
+            if can
+            else ""
+        )
+        raise InputError(
+            "the sequence needs a speed: the bag has no TwistStamped, "
+            f"TwistWithCovarianceStamped or Odometry topic{hint} (see --list-topics)",
+            path,
+        )
 
 
 def _gnss(bag: Bag, chosen: dict) -> BagGnss | None:

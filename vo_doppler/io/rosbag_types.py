@@ -9,6 +9,8 @@ Written here from the interfaces' field lists (they are interface facts):
   (GPS/Galileo/BeiDou Keplerian ephemeris), ``GnssGloEphemMsg`` (GLONASS) and
   ``StampedFloat64Array`` (the receiver's ionosphere parameters, Klobuchar α0–α3 β0–β3);
 - ``tf2_msgs/TFMessage`` (missing from rosbags' ROS 1 store);
+- ``can_msgs/Frame`` (ros_canopen / ros2_canopen, socketcan_bridge: one classic CAN frame, the
+  same fields in ROS 1 and ROS 2: id, RTR / extended / error flags, dlc, 8 data bytes);
 - ``ublox_msgs`` (the u-blox ROS driver): ``RxmRAWX`` with its measurement block and
   ``RxmSFRBX``, once with the ROS 1 driver's camelCase names (``RxmRAWX_Meas``, ``rcvTOW``,
   ``prMes``) and once with the ROS 2 driver's snake_case names (``RxmRAWXMeas``, ``rcv_tow``,
@@ -105,6 +107,18 @@ float64 delta_tau_n
     "gnss_comm/msg/StampedFloat64Array": "std_msgs/Header header\nfloat64[] data\n",
 }
 
+CAN_MSGS = {
+    "can_msgs/msg/Frame": """
+std_msgs/Header header
+uint32 id
+bool is_rtr
+bool is_extended
+bool is_error
+uint8 dlc
+uint8[8] data
+""",
+}
+
 UBLOX_ROS1 = {
     "ublox_msgs/msg/RxmRAWX_Meas": """
 float64 prMes
@@ -195,7 +209,8 @@ TF2 = {"tf2_msgs/msg/TFMessage": "geometry_msgs/TransformStamped[] transforms\n"
 def project_types(ros2: bool) -> dict:
     """The project's definitions as a rosbags types dict (ROS 1 or ROS 2 spelling of ublox)."""
     types: dict = {}
-    for name, text in (*GNSS_COMM.items(), *(UBLOX_ROS2 if ros2 else UBLOX_ROS1).items()):
+    ublox = UBLOX_ROS2 if ros2 else UBLOX_ROS1
+    for name, text in (*GNSS_COMM.items(), *CAN_MSGS.items(), *ublox.items()):
         types.update(get_types_from_msg(text, name))
     return types
 
