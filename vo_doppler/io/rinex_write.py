@@ -1,10 +1,12 @@
-"""RINEX 3.04 writers: mixed navigation file (GPS/Galileo/QZSS/BeiDou Keplerian records) and
-observation file (code, Doppler, signal strength).
+"""RINEX 3.04 writers: mixed navigation file (GPS/Galileo/QZSS/BeiDou Keplerian records and
+GLONASS state vectors) and observation file (code, Doppler, signal strength).
 
 Formats follow RINEX 3.04 (IGS/RTCM, 2018): header records with the label in columns 61–80
 (sec. 5.1), navigation records per Tables A6/A8 (system+PRN, epoch, then 7 "broadcast orbit"
-lines of four D19.12 numbers), observation epochs per Table A3 (``>`` epoch record, then one
-line per satellite of F14.3 value + LLI + signal-strength digit per observable).
+lines of four D19.12 numbers) and A10 (GLONASS: the epoch tb in UTC, then 3 lines; positions,
+velocities and accelerations in km, km/s, km/s²), observation epochs per Table A3 (``>``
+epoch record, then one line per satellite of F14.3 value + LLI + signal-strength digit per
+observable).
 
 Values are written with the precision the format allows (D19.12 ≈ 13 significant digits for
 navigation data, 1e-3 for observations), so a value read back equals :func:`nav_number` of
@@ -20,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.io.rinex_nav import KEPLER_FIELDS
+from vo_doppler.io.rinex_nav import GLONASS_FIELDS, KEPLER_FIELDS
 from vo_doppler.model.observations import Observations
 
 GPS_EPOCH = dt.datetime(1980, 1, 6)
@@ -75,13 +77,33 @@ class KeplerRecord:
     params: dict[str, float]
 
 
+GLONASS_RECORD_FIELDS = GLONASS_FIELDS[:4]
+"""The GLONASS record of RINEX 3.04 (Table A10): its fifth line (status flags, Δτn, URAI,
+health flags) appeared in 3.05."""
+KILOMETRE_FIELDS = frozenset(("x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"))
+
+
+@dataclass(frozen=True)
+class GlonassRecord:
+    """One GLONASS broadcast ephemeris (names as ``rinex_nav.GLONASS_FIELDS``' first four
+    lines): ``toc`` is its reference time tb in GPS seconds (written in UTC, as RINEX wants);
+    ``params`` in SI units as the reader returns them (m, m/s, m/s²; ``minus_tau_n`` s,
+    ``frame_time`` s of the UTC week, ``channel`` the frequency number)."""
+
+    prn: int
+    toc: float
+    params: dict[str, float]
+    system: str = "R"
+
+
 def write_nav(
     path: str | Path,
-    records: Sequence[KeplerRecord],
+    records: Sequence[KeplerRecord | GlonassRecord],
     leap_seconds: int = 18,
     klobuchar: np.ndarray | None = None,
 ) -> None:
-    """Write a RINEX 3.04 mixed navigation file (Keplerian records, GPS-time epochs).
+    """Write a RINEX 3.04 mixed navigation file (Keplerian records on GPS-time epochs,
+    GLONASS records on UTC epochs: ``leap_seconds`` before GPS time).
 
     ``klobuchar`` (α0–α3, β0–β3) goes into the 'IONOSPHERIC CORR' GPSA/GPSB records.
     """
@@ -98,12 +120,18 @@ def write_nav(
     lines.append(header_line(f"{leap_seconds:6d}", "LEAP SECONDS"))
     lines.append(header_line("", "END OF HEADER"))
     for record in records:
-        year, month, day, hour, minute, second = gps_calendar(record.toc)
+        glonass = isinstance(record, GlonassRecord)
+        epoch = record.toc - leap_seconds if glonass else record.toc
+        year, month, day, hour, minute, second = gps_calendar(epoch)
         first = (
             f"{record.system}{record.prn:02d} {year:4d} {month:02d} {day:02d} {hour:02d} "
             f"{minute:02d} {round(second):02d}"
         )
-        groups = [[record.params[name] for name in group] for group in KEPLER_FIELDS]
+        fields = GLONASS_RECORD_FIELDS if glonass else KEPLER_FIELDS
+        groups = [
+            [record.params[name] / (1000.0 if name in KILOMETRE_FIELDS else 1.0) for name in group]
+            for group in fields
+        ]
         lines.append(first + "".join(nav_number(v) for v in groups[0]) + "\n")
         lines.extend("    " + "".join(nav_number(v) for v in group) + "\n" for group in groups[1:])
     Path(path).write_text("".join(lines))

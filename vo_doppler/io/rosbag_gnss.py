@@ -18,9 +18,12 @@ parameters and the receiver's Doppler σ.
   ``tgd0`` → TGD or Galileo's BGD E5a/E1 or BeiDou's TGD1, ``tgd1`` → Galileo's BGD E5b/E1 or
   BeiDou's TGD2 in RINEX's IODC slot, ``iodc`` → BeiDou's AODC in the fit-interval slot); toc
   is gnss_comm's GPS time (BeiDou's written back on BDT as RINEX wants). Not in the message:
-  the L2 P flag (0) and the GPS/QZSS fit interval (4 h, the normal one). GLONASS
-  ``GnssGloEphemMsg`` records are counted and not written (the RINEX writer writes Keplerian
-  records only).
+  the L2 P flag (0) and the GPS/QZSS fit interval (4 h, the normal one).
+- ``GnssGloEphemMsg`` → GLONASS records (RINEX 3.04 Table A10): ``toe`` (gnss_comm's GPS
+  time of tb) → the epoch, ``tau_n`` → −τn, ``gamma`` → γn, ``ttr`` → the message frame
+  time (seconds of the UTC week), ``pos``/``vel``/``acc`` (m, m/s, m/s² in PZ-90, as gnss_comm
+  holds them) → the state vector, ``health``, ``freqo`` → the frequency number, ``age``. Not
+  in a 3.04 record: ``delta_tau_n`` and ``ura`` (the 3.05 fifth line).
 - ``StampedFloat64Array`` (the receiver's ionosphere parameters, 8 values) → the navigation
   file's Klobuchar α/β (the last message).
 
@@ -43,13 +46,13 @@ import numpy as np
 
 from vo_doppler.io.gps_lnav import KEPLER_NAMES, LnavAssembler, subframe_id
 from vo_doppler.io.rinex_nav import KEPLER_FIELDS
-from vo_doppler.io.rinex_write import KeplerRecord
+from vo_doppler.io.rinex_write import GlonassRecord, KeplerRecord
 from vo_doppler.io.rosbag_bag import Bag
 from vo_doppler.io.rosbag_types import field as get
 from vo_doppler.io.rosbag_types import has_field
-from vo_doppler.io.ubx import VALUE_RANGES, _RawxRows
+from vo_doppler.io.ubx import SYSTEMS, VALUE_RANGES, _RawxRows
 from vo_doppler.model.doppler_sigma import ReportedSigma
-from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, SECONDS_PER_WEEK
+from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, SECONDS_PER_WEEK, gps_minus_utc
 from vo_doppler.model.observations import Observations
 
 SPEED_OF_LIGHT = 299_792_458.0
@@ -120,6 +123,14 @@ GLONASS_BANDS = {"1": (1602.0e6, 0.5625e6), "2": (1246.0e6, 0.4375e6)}
 DEFAULT_ATTRIBUTE = {"1": "C", "2": "C", "5": "Q", "6": "C", "7": "Q", "8": "Q", "9": "A"}
 DEFAULT_ATTRIBUTE_BDS = {"2": "I", "7": "I", "6": "I", "1": "P", "5": "P"}
 FREQUENCY_TOLERANCE_HZ = 1.0e5
+SYSTEM_NAMES = {
+    "S": "SBAS",
+    "E": "Galileo",
+    "C": "BeiDou",
+    "J": "QZSS",
+    "R": "GLONASS",
+    "I": "NavIC",
+}
 FIT_HOURS = {"G": 4.0, "J": 4.0}
 """The fit interval GnssEphemMsg does not carry: 4 h, the normal one (fit flag 0, IS-GPS-200
 sec. 20.3.3.4.3.1; IS-QZSS the same)."""
@@ -130,7 +141,7 @@ class BagGnss:
     """The raw GNSS of a bag: observations, ephemerides to write, Klobuchar α/β, Doppler σ."""
 
     observations: Observations
-    ephemerides: list[KeplerRecord]
+    ephemerides: list[KeplerRecord | GlonassRecord]
     klobuchar: np.ndarray | None
     doppler_sigma: ReportedSigma | None
     source: str
@@ -227,18 +238,13 @@ def read_gnss_comm(
         problems.append(f"{meas_topic}: {n_unknown} signals of an unknown satellite or frequency")
     if rows.n_dropped:
         problems.append(f"{meas_topic}: {rows.n_dropped} values out of range dropped")
-    ephemerides: list[KeplerRecord] = []
-    n_glonass = 0
+    ephemerides: list[KeplerRecord | GlonassRecord] = []
     for topic in ephem_topics:
         for index, _, message in bag.messages(topic):
             if has_field(message, "pos_x"):
-                n_glonass += 1
-                continue
-            record = _gnss_comm_ephemeris(bag, topic, index, message)
-            if record is not None:
-                ephemerides.append(record)
-    if n_glonass:
-        problems.append(f"{n_glonass} GLONASS ephemerides not written (Keplerian records only)")
+                ephemerides.append(_gnss_comm_glonass(bag, topic, index, message))
+            else:
+                ephemerides.append(_gnss_comm_ephemeris(bag, topic, index, message))
     klobuchar = _klobuchar(bag, iono_topic) if iono_topic else None
     return BagGnss(
         rows.observations(bag.path, problems),
@@ -312,7 +318,7 @@ def _signal(system: str, band: str, code: float) -> str:
     return band + table.get(band, "C")
 
 
-def _gnss_comm_ephemeris(bag: Bag, topic: str, index: int, m) -> KeplerRecord | None:
+def _gnss_comm_ephemeris(bag: Bag, topic: str, index: int, m) -> KeplerRecord:
     sat = satellite(int(get(m, "sat", 0)))
     if sat is None or sat[0] == "R":
         raise bag.error(
@@ -322,8 +328,7 @@ def _gnss_comm_ephemeris(bag: Bag, topic: str, index: int, m) -> KeplerRecord | 
             "GPS, Galileo or BeiDou satellite",
         )
     system, prn = sat
-    toc_time = get(m, "toc")
-    toc = float(get(toc_time, "week", 0)) * SECONDS_PER_WEEK + float(get(toc_time, "tow", np.nan))
+    toc = _gnss_time(m, "toc")
     a = float(get(m, "A", np.nan))
     tgd1 = float(get(m, "tgd1", 0.0))
     params = {
@@ -373,6 +378,48 @@ def _gnss_comm_ephemeris(bag: Bag, topic: str, index: int, m) -> KeplerRecord | 
         toc += BDT_MINUS_GPST_S  # RINEX writes BeiDou epochs on BDT
     assert {n for g in KEPLER_FIELDS for n in g} <= set(values)
     return KeplerRecord(system, prn, toc, values)
+
+
+def _gnss_time(message, name: str) -> float:
+    time = get(message, name)
+    return float(get(time, "week", 0)) * SECONDS_PER_WEEK + float(get(time, "tow", np.nan))
+
+
+def _gnss_comm_glonass(bag: Bag, topic: str, index: int, m) -> GlonassRecord:
+    """A GnssGloEphemMsg as a GLONASS record (module docstring)."""
+    sat = satellite(int(get(m, "sat", 0)))
+    if sat is None or sat[0] != "R":
+        raise bag.error(
+            topic, index, f"GLONASS ephemeris of satellite number {get(m, 'sat')}: not GLONASS"
+        )
+    toe, ttr = _gnss_time(m, "toe"), _gnss_time(m, "ttr")
+    leap = float(gps_minus_utc(toe)) if np.isfinite(toe) else 0.0
+    params = {
+        "minus_tau_n": -float(get(m, "tau_n", np.nan)),
+        "gamma_n": get(m, "gamma"),
+        "frame_time": np.mod(ttr - leap, SECONDS_PER_WEEK),
+        "health": get(m, "health"),
+        "channel": get(m, "freqo"),
+        "age": get(m, "age"),
+    }
+    for axis in "xyz":
+        params |= {
+            axis: get(m, f"pos_{axis}"),
+            f"v{axis}": get(m, f"vel_{axis}"),
+            f"a{axis}": get(m, f"acc_{axis}"),
+        }
+    try:
+        values = {k: float(v) for k, v in params.items()}
+    except (TypeError, ValueError) as exc:
+        raise bag.error(topic, index, f"GLONASS ephemeris field is not a number: {exc}") from exc
+    bad = [k for k, v in values.items() if not np.isfinite(v)]
+    if bad or not np.isfinite(toe):
+        raise bag.error(
+            topic,
+            index,
+            f"GLONASS ephemeris of R{sat[1]:02d} without a usable {', '.join(bad) or 'toe'}",
+        )
+    return GlonassRecord(sat[1], toe, values)
 
 
 def _klobuchar(bag: Bag, topic: str) -> np.ndarray | None:
@@ -462,10 +509,15 @@ def read_ublox(bag: Bag, rawx_topic: str, sfrbx_topic: str | None) -> BagGnss:
 def _sfrbx_ephemerides(bag: Bag, topic: str, week: int | None, problems: list[str]):
     assembler = LnavAssembler.new()
     n_other = 0
+    foreign: dict[str, int] = {}
     for index, _, message in bag.messages(topic):
         words = [int(w) for w in np.asarray(get(message, "dwrd", ()), dtype=np.int64).ravel()]
         gnss = int(get(message, "gnssId", 0))
-        if gnss != 0 or len(words) != 10 or int(get(message, "sigId", 0) or 0) != 0:
+        if gnss != 0:
+            system = SYSTEMS.get(gnss, f"gnssId {gnss}")
+            foreign[system] = foreign.get(system, 0) + 1
+            continue
+        if len(words) != 10 or int(get(message, "sigId", 0) or 0) != 0:
             n_other += 1
             continue
         data = tuple((w >> 6) & 0xFFFFFF for w in words)
@@ -474,7 +526,15 @@ def _sfrbx_ephemerides(bag: Bag, topic: str, week: int | None, problems: list[st
         else:
             n_other += 1
     if n_other:
-        problems.append(f"{topic}: {n_other} subframes not decoded (GPS 4-5, other systems)")
+        problems.append(f"{topic}: {n_other} GPS subframes without ephemeris (4-5, L2C, L5)")
+    if foreign:
+        counts = ", ".join(f"{n} {SYSTEM_NAMES.get(s, s)}" for s, n in sorted(foreign.items()))
+        problems.append(
+            f"{topic}: navigation data of other systems not decoded ({counts} messages; only "
+            "GPS LNAV is): those satellites have no ephemeris in the sequence, so their "
+            "measurements are not used; add a RINEX navigation file of the day to gnss.nav "
+            "for them"
+        )
     records = assembler.navrecords()
     out = []
     for k in range(len(records)):

@@ -26,8 +26,8 @@ shows what would be used) or named by options:
   (:mod:`vo_doppler.io.rosbag_can`);
 - raw GNSS (:mod:`vo_doppler.io.rosbag_gnss`) → ``gnss/rover.obs`` (RINEX 3.04; its approximate
   position the first NavSatFix fix, else the origin), and
-  ``gnss/brdc.nav`` when the bag holds ephemerides, ``gnss/doppler_sigma.csv`` when the
-  receiver reported Doppler σ;
+  ``gnss/brdc.nav`` when the bag holds ephemerides (GLONASS ones from ``GnssGloEphemMsg``),
+  ``gnss/doppler_sigma.csv`` when the receiver reported Doppler σ;
 - the GNSS antenna lever arm (``gnss.antenna_lever_arm_m``) from ``/tf_static``: the vehicle
   frame → ``--gnss-frame`` or the NavSatFix topic's ``frame_id``; 0 without one;
 - ``sensor_msgs/NavSatFix`` → the origin (its first fix with status ≥ 0, unless ``--origin``)
@@ -911,7 +911,7 @@ def _write_gnss(
     )
     if not gnss.ephemerides:
         warnings.append(
-            f"{bag_path}: no GPS/Galileo/BeiDou ephemeris in the bag: {OBS} written, but no "
+            f"{bag_path}: no ephemeris in the bag: {OBS} written, but no "
             "gnss section (add gnss.nav or gnss.orbits by hand)"
         )
         return len(epochs.epoch_time)
