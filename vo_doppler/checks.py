@@ -336,7 +336,7 @@ def _above_noise(
     """Why the best ``lag`` is no match, or None: its median difference ``cost`` above
     ``MAX_CLOCK_NOISE_MULTIPLE`` times the GNSS speed's noise (over the epochs where the wheel
     speed changes when a ``threshold`` is given)."""
-    noise = max(_sample_noise(reference), MIN_CLOCK_NOISE_MPS)
+    noise = max(sample_noise(reference), MIN_CLOCK_NOISE_MPS)
     if cost <= MAX_CLOCK_NOISE_MULTIPLE * noise:
         return None
     where = "" if threshold is None else " where the speed changes"
@@ -347,7 +347,7 @@ def _above_noise(
     )
 
 
-def _sample_noise(values: np.ndarray) -> float:
+def sample_noise(values: np.ndarray) -> float:
     """Robust σ of a smooth signal's sample noise: the median absolute second difference
     (1.4826 MAD / √6), which the signal's own changes hardly touch."""
     second = np.diff(values, 2)
@@ -359,7 +359,7 @@ def speed_change_threshold(speed: SensorSeries) -> float:
     times the noise of its ±``CLOCK_SLOPE_HALF_WINDOW_S`` difference (the sample noise from
     the median absolute second difference, which a drive's own accelerations hardly touch),
     at least ``MIN_CLOCK_ACCELERATION``."""
-    slope_noise = _sample_noise(speed.value) * np.sqrt(2.0) / (2.0 * CLOCK_SLOPE_HALF_WINDOW_S)
+    slope_noise = sample_noise(speed.value) * np.sqrt(2.0) / (2.0 * CLOCK_SLOPE_HALF_WINDOW_S)
     return float(max(CLOCK_SLOPE_NOISE_FACTOR * slope_noise, MIN_CLOCK_ACCELERATION))
 
 

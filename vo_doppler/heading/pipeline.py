@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from vo_doppler.checks import sample_noise
 from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.heading.calibration import (
     PRIOR_GYRO_BIAS_SIGMA,
@@ -45,6 +46,12 @@ from vo_doppler.heading.integrity import (
     ConsistencyConfig,
     ConventionalIntegrity,
     conventional_integrity,
+)
+from vo_doppler.heading.smoother import (
+    HeadingSmootherConfig,
+    SmoothedHeading,
+    angle_random_walk,
+    smooth_heading,
 )
 from vo_doppler.heading.tight_heading import (
     TightHeadingConfig,
@@ -110,6 +117,8 @@ class HeadingPipelineConfig:
     "Sensor calibration"; measured in docs/benchmarks.md, "A street canyon from the start")."""
     fixed_gyro_bias: float | None = None
     fixed_wheel_scale: float | None = None
+    smoother: HeadingSmootherConfig = field(default_factory=HeadingSmootherConfig)
+    """The tight headings combined through the gyro (:mod:`vo_doppler.heading.smoother`)."""
 
     @classmethod
     def robust(cls) -> HeadingPipelineConfig:
@@ -119,6 +128,7 @@ class HeadingPipelineConfig:
         return cls(
             tight=TightHeadingConfig.robust(),
             gate=GateConfig(window_s=600.0),
+            smoother=HeadingSmootherConfig(enabled=True),
         )
 
 
@@ -402,6 +412,35 @@ class _Pass:
     tight_inputs: dict
 
 
+def _smoothed(
+    solved: _Pass,
+    yaw_rate: SensorSeries,
+    cal: CalibrationSeries,
+    covered: np.ndarray,
+    config: HeadingPipelineConfig,
+) -> SmoothedHeading:
+    """The pass's window headings smoothed through its calibrated yaw angle, with the gyro's
+    angle random walk from the yaw rate's sample noise unless configured."""
+    smoother = config.smoother
+    walk = smoother.angle_random_walk_rad_per_sqrt_s
+    if walk is None:
+        interval = float(np.median(np.diff(yaw_rate.t))) if len(yaw_rate.t) > 1 else 0.0
+        walk = angle_random_walk(sample_noise(np.asarray(yaw_rate.value)), interval)
+    result = solved.result
+    bias_sigma = cal.bias_sigma[covered]
+    return smooth_heading(
+        result.t,
+        np.where(result.available, result.yaw, np.nan),
+        result.sigma,
+        result.window_s,
+        solved.tight_inputs["yaw_angle"],
+        float(np.median(bias_sigma)) if bias_sigma.size else config.prior_gyro_bias_sigma,
+        walk,
+        smoother,
+        config.tight.max_sigma_rad,
+    )
+
+
 def heading_pipeline(
     t_epoch: np.ndarray,
     rows: DopplerRows,
@@ -564,11 +603,12 @@ def heading_pipeline(
             cal.scale[:], cal.scale_sigma[:] = scale
             solved = solve(cal)
     result, integrity = solved.result, solved.integrity
+    tight = _smoothed(solved, yaw_rate, cal, covered, config) if config.smoother.enabled else None
     return HeadingTable(
         t=t_epoch,
-        yaw_tc=result.yaw,
-        sigma_tc=result.sigma,
-        tc_reliable=result.reliable,
+        yaw_tc=result.yaw if tight is None else tight.yaw,
+        sigma_tc=result.sigma if tight is None else tight.sigma,
+        tc_reliable=result.reliable if tight is None else tight.reliable,
         n_obs_window=result.n_obs,
         n_sat_epoch=result.n_sat_epoch,
         yaw_conv=np.where(conv_ok, solved.conv_yaw, np.nan),
@@ -581,7 +621,9 @@ def heading_pipeline(
         speed_sigma_conv=_scaled_sigma(
             conventional_speed_sigma_mps, integrity.speed, integrity.valid
         ),
-        tc_window_s=config.tight.window_s,
+        tc_window_s=config.tight.window_s
+        if tight is None
+        else 2.0 * config.smoother.consensus_span_s,
         conv_gnss_valid=conv_ok,
         sigma_conv_gnss=_sigma_where(conventional_yaw_sigma, conv_ok),
         grade_prior_sigma=solved.grade[1],
