@@ -9,10 +9,11 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[2] / "vo_doppler"
-BASE = {"errors", "geo", "model", "robust", "time_hints"}
+BASE = {"errors", "choices", "geo", "model", "robust", "time_hints"}
 STAGES = {"vo", "gnss", "heading", "fusion", "lowcost", "eval"}
 ALLOWED: dict[str, set[str]] = {
     "errors": set(),
+    "choices": {"errors"},
     "geo": {"errors"},
     "robust": set(),
     "time_hints": {"errors", "model"},

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from vo_doppler.fusion.correction import CorrectionConfig, absolute_heading
 from vo_doppler.model.heading import HeadingTable
@@ -39,3 +40,10 @@ def test_a_table_without_gnss_only_flags_uses_its_conventional_validity():
     heading = absolute_heading(table, "conv", CorrectionConfig())
     np.testing.assert_array_equal(heading.valid, [True, False, False, True])
     np.testing.assert_array_equal(heading.sigma[heading.valid], [0.03, 0.03])
+
+
+def test_an_unknown_source_is_refused_naming_the_sources():
+    with pytest.raises(
+        ValueError, match=r"^source: unknown heading source 'gps'; choose from tc, conv, tc\+conv$"
+    ):
+        absolute_heading(_table(), "gps", CorrectionConfig())

@@ -366,11 +366,16 @@ def test_pipeline_dispatches_on_the_method():
     for method in ("window", "kalman"):
         out = correct(vo, heading, CorrectionConfig(method=method)).vehicle
         np.testing.assert_allclose(out.matrices, gt.matrices, atol=1e-9)
-    with pytest.raises(ValueError, match="unknown correction method"):
+    with pytest.raises(
+        ValueError,
+        match=r"CorrectionConfig.method: unknown correction method 'median'; choose from "
+        r"kalman, window$",
+    ):
         CorrectionConfig(method="median")
-    with pytest.raises(ValueError, match="reference must be"):
+    refused = r"unknown heading reference 'sideways'; choose from course, orientation$"
+    with pytest.raises(ValueError, match="CorrectionConfig.reference: " + refused):
         CorrectionConfig(reference="sideways")
-    with pytest.raises(ValueError, match="reference must be"):
+    with pytest.raises(ValueError, match="^reference: " + refused):
         blend_heading(vo, t, yaw, reference="sideways")
 
 

@@ -9,12 +9,13 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import finite_float, positive_float
 from vo_doppler.commands.correction_options import add_correction_options, correction_config
 from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.fusion.correction import (
-    HEADING_SOURCES,
+    HeadingSource,
     absolute_heading,
     correct,
     usable_tight_heading,
@@ -88,8 +89,8 @@ def register(subparsers, summary: str) -> None:
     add_correction_options(parser, window_s=True)
     parser.add_argument(
         "--source",
-        choices=HEADING_SOURCES,
-        default="tc+conv",
+        choices=values(HeadingSource),
+        default=HeadingSource.TC_CONV.value,
         help="absolute headings used: tightly coupled (usable: reliable and sigma < 2 deg), "
         "conventional, or the former where usable else the latter",
     )

@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import argparse
 
+from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import positive_float
-from vo_doppler.fusion.correction import CORRECTION_METHODS, REFERENCES, CorrectionConfig
+from vo_doppler.fusion.correction import CorrectionConfig, CorrectionMethod
 from vo_doppler.fusion.heading_blend import BlendConfig
+from vo_doppler.fusion.heading_correction import HeadingReference
 
 
 def add_correction_options(parser: argparse.ArgumentParser, window_s: bool = False) -> None:
@@ -15,8 +17,8 @@ def add_correction_options(parser: argparse.ArgumentParser, window_s: bool = Fal
     ``window_s``), with :func:`ignored_correction_option` as a usage check."""
     parser.add_argument(
         "--correction",
-        choices=CORRECTION_METHODS,
-        default=CorrectionConfig().method,
+        choices=values(CorrectionMethod),
+        default=CorrectionConfig().method.value,
         help="heading correction: window (the window method of [TK18], Takeyama & Kojima 2018, "
         "Eq. 11-13) or kalman (adaptive blend: filter and smoother on the VO heading offset)",
     )
@@ -36,8 +38,8 @@ def add_correction_options(parser: argparse.ArgumentParser, window_s: bool = Fal
         )
     parser.add_argument(
         "--reference",
-        choices=REFERENCES,
-        default=CorrectionConfig().reference,
+        choices=values(HeadingReference),
+        default=CorrectionConfig().reference.value,
         help="compare the absolute heading with the VO's direction of travel (course) or with "
         "its orientation yaw (orientation: [TK18] sec. 3.6 as the paper writes it)",
     )

@@ -4,17 +4,35 @@ the method ([TK18] Eq. 11–13 window, or the Kalman blend (B1)–(B4)), chosen 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from enum import StrEnum
 
 import numpy as np
 
+from vo_doppler.choices import check_fields, checked
 from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading, relative_times
-from vo_doppler.fusion.heading_correction import correct_heading
+from vo_doppler.fusion.heading_correction import HeadingReference, correct_heading
 from vo_doppler.fusion.result import CorrectionResult
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
 
-CORRECTION_METHODS = ("kalman", "window")
-REFERENCES = ("course", "orientation")
+
+class CorrectionMethod(StrEnum):
+    """How absolute headings correct the VO: the adaptive blend (B1)–(B4) or [TK18]'s window
+    (sec. 3.6, Eq. 11–13)."""
+
+    KALMAN = "kalman"
+    WINDOW = "window"
+
+
+class HeadingSource(StrEnum):
+    """Which absolute headings correct: the tightly coupled ones, the conventional ones, or the
+    former where usable and the latter elsewhere (:func:`absolute_heading`)."""
+
+    TC = "tc"
+    CONV = "conv"
+    TC_CONV = "tc+conv"
+
+
 TC_MAX_SIGMA = np.radians(2.0)
 
 
@@ -22,10 +40,10 @@ TC_MAX_SIGMA = np.radians(2.0)
 class CorrectionConfig:
     """How absolute headings correct the VO (angles in rad)."""
 
-    method: str = "kalman"
+    method: CorrectionMethod = CorrectionMethod.KALMAN
     """'kalman': the adaptive blend (B1)–(B4) (smoother; ``blend.smooth=False`` is causal);
     'window': [TK18] sec. 3.6, Eq. 11–13."""
-    reference: str = "course"
+    reference: HeadingReference = HeadingReference.COURSE
     """What the absolute heading is compared with: the VO's 'course' (direction of travel, as a
     Doppler heading is) or its 'orientation' yaw ([TK18] sec. 3.6 as written). The course is
     immune to camera-calibration and extrinsic yaw errors that skew the VO's motion."""
@@ -39,10 +57,7 @@ class CorrectionConfig:
     blend: BlendConfig = field(default_factory=BlendConfig)
 
     def __post_init__(self) -> None:
-        if self.method not in CORRECTION_METHODS:
-            raise ValueError(f"unknown correction method {self.method!r} {CORRECTION_METHODS}")
-        if self.reference not in REFERENCES:
-            raise ValueError(f"reference must be 'course' or 'orientation', not {self.reference!r}")
+        check_fields(self, method=CorrectionMethod, reference=HeadingReference)
 
 
 @dataclass
@@ -55,9 +70,6 @@ class AbsoluteHeading:
     valid: np.ndarray
     sigma: np.ndarray | None = None
     correlation_s: np.ndarray | float = 0.0
-
-
-HEADING_SOURCES = ("tc", "conv", "tc+conv")
 
 
 def usable_tight_heading(table: HeadingTable, max_sigma: float = TC_MAX_SIGMA) -> np.ndarray:
@@ -81,16 +93,17 @@ def conventional_absolute_heading(table: HeadingTable) -> AbsoluteHeading:
     return AbsoluteHeading(table.t, table.yaw_conv, valid, sigma)
 
 
-def absolute_heading(table: HeadingTable, source: str, config: CorrectionConfig) -> AbsoluteHeading:
+def absolute_heading(
+    table: HeadingTable, source: HeadingSource, config: CorrectionConfig
+) -> AbsoluteHeading:
     """The headings of ``source``: 'tc' usable tightly coupled ones, 'conv' conventional ones,
     'tc+conv' the former where usable, else the latter (each with its σ and correlation time)."""
-    if source not in HEADING_SOURCES:
-        raise ValueError(f"unknown heading source {source!r} ({', '.join(HEADING_SOURCES)})")
+    source = checked(HeadingSource, source, "source")
     tight = tight_absolute_heading(table, config)
     conventional = conventional_absolute_heading(table)
-    if source == "tc":
+    if source is HeadingSource.TC:
         return tight
-    if source == "conv":
+    if source is HeadingSource.CONV:
         return conventional
     use_tight = tight.valid
     return AbsoluteHeading(
@@ -117,7 +130,7 @@ def correct(
 def _correct(
     vehicle: Trajectory, heading: AbsoluteHeading, config: CorrectionConfig
 ) -> CorrectionResult:
-    if config.method == "kalman":
+    if config.method is CorrectionMethod.KALMAN:
         return blend_heading(
             vehicle,
             heading.t,

@@ -108,7 +108,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.fusion.heading_correction import chord_starts, headings_at
+from vo_doppler.choices import checked
+from vo_doppler.fusion.heading_correction import HeadingReference, chord_starts, headings_at
 from vo_doppler.fusion.result import CorrectionResult
 from vo_doppler.geo import wrap_angle, yaw_of
 from vo_doppler.model.trajectory import Trajectory
@@ -215,12 +216,16 @@ class NoiseModel:
 
 
 def vo_direction(
-    t: np.ndarray, positions: np.ndarray, rotations: np.ndarray, reference: str, min_chord_m
+    t: np.ndarray,
+    positions: np.ndarray,
+    rotations: np.ndarray,
+    reference: HeadingReference,
+    min_chord_m,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Times and yaw (rad) of the VO direction: the course of the chord of at least
     ``min_chord_m`` ending at each pose, at the chord's middle time, or the orientation yaw at
     every pose."""
-    if reference == "orientation":
+    if reference is HeadingReference.ORIENTATION:
         return t, yaw_of(rotations)
     start = chord_starts(positions, min_chord_m)
     has = np.flatnonzero(start >= 0)
@@ -603,7 +608,7 @@ def blend_heading(
     valid: np.ndarray | None = None,
     correlation_s: np.ndarray | float = 0.0,
     config: BlendConfig = BlendConfig(),
-    reference: str = "course",
+    reference: HeadingReference = HeadingReference.COURSE,
 ) -> CorrectionResult:
     """Correct the VO heading with absolute headings by the Kalman blend (B1)–(B4).
 
@@ -613,8 +618,7 @@ def blend_heading(
     heading's window; 0 for the single-epoch conventional heading); ``reference`` compares
     them with the VO's 'course' or its 'orientation' yaw. Frames as in
     :func:`~vo_doppler.fusion.heading_correction.correct_heading`."""
-    if reference not in ("course", "orientation"):
-        raise ValueError(f"reference must be 'course' or 'orientation', not {reference!r}")
+    reference = checked(HeadingReference, reference, "reference")
     t_heading = np.asarray(t_heading, dtype=float)
     n_heading = len(t_heading)
     yaw = np.asarray(yaw_heading, dtype=float).copy()

@@ -18,12 +18,22 @@ Headings are yaw, counter-clockwise from east. The output keeps the input's firs
 
 from __future__ import annotations
 
+from enum import StrEnum
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.choices import checked
 from vo_doppler.fusion.result import CorrectionResult
 from vo_doppler.geo import wrap_angle, yaw_of
 from vo_doppler.model.trajectory import Trajectory
+
+
+class HeadingReference(StrEnum):
+    """What an absolute heading is compared with: the VO's direction of travel or its yaw."""
+
+    COURSE = "course"
+    ORIENTATION = "orientation"
 
 
 def headings_at(
@@ -81,12 +91,12 @@ def _window_yaw(
     rotations: np.ndarray,
     start: int,
     stop: int,
-    reference: str,
+    reference: HeadingReference,
     chord_start: np.ndarray,
 ) -> np.ndarray:
     """VO yaw of poses start..stop−1: orientation yaw, or the course of the chord ending at each
     pose (NaN where the chord would begin before ``start`` or there is none)."""
-    if reference == "orientation":
+    if reference is HeadingReference.ORIENTATION:
         return yaw_of(rotations[start:stop])
     index = np.arange(start, stop)
     begin = chord_start[index]
@@ -103,7 +113,7 @@ def correct_heading(
     window_s: float = 2.0,
     max_gap_s: float = 1.5,
     gate_rad: float | None = None,
-    reference: str = "course",
+    reference: HeadingReference = HeadingReference.COURSE,
     min_chord_m: float = 0.5,
 ) -> CorrectionResult:
     """Correct the VO heading with absolute headings ([TK18] sec. 3.6, [TK18] Eq. 11–13).
@@ -121,17 +131,16 @@ def correct_heading(
     against its optical axis; the chord keeps the tiny, noisy steps of a vehicle that is
     slowing down or creeping out of the comparison.
     """
-    if reference not in ("orientation", "course"):
-        raise ValueError(f"reference must be 'orientation' or 'course', not {reference!r}")
+    reference = checked(HeadingReference, reference, "reference")
     poses = vehicle.matrices
     n = len(poses)
     vo_positions = poses[:, :3, 3] - (poses[0, :3, 3] if n else 0.0)
     chord_start = chord_starts(vo_positions, min_chord_m)
     t_compare = vehicle.t
-    if reference == "course":
+    if reference is HeadingReference.COURSE:
         t_compare = 0.5 * (vehicle.t + vehicle.t[np.maximum(chord_start, 0)])
     absolute, has_absolute = headings_at(t_compare, t_heading, yaw_heading, valid, max_gap_s)
-    if reference == "course":
+    if reference is HeadingReference.COURSE:
         has_absolute &= chord_start >= 0
     vo_rotations = poses[:, :3, :3]
     positions = np.zeros((n, 3))
