@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.choices import values
 from vo_doppler.errors import InputError
 from vo_doppler.eval.alignment import (
-    ALIGNMENTS,
+    Alignment,
     align,
-    check_alignment,
     rotation_about,
     se2_about_up,
     umeyama,
@@ -88,6 +88,11 @@ def test_align_by_method():
 
 
 def test_an_unknown_method_is_refused_with_the_choices():
-    assert [check_alignment(m) for m in ALIGNMENTS] == list(ALIGNMENTS)
-    with pytest.raises(InputError, match=r"^unknown alignment 'se3'; choose from none, start, se2"):
-        check_alignment("se3")
+    assert values(Alignment) == ("none", "start", "se2", "sim3")
+    truth = _trajectory(SOURCE, np.zeros(len(SOURCE)))
+    assert [align(truth, truth, m, UP).positions.shape for m in Alignment] == [SOURCE.shape] * 4
+    with pytest.raises(
+        InputError,
+        match=r"^alignment: unknown alignment 'se3'; choose from none, start, se2, sim3$",
+    ):
+        align(truth, truth, "se3", UP)

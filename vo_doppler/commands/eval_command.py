@@ -16,11 +16,12 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import positive_float
 from vo_doppler.commands.help_format import OptionsParser
 from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.errors import InputError
-from vo_doppler.eval.alignment import ALIGNMENTS
+from vo_doppler.eval.alignment import Alignment
 from vo_doppler.eval.gnss_scores import (
     HOLD_BELOW_MPS,
     MOVING_MPS,
@@ -96,8 +97,8 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--align",
-        choices=ALIGNMENTS,
-        default="start",
+        choices=values(Alignment),
+        default=Alignment.START.value,
         help="how the estimate is aligned to the ground truth before the final error, end yaw "
         "error and ATE (segment errors are relative: a rigid alignment leaves them as they are, "
         "sim3 scales the estimate and so changes the translation errors)",

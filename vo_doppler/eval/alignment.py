@@ -2,12 +2,22 @@
 
 from __future__ import annotations
 
+from enum import StrEnum
+
 import numpy as np
 
-from vo_doppler.errors import InputError
+from vo_doppler.choices import checked
 from vo_doppler.model.trajectory import Trajectory
 
-ALIGNMENTS = ("none", "start", "se2", "sim3")
+
+class Alignment(StrEnum):
+    """How an estimate is aligned to the ground truth before its errors are taken
+    (:func:`align`)."""
+
+    NONE = "none"
+    START = "start"
+    SE2 = "se2"
+    SIM3 = "sim3"
 
 
 def umeyama(source: np.ndarray, target: np.ndarray, with_scale: bool) -> tuple:
@@ -48,21 +58,15 @@ def se2_about_up(source: np.ndarray, target: np.ndarray, up: np.ndarray) -> tupl
     return rotation, mu_t - rotation @ mu_s, 1.0
 
 
-def check_alignment(method: str) -> str:
-    """``method`` if it names an alignment (:data:`ALIGNMENTS`), else an :class:`InputError`."""
-    if method not in ALIGNMENTS:
-        raise InputError(f"unknown alignment {method!r}; choose from {', '.join(ALIGNMENTS)}")
-    return method
-
-
-def align(estimate: Trajectory, truth: Trajectory, method: str, up: np.ndarray) -> Trajectory:
-    """Return ``estimate`` aligned to ``truth`` (same length, matched rows) by ``method``."""
-    check_alignment(method)
-    if method == "none":
+def align(estimate: Trajectory, truth: Trajectory, method: Alignment, up: np.ndarray) -> Trajectory:
+    """Return ``estimate`` aligned to ``truth`` (same length, matched rows) by ``method`` (a
+    :class:`~vo_doppler.choices.ChoiceError` when it names no :class:`Alignment`)."""
+    method = checked(Alignment, method, "alignment")
+    if method is Alignment.NONE:
         return estimate
-    if method == "start":
+    if method is Alignment.START:
         rel = truth.matrices[0] @ np.linalg.inv(estimate.matrices[0])
         return estimate.transformed(rel[:3, :3], rel[:3, 3])
-    if method == "se2":
+    if method is Alignment.SE2:
         return estimate.transformed(*se2_about_up(estimate.positions, truth.positions, up))
     return estimate.transformed(*umeyama(estimate.positions, truth.positions, True))

@@ -14,8 +14,9 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.choices import checked
 from vo_doppler.errors import InputError
-from vo_doppler.eval.alignment import align, check_alignment
+from vo_doppler.eval.alignment import Alignment, align
 from vo_doppler.eval.per_distance import too_short_for_distance_figures
 from vo_doppler.model.trajectory import Trajectory
 
@@ -171,7 +172,7 @@ def segment_errors(estimate: Trajectory, truth: Trajectory, lengths) -> list[Seg
 def evaluate(
     estimate: Trajectory,
     truth: Trajectory,
-    alignment: str = "start",
+    alignment: Alignment = Alignment.START,
     up: np.ndarray | None = None,
 ) -> TrajectoryErrors:
     """All error figures of ``estimate`` against ``truth`` (rows must already correspond).
@@ -179,7 +180,7 @@ def evaluate(
     An :class:`InputError` names the argument when the two differ in length, hold fewer than
     two poses, a non-finite position or orientation (it would turn every figure into NaN or
     stop the alignment's SVD), or ``alignment`` is not one of
-    :data:`~vo_doppler.eval.alignment.ALIGNMENTS`."""
+    :class:`~vo_doppler.eval.alignment.Alignment`."""
     if len(estimate) != len(truth):
         raise InputError(
             f"estimate has {len(estimate)} poses, truth {len(truth)}: the rows must correspond "
@@ -264,7 +265,7 @@ NO_MATCH = f"fewer than two timestamps match the ground truth's (within {MATCH_M
 def evaluate_by_time(
     estimate: Trajectory,
     truth: Trajectory,
-    alignment: str = "start",
+    alignment: Alignment = Alignment.START,
     up: np.ndarray | None = None,
     max_dt: float = MATCH_MAX_DT_S,
 ) -> TrajectoryErrors | None:
@@ -275,7 +276,7 @@ def evaluate_by_time(
     wrongly or not at all, and read as :data:`NO_MATCH`)."""
     _check_time_order(estimate, "estimate")
     _check_time_order(truth, "truth")
-    check_alignment(alignment)
+    checked(Alignment, alignment, "alignment")
     matched, matched_truth = associate(estimate, truth, max_dt)
     if len(matched) < 2:
         return None
