@@ -8,8 +8,18 @@ from enum import StrEnum
 
 import pytest
 
-from vo_doppler.choices import ChoiceError, allowed, check_fields, checked, kind_of, values
+from vo_doppler.choices import (
+    ChoiceError,
+    allowed,
+    check_fields,
+    checked,
+    checked_letters,
+    kind_of,
+    values,
+)
 from vo_doppler.errors import InputError
+from vo_doppler.model.signals import DEFAULT_SYSTEMS, SatelliteSystem
+from vo_doppler.run import RunConfig
 
 
 class RoadSurface(StrEnum):
@@ -53,3 +63,17 @@ def test_checked_names_the_argument_it_is_given():
     assert checked(RoadSurface, "asphalt", "surface") is RoadSurface.ASPHALT
     with pytest.raises(ChoiceError, match=r"^surface: unknown road surface 'ice'; choose from"):
         checked(RoadSurface, "ice", "surface")
+
+
+def test_gnss_systems_are_letters_of_the_satellite_systems():
+    assert checked_letters(SatelliteSystem, "GE", "systems") == "GE"
+    assert RunConfig().systems == DEFAULT_SYSTEMS == "GREJC"
+    assert "".join(SatelliteSystem) == "GRECJSI"
+    with pytest.raises(
+        ChoiceError,
+        match=r"^RunConfig.systems = 'Gx': unknown satellite system 'x'; choose from G, R, E, C, "
+        r"J, S, I$",
+    ):
+        RunConfig(systems="Gx")
+    with pytest.raises(ChoiceError, match=r"^RunConfig.systems: expected letters among G, R"):
+        RunConfig(systems="")

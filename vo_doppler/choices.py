@@ -47,6 +47,17 @@ def checked(choices: type[Choice], value: object, field: str) -> Choice:
         ) from None
 
 
+def checked_letters(choices: type[StrEnum], text: str, field: str) -> str:
+    """``text`` if it is one or more one-letter values of ``choices`` (e.g. GNSS systems
+    "GE"); else a :class:`ChoiceError` naming the ``field``, the first unknown letter and the
+    allowed ones."""
+    if not isinstance(text, str) or not text:
+        raise ChoiceError(f"{field}: expected letters among {allowed(choices)}, got {text!r}")
+    for letter in text:
+        checked(choices, letter, f"{field} = {text!r}")
+    return text
+
+
 def check_fields(config: object, **choices: type[StrEnum]) -> None:
     """Replace each named field of the dataclass ``config`` by its member of the given choice
     set (:func:`checked`; frozen dataclasses too), so that a configuration holds only members.

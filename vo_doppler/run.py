@@ -36,6 +36,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from vo_doppler.checks import check_vehicle_overlap, check_yaw_rate_unit, origin_warning
+from vo_doppler.choices import checked_letters
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.correction import (
     CorrectionConfig,
@@ -62,6 +63,7 @@ from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.signals import DEFAULT_SYSTEMS, SatelliteSystem
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.frames import vehicle_trajectory
@@ -87,7 +89,8 @@ class Pipeline(StrEnum):
 class RunConfig:
     """Everything :func:`run_sequence` can be told (SI units, radians)."""
 
-    systems: str = "GREJC"
+    systems: str = DEFAULT_SYSTEMS
+    """RINEX letters of the GNSS systems used (:class:`SatelliteSystem`)."""
     elevation_mask: float = np.radians(10.0)
     heading: HeadingPipelineConfig = field(default_factory=HeadingPipelineConfig)
     vo: VoConfig = field(default_factory=VoConfig)
@@ -98,6 +101,7 @@ class RunConfig:
         """Refuse values out of their domain now (an :class:`~vo_doppler.errors.InputError`
         naming the field), not as an empty result later: a mask of 10 (degrees given for
         radians) removes every satellite and leaves no heading, silently."""
+        checked_letters(SatelliteSystem, self.systems, "RunConfig.systems")
         check_elevation_mask(self.elevation_mask, "RunConfig.elevation_mask")
         rate = self.dead_reckoning_rate_hz
         if not (isinstance(rate, (int, float, np.number)) and math.isfinite(rate) and rate > 0):

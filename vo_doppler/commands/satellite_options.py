@@ -11,6 +11,7 @@ from vo_doppler.io.rinex_obs import SYSTEMS
 from vo_doppler.io.satellite_states import read_satellite_states
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.precise_orbits import PreciseOrbits
+from vo_doppler.model.signals import DEFAULT_SYSTEMS
 
 
 def add_satellite_options(parser: argparse.ArgumentParser, required: bool = True) -> None:
@@ -39,7 +40,7 @@ def add_selection_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--systems",
         type=system_letters(SYSTEMS),
-        default="GREJC",
+        default=DEFAULT_SYSTEMS,
         help="GNSS systems to use (RINEX letters: G, R, E, J, C)",
     )
     parser.add_argument(

@@ -34,10 +34,11 @@ from vo_doppler.io.rinex_common import (
 )
 from vo_doppler.model.gpstime import calendar_to_gps_seconds, utc_to_gps_seconds
 from vo_doppler.model.observations import Observations, ObsHeader
+from vo_doppler.model.signals import SatelliteSystem
 
 log = logging.getLogger(__name__)
 
-SYSTEMS = "GRECJSI"
+SYSTEMS = "".join(SatelliteSystem)
 FIELD_WIDTH = 16
 VALUE_WIDTH = 14
 _DOT_COLUMN = 10  # F14.3: the decimal point is the 11th character of the value field

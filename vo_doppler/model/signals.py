@@ -10,6 +10,26 @@ from 3.03 on it is band 2 (band 1 is B1C).
 
 from __future__ import annotations
 
+from enum import StrEnum
+
+
+class SatelliteSystem(StrEnum):
+    """The GNSS systems by their RINEX letter (RINEX 3.05 sec. 3.5), in the order the readers
+    index them."""
+
+    GPS = "G"
+    GLONASS = "R"
+    GALILEO = "E"
+    BEIDOU = "C"
+    QZSS = "J"
+    SBAS = "S"
+    NAVIC = "I"
+
+
+DEFAULT_SYSTEMS = "GREJC"
+"""The systems a run uses unless told otherwise (``--systems``): those the GNSS stage has
+ephemerides and signals for in the recordings met so far."""
+
 MHZ = 1e6
 FREQUENCIES_HZ: dict[str, dict[str, float]] = {
     "G": {"1": 1575.42 * MHZ, "2": 1227.60 * MHZ, "5": 1176.45 * MHZ},
