@@ -9,13 +9,14 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[2] / "vo_doppler"
-BASE = {"errors", "choices", "geo", "model", "robust", "time_hints"}
+BASE = {"errors", "choices", "geo", "model", "robust", "time_hints", "units"}
 STAGES = {"vo", "gnss", "heading", "fusion", "lowcost", "eval"}
 ALLOWED: dict[str, set[str]] = {
     "errors": set(),
     "choices": {"errors"},
     "geo": {"errors"},
     "robust": set(),
+    "units": set(),
     "time_hints": {"errors", "model"},
     "model": {"errors", "geo", "model"},
     "vo": BASE | {"vo"},

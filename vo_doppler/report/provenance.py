@@ -15,6 +15,7 @@ from vo_doppler import __version__
 from vo_doppler.errors import shown
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.run import RunConfig
+from vo_doppler.units import DEGREES_PER_RADIAN, in_people_units
 
 SYNTHETIC_KEYS = ("scenario", "command")
 """Manifest keys only ``vo-doppler simulate`` writes: their presence marks a simulated drive."""
@@ -123,13 +124,16 @@ ANGLE_FIELDS = {
 
 
 def _people_value(name: str, value) -> tuple[str, str]:
-    """(name, value) with radians turned into degrees (``_rad`` names become ``_deg``)."""
+    """(name, value) in people units: an angle in degrees, from the unit its name ends in
+    (:func:`~vo_doppler.units.in_people_units`: ``gate_rad`` becomes ``gate_deg``)."""
     unit = ANGLE_FIELDS.get(name)
-    for suffix, people in (("_rad_s", " deg/s"), ("_rad", " deg")):
-        if name.endswith(suffix):
-            name, unit = name[: -len(suffix)] + "_" + people.strip().replace("/", "_"), people
+    if unit is None:
+        shown, value, symbol = in_people_units(name, value)
+        unit, name = (f" {symbol}" if shown != name else ""), shown
+    elif isinstance(value, float):
+        value = value * DEGREES_PER_RADIAN
     if unit and isinstance(value, float) and np.isfinite(value):
-        return name, f"{np.degrees(value):.4g}{unit}"
+        return name, f"{value:.4g}{unit}"
     if isinstance(value, float):
         return name, f"{value:.4g}"
     return name, str(value)
