@@ -58,7 +58,7 @@ def evaluate(folder, _results_dir=None, _console=None) -> dict:
         )
         tc = np.degrees(np.abs(wrap_angle(table.yaw_tc - truth_yaw)))
         conv = np.degrees(np.abs(wrap_angle(table.yaw_conv - truth_yaw)))
-        used = usable_tight_heading(table, config.correction.tc_max_sigma)
+        used = usable_tight_heading(table, config.correction.tc_max_sigma_rad)
         figures["variants"][name] = {
             "tc_used": _errors(tc, used),
             "tc_used_turning": _errors(tc, used & turning),

@@ -75,7 +75,7 @@ def evaluate(folder: Path) -> dict:
         table = sequence_heading(inputs, gnss.rows, gnss.velocity, heading)
         seconds = time.perf_counter() - start
         error = np.degrees(np.abs(wrap_angle(table.yaw_tc - truth_yaw)))
-        used = usable_tight_heading(table, config.correction.tc_max_sigma)
+        used = usable_tight_heading(table, config.correction.tc_max_sigma_rad)
         figures["variants"][name] = {
             "available": _errors(error, table.tc_available),
             "used": _errors(error, used),

@@ -241,7 +241,7 @@ def dead_reckoning_figures(sequence: Sequence, table: HeadingTable, config: RunC
     speed = table.calibrated_speed(sequence.wheel_speed)
     origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)))  # the figures align the starts
     trajectories = correct_all(sequence, table, None, speed, origin, config)
-    usable = usable_tight_heading(table, config.correction.tc_max_sigma)
+    usable = usable_tight_heading(table, config.correction.tc_max_sigma_rad)
     errors, _, _ = evaluate_pipelines(trajectories, table, usable, sequence.truth)
     return {str(name): errors[name].error_per_100m_m for name in DEAD_RECKONING if name in errors}
 

@@ -348,7 +348,7 @@ def correct_all(
         begin, end = max(begin, vo_vehicle.t[0]), min(end, vo_vehicle.t[-1])
     t_dr = np.arange(begin, end, 1.0 / config.dead_reckoning_rate_hz)
     dr = wheel_gyro_track(speed, yaw_rate, t_dr) if len(t_dr) > 1 else None
-    usable = usable_tight_heading(table, config.correction.tc_max_sigma)
+    usable = usable_tight_heading(table, config.correction.tc_max_sigma_rad)
     tight = (
         tight_absolute_heading(table, config.correction)
         if tight_source == "tc"
@@ -512,7 +512,7 @@ def run_sequence(
     antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
     trajectories = correct_all(sequence, table, vo_vehicle, speed, antenna, config)
     release_free_heap()
-    usable = usable_tight_heading(table, config.correction.tc_max_sigma)
+    usable = usable_tight_heading(table, config.correction.tc_max_sigma_rad)
     warnings = ([origin] if origin else []) + table.warnings
     return RunResult(gnss, table, vo, speed, trajectories, antenna, usable, warnings)
 

@@ -35,7 +35,7 @@ from vo_doppler.io.trajectory import read_tum, write_tum
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD as FORWARD_CAMERA_TO_VEHICLE
 from vo_doppler.model.trajectory import Trajectory
 
-FIXED = BlendConfig(sigma_distance=1e-3, sigma_turn=1e-3, measurement_scale=1.0)
+FIXED = BlendConfig(sigma_distance_rad_per_sqrt_m=1e-3, sigma_turn=1e-3, measurement_scale=1.0)
 """Noise given, nothing fitted."""
 
 
@@ -144,7 +144,7 @@ def test_offset_across_the_wrap():
     t = gt.t
     true_offset = np.linspace(3.0, 3.3, len(t))  # crosses +π
     vo = _turned_vo(gt, true_offset)
-    config = BlendConfig(sigma_distance=0.02, sigma_turn=1e-3, measurement_scale=1.0)
+    config = BlendConfig(sigma_distance_rad_per_sqrt_m=0.02, sigma_turn=1e-3, measurement_scale=1.0)
     result = blend_heading(vo, t, np.zeros(len(t)), 1e-4, config=config)
     assert np.max(np.abs(wrap_angle(result.correction - true_offset))) < 1e-3
     assert np.max(np.abs(np.diff(result.correction))) < 0.01  # held unwrapped, no 2π jumps
@@ -217,19 +217,22 @@ def test_too_few_measurements_keep_the_defaults_and_the_floor_holds():
     noise = fit_process_noise(few, clock, config)
     assert not noise.fitted
     assert (noise.sigma_distance, noise.sigma_turn, noise.scale) == (
-        config.default_sigma_distance,
+        config.default_sigma_distance_rad_per_sqrt_m,
         config.default_sigma_turn,
         1.0,
     )
     n = 400
     still = OffsetMeasurements(np.arange(n) / 10, np.zeros(n), np.full(n, 0.01), np.zeros(n))
     long_clock = DriftClock(np.arange(n) / 10, np.arange(n, dtype=float), np.zeros(n))
-    assert fit_process_noise(still, long_clock, config).sigma_distance == config.min_sigma_distance
+    assert (
+        fit_process_noise(still, long_clock, config).sigma_distance
+        == config.min_sigma_distance_rad_per_sqrt_m
+    )
 
 
 def test_correlated_headings_are_inflated_in_the_filter():
     gt = _straight(400)
-    static = BlendConfig(sigma_distance=1e-9, sigma_turn=1e-9, measurement_scale=1.0)
+    static = BlendConfig(sigma_distance_rad_per_sqrt_m=1e-9, sigma_turn=1e-9, measurement_scale=1.0)
     common = dict(config=static)
     white = blend_heading(gt, gt.t, np.zeros(len(gt)), 0.01, **common)
     correlated = blend_heading(gt, gt.t, np.zeros(len(gt)), 0.01, correlation_s=2.0, **common)
@@ -295,7 +298,7 @@ def test_robust_update_follows_a_lasting_change_and_ignores_a_burst():
     gt = _straight(n)
     yaw = np.zeros(n)
     yaw[150:180] = np.radians(20.0)  # three seconds of a reflected conventional heading
-    fixed = BlendConfig(sigma_distance=1e-4, sigma_turn=1e-4, measurement_scale=1.0)
+    fixed = BlendConfig(sigma_distance_rad_per_sqrt_m=1e-4, sigma_turn=1e-4, measurement_scale=1.0)
     common = {"config": fixed, "reference": "orientation"}
     robust = blend_heading(gt, gt.t, yaw, np.radians(0.5), **common)
     plain = blend_heading(
@@ -345,7 +348,9 @@ def test_a_wrong_first_heading_does_not_start_the_blend():
     gt = _straight(n)
     yaw = np.zeros(n)
     yaw[0] = np.radians(30.0)  # the first heading is wrong
-    config = BlendConfig(sigma_distance=1e-4, sigma_turn=1e-4, measurement_scale=1.0, smooth=False)
+    config = BlendConfig(
+        sigma_distance_rad_per_sqrt_m=1e-4, sigma_turn=1e-4, measurement_scale=1.0, smooth=False
+    )
     common = {"config": config, "reference": "orientation"}
     robust = blend_heading(gt, gt.t, yaw, np.radians(0.5), **common)
     first = blend_heading(
@@ -490,7 +495,7 @@ def test_reflected_bursts_do_not_make_the_vo_follow_the_headings(burst_deg):
     drift-free VO and put the bursts down as outliers."""
     vo, t_heading, headings, yaw = _burst_headings(0, burst_deg)
     result = blend_heading(vo, t_heading, headings, np.radians(1.0))
-    assert result.noise.sigma_distance == BlendConfig().min_sigma_distance
+    assert result.noise.sigma_distance == BlendConfig().min_sigma_distance_rad_per_sqrt_m
     assert result.noise.outlier_fraction >= 0.01
     assert _yaw_rmse(result, yaw) < np.radians(0.1)
 

@@ -188,7 +188,7 @@ def test_heading_csv_round_trip(tmp_path):
     np.testing.assert_allclose(back.gyro_bias, 0.001, atol=1e-7)
     first_course = float(path.read_text().splitlines()[1].split(",")[1])
     assert first_course == pytest.approx(80.0)  # yaw 10° ccw from east = course 80°
-    combined = absolute_heading(back, "tc+conv", CorrectionConfig(tc_max_sigma=np.inf))
+    combined = absolute_heading(back, "tc+conv", CorrectionConfig(tc_max_sigma_rad=np.inf))
     assert combined.valid.all() and combined.yaw[2] == pytest.approx(back.yaw_conv[2])
     path.write_text(path.read_text() + "1,2,3\n")
     with pytest.raises(InputError, match=r"heading.csv:7"):

@@ -208,7 +208,7 @@ def run(args: argparse.Namespace) -> int:
         log.warning("%s", text)
     # The starting heading as `run` sets it: before its first absolute heading (and through
     # the window method's first window) the trajectory would stay in the VO's own frame.
-    usable = usable_tight_heading(table, config.tc_max_sigma)
+    usable = usable_tight_heading(table, config.tc_max_sigma_rad)
     start_turn = initial_yaw_offset(
         table, usable, vehicle, source=args.source, reference=config.reference
     )

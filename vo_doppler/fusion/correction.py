@@ -49,10 +49,10 @@ class CorrectionConfig:
     immune to camera-calibration and extrinsic yaw errors that skew the VO's motion."""
     window_s: float = 2.0
     """The window method's W."""
-    gate: float = 0.0
+    gate_rad: float = 0.0
     """Window method: if > 0, absolute headings this far from the corrected VO heading are not
     used. Off by default: a wrong first heading would then lock out the right ones."""
-    tc_max_sigma: float = TC_MAX_SIGMA
+    tc_max_sigma_rad: float = TC_MAX_SIGMA
     """Tightly coupled headings with a larger standard deviation do not correct."""
     blend: BlendConfig = field(default_factory=BlendConfig)
 
@@ -81,7 +81,7 @@ def usable_tight_heading(table: HeadingTable, max_sigma: float = TC_MAX_SIGMA) -
 def tight_absolute_heading(table: HeadingTable, config: CorrectionConfig) -> AbsoluteHeading:
     """The usable tightly coupled headings; their errors are correlated over the solver's
     window."""
-    usable = usable_tight_heading(table, config.tc_max_sigma)
+    usable = usable_tight_heading(table, config.tc_max_sigma_rad)
     return AbsoluteHeading(table.t, table.yaw_tc, usable, table.sigma_tc, table.tc_window_s)
 
 
@@ -148,6 +148,6 @@ def _correct(
         heading.valid,
         config.window_s,
         max_gap_s=config.blend.max_gap_s,
-        gate_rad=config.gate if config.gate > 0 else None,
+        gate_rad=config.gate_rad if config.gate_rad > 0 else None,
         reference=config.reference,
     )

@@ -128,23 +128,23 @@ DEFAULT_OUTLIER_FRACTION = 0.01
 class BlendConfig:
     """Parameters of (B1)–(B4); angles in rad."""
 
-    sigma_distance: float | None = None
+    sigma_distance_rad_per_sqrt_m: float | None = None
     """σ_d (rad/√m) of (B1); None: maximum-likelihood fit over the drive."""
     sigma_turn: float | None = None
     """σ_ψ (rad/√rad) of (B1); None: fitted with σ_d."""
     measurement_scale: float | None = None
     """s of (B2); None: fitted with σ_d."""
-    default_sigma_distance: float = 0.002
+    default_sigma_distance_rad_per_sqrt_m: float = 0.002
     """σ_d without enough measurements to fit: 1.1° of drift per √(100 m), a common
     monocular VO (KITTI rotation errors are 0.5–2° per 100 m)."""
     default_sigma_turn: float = 0.01
     """σ_ψ without enough measurements to fit: a 90° turn adds 0.7° of drift std, as a 1 %
     yaw-scale error of the VO (e.g. a focal length 1 % off) would."""
-    min_sigma_distance: float = 1e-4
+    min_sigma_distance_rad_per_sqrt_m: float = 1e-4
     """Floor on σ_d: the VO is never trusted beyond 0.06° per √(100 m)."""
     min_sigma_turn: float = 1e-4
     """Floor on σ_ψ: 0.01 % yaw-scale error."""
-    default_measurement_sigma: float = np.radians(1.0)
+    default_measurement_sigma_rad: float = np.radians(1.0)
     """σ_j of epochs whose heading carries no standard deviation (e.g. conventional headings
     read from a heading.csv written before it had their column)."""
     smooth: bool = True
@@ -491,13 +491,13 @@ def fit_process_noise(
     defaults when fewer than ``min_fit_measurements`` remain or nothing is left to fit."""
     keep = decimate(measurements.t, measurements.correlation_s)
     fixed = (
-        config.sigma_distance,
+        config.sigma_distance_rad_per_sqrt_m,
         config.sigma_turn,
         config.measurement_scale,
         config.outlier_fraction,
     )
     defaults = (
-        config.default_sigma_distance,
+        config.default_sigma_distance_rad_per_sqrt_m,
         config.default_sigma_turn,
         1.0,
         DEFAULT_OUTLIER_FRACTION,
@@ -506,7 +506,7 @@ def fit_process_noise(
     if len(keep) < config.min_fit_measurements or all(f is not None for f in fixed[:3]):
         return NoiseModel(*chosen[:3], fitted=False, outlier_fraction=chosen[3])
     grids = (
-        np.maximum(SIGMA_GRID, config.min_sigma_distance),
+        np.maximum(SIGMA_GRID, config.min_sigma_distance_rad_per_sqrt_m),
         np.maximum(SIGMA_GRID, config.min_sigma_turn),
         SCALE_GRID,
         OUTLIER_GRID,
@@ -613,7 +613,7 @@ def blend_heading(
     """Correct the VO heading with absolute headings by the Kalman blend (B1)–(B4).
 
     ``t_heading``/``yaw_heading`` (yaw, rad) are on the trajectory's clock; ``sigma_heading``
-    their standard deviations (NaN or None: ``default_measurement_sigma``), ``valid`` marks
+    their standard deviations (NaN or None: ``default_measurement_sigma_rad``), ``valid`` marks
     the usable epochs, ``correlation_s`` is T_c of (B2) per epoch or for all (the tight
     heading's window; 0 for the single-epoch conventional heading); ``reference`` compares
     them with the VO's 'course' or its 'orientation' yaw. Frames as in
@@ -627,7 +627,7 @@ def blend_heading(
     sigma = np.broadcast_to(
         np.asarray(np.nan if sigma_heading is None else sigma_heading, dtype=float), (n_heading,)
     )
-    sigma = np.where(np.isfinite(sigma), sigma, config.default_measurement_sigma)
+    sigma = np.where(np.isfinite(sigma), sigma, config.default_measurement_sigma_rad)
     correlation = np.broadcast_to(np.asarray(correlation_s, dtype=float), (n_heading,))
     poses = vehicle.matrices
     # Every step on times relative to the first pose: nothing depends on the time origin.

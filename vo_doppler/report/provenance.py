@@ -112,9 +112,6 @@ def version() -> str:
 
 ANGLE_FIELDS = {
     "elevation_mask": " deg",
-    "tc_max_sigma": " deg",
-    "gate": " deg",
-    "default_measurement_sigma": " deg",
     "init_min_parallax": " deg",
     "triangulation_min_parallax": " deg",
     "prior_gyro_bias_sigma": " deg/s",
@@ -200,7 +197,7 @@ def main_settings(
             (f"{'VO' if camera else 'dead-reckoning'} heading compared as", correction.reference),
             (
                 "tightly coupled heading used when σ <",
-                f"{np.degrees(correction.tc_max_sigma):.1f} deg",
+                f"{np.degrees(correction.tc_max_sigma_rad):.1f} deg",
             ),
             ("heading calibration", config.heading.calibration),
         ]
