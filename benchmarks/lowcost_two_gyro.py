@@ -42,7 +42,7 @@ def calibration_k(spec: TwoGyroSpec) -> float:
 
 def run_record(spec: TwoGyroSpec, k: float | None, downsample: int = 1) -> dict:
     record = generate_two_gyro(spec)
-    config = DeadReckonConfig(standstill=record.standstill, k=k, downsample=downsample)
+    config = DeadReckonConfig(standstill_s=record.standstill, k=k, downsample=downsample)
     reference = Reference(record.truth_t, record.truth_yaw, "truth")
     result = run_deadreckon(record.gyro1, record.gyro2, record.gps, config, reference=reference)
     rows = {

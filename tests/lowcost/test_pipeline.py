@@ -42,7 +42,7 @@ def calibrated_k():
 
 def _run(record, **config):
     reference = Reference(record.truth_t, record.truth_yaw, "truth")
-    config = DeadReckonConfig(standstill=record.standstill, **config)
+    config = DeadReckonConfig(standstill_s=record.standstill, **config)
     return run_deadreckon(record.gyro1, record.gyro2, record.gps, config, reference=reference)
 
 
@@ -118,7 +118,7 @@ def test_gps_gaps_duplicates_and_nans_are_handled_and_reported(record, calibrate
             (g1t, g1),
             record.gyro2,
             (t, lat, lon),
-            DeadReckonConfig(standstill=record.standstill, k=calibrated_k),
+            DeadReckonConfig(standstill_s=record.standstill, k=calibrated_k),
             reference=Reference(record.truth_t, record.truth_yaw, "truth"),
         )
     report = result.prepared.report
@@ -141,7 +141,7 @@ def test_missing_standstill_and_disjoint_inputs_raise(record):
         run_deadreckon(record.gyro1, (g2t + 1e5, g2), record.gps)
     with pytest.raises(InputError, match="gyro samples inside the standstill"):
         run_deadreckon(
-            record.gyro1, record.gyro2, record.gps, DeadReckonConfig(standstill=(0.0, 1.0))
+            record.gyro1, record.gyro2, record.gps, DeadReckonConfig(standstill_s=(0.0, 1.0))
         )
 
 
@@ -150,7 +150,7 @@ def test_the_initial_heading_is_the_gps_track_fitted_not_the_reference(record, c
     σ; a ground truth given as the reference scores the result and must not start it (before,
     the dead reckoning started from the reference's first yaw: a benchmark given the truth
     reported the drift alone, not the figure a user gets)."""
-    config = DeadReckonConfig(standstill=record.standstill, k=calibrated_k)
+    config = DeadReckonConfig(standstill_s=record.standstill, k=calibrated_k)
     own = run_deadreckon(record.gyro1, record.gyro2, record.gps, config)
     turned = Reference(record.truth_t, record.truth_yaw + 0.3, "truth turned by 0.3 rad")
     scored = run_deadreckon(record.gyro1, record.gyro2, record.gps, config, reference=turned)

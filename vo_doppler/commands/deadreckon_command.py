@@ -146,9 +146,9 @@ def run(args: argparse.Namespace) -> int:
     config = DeadReckonConfig(
         k=args.k,
         tau_s=args.tau,
-        standstill=args.standstill or args.straight,
+        standstill_s=args.standstill or args.straight,
         window_is_standstill=args.straight is None,
-        threshold=args.threshold,
+        threshold_rad_s=args.threshold,
         downsample=args.downsample,
         cluster_m=args.cluster_m,
     )

@@ -26,7 +26,7 @@ def heading_run(truth, fixes, gyro, can, window_s: float, k: float | None, body:
     config = DeadReckonConfig(
         k=k,
         tau_s=window_s,
-        standstill=(start, start + window_s),
+        standstill_s=(start, start + window_s),
         window_is_standstill=False,
         drift_window_s=0.0,
     )

@@ -54,7 +54,7 @@ SPEED_WINDOW_S = 5.0
 class DeadReckonConfig:
     """Choices of the chain; ``None`` means "propose it from the data".
 
-    ``standstill`` is the interval over which k and ε0 are estimated. With
+    ``standstill_s`` is the interval (s) over which k and ε0 are estimated. With
     ``window_is_standstill=False`` it is instead a stretch of straight constant-course driving
     (a proxy when the record has no standstill): the vehicle moves there, so its GPS steps are
     kept.
@@ -62,11 +62,12 @@ class DeadReckonConfig:
 
     k: float | None = None
     tau_s: float | None = None
-    standstill: tuple[float, float] | None = None
-    threshold: float | None = None
+    standstill_s: tuple[float, float] | None = None
+    threshold_rad_s: float | None = None
+    """h of [KZ] Eq. 9; None: 3σ of the de-biased standstill rate."""
     downsample: int = 1
     cluster_m: float = 3.0
-    standstill_max_speed: float = 0.2
+    standstill_max_speed_mps: float = 0.2
     standstill_min_s: float = 5.0
     drift_window_s: float = 5.0
     zero_steps_at_standstill: bool = True
@@ -103,10 +104,10 @@ def _standstills(config, track_t, track_enu, speed):
     else:
         source = "given speed"
     found = detect_standstill(
-        speed[0], speed[1], config.standstill_max_speed, config.standstill_min_s
+        speed[0], speed[1], config.standstill_max_speed_mps, config.standstill_min_s
     )
-    if config.standstill is not None:
-        t0, t1 = (float(v) for v in config.standstill)
+    if config.standstill_s is not None:
+        t0, t1 = (float(v) for v in config.standstill_s)
         if t1 <= t0:
             raise InputError(f"standstill interval must end after it starts: {t0}, {t1}")
         others = [iv for iv in found if iv[1] < t0 or iv[0] > t1]
@@ -116,7 +117,7 @@ def _standstills(config, track_t, track_enu, speed):
     if not found:
         raise InputError(
             f"no standstill of ≥ {config.standstill_min_s} s at ≤ "
-            f"{config.standstill_max_speed} m/s found from the {source}; give the interval"
+            f"{config.standstill_max_speed_mps} m/s found from the {source}; give the interval"
         )
     longest = max(found, key=lambda iv: iv[1] - iv[0])
     log.info("standstill %.2f–%.2f s found from the %s", *longest, source)
@@ -241,10 +242,10 @@ def _bias_model(rates: AlignedRates, standstill, config: DeadReckonConfig) -> Bi
     tau = choice.tau
     window = (standstill[1] - tau, standstill[1])
     eps0 = {name: static_bias(rates.t, values, *window).eps0 for name, values in series.items()}
-    if config.threshold is None:
+    if config.threshold_rad_s is None:
         h = 3.0 * float(np.std(remove_bias(combined[still], eps0["combined"])))
     else:
-        h = float(config.threshold)
+        h = float(config.threshold_rad_s)
     return BiasModel(k_choices, k, combined, allan, tau, eps0, h)
 
 
@@ -375,7 +376,7 @@ def run_deadreckon(
         raise InputError(f"the {source} covers fewer than 2 dead-reckoning epochs")
 
     result = DeadReckonResult(rates, prepared, model, source, config)
-    if config.threshold is not None:
+    if config.threshold_rad_s is not None:
         result.selected = "combined + ε0 removed + threshold"
     start = (float(epoch_enu[0, 0]), float(epoch_enu[0, 1]))
     rates_by_variant = variant_rates(
@@ -389,8 +390,8 @@ def run_deadreckon(
     )
     moving = epochs[speed_at >= MOVING_SPEED_MPS]
     span = (epochs[0], epochs[0])
-    if config.standstill is not None and not config.window_is_standstill:
-        span = config.standstill
+    if config.standstill_s is not None and not config.window_is_standstill:
+        span = config.standstill_s
     elif moving.size:
         span = (moving[0], moving[0] + INITIAL_FIT_S)
     fix_t = prepared.raw_t
