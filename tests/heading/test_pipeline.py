@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -334,3 +336,55 @@ def test_a_drive_without_any_estimate_keeps_the_prior_for_the_tight_pass():
     backfill_start(cal)
     np.testing.assert_array_equal(cal.bias_sigma, 0.5)
     assert not cal.bias_estimated.any() and not cal.scale_estimated.any()
+
+
+@pytest.mark.parametrize(
+    ("rate_hz", "method"),
+    [(1.0, "robust"), (5.0, "robust"), (10.0, "snooping"), (20.0, "snooping")],
+)
+def test_auto_takes_the_robust_settings_below_10_hz(rate_hz, method):
+    """``--heading-method auto``: the robust settings (smoother on) below 10 Hz, the snooping
+    ones from 10 Hz; the other settings are kept and the choice is made once."""
+    t = 1000.0 + np.arange(0.0, 30.0, 1.0 / rate_hz)
+    auto = replace(HeadingPipelineConfig.auto(), calibration="kalman")
+    chosen = auto.for_rate(t)
+    assert chosen.method == method and chosen.robust_below_rate_hz is None
+    assert chosen.calibration == "kalman"
+    expected = HeadingPipelineConfig.robust() if method == "robust" else HeadingPipelineConfig()
+    assert chosen.tight == expected.tight and chosen.gate == expected.gate
+    assert chosen.smoother == expected.smoother
+    assert HeadingPipelineConfig().for_rate(t) == HeadingPipelineConfig()
+
+
+@pytest.mark.parametrize(("step_s", "method"), [(1.0, "robust"), (0.1, "snooping")])
+def test_the_table_names_the_settings_auto_chose(step_s, method):
+    t = np.arange(0.0, 60.0, step_s)
+    scenario = simulate_doppler(
+        t,
+        lambda t: 1.0 + 0.5 * np.sin(0.05 * t),
+        lambda t: 10.0 + 0.0 * t,
+        AZIMUTH,
+        ELEVATION,
+        sats_per_epoch=2,
+        rotate=False,
+        noise_mps=0.05,
+        seed=2,
+    )
+    velocity = scenario.speed[:, None] * np.stack(
+        [np.cos(scenario.yaw), np.sin(scenario.yaw), np.zeros_like(t)], axis=1
+    )
+    t_gyro, rate = gyro_from_heading(
+        t, scenario.yaw, np.ones(len(t), bool), 0.0, np.radians(0.05), rate_hz=50.0
+    )
+    table = heading_pipeline(
+        t,
+        scenario.rows,
+        velocity,
+        np.ones(len(t), bool),
+        SensorSeries(t, scenario.speed),
+        SensorSeries(t_gyro, rate),
+        HeadingPipelineConfig.auto(),
+    )
+    assert table.method == method
+    error = np.degrees(np.abs(wrap_angle(table.yaw_tc - scenario.yaw)))
+    assert np.nanmedian(error[t > 10.0]) < 1.0

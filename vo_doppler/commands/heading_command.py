@@ -320,6 +320,7 @@ def run(args: argparse.Namespace) -> int:
         "rejected_rows": int(table.rejected_rows.sum()),
         "epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "tc_verifiable": float(table.tc_verifiable.mean()),
+        "method": table.method,
         "gyro_bias_dps": final["final_gyro_bias_dps"],
         "wheel_scale": final["final_wheel_scale"],
         "calibration": None if table.calibration is None else table.calibration.to_dict(),

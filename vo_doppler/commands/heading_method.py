@@ -10,10 +10,12 @@ from vo_doppler.heading.pipeline import HeadingPipelineConfig
 
 
 class HeadingMethod(StrEnum):
-    """``snooping``: windows of 2 s, reflections detected and named by data snooping (tuned on
+    """``auto``: :meth:`HeadingPipelineConfig.auto`, robust below 10 Hz and snooping from 10 Hz;
+    ``snooping``: windows of 2 s, reflections detected and named by data snooping (tuned on
     10–20 Hz recordings); ``robust``: :meth:`HeadingPipelineConfig.robust`, for any rate and
     deep street canyons (1-Hz receivers)."""
 
+    AUTO = "auto"
     SNOOPING = "snooping"
     ROBUST = "robust"
 
@@ -22,15 +24,19 @@ def add_heading_method_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--heading-method",
         choices=[m.value for m in HeadingMethod],
-        default=HeadingMethod.SNOOPING.value,
+        default=HeadingMethod.AUTO.value,
         help="tight heading: snooping (2-s windows, reflected satellites detected and named; "
-        "tuned at 10-20 Hz) or robust (noise model measured from the data, robust fit, "
-        "windows and reliability in seconds; for 1-Hz receivers in street canyons)",
+        "tuned at 10-20 Hz), robust (noise model measured from the data, robust fit, windows "
+        "and reliability in seconds, the windows smoothed through the gyro; for 1-Hz "
+        "receivers in street canyons) or auto: robust below 10 Hz GNSS, else snooping",
     )
 
 
 def heading_method_config(method: str) -> HeadingPipelineConfig:
     """The heading stage's configuration of ``--heading-method``."""
-    if HeadingMethod(method) is HeadingMethod.ROBUST:
+    chosen = HeadingMethod(method)
+    if chosen is HeadingMethod.ROBUST:
         return HeadingPipelineConfig.robust()
+    if chosen is HeadingMethod.AUTO:
+        return HeadingPipelineConfig.auto()
     return HeadingPipelineConfig()

@@ -81,7 +81,7 @@ def register(subparsers, summary: str) -> None:
 def heading_method_problem(args: argparse.Namespace) -> str | None:
     """``--heading-method`` chooses how the tight heading is computed: with ``--heading FILE``
     none is computed, and a method other than the default would be ignored."""
-    if args.heading is not None and args.heading_method != HeadingMethod.SNOOPING.value:
+    if args.heading is not None and args.heading_method != HeadingMethod.AUTO.value:
         return (
             f"--heading-method {args.heading_method} has no effect with --heading: the heading "
             "is the file's, not computed from GNSS (drop one of them)"

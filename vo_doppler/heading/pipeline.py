@@ -66,6 +66,8 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
 
 CALIBRATION_METHODS = ("ls", "kalman", "none")
+AUTO_ROBUST_BELOW_RATE_HZ = 10.0
+""":meth:`HeadingPipelineConfig.auto`: GNSS rates below this take the robust settings."""
 
 
 @dataclass(frozen=True)
@@ -119,6 +121,11 @@ class HeadingPipelineConfig:
     fixed_wheel_scale: float | None = None
     smoother: HeadingSmootherConfig = field(default_factory=HeadingSmootherConfig)
     """The tight headings combined through the gyro (:mod:`vo_doppler.heading.smoother`)."""
+    robust_below_rate_hz: float | None = None
+    """Recordings whose GNSS epochs come at a lower rate take the settings of :meth:`robust`
+    (:meth:`for_rate`); None: these settings at any rate."""
+    method: str = "snooping"
+    """The name of these settings, kept in the heading table."""
 
     @classmethod
     def robust(cls) -> HeadingPipelineConfig:
@@ -129,6 +136,35 @@ class HeadingPipelineConfig:
             tight=TightHeadingConfig.robust(),
             gate=GateConfig(window_s=600.0),
             smoother=HeadingSmootherConfig(enabled=True),
+            method="robust",
+        )
+
+    @classmethod
+    def auto(cls) -> HeadingPipelineConfig:
+        """``--heading-method auto`` (the default): :meth:`robust` for recordings below 10 Hz,
+        the snooping settings (tuned at 10–20 Hz) at 10 Hz and above. At 1 and 5 Hz the robust
+        method with its smoother holds the heading where snooping's 2-s windows hold a few
+        epochs; at 10–20 Hz snooping keeps the bundled sample's error per 100 m lower
+        (measured in docs/benchmarks.md, "The heading smoother")."""
+        return cls(robust_below_rate_hz=AUTO_ROBUST_BELOW_RATE_HZ)
+
+    def for_rate(self, t_epoch: np.ndarray) -> HeadingPipelineConfig:
+        """These settings for a recording with GNSS epochs at ``t_epoch``: the robust method's
+        tight, gate and smoother settings when its median epoch interval is longer than
+        1/``robust_below_rate_hz`` (the rest of the settings kept)."""
+        if self.robust_below_rate_hz is None or len(t_epoch) < 2:
+            return self
+        interval = float(np.median(np.diff(np.asarray(t_epoch, dtype=float))))
+        if interval * self.robust_below_rate_hz <= 1.0 + 1e-9:
+            return replace(self, robust_below_rate_hz=None)
+        robust = type(self).robust()
+        return replace(
+            self,
+            tight=robust.tight,
+            gate=robust.gate,
+            smoother=robust.smoother,
+            method=robust.method,
+            robust_below_rate_hz=None,
         )
 
 
@@ -494,6 +530,7 @@ def heading_pipeline(
     grade prior's σ leaves out (:func:`~vo_doppler.heading.grade.grade_prior`).
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
+    config = config.for_rate(t_epoch)
     velocity = np.asarray(conventional_velocity_enu, dtype=float).reshape(-1, 3)
     valid = np.asarray(conventional_valid, dtype=bool)
     candidates = valid.copy()
@@ -629,4 +666,5 @@ def heading_pipeline(
         grade_prior_sigma=solved.grade[1],
         grade_from_accelerometer=solved.grade_from_accelerometer,
         calibration=calibration_summary(cal, covered),
+        method=config.method,
     )

@@ -95,6 +95,10 @@ class HeadingTable:
     no lag was found or not checked (:func:`vo_doppler.checks.estimate_clock_offset`)."""
     calibration: CalibrationSummary | None = None
     """The drive's calibration over the epochs the vehicle signals cover."""
+    method: str = ""
+    """The tight heading's settings that made the table: "snooping" or "robust"
+    (:meth:`vo_doppler.heading.pipeline.HeadingPipelineConfig.for_rate`); empty where unknown
+    (a table read from a file)."""
 
     def __post_init__(self) -> None:
         n = len(self.t)

@@ -141,6 +141,7 @@ def summarise(result: RunResult, vehicle_span: tuple[float, float] | None = None
         "tight_heading_availability": float(np.mean(table.tc_available)),
         "tight_heading_reliable": float(np.mean(table.tc_reliable)),
         "tight_heading_used": float(np.mean(result.tc_usable)),
+        "tight_heading_method": table.method,
         "vehicle_signal_epochs": int(np.count_nonzero(covered)),
         "tight_heading_used_with_vehicle_signals": (
             float(np.mean(result.tc_usable[covered])) if covered.any() else None
