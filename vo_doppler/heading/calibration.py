@@ -36,8 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.geo import wrap_angle
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
-from vo_doppler.robust import median_of_finite
+from vo_doppler.robust import huber_variance, huber_weight, irls, nmad
 
 PRIOR_WHEEL_SCALE = 1.0
 PRIOR_WHEEL_SCALE_SIGMA = 0.03
@@ -142,9 +141,12 @@ def _centred(
     return out
 
 
-def _robust_scale(residual: np.ndarray) -> float:
-    """1.4826·MAD of the residuals (their standard deviation if Gaussian)."""
-    return MAD_TO_SIGMA * median_of_finite(np.abs(residual - median_of_finite(residual)))
+def _line(x, y, weights, members) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """x and y centred per group (:func:`_centred`) and the weighted least-squares slope of
+    one on the other (None when the weighted x has no spread)."""
+    xc, yc = _centred(x, weights, members), _centred(y, weights, members)
+    sxx = float((weights * xc) @ xc)
+    return xc, yc, (float((weights * xc) @ yc) / sxx if sxx > 0 else None)
 
 
 def huber_line(
@@ -155,51 +157,39 @@ def huber_line(
     iterations: int = 50,
 ) -> RobustLine:
     """Huber M-estimate of the slope β of y = β·x (``groups`` None) or of y = c_g + β·x with
-    an intercept per group, by iteratively reweighted least squares: with residuals r_i and
-    their scale s = 1.4826·MAD(r), weights w_i = min(1, k·s/|r_i|), until the weights settle
-    (least squares below :data:`MIN_ROBUST_SAMPLES`).
-    With u_i = r_i/s, ψ(u) = max(−k, min(k, u)) and m the fraction of |u_i| ≤ k,
-    σ_β² = K²·s²·Σψ(u_i)²/(n − p)/m² / Σx̃², K = 1 + p(1 − m)/(n·m), x̃ centred per group and
-    p the number of parameters (Huber, "Robust Statistics", 1981, sec. 7.6); with k = ∞ it is
-    the least-squares σ."""
+    an intercept per group, by iteratively reweighted least squares
+    (:func:`vo_doppler.robust.irls`): with residuals r_i and their scale s = NMAD(r), Huber's
+    weights (R2) w_i = min(1, k·s/|r_i|), until the weights settle
+    (least squares below :data:`MIN_ROBUST_SAMPLES`). σ_β is (R5) (Huber, "Robust
+    Statistics", 1981, sec. 7.6) over Σx̃², x̃ centred per group; with k = ∞ it is the
+    least-squares σ."""
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     if x.size < MIN_ROBUST_SAMPLES:
         k = np.inf
-    weights = np.ones_like(x)
     members = None if groups is None else [np.flatnonzero(groups == g) for g in np.unique(groups)]
     params = 1 + (0 if members is None else len(members))
-    for _ in range(iterations):
-        xc, yc = _centred(x, weights, members), _centred(y, weights, members)
-        sxx = float((weights * xc) @ xc)
-        if sxx <= 0:
-            return RobustLine(np.nan, np.nan, weights)
-        slope = float((weights * xc) @ yc) / sxx
-        residual = yc - slope * xc
-        scale = _robust_scale(residual)
-        if scale <= 0:
-            break
-        updated = np.minimum(1.0, k * scale / np.maximum(np.abs(residual), 1e-300))
-        settled = bool(np.all(np.abs(updated - weights) <= 1e-6))
-        weights = updated
-        if settled:
-            break
-    xc, yc = _centred(x, weights, members), _centred(y, weights, members)
-    slope = float((weights * xc) @ yc) / float((weights * xc) @ xc)
+
+    def fit(weights):
+        xc, yc, slope = _line(x, y, weights, members)
+        return None if slope is None else yc - slope * xc
+
+    def weigh(residual, _pass):
+        scale = nmad(residual)
+        return None if scale <= 0 else huber_weight(residual, k, scale, floor=1e-300)
+
+    weights = irls(fit, weigh, np.ones_like(x), iterations, tolerance=1e-6)
+    xc, yc, slope = _line(x, y, weights, members)
+    if slope is None:
+        return RobustLine(np.nan, np.nan, weights)
     residual = yc - slope * xc
     n = x.size
     if n <= params:
         return RobustLine(slope, np.nan, weights)
-    scale = _robust_scale(residual)
+    scale = nmad(residual)
     if not np.isfinite(k) or scale <= 0:
         sigma = np.sqrt(float(residual @ residual) / (n - params) / float(xc @ xc))
         return RobustLine(slope, float(sigma), weights)
-    u = residual / scale
-    inside = float(np.mean(np.abs(u) <= k))
-    if inside == 0:
-        return RobustLine(slope, np.nan, weights)
-    factor = 1.0 + params * (1.0 - inside) / (n * inside)
-    psi = np.clip(u, -k, k)
-    variance = factor**2 * scale**2 * float(psi @ psi) / (n - params) / inside**2
+    variance = huber_variance(residual, scale, k, params)
     return RobustLine(slope, float(np.sqrt(variance / float(xc @ xc))), weights)
 
 
