@@ -4,25 +4,26 @@ residuals of the conventional solutions, per satellite and signal, refreshed as 
 For each (satellite, Doppler code) the residuals r = y − H x̂ of the solved epochs over the
 last ``window_s`` seconds (causal: only rows up to the current one), each divided by the row's
 ``reference`` σ (1 m/s, or the C/N0 model's σ of ``noise_model``), give a robust scale
-k = 1.4826 · median |z − median z| (the normalised median absolute deviation, consistent with
-a Gaussian σ and unmoved by up to half of the rows being faults, e.g. reflections); the row's
-σ is k times its reference, so that a satellite's multipath scales the C/N0 law instead of
-replacing it. Until a satellite has ``min_rows`` residuals its σ stays the prior one. Each
-residual is first divided by √r_i, r_i = 1 − h_ii its redundancy number (h_ii the diagonal of
-the weighted hat matrix H (HᵀWH)⁻¹ HᵀW of its epoch): a least-squares residual has variance
-r_i σ_i², so the raw residuals would understate σ. A floor keeps one quiet satellite from
-dominating. The residuals include the fault rows the exclusion removed, so a satellite that
-keeps faulting gets a large σ.
+k = 1.4826 · median |z − median z| (the normalised median absolute deviation (R1) of
+:mod:`vo_doppler.robust`, consistent with a Gaussian σ and unmoved by up to half of the rows
+being faults, e.g. reflections); the row's σ is k times its reference, so that a satellite's
+multipath scales the C/N0 law instead of replacing it. Until a satellite has ``min_rows``
+residuals its σ stays the prior one. Each residual is first divided by √r_i, r_i = 1 − h_ii its
+redundancy number (h_ii the diagonal of the weighted hat matrix H (HᵀWH)⁻¹ HᵀW of its epoch): a
+least-squares residual has variance r_i σ_i², so the raw residuals would understate σ. A floor
+keeps one quiet satellite from dominating. The residuals include the fault rows the exclusion
+removed, so a satellite that keeps faulting gets a large σ.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from vo_doppler.robust import nmad
+
 WINDOW_S = 60.0
 MIN_ROWS = 20
 FLOOR_MPS = 0.02
-MAD_TO_SIGMA = 1.4826
 
 
 def fitted_sigma(
@@ -52,7 +53,7 @@ def fitted_sigma(
             if k + 1 - start[k] < min_rows:
                 continue
             recent = residual[members[start[k] : k + 1]]
-            spread = MAD_TO_SIGMA * np.median(np.abs(recent - np.median(recent)))
+            spread = nmad(recent)
             sigma[row] = max(spread * reference[row], floor_mps)
     return sigma
 

@@ -32,10 +32,10 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.gnss.noise_model import normalised_residuals
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.gnss_solutions import VelocitySolution
+from vo_doppler.robust import nmad
 
 CN0_REFERENCE_DBHZ = 35.0
 CN0_BIN_DBHZ = 5.0
@@ -113,7 +113,7 @@ def fit_moving_noise(
     factor = 1.0
     if rest.sum() >= MIN_REST_ROWS:
         ratio = residual[rest] / prior_sigma[rest]
-        factor = float(np.clip(MAD_TO_SIGMA * np.median(np.abs(ratio)), *FACTOR_RANGE))
+        factor = float(np.clip(nmad(ratio, centre=False), *FACTOR_RANGE))
     moving = known & np.isfinite(cn0) & (speed >= AT_REST_MPS)
     bins = np.floor(cn0 / CN0_BIN_DBHZ)
     centres, logs, counts = [], [], []
@@ -122,7 +122,7 @@ def fit_moving_noise(
         if members.sum() < MIN_BIN_ROWS:
             continue
         r = residual[members]
-        spread = MAD_TO_SIGMA * np.median(np.abs(r - np.median(r)))
+        spread = nmad(r)
         excess = spread**2 - np.median((factor * prior_sigma[members]) ** 2)
         if excess <= 0:
             continue

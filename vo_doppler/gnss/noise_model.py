@@ -27,9 +27,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA, redundancy_numbers
+from vo_doppler.gnss.doppler_noise import redundancy_numbers
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.gnss_solutions import VelocitySolution
+from vo_doppler.robust import nmad
 
 CN0_REFERENCE_DBHZ = 45.0
 CN0_BIN_DBHZ = 2.0
@@ -162,7 +163,7 @@ def fit_sigma_law(
     inverse = inverse.reshape(-1)
     count = np.bincount(inverse, minlength=len(keys))
     bins = np.flatnonzero(count >= min_bin_rows)
-    spread = np.array([MAD_TO_SIGMA * np.median(np.abs(residual[inverse == k])) for k in bins])
+    spread = np.array([nmad(residual[inverse == k], centre=False) for k in bins])
     bins, spread = bins[spread > 0.0], spread[spread > 0.0]  # exact rows: no noise to fit
     if np.unique(keys[bins, 0]).size < 2:
         return None

@@ -31,9 +31,9 @@ from dataclasses import replace
 import numpy as np
 
 from vo_doppler.geo import EnuFrame
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.gnss.spp import nearest_time
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
+from vo_doppler.robust import nmad
 
 WINDOW_S = 60.0
 """Half-width (s) of the neighbours: longer than a canyon's reflection episodes (on the Hong Kong
@@ -97,8 +97,8 @@ def doppler_consistency(spp: SppSolution, velocity: VelocitySolution) -> SppSolu
     tested = np.all(np.isfinite(z), axis=1)
     if not tested.any():
         return spp
-    scale_h = max(1.0, MAD_TO_SIGMA * float(np.median(np.abs(z[tested, :2]))))
-    scale_u = max(1.0, MAD_TO_SIGMA * float(np.median(np.abs(z[tested, 2]))))
+    scale_h = max(1.0, nmad(z[tested, :2], centre=False))
+    scale_u = max(1.0, nmad(z[tested, 2], centre=False))
     limit = GATE * np.array([scale_h, scale_h, scale_u])
     consistent = ~tested | np.all(np.abs(np.nan_to_num(z)) <= limit, axis=1)
     return replace(

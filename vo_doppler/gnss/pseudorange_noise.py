@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.gnss.noise_model import MIN_BIN_ROWS, MIN_ELEVATION_RAD, fit_sigma_law, sigma_law
+from vo_doppler.robust import nmad
 
 SIGMA_PRIOR_M = 3.0
 """σ (m) of a zenith pseudorange before any fit (a GPS C/A code receiver's, multipath included)."""
@@ -85,7 +85,7 @@ def fit_pseudorange_noise(
             )
         elif members.sum() >= MIN_SCALE_ROWS:
             ratio = residual[members] / prior_sigma(elevation[members])
-            scale = float(np.clip(MAD_TO_SIGMA * np.median(np.abs(ratio)), *SCALE_RANGE))
+            scale = float(np.clip(nmad(ratio, centre=False), *SCALE_RANGE))
             models[(s, c)] = PseudorangeNoiseModel(
                 s,
                 c,

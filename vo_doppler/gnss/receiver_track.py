@@ -66,7 +66,7 @@ import numpy as np
 from scipy.linalg import solveh_banded
 
 from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
+from vo_doppler.robust import cauchy_weight, huber_weight, irls, nmad
 
 MIN_STEP_VARIANCE_M2 = 1e-12
 """Floor of τ_k² in (T1): a step of exactly known displacement stays a finite weight."""
@@ -221,24 +221,32 @@ def receiver_track(
     horizontal = np.maximum(fix_sigma_m / np.sqrt(2.0), config.min_fix_sigma_m)
     fix_sigma = np.stack([horizontal, horizontal, config.vertical_ratio * horizontal], axis=1)
     fix_sigma = np.where(fixed[:, None], fix_sigma, np.inf)
-    scale = np.ones(3)
-    robust = np.ones((t.size, 3))
-    track = np.zeros((t.size, 3))
-    for done in range(1, config.passes + 1):
+
+    def solve(state):
+        """(T1) with the fixes' robust weights and per-axis scale ``state``: the track and
+        the fixes' weights."""
+        robust, scale = state
         weight = np.where(fixed[:, None], robust / (scale * fix_sigma) ** 2, 0.0)
-        used, anchor = weight, fixed[:, None] & (robust >= config.anchor_weight)
         solved = np.where(connected[:, None], weight, 1.0)  # a unit weight decouples the rest
-        for axis in range(3):
-            track[:, axis] = _solve_axis(
-                fix[:, axis], solved[:, axis], step[:, axis], step_weight[:, axis]
-            )
-        z = (fix - track) / fix_sigma
-        scale = np.maximum(MAD_TO_SIGMA * np.nanmedian(np.abs(z[fixed]), axis=0), 1e-3)
+        track = [
+            _solve_axis(fix[:, i], solved[:, i], step[:, i], step_weight[:, i]) for i in range(3)
+        ]
+        return np.stack(track, axis=1), weight
+
+    def weigh(z, n):
+        scale = np.maximum(nmad(z[fixed], axis=0, centre=False, skip_nan=True), 1e-3)
         normalised = np.abs(z) / scale
-        if 2 * done <= config.passes:
-            robust = np.minimum(1.0, config.huber_k / np.maximum(normalised, 1e-12))
-        else:
-            robust = 1.0 / (1.0 + (normalised / config.cauchy_c) ** 2)
+        if 2 * (n + 1) <= config.passes:
+            return huber_weight(normalised, config.huber_k, floor=1e-12), scale
+        return cauchy_weight(normalised, config.cauchy_c), scale
+
+    def normalised_residual(state):
+        return (fix - solve(state)[0]) / fix_sigma
+
+    start = (np.ones((t.size, 3)), np.ones(3))
+    state = irls(normalised_residual, weigh, start, config.passes - 1)
+    track, used = solve(state)
+    anchor = fixed[:, None] & (state[0] >= config.anchor_weight)
     step_sigma = np.sqrt(step_variance)
     variance = sum(
         _smoothed_variance(used[:, axis], step_variance[:, axis])

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.special import ndtri
 
 from vo_doppler.geo import wrap_angle
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
+from vo_doppler.robust import huber_weight, irls, nmad
 
 HUBER_K = 1.345
 IRLS_STEPS = 5
@@ -141,14 +141,22 @@ def _line_at_epochs(
         warnings.simplefilter("ignore", RuntimeWarning)  # rows without neighbours
         coefficients[:, 0] = np.nanmedian(np.where(mask, y, np.nan), axis=1)
     coefficients[~solvable] = 0.0
+
+    def normalised(coefficients):
+        return np.abs(y - np.einsum("kwp,kp->kw", powers, coefficients)) * np.sqrt(precision)
+
+    def weigh(normalised, _pass=0):
+        return huber_weight(normalised, HUBER_K, prior=precision)
+
+    def solve(weight):
+        normal = np.einsum("kw,kwi,kwj->kij", weight, powers, powers) + prior
+        right = np.einsum("kw,kwi,kw->ki", weight, powers, y)
+        return np.linalg.solve(normal, right[..., None])[..., 0], normal
+
     with np.errstate(divide="ignore", invalid="ignore"):
-        for _ in range(IRLS_STEPS):
-            fit = np.einsum("kwp,kp->kw", powers, coefficients)
-            normalised = np.abs(y - fit) * np.sqrt(precision)
-            weight = precision * np.minimum(1.0, HUBER_K / normalised)
-            normal = np.einsum("kw,kwi,kwj->kij", weight, powers, powers) + prior
-            right = np.einsum("kw,kwi,kw->ki", weight, powers, y)
-            coefficients = np.linalg.solve(normal, right[..., None])[..., 0]
+        start = weigh(normalised(coefficients))
+        weight = irls(lambda w: normalised(solve(w)[0]), weigh, start, IRLS_STEPS - 1)
+        coefficients, normal = solve(weight)
     variance = np.linalg.inv(normal)[:, 0, 0]
     return -coefficients[:, 0], variance, count
 
@@ -182,7 +190,7 @@ def consistency_test(
     tested = np.isfinite(z)
     factor = 1.0
     if tested.sum() >= config.min_tested_for_scale:
-        factor = max(1.0, MAD_TO_SIGMA * float(np.median(np.abs(z[tested]))))
+        factor = max(1.0, nmad(z[tested], centre=False))
     with np.errstate(invalid="ignore"):
         failed = tested & (np.abs(z) > config.threshold * factor)
     return ConsistencyTest(z, factor, failed)

@@ -38,9 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
+from vo_doppler.robust import MAD_TO_SIGMA
 
 STANDARD_GRAVITY = 9.80665
 """g₀ (m/s²)."""

@@ -28,7 +28,6 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from vo_doppler.checks import sample_noise
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.heading.calibration import (
     PRIOR_GYRO_BIAS_SIGMA,
     PRIOR_WHEEL_SCALE_SIGMA,
@@ -64,6 +63,7 @@ from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.heading import CalibrationSummary, HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
+from vo_doppler.robust import MAD_TO_SIGMA
 
 CALIBRATION_METHODS = ("ls", "kalman", "none")
 AUTO_ROBUST_BELOW_RATE_HZ = 10.0

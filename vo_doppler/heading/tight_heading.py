@@ -70,7 +70,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.geo import wrap_angle, yaw_to_course
-from vo_doppler.gnss.doppler_noise import MAD_TO_SIGMA
 from vo_doppler.heading.profile import (
     dz_of,
     gauss_newton,
@@ -87,6 +86,7 @@ from vo_doppler.heading.snooping import (
     snoop_satellites,
 )
 from vo_doppler.model.doppler import DopplerRows
+from vo_doppler.robust import MAD_TO_SIGMA
 
 ROW_FLOATS = 52
 """float64 values held per window and padded row at the peak of :func:`solve_windows`."""
