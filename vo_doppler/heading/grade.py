@@ -40,7 +40,7 @@ import numpy as np
 
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.robust import MAD_TO_SIGMA
+from vo_doppler.robust import nmad
 
 STANDARD_GRAVITY = 9.80665
 """g₀ (m/s²)."""
@@ -115,7 +115,7 @@ def grade_prior(
     if d.size < config.min_samples:
         return np.full(m, np.nan), np.full(m, np.nan)
     offset = float(np.median(d))
-    scatter = MAD_TO_SIGMA * float(np.median(np.abs(d - offset)))
+    scatter = nmad(d)
     own = np.sqrt(max(scatter**2 - float(np.median(doppler_variance[calibrating])), 0.0))
     sigma = max(own + 1.25 * scatter / np.sqrt(d.size), config.min_sigma)
     return raw_grade - offset, np.full(m, sigma)

@@ -63,7 +63,7 @@ from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.heading import CalibrationSummary, HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.robust import MAD_TO_SIGMA
+from vo_doppler.robust import nmad
 
 CALIBRATION_METHODS = ("ls", "kalman", "none")
 AUTO_ROBUST_BELOW_RATE_HZ = 10.0
@@ -325,7 +325,7 @@ def calibration_summary(cal: CalibrationSeries, covered: np.ndarray) -> Calibrat
     def stats(value, sigma):
         v = value[covered]
         median = float(np.median(v))
-        spread = MAD_TO_SIGMA * float(np.median(np.abs(v - median)))
+        spread = nmad(v)
         return median, spread, float(np.median(sigma[covered])), float(value[last])
 
     return CalibrationSummary(

@@ -68,7 +68,6 @@ c_jᵀWr over (Σ_j w − A_j N⁻¹ A_jᵀ)²); the largest such term over the 
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,6 +81,7 @@ from vo_doppler.heading.profile import (
     weighted_gram,
     z_of,
 )
+from vo_doppler.robust import nmad
 
 MIN_SCALE_DOF = 10
 """Windows with fewer degrees of freedom do not estimate the scale of the a-priori σ."""
@@ -170,9 +170,8 @@ def _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma):
     params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
     residual = (X @ z[:, :, None])[:, :, 0] - np.einsum("krj,kj->kr", T, params)
     normalised = np.where(w > 0, np.abs(residual) * np.sqrt(w), np.nan)
-    with warnings.catch_warnings():  # windows without rows give NaN: no scale-up
-        warnings.simplefilter("ignore", RuntimeWarning)
-        mad = 1.4826 * np.nan_to_num(np.nanmedian(normalised, axis=1))
+    # windows without rows give NaN: no scale-up
+    mad = np.nan_to_num(nmad(normalised, axis=1, centre=False, skip_nan=True))
     N_inv = np.linalg.pinv(weighted_gram(J, w, J), hermitian=True)
     leverage = np.sum((J @ N_inv) * J, axis=-1) * w
     model_rows = []

@@ -86,7 +86,7 @@ from vo_doppler.heading.snooping import (
     snoop_satellites,
 )
 from vo_doppler.model.doppler import DopplerRows
-from vo_doppler.robust import MAD_TO_SIGMA
+from vo_doppler.robust import huber_weight, irls, nmad, student_weight
 
 ROW_FLOATS = 52
 """float64 values held per window and padded row at the peak of :func:`solve_windows`."""
@@ -267,19 +267,21 @@ def _fit(X, T, prior, w, config):
     linear parameters and the precision ``prior`` of their prior, a-priori weights ``w``): the
     robust weights, both minima of the final profiled cost and the linear parameters at the
     best one."""
-    weights = np.array(w)
-    passes = config.robust_passes + config.redescending_passes
-    for n in range(passes):
+
+    def normalised(weights):
         Q, _, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, weights, prior)
         theta = gauss_newton(Q, grid_minima(Q, config.grid_size)[0], config.gauss_newton_iterations)
-        normalised = np.abs(_residual(X, T, XtWT, TtWT_pinv, theta)) * np.sqrt(w)
+        return np.abs(_residual(X, T, XtWT, TtWT_pinv, theta)) * np.sqrt(w)
+
+    def weigh(normalised, n):
+        scale = _robust_scale(normalised, w, config)
         if n < config.robust_passes:
-            ratio = normalised / _robust_scale(normalised, w, config)[:, None]
-            weights = w * np.minimum(1.0, config.huber_k / np.maximum(ratio, 1e-300))
-        else:
-            nu = config.student_dof
-            ratio = normalised / np.maximum(_robust_scale(normalised, w, config), 1.0)[:, None]
-            weights = w * (nu + 1.0) / (nu + ratio**2)
+            return huber_weight(normalised / scale[:, None], config.huber_k, floor=1e-300, prior=w)
+        ratio = normalised / np.maximum(scale, 1.0)[:, None]
+        return student_weight(ratio, config.student_dof, prior=w)
+
+    passes = config.robust_passes + config.redescending_passes
+    weights = irls(normalised, weigh, np.array(w), passes)
     Q, XtWX, XtWT, TtWT_pinv, rank_t = projected_normal_matrix(X, T, weights, prior)
     first, second = grid_minima(Q, config.grid_size)
     theta = gauss_newton(Q, first, config.gauss_newton_iterations)
@@ -575,11 +577,11 @@ def _normal_inverse(J, weights, prior):
 
 
 def _robust_scale(normalised, w, config):
-    """1.4826 × median |normalised residual| per window (floored), the Huber scale."""
-    masked = np.where(w > 0, normalised, np.nan)
+    """NMAD (R1) of the normalised residuals (≥ 0, not centred) per window, floored: the scale
+    of the Huber weights."""
+    mad = nmad(np.where(w > 0, normalised, np.nan), axis=1, centre=False, skip_nan=True)
     with warnings.catch_warnings():  # windows without rows give NaN, replaced below
         warnings.simplefilter("ignore", RuntimeWarning)
-        mad = MAD_TO_SIGMA * np.nanmedian(masked, axis=1)
         mean_w = np.nanmean(np.where(w > 0, w, np.nan), axis=1)
     floor = config.sigma_floor_mps * np.sqrt(np.nan_to_num(mean_w, nan=1.0))
     return np.maximum(np.nan_to_num(mad, nan=1.0), np.maximum(floor, 1e-300))
@@ -798,7 +800,7 @@ def speed_scale_ratio(
     order = np.argsort(ratio)
     cumulative = np.cumsum(weight[order])
     median = float(ratio[order][np.searchsorted(cumulative, 0.5 * cumulative[-1])])
-    spread = max(MAD_TO_SIGMA * float(np.median(np.abs(ratio - median) * np.sqrt(weight))), 1.0)
+    spread = max(nmad(np.abs(ratio - median) * np.sqrt(weight), centre=False), 1.0)
     white = 1.2533 * spread / float(np.sqrt(np.sum(weight)))
     shared = float(np.sum(weight * prior_sigma) / np.sum(weight))
     return median, float(np.hypot(white, shared))
