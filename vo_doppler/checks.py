@@ -68,6 +68,7 @@ from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at
 from vo_doppler.model.vehicle_source import VehicleSignalSource
+from vo_doppler.robust import mad, nmad
 from vo_doppler.time_hints import overlap_error, overlaps
 
 MOVING_SPEED_MPS = 2.0
@@ -351,7 +352,7 @@ def sample_noise(values: np.ndarray) -> float:
     """Robust σ of a smooth signal's sample noise: the median absolute second difference
     (1.4826 MAD / √6), which the signal's own changes hardly touch."""
     second = np.diff(values, 2)
-    return float(1.4826 * np.median(np.abs(second)) / np.sqrt(6.0)) if second.size else 0.0
+    return float(nmad(second, centre=False) / np.sqrt(6.0)) if second.size else 0.0
 
 
 def speed_change_threshold(speed: SensorSeries) -> float:
@@ -394,7 +395,7 @@ def _speed_difference(
     if not moving.any() or np.count_nonzero(changing) < MIN_CLOCK_EPOCHS:
         return float("nan")
     scale = np.median(reference[moving] / shifted[moving])
-    return float(np.median(np.abs(reference - scale * shifted)[changing]))
+    return mad((reference - scale * shifted)[changing], centre=False)
 
 
 def _featureless(speed: SensorSeries, t: np.ndarray, lag: float, threshold: float | None) -> str:
@@ -800,7 +801,7 @@ def check_standstill_is_still(
     inside = inside[np.isfinite(inside)]
     if inside.size == 0:
         return
-    median = float(np.median(np.abs(inside)))
+    median = mad(inside, centre=False)  # the median speed magnitude
     if median > STANDSTILL_MAX_MEDIAN_SPEED_MPS:
         raise InputError(
             f"standstill {t0:.2f}–{t1:.2f} s: the {source} shows the vehicle moving there (median "
