@@ -286,6 +286,8 @@ def test_origin_far_from_the_approximate_position_is_a_warning():
     far = enu.enu_to_ecef(np.array([30_000.0, 40_000.0, 0.0]))
     assert "50.0 km from the manifest's origin" in origin_warning(enu, far)
     assert origin_warning(enu, np.zeros(3)) is None
+    assert origin_warning(enu, far / np.linalg.norm(far) * 7.5e6) is None  # 1,100 km up
+    assert origin_warning(enu, np.array([np.nan, 0.0, 0.0])) is None
     assert origin_warning(enu, None) is None
 
 

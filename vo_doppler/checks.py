@@ -61,6 +61,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from vo_doppler.bounds import RECEIVER_RADIUS
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.model.gnss_solutions import VelocitySolution
@@ -118,8 +119,6 @@ MIN_SPEED_COVERAGE = 0.9
 WHEEL_SCALE_TOLERANCE = 0.10
 STANDSTILL_MAX_MEDIAN_SPEED_MPS = 0.5
 ORIGIN_TOLERANCE_M = 10_000.0
-EARTH_SURFACE_M = (6.3e6, 6.4e6)
-"""Norm of an ECEF position on the ground (m): outside, the approximate position is no place."""
 SIGN_SPAN_S = (1.0, 8.0)
 """Shortest and longest time (s) between the two conventional headings of a compared span:
 the longest bridges a turn (a right angle at 30 °/s: 3 s) and a gap of the heading in a
@@ -778,9 +777,7 @@ def origin_warning(enu: EnuFrame, approx_position_ecef: np.ndarray | None) -> st
     if approx_position_ecef is None:
         return None
     approx = np.asarray(approx_position_ecef, dtype=float)
-    if not (np.all(np.isfinite(approx)) and EARTH_SURFACE_M[0] < np.linalg.norm(approx)):
-        return None
-    if np.linalg.norm(approx) > EARTH_SURFACE_M[1]:
+    if RECEIVER_RADIUS.outside(np.linalg.norm(approx)):  # NaN, zeros or no place on Earth
         return None
     distance = float(np.linalg.norm(enu.ecef_to_enu(approx)[:2]))
     if distance <= ORIGIN_TOLERANCE_M:

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[2] / "vo_doppler"
-BASE = {"errors", "choices", "geo", "model", "robust", "time_hints", "units"}
+BASE = {"bounds", "errors", "choices", "geo", "model", "robust", "time_hints", "units"}
 STAGES = {"vo", "gnss", "heading", "fusion", "lowcost", "eval"}
 ALLOWED: dict[str, set[str]] = {
     "errors": set(),
@@ -17,6 +17,7 @@ ALLOWED: dict[str, set[str]] = {
     "geo": {"errors"},
     "robust": set(),
     "units": set(),
+    "bounds": {"geo"},
     "time_hints": {"errors", "model"},
     "model": {"errors", "geo", "model"},
     "vo": BASE | {"vo"},

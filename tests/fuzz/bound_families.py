@@ -2,7 +2,7 @@
 independent fuzz): values out of range in text tables, arrays of the wrong type, shape or length
 for the npy-based comma2k19 import, UBX frames whose content is wrong but whose checksum is
 valid; and, for every family of these kinds, checks that a successful read holds only values
-within :mod:`vo_doppler.io.vehicle_limits`' bounds.
+within :mod:`vo_doppler.bounds`' bounds.
 
 Registered by ``families.py`` with one line, after the other families::
 
@@ -33,12 +33,7 @@ from tests.fuzz.gnss_families import YAMATOGAWA, _present, make_check_ubx, ubx_s
 from tests.fuzz.mutators import TEXT_MUTATIONS
 from tests.helpers.comma2k19_segment import npy_bytes, segment_arrays, write_orbits
 from tests.helpers.precise_text import sp3_text
-from vo_doppler.errors import VoDopplerError
-from vo_doppler.io.comma2k19_import import import_comma2k19
-from vo_doppler.io.sequence import read_sequence
-from vo_doppler.io.sp3 import read_sp3
-from vo_doppler.io.ubx import checksum, read_ubx
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     ANGULAR_RATE,
     CARRIER_PHASE,
     CN0,
@@ -63,6 +58,11 @@ from vo_doppler.io.vehicle_limits import (
     YAW_RATE,
     SignalBounds,
 )
+from vo_doppler.errors import VoDopplerError
+from vo_doppler.io.comma2k19_import import import_comma2k19
+from vo_doppler.io.sequence import read_sequence
+from vo_doppler.io.sp3 import read_sp3
+from vo_doppler.io.ubx import checksum, read_ubx
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 
 # ---------------------------------------------------------------------------------------------

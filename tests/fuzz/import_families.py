@@ -21,11 +21,11 @@ import numpy as np
 
 from tests.conftest import shared_data_dir
 from tests.helpers.smartloc_text import Measurement, Truth, smartloc_text
+from vo_doppler.bounds import SPEED, YAW_RATE
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.kitti_raw_import import import_kitti_raw
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.io.smartloc import read_smartloc
-from vo_doppler.io.vehicle_limits import SPEED, YAW_RATE
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 
 SMARTLOC = "smartloc_berlin/tu_chemnitz_berlin_1_raw.csv"

@@ -13,10 +13,10 @@ from hypothesis import strategies as st
 
 from tests.conftest import shared_data_dir
 from tests.io.test_android import CHIPSET, L1, RAW, synthetic_rows, write_log
+from vo_doppler.bounds import CN0, MEASUREMENT_SIGMA
 from vo_doppler.errors import InputError
 from vo_doppler.io.android import read_gnsslogger
 from vo_doppler.io.gsdc import REQUIRED, read_device_gnss
-from vo_doppler.io.vehicle_limits import CN0, MEASUREMENT_SIGMA
 
 GPS_NS = 1_300_000_000 * 10**9
 SATELLITES = (3, 7, 12, 19, 25)

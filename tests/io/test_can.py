@@ -224,7 +224,7 @@ def test_bad_signal_names_and_units(dbc_path):
 
 
 @settings(max_examples=40, deadline=None)
-@given(  # what a car can report (vo_doppler.io.vehicle_limits): ±286 deg/s, 540 km/h
+@given(  # what a car can report (vo_doppler.bounds): ±286 deg/s, 540 km/h
     yaw=st.floats(-286, 286, allow_nan=False).map(lambda v: round(v, 2)),
     kmh=st.floats(0, 540, allow_nan=False).map(lambda v: round(v, 2)),
 )

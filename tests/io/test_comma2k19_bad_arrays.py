@@ -22,12 +22,12 @@ from tests.helpers.comma2k19_segment import (
     write_orbits,
     write_segment,
 )
+from vo_doppler.bounds import CARRIER_PHASE, DOPPLER
 from vo_doppler.cli import main
 from vo_doppler.errors import EXIT_FAILURE, InputError
 from vo_doppler.io.comma2k19 import array_header, read_raw_gnss
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.rinex_obs import read_obs
-from vo_doppler.io.vehicle_limits import CARRIER_PHASE, DOPPLER
 
 GOOD = segment_arrays()
 POSITIONS = "global_pose/frame_positions"

@@ -35,7 +35,7 @@ from vo_doppler.io.sensor_csv import (
 from vo_doppler.model.series import SensorSeries
 
 finite = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)
-yaw_rates = st.floats(-5.0, 5.0, allow_nan=False)  # what a car can report (vehicle_limits)
+yaw_rates = st.floats(-5.0, 5.0, allow_nan=False)  # what a car can report (vo_doppler.bounds)
 tmp_settings = settings(
     max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )

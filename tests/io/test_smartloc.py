@@ -13,10 +13,10 @@ from hypothesis import strategies as st
 
 from tests.conftest import require_shared
 from tests.helpers.smartloc_text import HEADER, Measurement, Truth, row, smartloc_text
+from vo_doppler.bounds import DOPPLER
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT
 from vo_doppler.io.smartloc import read_smartloc
-from vo_doppler.io.vehicle_limits import DOPPLER
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 
 REAL = "smartloc_berlin/tu_chemnitz_berlin_1_raw.csv"

@@ -6,8 +6,8 @@ import argparse
 import math
 from collections.abc import Callable
 
+from vo_doppler.bounds import lever_arm_problem
 from vo_doppler.gnss.signals import bands_problem
-from vo_doppler.io.vehicle_limits import lever_arm_problem
 
 
 def positive_int(text: str) -> int:
@@ -122,7 +122,7 @@ def system_letters(allowed: str) -> Callable[[str], str]:
 def lever_arm(components: tuple[int, ...] = (2, 3)) -> Callable[[str], tuple[float, ...]]:
     """argparse type: a GNSS antenna lever arm ``X,Y[,Z]`` in metres (as many components as
     ``components`` allows), finite and no longer than a vehicle
-    (:func:`vo_doppler.io.vehicle_limits.lever_arm_problem`, as for sequence.yaml)."""
+    (:func:`vo_doppler.bounds.lever_arm_problem`, as for sequence.yaml)."""
     shape = " or ".join(",".join("XYZ"[:n]) for n in components)
 
     def parse(text: str) -> tuple[float, ...]:

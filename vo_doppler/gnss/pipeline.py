@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vo_doppler.bounds import RECEIVER_RADIUS
 from vo_doppler.errors import InputError
 from vo_doppler.gnss.doppler_velocity import (
     DopplerRows,
@@ -23,7 +24,7 @@ from vo_doppler.gnss.position_check import doppler_consistency
 from vo_doppler.gnss.receiver_track import smoothed_track
 from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.signals import bands_problem
-from vo_doppler.gnss.spp import EARTH_SURFACE_M, receiver_positions, solve_spp
+from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.observations import Observations
@@ -48,9 +49,6 @@ class GnssVelocityResult:
 
 
 RANGE_RATE_SOURCES = ("doppler", "phase")
-RECEIVER_RADIUS_M = (EARTH_SURFACE_M, 7.0e6)
-"""Distance from the Earth's centre (m) a receiver position given to :func:`gnss_velocity` must
-have: on or near the Earth, at most about 600 km up."""
 
 
 def check_elevation_mask(value: float, name: str = "elevation_mask_rad") -> float:
@@ -102,15 +100,13 @@ def _check_arguments(
             f"epoch ({obs.epoch_time.size}, 3)"
         )
     radius = np.linalg.norm(position.reshape(-1, 3), axis=1)
-    bad = np.flatnonzero(
-        ~np.isfinite(radius) | (radius < RECEIVER_RADIUS_M[0]) | (radius > RECEIVER_RADIUS_M[1])
-    )
+    bad = np.flatnonzero(RECEIVER_RADIUS.outside(radius))
     if bad.size:
         where = f" at epoch {bad[0]}" if position.ndim == 2 else ""
         raise InputError(
             f"receiver_ecef{where} is {position.reshape(-1, 3)[bad[0]]}, {radius[bad[0]]:.6g} m "
-            f"from the Earth's centre: an ECEF position (m) is {RECEIVER_RADIUS_M[0]:.3g} to "
-            f"{RECEIVER_RADIUS_M[1]:.3g} m from it"
+            f"from the Earth's centre: an ECEF position (m) is {RECEIVER_RADIUS.low:.3g} to "
+            f"{RECEIVER_RADIUS.high:.3g} m from it"
         )
     return position
 

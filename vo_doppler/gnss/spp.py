@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from vo_doppler.bounds import RECEIVER_RADIUS
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
@@ -47,7 +48,8 @@ PSEUDORANGE_PRIORITY = {
     "S": ("C1C", "C1"),
     "I": ("C5A", "C9A"),
 }
-EARTH_SURFACE_M = 6.0e6
+EARTH_SURFACE_M = RECEIVER_RADIUS.low
+"""A position nearer the Earth's centre (m) is no receiver's: no solution, or zeros for none."""
 SIGNAL_IN_SPACE_SIGMA_M = {"G": 0.6, "E": 0.4, "C": 1.0, "J": 0.6, "R": 1.8, "I": 2.0, "S": 2.0}
 """σ (m) of the broadcast orbit and clock along the line of sight per system (the signal-in-
 space range errors of O. Montenbruck et al., "Multi-GNSS signal-in-space range error

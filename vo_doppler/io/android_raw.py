@@ -23,7 +23,7 @@ Google's white paper "Using GNSS raw measurements on Android devices" (2017, sec
 - C/N0 → ``S`` rows. The receiver-reported σ of D (PseudorangeRateUncertaintyMetersPerSecond,
   converted to Hz) and of C (ReceivedSvTimeUncertaintyNanos·c, NaN when not positive and
   finite) are returned as a RowSigma. C/N0 outside ``CN0`` and carrier phases outside
-  ``CARRIER_PHASE`` are dropped and counted (bounds: :mod:`vo_doppler.io.vehicle_limits`).
+  ``CARRIER_PHASE`` are dropped and counted (bounds: :mod:`vo_doppler.bounds`).
 
 Signals: band from CarrierFrequencyHz, attribute from CodeType, or for logs without CodeType
 the usual phone signal of that band (``DEFAULT_ATTRIBUTE``). Satellite numbers: SBAS 120–158 →
@@ -39,11 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.errors import InputError
-from vo_doppler.geo import SPEED_OF_LIGHT
-from vo_doppler.io.obs_rows import observations_from_rows
-from vo_doppler.io.rinex_common import PRN_RANGE
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     CARRIER_PHASE,
     CN0,
     GPS_TIME,
@@ -51,6 +47,10 @@ from vo_doppler.io.vehicle_limits import (
     RANGE_RATE,
     SIGNAL_TRAVEL_TIME,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.geo import SPEED_OF_LIGHT
+from vo_doppler.io.obs_rows import observations_from_rows
+from vo_doppler.io.rinex_common import PRN_RANGE
 from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, gps_minus_utc
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.row_sigma import RowSigma

@@ -14,7 +14,7 @@ beyond 29 bits), are counted, logged and skipped — the result keeps every fram
 decoded. After a bad line the line formats resume at the next line (linear time); ASC and BLF
 keep what came before a corrupt record; a log in which no frame at all could be read, or without
 a single frame of a requested message, is an error saying what was found. Decoded values beyond
-what a car can report (:mod:`vo_doppler.io.vehicle_limits`) are skipped and counted when
+what a car can report (:mod:`vo_doppler.bounds`) are skipped and counted when
 isolated (1 % of the signal's samples at most); more is an error naming the signal and the time
 of the first one (a wrong DBC factor or unit). ASC times are on UTC whatever the reading machine's
 timezone. Decoding is streamed: frames are decoded as they are read into compact arrays, so
@@ -39,6 +39,13 @@ import can
 import cantools
 import numpy as np
 
+from vo_doppler.bounds import (
+    FORWARD_ACCELERATION,
+    SPEED,
+    YAW_RATE,
+    SignalBounds,
+    too_many_out_of_range,
+)
 from vo_doppler.errors import InputError
 from vo_doppler.io.textfile import (
     MAX_LINE_CHARS,
@@ -48,13 +55,6 @@ from vo_doppler.io.textfile import (
     regular_file,
 )
 from vo_doppler.io.time_order import TimeOrderReport, order_samples
-from vo_doppler.io.vehicle_limits import (
-    FORWARD_ACCELERATION,
-    SPEED,
-    YAW_RATE,
-    SignalBounds,
-    too_many_out_of_range,
-)
 from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)

@@ -19,11 +19,7 @@ import numpy as np
 from numpy.lib import format as npformat
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.errors import InputError
-from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
-from vo_doppler.io.can import read_can_motion
-from vo_doppler.io.gps_fixes import GpsFixes
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     CARRIER_PHASE,
     CN0,
     FORWARD_ACCELERATION,
@@ -38,6 +34,10 @@ from vo_doppler.io.vehicle_limits import (
     SignalBounds,
     too_many_out_of_range,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
+from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.gps_fixes import GpsFixes
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK, unix_to_gps_seconds
 
 log = logging.getLogger(__name__)
@@ -152,7 +152,7 @@ def read_signal(base: str | Path, *parts: str, columns: int) -> tuple[np.ndarray
 def bounded(
     t: np.ndarray, value: np.ndarray, bounds: SignalBounds, path: Path, what: str
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The samples within ``bounds`` (:mod:`vo_doppler.io.vehicle_limits`): isolated ones
+    """The samples within ``bounds`` (:mod:`vo_doppler.bounds`): isolated ones
     outside are skipped with a warning naming the file, more are an :class:`InputError`."""
     outside = bounds.outside(value)
     n_out = int(outside.sum())
@@ -404,7 +404,7 @@ def _raw_arrays(base: str | Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _plausible(value: np.ndarray, glonass: np.ndarray) -> np.ndarray:
-    """Rows whose measurements can be real (:mod:`vo_doppler.io.vehicle_limits`; NaN is outside
+    """Rows whose measurements can be real (:mod:`vo_doppler.bounds`; NaN is outside
     every bound): pseudorange rate within ``RANGE_RATE`` and its σ within
     ``MEASUREMENT_SIGMA``, pseudorange within ``PSEUDORANGE`` or missing, C/N0 within ``CN0``,
     carrier phase within ``CARRIER_PHASE`` or missing, GLONASS channel −7…6."""

@@ -31,6 +31,7 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.bounds import GPS_TIME
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, EnuFrame, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.io.can import check_dbc
@@ -61,7 +62,6 @@ from vo_doppler.io.sensor_csv import (
 from vo_doppler.io.sequence import FORMAT, MANIFEST, origin_entry
 from vo_doppler.io.sp3 import read_sp3
 from vo_doppler.io.trajectory import write_tum
-from vo_doppler.io.vehicle_limits import GPS_TIME
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.series import SensorSeries

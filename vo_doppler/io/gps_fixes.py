@@ -5,7 +5,7 @@ NMEA: GGA, RMC and VTG sentences through pynmeagps. Fix times become GPS time in
 no date, so its times stay UTC seconds of day (logged). Sentences with a bad checksum or no fix
 (GGA quality 0, RMC status V, VTG mode N) are skipped and counted. A speed over ground (RMC's,
 or VTG's in km/h, else in knots) beyond what a vehicle can report
-(:data:`vo_doppler.io.vehicle_limits.GROUND_SPEED`: negative or above 150 m/s) skips its
+(:data:`vo_doppler.bounds.GROUND_SPEED`: negative or above 150 m/s) skips its
 sentence, warned with its line; more than 1 % of the speeds beyond it is an error naming the
 first such line (the receiver's output is wrong, not a sentence). When GGA and RMC report the
 same time, one fix is kept (GGA position, RMC speed over ground). Fix times must not go
@@ -30,16 +30,16 @@ from pathlib import Path
 import numpy as np
 from pynmeagps import NMEAMessageError, NMEAParseError, NMEAReader, NMEATypeError
 
-from vo_doppler.errors import InputError
-from vo_doppler.io.sensor_csv import read_numeric_csv
-from vo_doppler.io.textfile import read_text, regular_file
-from vo_doppler.io.time_order import order_samples
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     GROUND_SPEED,
     LATITUDE_DEG,
     LONGITUDE_DEG,
     too_many_out_of_range,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.io.sensor_csv import read_numeric_csv
+from vo_doppler.io.textfile import read_text, regular_file
+from vo_doppler.io.time_order import order_samples
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.model.gpstime import utc_to_gps_seconds as gpstime_utc_to_gps
 

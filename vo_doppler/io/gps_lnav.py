@@ -15,7 +15,7 @@ not match, as any one flipped bit makes it.
 An ephemeris is emitted when subframes 1, 2 and 3 of one satellite agree on their issue of data
 (IODE of 2 and 3 = the 8 LSBs of IODC, sec. 20.3.4.4) and describe a GPS orbit
 (:func:`off_gps_orbit`: semi-major axis, eccentricity and inclination of the constellation,
-:mod:`vo_doppler.io.vehicle_limits`); a repeated (PRN, IODC, toe) is emitted once. Not
+:mod:`vo_doppler.bounds`); a repeated (PRN, IODC, toe) is emitted once. Not
 decoded: subframes 4 and 5 (almanac, ionosphere and UTC parameters, pages of sec. 20.3.3.5).
 The 10-bit week number is resolved with a full GPS week from the same recording.
 """
@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vo_doppler.bounds import GPS_ECCENTRICITY, GPS_INCLINATION, GPS_SQRT_A
 from vo_doppler.io.rinex_nav import GLONASS_FIELDS, KEPLER_FIELDS
-from vo_doppler.io.vehicle_limits import GPS_ECCENTRICITY, GPS_INCLINATION, GPS_SQRT_A
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.navigation import NavRecords
 

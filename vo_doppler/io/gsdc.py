@@ -20,12 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.errors import InputError
-from vo_doppler.geo import SPEED_OF_LIGHT
-from vo_doppler.io.android import Records, raw_columns, records
-from vo_doppler.io.android_raw import numbered, raw_observations, satellite_ids
-from vo_doppler.io.textfile import read_text
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     RECEIVER_RADIUS,
     SATELLITE_CLOCK_BIAS,
     SATELLITE_CLOCK_DRIFT,
@@ -33,6 +28,11 @@ from vo_doppler.io.vehicle_limits import (
     SATELLITE_SPEED,
     SIGNAL_TRAVEL_TIME,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.geo import SPEED_OF_LIGHT
+from vo_doppler.io.android import Records, raw_columns, records
+from vo_doppler.io.android_raw import numbered, raw_observations, satellite_ids
+from vo_doppler.io.textfile import read_text
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.row_sigma import RowSigma
 from vo_doppler.model.satellite_table import SatelliteTable
@@ -46,8 +46,6 @@ REQUIRED = (
     "SvClockDriftMetersPerSecond",
 )
 ORBIT_RADIUS_RANGE_M = (SATELLITE_ORBIT_RADIUS.low, SATELLITE_ORBIT_RADIUS.high)
-EARTH_RADIUS_RANGE_M = (RECEIVER_RADIUS.low, RECEIVER_RADIUS.high)
-"""Geocentric distances of a receiver on or near the ground (m)."""
 
 
 @dataclass(frozen=True)
@@ -91,9 +89,7 @@ def read_device_gnss(path: str | Path) -> GsdcRecording:
     satellites = _satellite_table(rows, path, arrival_ns, problems)
     wls = np.stack([number(f"WlsPosition{a}EcefMeters") for a in "XYZ"], axis=1)
     radius = np.linalg.norm(wls, axis=1)
-    off = np.isfinite(radius) & (
-        (radius < EARTH_RADIUS_RANGE_M[0]) | (radius > EARTH_RADIUS_RANGE_M[1])
-    )
+    off = np.isfinite(radius) & RECEIVER_RADIUS.outside(radius)
     if np.any(off):
         raise InputError(
             "WLS receiver position off the Earth's surface", path, int(rows.line[off][0])
@@ -133,7 +129,7 @@ def _satellite_table(
     """One row per (epoch, satellite), validated: finite states; a radius off any GNSS orbit is
     an :class:`InputError` naming the line; rows with a satellite speed, clock bias or drift,
     signal travel time or satellite number no GNSS satellite has (bounds of
-    :mod:`vo_doppler.io.vehicle_limits`) are dropped and counted in ``problems``."""
+    :mod:`vo_doppler.bounds`) are dropped and counted in ``problems``."""
     number = lambda name: rows.numbers(name, path)  # noqa: E731
     position = np.stack([number(f"SvPosition{a}EcefMeters") for a in "XYZ"], axis=1)
     velocity = np.stack([number(f"SvVelocity{a}EcefMetersPerSecond") for a in "XYZ"], axis=1)

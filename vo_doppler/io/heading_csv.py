@@ -31,10 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.errors import InputError
-from vo_doppler.geo import course_to_yaw
-from vo_doppler.io.textfile import read_text
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     DOP,
     HEADING_DEG,
     HEADING_SIGMA_DEG,
@@ -45,6 +42,9 @@ from vo_doppler.io.vehicle_limits import (
     YAW_RATE,
     SignalBounds,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.geo import course_to_yaw
+from vo_doppler.io.textfile import read_text
 from vo_doppler.model.heading import DEFAULT_TC_WINDOW_S, HeadingTable
 
 COLUMNS = (
@@ -201,7 +201,7 @@ RANGES: dict[str, SignalBounds] = {
     "gyro_bias_dps": GYRO_BIAS_DEG_S,
     "wheel_scale": WHEEL_SCALE,
 }
-"""Physical bounds of the columns (:mod:`vo_doppler.io.vehicle_limits`); NaN, where a column
+"""Physical bounds of the columns (:mod:`vo_doppler.bounds`); NaN, where a column
 may hold it, is checked apart."""
 
 

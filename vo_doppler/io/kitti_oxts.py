@@ -46,9 +46,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.errors import InputError
-from vo_doppler.geo import EnuFrame, ecef_to_enu_rotation, geodetic_to_ecef
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     ANGULAR_RATE,
     FORWARD_ACCELERATION,
     HEIGHT,
@@ -56,6 +54,8 @@ from vo_doppler.io.vehicle_limits import (
     VELOCITY_COMPONENT,
     SignalBounds,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.geo import EnuFrame, ecef_to_enu_rotation, geodetic_to_ecef
 from vo_doppler.model.gpstime import calendar_to_gps_seconds, utc_to_gps_seconds
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
@@ -78,7 +78,7 @@ BOUNDS: dict[str, SignalBounds] = {
     **dict.fromkeys(("ax", "ay", "az", "af", "al", "au"), FORWARD_ACCELERATION),
     **dict.fromkeys(("wx", "wy", "wz", "wf", "wl", "wu"), ANGULAR_RATE),
 }
-"""What a road vehicle's OXTS can report (:mod:`vo_doppler.io.vehicle_limits`): a packet with
+"""What a road vehicle's OXTS can report (:mod:`vo_doppler.bounds`): a packet with
 a value beyond is an error naming the file and the field."""
 
 

@@ -5,7 +5,7 @@ One header row naming the columns, then one sample per row; ``#`` comments and b
 allowed. Rows that cannot be read or hold non-finite numbers are skipped, counted and logged; a
 file without a single usable row is an error. A column that holds a vehicle signal
 (``speed_mps``, ``yaw_rate_rad_s``, ``forward_acceleration_mps2``, in whichever file it
-appears) is checked against what a car can report (:mod:`vo_doppler.io.vehicle_limits`):
+appears) is checked against what a car can report (:mod:`vo_doppler.bounds`):
 isolated rows beyond it are skipped, counted and logged like non-finite ones; more than 1 % of
 the rows beyond it is an error naming the first such line (the column's unit or scale is
 wrong). A file with a ``t`` column follows the ``"error"`` time-order policy of
@@ -24,16 +24,16 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.errors import InputError
-from vo_doppler.io.textfile import read_text
-from vo_doppler.io.time_order import TimeOrderReport, order_samples
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     FORWARD_ACCELERATION,
     SPEED,
     YAW_RATE,
     SignalBounds,
     too_many_out_of_range,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.io.textfile import read_text
+from vo_doppler.io.time_order import TimeOrderReport, order_samples
 from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from vo_doppler.bounds import TIME_OFFSET, lever_arm_problem
 from vo_doppler.errors import InputError, ManifestError, shown
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import read_camera
@@ -35,7 +36,6 @@ from vo_doppler.io.sensor_csv import (
 from vo_doppler.io.textfile import regular_file
 from vo_doppler.io.time_order import TimeOrderReport
 from vo_doppler.io.trajectory import read_tum
-from vo_doppler.io.vehicle_limits import TIME_OFFSET, lever_arm_problem
 from vo_doppler.io.yaml_file import load_yaml
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries

@@ -35,7 +35,7 @@ ground truth comes as a :class:`SmartLocTruth`, one state per epoch.
 
 Every value is checked: a field that is not a number, outside what the format can hold (a GPS
 week beyond 4095, a second of week beyond 604,800, a GLONASS freqId beyond 0–13) or beyond the
-bounds of :mod:`vo_doppler.io.vehicle_limits` (latitude, longitude, height, speed, yaw rate,
+bounds of :mod:`vo_doppler.bounds` (latitude, longitude, height, speed, yaw rate,
 acceleration, C/N0, a σ not within 1e-9 … 1e7), or an epoch whose rows disagree
 on the ground truth is an :class:`InputError` naming the file, line and column; epochs must
 not go back in time. A pseudorange, carrier phase or Doppler beyond the u-blox ranges of
@@ -52,13 +52,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.errors import InputError
-from vo_doppler.geo import SPEED_OF_LIGHT
-from vo_doppler.io.obs_rows import observations_from_rows
-from vo_doppler.io.rinex_common import PRN_RANGE
-from vo_doppler.io.textfile import read_text
-from vo_doppler.io.ubx import VALUE_RANGES
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     CN0,
     FORWARD_ACCELERATION,
     HEIGHT,
@@ -69,6 +63,12 @@ from vo_doppler.io.vehicle_limits import (
     YAW_RATE,
     SignalBounds,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.geo import SPEED_OF_LIGHT
+from vo_doppler.io.obs_rows import observations_from_rows
+from vo_doppler.io.rinex_common import PRN_RANGE
+from vo_doppler.io.textfile import read_text
+from vo_doppler.io.ubx import VALUE_RANGES
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.observations import Observations
@@ -275,7 +275,7 @@ class _Rows:
         return value
 
     def _within(self, row: dict[str, str], name: str, line: int, bounds: SignalBounds) -> float:
-        """The column's value, checked against the bounds of :mod:`.vehicle_limits`."""
+        """The column's value, checked against the bounds of :mod:`vo_doppler.bounds`."""
         return self._bounded(row, name, line, bounds.low, bounds.high, bounds.unit)
 
     def _integer(self, row: dict[str, str], name: str, line: int, low: int, high: int) -> int:

@@ -8,7 +8,7 @@ message needs (an empty one included) or one pyubx2 cannot parse is skipped with
 ``FILE, byte OFFSET: …`` in ``problems`` (and the log); a truncated last frame likewise.
 A file larger than ``MAX_UBX_BYTES`` is refused before it is read; the file is scanned a chunk
 at a time, and after ``MAX_GAP`` bytes without a frame the rest of it is not read (a problem).
-Physical bounds come from :mod:`vo_doppler.io.vehicle_limits`.
+Physical bounds come from :mod:`vo_doppler.bounds`.
 
 - RXM-RAWX → :class:`Observations`, epoch = week·604800 + rcvTow (receiver time, like a RINEX
   epoch). Per signal (gnssId, sigId → RINEX 3 code, ``SIGNAL_CODES``): pseudorange ``C`` when
@@ -46,12 +46,7 @@ from typing import BinaryIO
 import numpy as np
 from pyubx2 import UBXMessageError, UBXParseError, UBXReader, UBXTypeError
 
-from vo_doppler.errors import InputError
-from vo_doppler.io.gps_lnav import LnavAssembler, empty_glonass, parity_error, subframe_id
-from vo_doppler.io.obs_rows import observations_from_rows
-from vo_doppler.io.rinex_common import prn_in_range
-from vo_doppler.io.textfile import regular_file
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     CARRIER_PHASE,
     CN0,
     DOPPLER,
@@ -60,6 +55,11 @@ from vo_doppler.io.vehicle_limits import (
     PSEUDORANGE,
     VELOCITY_COMPONENT,
 )
+from vo_doppler.errors import InputError
+from vo_doppler.io.gps_lnav import LnavAssembler, empty_glonass, parity_error, subframe_id
+from vo_doppler.io.obs_rows import observations_from_rows
+from vo_doppler.io.rinex_common import prn_in_range
+from vo_doppler.io.textfile import regular_file
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK, calendar_to_gps_seconds, utc_to_gps_seconds
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations

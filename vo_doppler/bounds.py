@@ -1,7 +1,9 @@
-"""The physical bounds every reader checks its values against, in one place: what a road
+"""The physical bounds of the project, in one place (a base-layer module): what a road
 vehicle's motion sensors can report, how far its GNSS antenna can sit from its reference point,
 where on Earth and when a recording can be, and what a GNSS receiver can measure of the
-satellites it tracks (the second half of this module).
+satellites it tracks (the second half of this module). Every reader checks its values against
+them; the GNSS stage and the checks take :data:`RECEIVER_RADIUS` for "a position on Earth" (a
+receiver position given or solved, the RINEX header's approximate position).
 
 A value beyond these bounds is not a measurement: it is a corrupt row, a wrong unit or a wrong
 DBC factor, and integrating it moves a dead-reckoned track by kilometres (one wheel-speed row of
@@ -130,7 +132,8 @@ nothing about the measurement."""
 SATELLITE_ORBIT_RADIUS = SignalBounds(1.0e7, 5.0e7, "m")
 """Geocentric distance of a GNSS satellite (MEO 25,500–29,600 km, GEO/IGSO 42,200 km)."""
 RECEIVER_RADIUS = SignalBounds(6.0e6, 7.0e6, "m")
-"""Geocentric distance of a receiver on or near the ground."""
+"""Geocentric distance of a receiver on or near the ground (the Earth's radius is 6.357–6.378 Mm;
+a position beyond these bounds is zeros, garbage or no receiver's, at most about 600 km up)."""
 SATELLITE_SPEED = SignalBounds(0.0, 5.0e3, "m/s")
 """Speed of a GNSS satellite in the Earth-fixed frame (MEO about 3.9 km/s, GEO ≈ 0)."""
 SATELLITE_CLOCK_BIAS = SignalBounds(-0.01, 0.01, "s")

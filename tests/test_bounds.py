@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vo_doppler.io.vehicle_limits import (
+from vo_doppler.bounds import (
     SPEED,
     YAW_RATE,
     lever_arm_problem,
@@ -36,8 +36,7 @@ def test_a_lever_arm_longer_than_a_vehicle_is_named():
 def test_the_gnss_bounds_follow_from_each_other():
     """The Doppler bound is the range-rate bound at the highest GNSS carrier; the travel time
     bound covers every pseudorange bound; the clock-offset bound covers every GPS time."""
-    from vo_doppler.geo import SPEED_OF_LIGHT
-    from vo_doppler.io.vehicle_limits import (
+    from vo_doppler.bounds import (
         DOPPLER,
         GPS_TIME,
         PSEUDORANGE,
@@ -45,6 +44,7 @@ def test_the_gnss_bounds_follow_from_each_other():
         SIGNAL_TRAVEL_TIME,
         TIME_OFFSET,
     )
+    from vo_doppler.geo import SPEED_OF_LIGHT
 
     assert DOPPLER.high == RANGE_RATE.high * 1.61e9 / SPEED_OF_LIGHT
     assert 53_000 < DOPPLER.high < 54_000
