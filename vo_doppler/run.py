@@ -92,7 +92,9 @@ class RunConfig:
     systems: str = DEFAULT_SYSTEMS
     """RINEX letters of the GNSS systems used (:class:`SatelliteSystem`)."""
     elevation_mask: float = np.radians(10.0)
-    heading: HeadingPipelineConfig = field(default_factory=HeadingPipelineConfig)
+    heading: HeadingPipelineConfig = field(default_factory=HeadingPipelineConfig.auto)
+    """The heading stage's settings; by default ``--heading-method auto``'s (robust below
+    10 Hz GNSS, snooping from 10 Hz)."""
     vo: VoConfig = field(default_factory=VoConfig)
     correction: CorrectionConfig = field(default_factory=CorrectionConfig)
     dead_reckoning_rate_hz: float = 20.0
