@@ -9,7 +9,9 @@ from filterpy.kalman import KalmanFilter
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.smoother import (
+    GyroAngle,
     HeadingSmootherConfig,
+    WindowHeadings,
     _Model,
     _rts,
     angle_random_walk,
@@ -29,17 +31,9 @@ def drive(rate_hz: float, duration_s: float = 120.0):
 
 
 def smooth(t, yaw, sigma, window_s, phi, config=CONFIG, bias_sigma=0.001 * DEG):
-    return smooth_heading(
-        t,
-        yaw,
-        np.full(len(t), sigma),
-        np.full(len(t), window_s),
-        phi,
-        bias_sigma,
-        ARW,
-        config,
-        20.0 * DEG,
-    )
+    n = len(t)
+    windows = WindowHeadings(t, yaw, np.full(n, sigma), np.full(n, window_s))
+    return smooth_heading(windows, GyroAngle(phi, bias_sigma, ARW), config, 20.0 * DEG)
 
 
 def test_exact_windows_give_the_true_heading_everywhere():

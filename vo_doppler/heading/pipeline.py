@@ -47,8 +47,10 @@ from vo_doppler.heading.integrity import (
     conventional_integrity,
 )
 from vo_doppler.heading.smoother import (
+    GyroAngle,
     HeadingSmootherConfig,
     SmoothedHeading,
+    WindowHeadings,
     angle_random_walk,
     smooth_heading,
 )
@@ -464,17 +466,15 @@ def _smoothed(
         walk = angle_random_walk(sample_noise(np.asarray(yaw_rate.value)), interval)
     result = solved.result
     bias_sigma = cal.bias_sigma[covered]
-    return smooth_heading(
-        result.t,
-        np.where(result.available, result.yaw, np.nan),
-        result.sigma,
-        result.window_s,
+    windows = WindowHeadings(
+        result.t, np.where(result.available, result.yaw, np.nan), result.sigma, result.window_s
+    )
+    gyro = GyroAngle(
         solved.tight_inputs["yaw_angle"],
         float(np.median(bias_sigma)) if bias_sigma.size else config.prior_gyro_bias_sigma,
         walk,
-        smoother,
-        config.tight.max_sigma_rad,
     )
+    return smooth_heading(windows, gyro, smoother, config.tight.max_sigma_rad)
 
 
 def heading_pipeline(

@@ -88,38 +88,55 @@ def angle_random_walk(sample_noise_rad_s: float, sample_interval_s: float) -> fl
     return float(sample_noise_rad_s * np.sqrt(sample_interval_s))
 
 
+@dataclass(frozen=True)
+class WindowHeadings:
+    """The tight windows' headings per epoch: times (s), yaw (rad, NaN where a window has
+    none), σ (rad) and the windows' lengths (s)."""
+
+    t: np.ndarray
+    yaw: np.ndarray
+    sigma: np.ndarray
+    window_s: np.ndarray
+
+
+@dataclass(frozen=True)
+class GyroAngle:
+    """The calibrated integrated yaw rate Φ per epoch (rad, NaN where the vehicle signals do
+    not cover), the σ of its calibrated bias (rad/s) and its angle random walk (rad/√s)."""
+
+    yaw_angle: np.ndarray
+    bias_sigma: float
+    angle_random_walk: float
+
+
 def smooth_heading(
-    t: np.ndarray,
-    yaw: np.ndarray,
-    sigma: np.ndarray,
-    window_s: np.ndarray,
-    yaw_angle: np.ndarray,
-    bias_sigma: float,
-    angle_random_walk_rad_per_sqrt_s: float,
+    windows: WindowHeadings,
+    gyro: GyroAngle,
     config: HeadingSmootherConfig,
     max_sigma_rad: float,
 ) -> SmoothedHeading:
-    """Smooth the window headings ``yaw`` (rad, NaN where a window has none) with σ ``sigma``
-    and lengths ``window_s`` through the calibrated integrated yaw rate ``yaw_angle`` (Φ, NaN
-    where the vehicle signals do not cover); ``bias_sigma`` (rad/s): σ of the calibrated bias.
-    Runs of epochs with Φ defined are smoothed apart (module docstring)."""
-    t = np.asarray(t, dtype=float)
+    """Smooth the window headings through the gyro's Φ; runs of epochs with Φ defined are
+    smoothed apart (module docstring). ``max_sigma_rad``: the largest σ of an available
+    heading."""
+    t = np.asarray(windows.t, dtype=float)
+    sigma = np.asarray(windows.sigma, dtype=float)
+    yaw_angle = np.asarray(gyro.yaw_angle, dtype=float)
     m = len(t)
     out_yaw = np.full(m, np.nan)
     out_sigma = np.full(m, np.nan)
     weight = np.zeros(m)
     covered = np.isfinite(yaw_angle)
-    z = wrap_angle(np.asarray(yaw, dtype=float) - yaw_angle)
+    z = wrap_angle(np.asarray(windows.yaw, dtype=float) - yaw_angle)
     measured = covered & np.isfinite(z) & np.isfinite(sigma) & (sigma > 0)
     step = float(np.median(np.diff(t))) if m > 1 else 1.0
-    overlap = np.maximum(1.0, np.nan_to_num(np.asarray(window_s, dtype=float)) / step)
-    q_a = max(angle_random_walk_rad_per_sqrt_s, config.min_angle_random_walk_rad_per_sqrt_s)
+    overlap = np.maximum(1.0, np.nan_to_num(np.asarray(windows.window_s, dtype=float)) / step)
+    q_a = max(gyro.angle_random_walk, config.min_angle_random_walk_rad_per_sqrt_s)
     residuals: list[np.ndarray] = []
     for run in _runs(covered):
         inside = run[measured[run]]
         if not inside.size:
             continue
-        model = _Model(t[run], yaw_angle[run], q_a, config.scale_sigma, bias_sigma, config)
+        model = _Model(t[run], yaw_angle[run], q_a, config.scale_sigma, gyro.bias_sigma, config)
         rows = np.searchsorted(run, inside)
         base = sigma[inside] ** 2 * overlap[inside]
         offset, variance, w = _robust_offset(model, rows, z[inside], base, config)
