@@ -45,6 +45,17 @@ first half only). Figures:
   conventional velocity ever calibrates: the gyro bias comes from the tight heading,
   ``heading.pipeline.tight_gyro_bias``); the dead reckoning's error per 100 m alone and
   corrected by either heading (``run``'s pipelines).
+
+A folder without ground truth whose reference came from its own GNSS (``hk_klt_f9p_drive``,
+built by ``benchmarks/real_sequences.py``, which writes the reference speed beside the
+signals) gets self-consistency figures instead, since nothing measures its accuracy: moving
+epochs are those of reference speed above ``MOVING_MPS``; the tight heading's availability over
+them; its difference there from the valid conventional headings with σ below
+``CONFIDENT_CONV_SIGMA_DEG`` (1°) where both exist (median, p95, how many beyond
+``CONSISTENT_DEG``, 3°), with the conventional flags and σ of heading.csv (after the gyro and
+wheel test, whose σ is the velocity's times that test's factor) and of the GNSS stage alone
+(vel.csv); and the calibration against the synthesised gyro bias and wheel
+scale (against the receiver's own speed).
 """
 
 from __future__ import annotations
@@ -59,15 +70,23 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmarks.decimate import decimate, recorded_interval
-from benchmarks.real_sequences import HK_TST_CANYON
+from benchmarks.real_sequences import (
+    GYRO_BIAS_RAD_S,
+    HK_KLT_DRIVE,
+    HK_TST_CANYON,
+    WHEEL_SCALE,
+    read_self_reference,
+)
 from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConfig
+from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
+from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
 from vo_doppler.run import (
     AntennaTrack,
@@ -88,8 +107,12 @@ STANDSTILL_MPS = 0.2
 DEAD_RECKONING = (Pipeline.DR, Pipeline.DR_GPS_CONV, Pipeline.DR_GPS_TC)
 HEADING_METHODS = {"snooping": HeadingPipelineConfig, "robust": HeadingPipelineConfig.robust}
 NOISES = ("receiver", "fitted")
-RECORDED_CANYONS = (HK_TST_CANYON.folder, "hk_klt_f9p_drive")
+RECORDED_CANYONS = (HK_TST_CANYON.folder, HK_KLT_DRIVE.folder)
 """Recordings (by sequence name) made in real street canyons: no canyon is emulated on them."""
+SELF_REFERENCED = "self-referenced"
+"""The kind of a recording whose reference came from its own GNSS (module docstring)."""
+CONFIDENT_CONV_SIGMA_DEG = 1.0
+CONSISTENT_DEG = 3.0
 CASE_LABELS = {
     "recorded": "as recorded",
     "canyon": "canyon",
@@ -219,6 +242,74 @@ def tight_figures(sequence: Sequence, table, epochs: np.ndarray) -> dict:
     }
 
 
+def tight_against_conventional(
+    table: HeadingTable, epochs: np.ndarray, valid: np.ndarray, sigma: np.ndarray
+) -> dict:
+    """|tight − conventional heading| (°) at the ``epochs`` (mask) with a reliable tight
+    heading and a ``valid`` conventional one whose ``sigma`` (rad) is below
+    ``CONFIDENT_CONV_SIGMA_DEG``."""
+    confident = epochs & valid & (sigma < np.radians(CONFIDENT_CONV_SIGMA_DEG))
+    both = table.tc_available & table.tc_reliable & confident
+    difference = np.degrees(np.abs(wrap_angle(table.yaw_tc - table.yaw_conv)))[both]
+    return {
+        "conv_confident_epochs": int(confident.sum()),
+        "compared_epochs": int(both.sum()),
+        "tc_minus_conv_deg": _stats(difference),
+        "beyond_consistent": int((difference > CONSISTENT_DEG).sum()),
+    }
+
+
+def self_consistency_figures(table: HeadingTable, reference: SensorSeries) -> dict:
+    """The tight heading's availability over the moving epochs by the ``reference`` speed, and
+    its difference there from the confident conventional headings as heading.csv and as the
+    GNSS stage flag them (module docstring). The calibration is the table's at the last epoch."""
+    moving = sample(reference.t, reference.value, table.t) > MOVING_MPS
+    tight = table.tc_available & table.tc_reliable
+    return {
+        "moving_epochs": int(moving.sum()),
+        "tc_available": float((tight & moving).sum() / max(moving.sum(), 1)),
+        "conv_valid": float((table.conv_valid & moving).sum() / max(moving.sum(), 1)),
+        "against": {
+            "heading.csv": tight_against_conventional(
+                table, moving, table.conv_valid, table.sigma_conv
+            ),
+            "GNSS stage": tight_against_conventional(table, moving, *table.published_conventional),
+        },
+        "wheel_scale": float(table.wheel_scale[-1]),
+        "gyro_bias_dps": float(np.degrees(table.gyro_bias[-1])),
+    }
+
+
+def evaluate_self_referenced(
+    sequence: Sequence,
+    reference: SensorSeries,
+    fit_noise: bool,
+    methods: tuple[str, ...] = ("snooping",),
+    calibration: str = "ls",
+) -> dict:
+    """The self-consistency figures of a recording without ground truth, per heading method."""
+    config = RunConfig()
+    obs = sequence.observations
+    gnss = sequence_gnss(sequence, config, fit_noise)
+    figures = {
+        "epochs": int(obs.epoch_time.size),
+        "rate_hz": 1.0 / recorded_interval(obs.epoch_time),
+        "kind": SELF_REFERENCED,
+        "synthesised_wheel_scale": 1.0 / WHEEL_SCALE,
+        "synthesised_gyro_bias_dps": float(np.degrees(GYRO_BIAS_RAD_S)),
+        "doppler_noise": [model.to_dict() for model in gnss.noise_models.values()],
+        "methods": {},
+    }
+    for method in methods:
+        heading = heading_config(method, calibration)
+        table = sequence_heading(sequence, gnss.rows, gnss.velocity, heading)
+        figures["methods"][method] = {
+            "self_consistency": self_consistency_figures(table, reference),
+            "warnings": list(table.warnings),
+        }
+    return figures
+
+
 def canyon_inputs(sequence: Sequence, config: RunConfig, after_s: float = CANYON_AFTER_S):
     """Doppler rows and conventional velocities of the emulated canyon from ``after_s`` into
     the recording (module docstring)."""
@@ -319,12 +410,21 @@ def evaluate_folder(
     methods: tuple[str, ...],
     calibration: str,
 ) -> dict:
-    """Every noise variant of one folder, decimated to ``rate_hz`` when given."""
-    sequence = read_with_truth(folder)
+    """Every noise variant of one folder, decimated to ``rate_hz`` when given; a folder
+    whose reference came from its own GNSS gets the self-consistency figures."""
+    reference = read_self_reference(folder)
+    sequence = read_with_truth(folder) if reference is None else read_sequence(folder)
     if rate_hz is not None:
         sequence = decimate(sequence, rate_hz)
     logging.disable(logging.WARNING)  # the tables' warnings go to the JSON
     try:
+        if reference is not None:
+            return {
+                noise: evaluate_self_referenced(
+                    sequence, reference, noise == "fitted", methods, calibration
+                )
+                for noise in noises
+            }
         return {
             noise: evaluate(sequence, noise == "fitted", methods, calibration) for noise in noises
         }
@@ -356,6 +456,10 @@ def _flag_rows(figures: dict, gnss_key: str, key: str) -> list[tuple[str, dict]]
 
 
 def print_variant(console: Console, name: str, figures: dict) -> None:
+    if figures["kind"] == SELF_REFERENCED:
+        print_self_consistency(console, name, figures)
+        print_noise(console, name, figures)
+        return
     moving = figures["conventional_gnss"]["moving_epochs"]
     table = _table(
         f"{name}: conventional Doppler velocity ({figures['epochs']} epochs, {moving} moving)",
@@ -389,6 +493,10 @@ def print_variant(console: Console, name: str, figures: dict) -> None:
         print_standstill(console, name, figures)
     if figures["kind"] != "standstill":
         print_heading(console, name, figures)
+    print_noise(console, name, figures)
+
+
+def print_noise(console: Console, name: str, figures: dict) -> None:
     noise = _table(
         f"{name}: Doppler σ model fitted from the data (gnss.noise_model)",
         ("signal", "σ at 45 dB-Hz, zenith [m/s]", "C/N0 slope", "elevation exponent"),
@@ -455,6 +563,45 @@ def print_heading(console: Console, name: str, figures: dict) -> None:
                 " / ".join(_fmt(dr.get(name), ".2f") for name in DEAD_RECKONING),
             )
     console.print(heading)
+
+
+def print_self_consistency(console: Console, name: str, figures: dict) -> None:
+    sigma = f"σ < {CONFIDENT_CONV_SIGMA_DEG:g}°"
+    table = _table(
+        f"{name}: self-consistency, no ground truth (reference from the receiver's own GNSS)",
+        (
+            "method",
+            "moving",
+            "tc avail",
+            "conv valid",
+            "conv flags",
+            f"valid, {sigma}",
+            "compared",
+            "|tc − conv| med [°]",
+            "p95 [°]",
+            f"> {CONSISTENT_DEG:g}°",
+            "wheel scale (synth.)",
+            "gyro bias °/s (synth.)",
+        ),
+    )
+    for method, m in figures["methods"].items():
+        f = m["self_consistency"]
+        for flags, c in f["against"].items():
+            difference = c["tc_minus_conv_deg"]
+            table.add_row(
+                method,
+                str(f["moving_epochs"]),
+                f"{f['tc_available']:.1%}",
+                f"{f['conv_valid']:.1%}",
+                flags,
+                str(c["conv_confident_epochs"]),
+                str(c["compared_epochs"]),
+                *(_fmt(difference[k], ".2f") for k in ("median", "p95")),
+                str(c["beyond_consistent"]),
+                f"{f['wheel_scale']:.4f} ({figures['synthesised_wheel_scale']:.4f})",
+                f"{f['gyro_bias_dps']:.3f} ({figures['synthesised_gyro_bias_dps']:.3f})",
+            )
+    console.print(table)
 
 
 def _choice(value: str, names: tuple[str, ...]) -> tuple[str, ...]:
