@@ -45,7 +45,7 @@ from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 @pytest.fixture(scope="module")
 def sequence(tmp_path_factory):
     folder = tmp_path_factory.mktemp("canyon") / "seq"
-    config = UrbanCanyonConfig(duration_s=25.0, seed=4, image_size=(480, 270))
+    config = UrbanCanyonConfig(duration_s=25.0, seed=4, image_size_px=(480, 270))
     simulate_urban_canyon(folder, config)
     return folder
 

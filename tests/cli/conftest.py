@@ -41,7 +41,7 @@ class SpanDrive:
 def span_drive(tmp_path_factory) -> SpanDrive:
     """A 16-s simulated canyon drive (320×180 images at 10 Hz) and its 8-s cut."""
     root = tmp_path_factory.mktemp("span")
-    config = UrbanCanyonConfig(duration_s=16.0, seed=2, fps=10.0, image_size=(320, 180))
+    config = UrbanCanyonConfig(duration_s=16.0, seed=2, fps=10.0, image_size_px=(320, 180))
     simulate_urban_canyon(root / "simulated", config)
     full = csv_sequence(root / "simulated", root / "full")
     first = float(read_obs(full / "gnss" / "rover.obs").epoch_time[0])

@@ -32,7 +32,9 @@ OUTPUTS = ("trajectory_vo.tum", "trajectory_corrected.tum", "heading.csv", "summ
 @pytest.fixture(scope="module")
 def clean(tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("bad_input") / "clean"
-    simulate_urban_canyon(folder, UrbanCanyonConfig(duration_s=10.0, seed=4, image_size=(320, 180)))
+    simulate_urban_canyon(
+        folder, UrbanCanyonConfig(duration_s=10.0, seed=4, image_size_px=(320, 180))
+    )
     return folder
 
 

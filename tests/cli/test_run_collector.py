@@ -18,7 +18,9 @@ pytestmark = pytest.mark.slow
 
 def test_the_collector_is_frozen_during_the_stages_and_unfrozen_after(tmp_path, monkeypatch):
     drive = tmp_path / "drive"
-    simulate_urban_canyon(drive, UrbanCanyonConfig(duration_s=10.0, seed=4, image_size=(320, 180)))
+    simulate_urban_canyon(
+        drive, UrbanCanyonConfig(duration_s=10.0, seed=4, image_size_px=(320, 180))
+    )
     frozen_during = []
 
     def failing_stages(*args, **kwargs):

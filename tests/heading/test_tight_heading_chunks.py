@@ -32,7 +32,7 @@ def heading_inputs(tmp_path_factory):
     few tiny images (only the GNSS and CAN are used)."""
     folder = tmp_path_factory.mktemp("chunks") / "drive"
     gnss = GnssSimConfig(nlos=True)
-    config = UrbanCanyonConfig(duration_s=12.0, seed=7, fps=1.0, image_size=(64, 36), gnss=gnss)
+    config = UrbanCanyonConfig(duration_s=12.0, seed=7, fps=1.0, image_size_px=(64, 36), gnss=gnss)
     simulate_urban_canyon(folder, config)
     sequence = read_sequence(folder)
     run = RunConfig()

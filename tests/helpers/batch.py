@@ -17,7 +17,7 @@ def tiny_drive(tmp_path_factory, seed: int) -> Path:
     """An 8 s urban-canyon drive with 320×180 images, generated once per test session."""
     folder = tmp_path_factory.getbasetemp() / "tiny_drives" / f"drive{seed}"
     if not (folder / "sequence.yaml").exists():
-        config = UrbanCanyonConfig(duration_s=8.0, seed=seed, image_size=(320, 180))
+        config = UrbanCanyonConfig(duration_s=8.0, seed=seed, image_size_px=(320, 180))
         simulate_urban_canyon(folder, config)
     return folder
 

@@ -82,7 +82,7 @@ def test_missing_section_and_key_are_named(tmp_path):
 @pytest.mark.slow
 def test_antenna_lever_arm_is_read_and_defaults_to_zero(tmp_path):
     config = UrbanCanyonConfig(
-        duration_s=1.0, seed=1, image_size=(64, 36), antenna_lever_arm_m=(1.2, -0.3, 1.5)
+        duration_s=1.0, seed=1, image_size_px=(64, 36), antenna_lever_arm_m=(1.2, -0.3, 1.5)
     )
     simulate_urban_canyon(tmp_path, config)
     assert read_sequence(tmp_path).antenna_lever_arm_m == (1.2, -0.3, 1.5)
@@ -110,7 +110,9 @@ def test_antenna_lever_arm_is_read_and_defaults_to_zero(tmp_path):
 
 @pytest.mark.slow
 def test_a_ground_truth_file_named_but_absent_is_an_error_naming_the_key(tmp_path):
-    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=1.0, seed=1, image_size=(64, 36)))
+    simulate_urban_canyon(
+        tmp_path, UrbanCanyonConfig(duration_s=1.0, seed=1, image_size_px=(64, 36))
+    )
     assert read_sequence(tmp_path).truth is not None
     manifest = yaml.safe_load((tmp_path / "sequence.yaml").read_text())
     manifest["ground_truth"]["trajectory"] = "nothere.tum"
@@ -125,7 +127,9 @@ def test_a_ground_truth_file_named_but_absent_is_an_error_naming_the_key(tmp_pat
 
 @pytest.mark.slow
 def test_forward_acceleration_from_the_can_bus_or_a_csv_but_not_both(tmp_path):
-    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
+    simulate_urban_canyon(
+        tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size_px=(64, 36))
+    )
     sequence = read_sequence(tmp_path)
     acceleration = sequence.forward_acceleration
     assert acceleration.unit == "m/s^2" and len(acceleration) > 100
@@ -160,7 +164,9 @@ def test_forward_acceleration_from_the_can_bus_or_a_csv_but_not_both(tmp_path):
 
 @pytest.mark.slow
 def test_vehicle_signals_from_sensor_csvs_instead_of_a_can_log(tmp_path):
-    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
+    simulate_urban_canyon(
+        tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size_px=(64, 36))
+    )
     from_can = read_sequence(tmp_path)
     offset = 1.0e9
     (tmp_path / "vehicle").mkdir()
@@ -219,7 +225,9 @@ def test_vehicle_signals_from_sensor_csvs_instead_of_a_can_log(tmp_path):
 
 @pytest.mark.slow
 def test_vehicle_rows_skipped_by_the_readers_are_warnings_of_the_run(tmp_path):
-    simulate_urban_canyon(tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size=(64, 36)))
+    simulate_urban_canyon(
+        tmp_path, UrbanCanyonConfig(duration_s=2.0, seed=1, image_size_px=(64, 36))
+    )
     from_can = read_sequence(tmp_path)
     speed = from_can.wheel_speed.value.copy()
     speed[50] = 1.0e9  # one corrupt row: 5,174 km of dead reckoning if it were integrated

@@ -21,7 +21,7 @@ from vo_doppler.sim.urban_canyon import (
     too_few_frames,
 )
 
-SMALL = {"duration_s": 6.0, "fps": 5.0, "image_size": (160, 90)}
+SMALL = {"duration_s": 6.0, "fps": 5.0, "image_size_px": (160, 90)}
 
 
 def _files(folder: Path) -> dict[str, bytes]:

@@ -164,7 +164,7 @@ def register(subparsers, summary: str) -> None:
         default=defaults.fps,
         help=f"camera rate (Hz); over --duration at least {MIN_VO_FRAMES} frames (VO needs them)",
     )
-    parser.add_argument("--size", type=_int_pair, default=defaults.image_size, help="W,H px")
+    parser.add_argument("--size", type=_int_pair, default=defaults.image_size_px, help="W,H px")
     parser.add_argument("--image-format", choices=("png", "jpg"), default="png", help="images")
     parser.add_argument(
         "--jpeg-quality",
@@ -213,7 +213,7 @@ def register(subparsers, summary: str) -> None:
         "--clean",
         action="store_true",
         help="the clean rendering of earlier versions: pinhole frames exactly as rendered plus "
-        f"Gaussian noise ({defaults.image_noise:g} grey levels), no traffic, no repetitive "
+        f"Gaussian noise ({defaults.image_noise_grey:g} grey levels), no traffic, no repetitive "
         "facades, full-contrast ground, exact calibration unless --calib-error is given",
     )
     parser.add_argument("--blocks", type=_int_pair, default=city.blocks, help="NX,NY blocks")
@@ -394,7 +394,7 @@ def run(args: argparse.Namespace) -> int:
         initial_speed_mps=args.initial_speed / 3.6,
         stops_per_lap=args.stops_per_lap,
         fps=args.fps,
-        image_size=args.size,
+        image_size_px=args.size,
         image_format=args.image_format,
         jpeg_quality=args.jpeg_quality,
         render=not args.no_images,

@@ -189,21 +189,21 @@ class UrbanCanyonConfig:
     seed: int = 0
     city: CityConfig = field(default_factory=CityConfig)
     max_speed_mps: float = 13.5
-    max_lateral_accel: float = 2.5
+    max_lateral_accel_mps2: float = 2.5
     initial_speed_mps: float = 0.0
     stops_per_lap: int = 1
     stop_duration_s: float = 4.0
     fps: float = 15.0
-    image_size: tuple[int, int] = (640, 360)
+    image_size_px: tuple[int, int] = (640, 360)
     image_format: str = "png"
     jpeg_quality: int = 90
-    image_noise: float = 2.0
+    image_noise_grey: float = 2.0
     """Gaussian pixel noise (grey levels) of the clean rendering (``camera_effects`` None)."""
     calib_focal_error: float = -0.005
     calib_principal_offset_px: tuple[float, float] = (2.0, -1.5)
     camera_effects: CameraEffects | None = field(default_factory=CameraEffects)
     """Lens, rolling shutter and sensor (None: the clean pinhole rendering of earlier versions,
-    frames exactly as rendered plus ``image_noise``)."""
+    frames exactly as rendered plus ``image_noise_grey``)."""
     traffic: TrafficConfig = field(default_factory=TrafficConfig)
     render: bool = True
     start_gps_s: float = DEFAULT_START_GPS_S
@@ -265,7 +265,7 @@ class VehicleDrive:
         self.start = config.start_gps_s
         self.options = {
             "max_speed": config.max_speed_mps,
-            "max_lateral_accel": config.max_lateral_accel,
+            "max_lateral_accel": config.max_lateral_accel_mps2,
             "initial_speed": config.initial_speed_mps,
             "stops_m": self.stops_m,
             "stop_duration_s": config.stop_duration_s,
@@ -365,7 +365,7 @@ def simulate_urban_canyon(
     )
     truth = vehicle(t_truth)
     write_tum(out / "ground_truth.tum", Trajectory.from_matrices(t_truth, truth.T_world_vehicle))
-    camera = synthetic_camera(*config.image_size)
+    camera = synthetic_camera(*config.image_size_px)
     n_frames = camera_frame_count(config.duration_s, config.fps)
     camera_clock = np.arange(n_frames) / config.fps
     camera_offset = t0 + CAMERA_START_DELAY_S
@@ -425,7 +425,9 @@ def camera_frames(config, scene, camera, vehicle: VehicleDrive, times: np.ndarra
     if config.camera_effects is None:
         motion = vehicle(times)
         T_world_camera = motion.T_world_vehicle @ camera.T_vehicle_camera
-        plan = VoPlan(scene, camera, times, motion, T_world_camera, config.image_noise, config.seed)
+        plan = VoPlan(
+            scene, camera, times, motion, T_world_camera, config.image_noise_grey, config.seed
+        )
         return render_frames(plan)
     ego = vehicle(times)
     vehicles = add_traffic(
@@ -524,8 +526,8 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
         "times": files["times"],
         "calib": files["calib"],
         "fps": config.fps,
-        "width": config.image_size[0],
-        "height": config.image_size[1],
+        "width": config.image_size_px[0],
+        "height": config.image_size_px[1],
         "time_offset_s": camera_offset,
     }
     city = config.city
@@ -573,7 +575,7 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
                 "cy": camera.cy,
                 "focal_error": config.calib_focal_error,
                 "principal_offset_px": list(config.calib_principal_offset_px),
-                "image_noise_grey_levels": config.image_noise,
+                "image_noise_grey_levels": config.image_noise_grey,
                 "effects": None
                 if config.camera_effects is None
                 else _plain(asdict(config.camera_effects)),

@@ -14,7 +14,7 @@ from vo_doppler.vo.geometry import invert_pose, make_pose
 
 @dataclass
 class BaselineConfig:
-    fast_threshold: int = 20
+    fast_threshold_grey: int = 20
     min_features: int = 1500
     ransac_threshold_px: float = 1.0
 
@@ -25,7 +25,7 @@ class FrameToFrameVO:
     def __init__(self, K: np.ndarray, config: BaselineConfig | None = None):
         self.K = K
         self.config = config or BaselineConfig()
-        self._detector = cv2.FastFeatureDetector_create(self.config.fast_threshold, True)
+        self._detector = cv2.FastFeatureDetector_create(self.config.fast_threshold_grey, True)
         self._previous: np.ndarray | None = None
         self._points = np.zeros((0, 1, 2), np.float32)
         self._T_wc = np.eye(4)
