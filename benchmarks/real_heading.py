@@ -78,11 +78,12 @@ from benchmarks.real_sequences import (
     read_self_reference,
 )
 from benchmarks.sequence_runs import read_with_truth, run_sequences
+from vo_doppler.choices import values
 from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
-from vo_doppler.heading.pipeline import CALIBRATION_METHODS, HeadingPipelineConfig
+from vo_doppler.heading.pipeline import CalibrationMethod, HeadingPipelineConfig
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
@@ -612,7 +613,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="real_heading.py", add_help=False, description="This benchmark's own options:"
     )
-    parser.add_argument("--calibration", choices=CALIBRATION_METHODS, default="ls")
+    parser.add_argument("--calibration", choices=values(CalibrationMethod), default="ls")
     parser.add_argument(
         "--rate",
         type=float,

@@ -11,6 +11,7 @@ from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.calibration import GateConfig, estimate_gyro_bias
 from vo_doppler.heading.grade import grade_prior
 from vo_doppler.heading.pipeline import (
+    CalibrationMethod,
     CalibrationSeries,
     HeadingPipelineConfig,
     backfill_start,
@@ -388,3 +389,14 @@ def test_the_table_names_the_settings_auto_chose(step_s, method):
     assert table.method == method
     error = np.degrees(np.abs(wrap_angle(table.yaw_tc - scenario.yaw)))
     assert np.nanmedian(error[t > 10.0]) < 1.0
+
+
+def test_the_calibration_is_a_checked_choice():
+    config = HeadingPipelineConfig(calibration="kalman")
+    assert config.calibration is CalibrationMethod.KALMAN
+    with pytest.raises(
+        ValueError,
+        match=r"^HeadingPipelineConfig.calibration: unknown calibration method 'rls'; choose "
+        r"from ls, kalman, none$",
+    ):
+        HeadingPipelineConfig(calibration="rls")

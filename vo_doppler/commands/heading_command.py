@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import (
     finite_float,
     lever_arm,
@@ -29,7 +30,7 @@ from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
-from vo_doppler.heading.pipeline import CALIBRATION_METHODS
+from vo_doppler.heading.pipeline import CalibrationMethod
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.rinex_obs import read_obs
@@ -114,8 +115,8 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--calibration",
-        choices=CALIBRATION_METHODS,
-        default="ls",
+        choices=values(CalibrationMethod),
+        default=CalibrationMethod.LS.value,
         help="wheel-scale and gyro-bias calibration from the conventional Doppler velocity "
         "([TK18] sec. 3.3-3.4): ls (least squares over a sliding window), kalman, or none",
     )

@@ -24,10 +24,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from enum import StrEnum
 
 import numpy as np
 
 from vo_doppler.checks import sample_noise
+from vo_doppler.choices import check_fields
 from vo_doppler.heading.calibration import (
     PRIOR_GYRO_BIAS_SIGMA,
     PRIOR_WHEEL_SCALE_SIGMA,
@@ -67,7 +69,16 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
 from vo_doppler.robust import nmad
 
-CALIBRATION_METHODS = ("ls", "kalman", "none")
+
+class CalibrationMethod(StrEnum):
+    """How the wheel scale and gyro bias are calibrated from the conventional Doppler velocity
+    ([TK18] sec. 3.3–3.4): least squares over a sliding window, a Kalman filter, or not."""
+
+    LS = "ls"
+    KALMAN = "kalman"
+    NONE = "none"
+
+
 AUTO_ROBUST_BELOW_RATE_HZ = 10.0
 """:meth:`HeadingPipelineConfig.auto`: GNSS rates below this take the robust settings."""
 
@@ -76,7 +87,7 @@ AUTO_ROBUST_BELOW_RATE_HZ = 10.0
 class HeadingPipelineConfig:
     """``calibration``: least squares, Kalman or none; fixed values override the estimates."""
 
-    calibration: str = "ls"
+    calibration: CalibrationMethod = CalibrationMethod.LS
     gate: GateConfig = field(default_factory=GateConfig)
     tight: TightHeadingConfig = field(default_factory=TightHeadingConfig)
     grade: GradePriorConfig = field(default_factory=GradePriorConfig)
@@ -128,6 +139,9 @@ class HeadingPipelineConfig:
     (:meth:`for_rate`); None: these settings at any rate."""
     method: str = "snooping"
     """The name of these settings, kept in the heading table."""
+
+    def __post_init__(self) -> None:
+        check_fields(self, calibration=CalibrationMethod)
 
     @classmethod
     def robust(cls) -> HeadingPipelineConfig:
@@ -197,16 +211,14 @@ def _scaled_sigma(sigma, test, valid):
 
 
 def _calibrators(config: HeadingPipelineConfig):
-    if config.calibration == "ls":
+    if config.calibration is CalibrationMethod.LS:
         return GyroBiasCalibrator(config.gate), WheelScaleCalibrator(config.gate)
-    if config.calibration == "kalman":
+    if config.calibration is CalibrationMethod.KALMAN:
         return (
             GyroBiasKalman(config=config.gate, prior_sigma=config.prior_gyro_bias_sigma),
             WheelScaleKalman(config=config.gate, prior_sigma=config.prior_wheel_scale_sigma),
         )
-    if config.calibration == "none":
-        return None, None
-    raise ValueError(f"unknown calibration {config.calibration!r} ({CALIBRATION_METHODS})")
+    return None, None
 
 
 @dataclass
