@@ -28,7 +28,7 @@ import functools
 import logging
 import math
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import StrEnum
 from typing import TYPE_CHECKING
 
@@ -108,6 +108,14 @@ class RunConfig:
         rate = self.dead_reckoning_rate_hz
         if not (isinstance(rate, (int, float, np.number)) and math.isfinite(rate) and rate > 0):
             raise InputError(f"RunConfig.dead_reckoning_rate_hz = {rate!r}: expected a rate > 0 Hz")
+
+    def for_sequence(self, sequence: Sequence) -> RunConfig:
+        """The settings a run of ``sequence`` applies: the heading stage's for its GNSS rate
+        (:meth:`~vo_doppler.heading.pipeline.HeadingPipelineConfig.for_rate`), so that the
+        report shows what ran, not ``auto``."""
+        if not sequence.has_gnss:
+            return self
+        return replace(self, heading=self.heading.for_rate(sequence.observations.epoch_time))
 
 
 @dataclass
@@ -490,7 +498,7 @@ def run_sequence(
     the GNSS stage) or turning against the GNSS Doppler
     course (after the heading stage, before the VO) raises :class:`InputError`; the rest are
     warnings, logged and returned in ``RunResult.warnings``."""
-    config = config or RunConfig()
+    config = (config or RunConfig()).for_sequence(sequence)
     if given is not None:
         return run_with_given_heading(sequence, given, config, on_frame, images)
     if not sequence.has_gnss:

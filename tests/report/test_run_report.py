@@ -4,6 +4,7 @@ GeoJSON, the configuration in degrees, synthetic vs recorded, the definitions.""
 from __future__ import annotations
 
 import json
+from types import SimpleNamespace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -236,3 +237,27 @@ def test_the_sample_is_described_as_a_synthetic_drive_with_its_sensors():
     assert any(s.startswith("GNSS receiver (761 epochs, systems EG") for s in data.sensors)
     unstated = describe_data(sequence, None, driven_m=300.0)
     assert unstated.kind == "" and unstated.origin.startswith("not stated")
+
+
+def test_the_report_shows_the_heading_settings_that_ran():
+    """``--heading-method auto`` resolved for the recording's GNSS rate: a 1-Hz recording's
+    report says robust (and its configuration table the robust values), a 20-Hz one's snooping;
+    an unresolved configuration states auto's rule."""
+    auto = RunConfig()
+    assert dict(main_settings(auto))["tight heading settings"] == (
+        "auto: robust below 10 Hz GNSS, else snooping"
+    )
+    for step_s, words, window in (
+        (1.0, "robust, smoothed through the gyro", "8"),
+        (0.05, "snooping", "2"),
+    ):
+        recording = SimpleNamespace(
+            has_gnss=True,
+            observations=SimpleNamespace(epoch_time=1000.0 + np.arange(0.0, 30.0, step_s)),
+        )
+        ran = auto.for_sequence(recording)
+        assert dict(main_settings(ran))["tight heading settings"] == words
+        rows = dict(config_rows(ran))
+        assert rows["heading.method"] == words.split(",")[0]
+        assert rows["heading.tight.max_window_s"].split()[0] == window
+    assert auto.for_sequence(SimpleNamespace(has_gnss=False)) is auto

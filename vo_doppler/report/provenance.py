@@ -200,5 +200,16 @@ def main_settings(
                 f"{np.degrees(correction.tc_max_sigma_rad):.1f} deg",
             ),
             ("heading calibration", config.heading.calibration),
+            ("tight heading settings", _heading_settings(config)),
         ]
     return rows
+
+
+def _heading_settings(config: RunConfig) -> str:
+    """The tight heading's settings in words: the method that ran, or ``auto``'s rule when the
+    configuration was not resolved for a recording (:meth:`RunConfig.for_sequence`)."""
+    heading = config.heading
+    if heading.robust_below_rate_hz is not None:
+        return f"auto: robust below {heading.robust_below_rate_hz:g} Hz GNSS, else snooping"
+    smoother = ", smoothed through the gyro" if heading.smoother.enabled else ""
+    return heading.method + smoother

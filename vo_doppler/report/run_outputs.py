@@ -299,6 +299,7 @@ def write_run_outputs(
     summary as it is.
     """
     out.mkdir(parents=True, exist_ok=True)
+    config = config.for_sequence(sequence)
     for name, trajectory in result.trajectories.items():
         file = (
             "trajectory_corrected.tum" if name == Pipeline.VO_GPS_TC else f"trajectory_{name}.tum"
