@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from tests.helpers.velocity import velocity_solution
+from vo_doppler.checks import continuity_warning
 from vo_doppler.gnss.continuity import continuity_checked
 from vo_doppler.model.gnss_solutions import VelocitySolution
 
@@ -83,3 +85,24 @@ def test_invalid_epochs_stay_invalid_and_are_not_neighbours():
     checked = continuity_checked(given)
     assert not checked.valid[100:110].any()
     assert checked.valid[90:100].all() and checked.valid[110:120].all()
+
+
+@pytest.mark.parametrize(
+    "rate_hz, decides", [(1.0, False), (5.0, False), (10.0, True), (20.0, True)]
+)
+def test_the_test_decides_where_half_a_second_holds_five_neighbours_and_says_so_elsewhere(
+    rate_hz, decides
+):
+    """±0.5 s holds 0 (1 Hz), 4 (5 Hz), 10 (10 Hz) or 20 (20 Hz) other epochs; the parabola
+    needs 5. Where it cannot decide, the epoch 8σ off course keeps its verdict, untested, and
+    the warning says so."""
+    solution, _ = _solution(rate_hz, seed=4)
+    k = int(np.argmin(np.abs(solution.t - 60.0)))
+    faulty = continuity_checked(_turned(solution, k, np.radians(2.4)))
+    assert bool(faulty.valid[k]) is not decides
+    tested = faulty.continuity_tested.mean()
+    assert tested > 0.99 if decides else tested == 0.0
+    warning = continuity_warning(faulty)
+    assert (warning is None) is decides
+    if not decides:
+        assert f"the epochs are {1.0 / rate_hz:.2g} s apart" in warning

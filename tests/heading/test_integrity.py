@@ -7,9 +7,14 @@ import pytest
 
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.gnss.doppler_velocity import solve_velocity
-from vo_doppler.gnss.windowed_line import ConsistencyConfig
+from vo_doppler.gnss.windowed_line import ConsistencyConfig, epochs_in_window
 from vo_doppler.heading.from_gnss import heading_from_gnss
-from vo_doppler.heading.integrity import conventional_integrity
+from vo_doppler.heading.integrity import (
+    car_vertical_bound,
+    conventional_integrity,
+    course_protection,
+    integrity_rate_warning,
+)
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.series import SensorSeries
@@ -127,3 +132,127 @@ def test_a_speed_while_the_wheels_stand_fails_whatever_its_sigma():
         np.zeros(20),
     )
     assert moving.valid[10]  # 0.75 m/s off at 5 m/s is within the speed test's 3σ here
+
+
+RATES_HZ = (1.0, 5.0, 10.0, 20.0)
+STATED_SIGMA = np.radians(3.0)
+"""The course σ the velocity states: four times the actual noise (0.7°)."""
+
+
+def _courses(rate_hz: float, fault_deg: float = 0.0):
+    """Two minutes weaving at 8 m/s at ``rate_hz``: the true yaw, the calibrated gyro's
+    integrated angle (an unknown constant off), and conventional courses with 0.7° of noise
+    (stated 3°), ``fault_deg`` off from 60 to 63 s."""
+    t = np.arange(0.0, 120.0, 1.0 / rate_hz)
+    yaw = np.radians(40.0) * np.sin(2.0 * np.pi * t / 30.0)
+    rng = np.random.default_rng(int(rate_hz))
+    course = yaw + rng.normal(0.0, np.radians(0.7), t.size)
+    fault = (t >= 60.0) & (t < 63.0)
+    course[fault] += np.radians(fault_deg)
+    return t, wrap_angle(course), yaw - 1.3, fault
+
+
+def _judged(t, course, angle, valid=None, wheel=8.0):
+    n = t.size
+    return conventional_integrity(
+        t,
+        np.ones(n, bool) if valid is None else valid,
+        course,
+        np.full(n, STATED_SIGMA),
+        angle,
+        np.full(n, 8.0),
+        np.full(n, 0.3),
+        np.full(n, wheel),
+        np.full(n, 1e-4),
+    )
+
+
+@pytest.mark.parametrize("rate_hz", RATES_HZ)
+def test_the_gyro_bounds_the_course_error_at_any_rate(rate_hz):
+    """An 8° fault within its stated 3° σ (z below 2.7 < 3.29) passes the consistency test,
+    but the gyro-propagated course of its neighbours shows it 8° off: beyond the alert limit
+    of 5°, not valid, at 1, 5, 10 and 20 Hz; the clean epochs stay valid."""
+    t, course, angle, fault = _courses(rate_hz, fault_deg=8.0)
+    result = _judged(t, course, angle)
+    assert not result.course.failed[fault].any()  # the consistency test alone passes it
+    assert not result.valid[fault].any()
+    away = np.abs(t - 61.5) > 6.5  # windows free of the fault
+    assert result.valid[away].all()
+    clean = _judged(*_courses(rate_hz)[:3])
+    assert clean.valid.all() and not clean.untested.any()
+
+
+@pytest.mark.parametrize("rate_hz", RATES_HZ)
+def test_the_protection_is_the_residual_plus_the_references_sigma(rate_hz):
+    """Exact: a course at a constant offset from the gyro has no residual, and the line through
+    its n neighbours within ±5 s (equal σ, symmetric in time) has σ/√n at its centre, so the
+    bound is 1.96·σ/√n (λ 1: the stated σ is not exceeded)."""
+    t = np.arange(0.0, 60.0, 1.0 / rate_hz)
+    result = _judged(t, np.full(t.size, 0.7), np.zeros(t.size))
+    middle = np.abs(t - 30.0) < 20.0
+    n = epochs_in_window(t, 5.0)[middle]  # 10·rate, or one less where ±5 s falls between floats
+    assert np.all(np.abs(n - 10 * rate_hz) <= 1)
+    protection = course_protection(result.course)
+    np.testing.assert_allclose(result.course.residual[middle], 0.0, atol=1e-12)
+    np.testing.assert_allclose(protection[middle], 1.96 * STATED_SIGMA / np.sqrt(n), rtol=1e-6)
+    assert result.course.sigma_factor == 1.0
+
+
+@pytest.mark.parametrize("rate_hz", RATES_HZ)
+def test_an_epoch_among_failed_neighbours_is_not_valid_at_any_rate(rate_hz):
+    """Every other epoch within ±5 s failed its GNSS tests: the window holds epochs enough
+    (±5 s: 10 at 1 Hz) but none to compare with, so the epoch cannot be confirmed and is not
+    valid, flagged untested; where the sensors do not cover it, it keeps the GNSS verdict."""
+    t, course, angle, _ = _courses(rate_hz)
+    valid = np.abs(t - 60.0) > 5.5
+    k = int(np.argmin(np.abs(t - 60.0)))
+    valid[k] = True
+    result = _judged(t, course, angle, valid)
+    assert result.untested[k] and not result.valid[k]
+    assert result.untested.sum() == 1
+    uncovered = angle.copy()
+    uncovered[k] = np.nan
+    kept = _judged(t, course, uncovered, valid)
+    assert kept.valid[k] and not kept.untested[k]
+
+
+@pytest.mark.parametrize(
+    "interval_s, warns", [(0.05, False), (1.0, False), (2.0, True), (5.0, True)]
+)
+def test_a_rate_the_window_cannot_judge_is_named(interval_s, warns):
+    """±5 s holds 200, 10, 4 or 2 other epochs at 20, 1, 0.5 and 0.2 Hz; the test needs 5."""
+    t = np.arange(0.0, 300.0, interval_s)
+    warning = integrity_rate_warning(t)
+    assert (warning is not None) is warns
+    if warns:
+        assert warning == (
+            "conventional velocity against the gyro and wheels (I1): 100% of the epochs have "
+            f"fewer than 5 others within ±5 s (they are {interval_s:g} s apart) and keep the "
+            "GNSS stage's verdict"
+        )
+    assert integrity_rate_warning(t, ConsistencyConfig(enabled=False)) is None
+
+
+def test_a_velocity_climbing_beyond_a_cars_road_is_not_valid_whatever_its_sigma():
+    """3·√((0.1·s)² + 0.1²): 2.419 m/s at 8 m/s, 0.3 m/s at rest; unknown is not a car's."""
+    velocity = np.array(
+        [[8.0, 0.0, 2.41], [0.0, -8.0, -2.43], [0.0, 0.0, 0.29], [0.0, 0.0, 0.31], [np.nan] * 3]
+    )
+    np.testing.assert_array_equal(car_vertical_bound(velocity), [True, False, True, False, False])
+    t, course, angle, _ = _courses(1.0)
+    bound = np.ones(t.size, bool)
+    bound[60] = False
+    result = conventional_integrity(
+        t,
+        np.ones(t.size, bool),
+        course,
+        np.full(t.size, STATED_SIGMA),
+        angle,
+        np.full(t.size, 8.0),
+        np.full(t.size, 0.3),
+        np.full(t.size, 8.0),
+        np.full(t.size, 1e-4),
+        vertical_bound=bound,
+    )
+    assert not result.valid[60] and np.isnan(result.course.z[60])  # not tested: not usable
+    assert result.valid[bound].all()

@@ -59,11 +59,30 @@ class ConsistencyConfig:
 @dataclass(frozen=True)
 class ConsistencyTest:
     """One quantity's test: normalised residual z (NaN where untested), the σ factor λ, and
-    which epochs fail (|z| > K·λ)."""
+    which epochs fail (|z| > K·λ); also the residual e_k itself and the fitted line's σ at
+    t_k (NaN where untested)."""
 
     z: np.ndarray
     sigma_factor: float
     failed: np.ndarray
+    residual: np.ndarray | None = None
+    line_sigma: np.ndarray | None = None
+    decidable: np.ndarray | None = None
+    """Usable epochs whose window holds enough other epochs of the recording for the test,
+    usable or not: untested there, the epoch's neighbours were not usable."""
+
+    @property
+    def tested(self) -> np.ndarray:
+        return np.isfinite(self.z)
+
+    @property
+    def unjudged(self) -> np.ndarray:
+        """Untested epochs whose window could have held the neighbours the test needs (its
+        neighbours were not usable); False where the recording's rate or a gap left too few
+        epochs to decide."""
+        if self.decidable is None:
+            return np.zeros(self.z.shape, dtype=bool)
+        return self.decidable & ~self.tested
 
 
 def windowed_line_residuals(
@@ -193,4 +212,18 @@ def consistency_test(
         factor = max(1.0, nmad(z[tested], centre=False))
     with np.errstate(invalid="ignore"):
         failed = tested & (np.abs(z) > config.threshold * factor)
-    return ConsistencyTest(z, factor, failed)
+    line_sigma = np.where(tested, np.sqrt(variance), np.nan)
+    decidable = np.asarray(usable, dtype=bool) & (
+        epochs_in_window(t, config.half_window_s) >= max(config.min_neighbours, config.degree + 1)
+    )
+    return ConsistencyTest(
+        z, factor, failed, np.where(tested, residual, np.nan), line_sigma, decidable
+    )
+
+
+def epochs_in_window(t: np.ndarray, half_window_s: float) -> np.ndarray:
+    """How many other epochs of ``t`` (sorted) lie within ±``half_window_s`` of each."""
+    t = np.asarray(t, dtype=float)
+    lo = np.searchsorted(t, t - half_window_s, "left")
+    hi = np.searchsorted(t, t + half_window_s, "right")
+    return hi - lo - 1

@@ -18,6 +18,7 @@ from vo_doppler.gnss.moving_noise import moving_noise_weights
 from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.heading.conventional import velocity_heading_sigma
+from vo_doppler.heading.integrity import integrity_rate_warning
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.doppler_sigma import ReportedSigma
@@ -137,6 +138,7 @@ def heading_from_gnss(
         scale_calibrated=config.fixed_wheel_scale is None,
         bias_calibrated=config.fixed_gyro_bias is None,
     )
+    warnings += [w for w in [integrity_rate_warning(epoch_time, config.integrity)] if w]
     for warning in warnings:
         log.warning("%s", warning)
     table.warnings = warnings

@@ -46,6 +46,7 @@ from vo_doppler.heading.grade import GradePriorConfig, accelerometer_grade, grad
 from vo_doppler.heading.integrity import (
     ConsistencyConfig,
     ConventionalIntegrity,
+    car_vertical_bound,
     conventional_integrity,
 )
 from vo_doppler.heading.smoother import (
@@ -575,8 +576,19 @@ def heading_pipeline(
     calibrating &= np.abs(np.nan_to_num(conv_speed - wheel, nan=np.inf)) <= tolerance
     raw_angle = integral_at(yaw_rate.t, yaw_rate.value, t_epoch)
     covered = np.isfinite(wheel) & np.isfinite(raw_angle)
+    # A redundantly tested course beyond the car's vertical bound calibrates no gyro bias
+    # (design (I1b)); its speed still calibrates the wheels, the untestable epochs both.
+    car = car_vertical_bound(velocity)
     cal = backfill_start(
-        causal_calibration(t_epoch, conv_speed, conv_yaw, calibrating, wheel, raw_angle, config),
+        causal_calibration(
+            t_epoch,
+            conv_speed,
+            np.where(car | ~valid, conv_yaw, np.nan),
+            calibrating,
+            wheel,
+            raw_angle,
+            config,
+        ),
         config.backfill_bias_sigma,
         covered,
     )
@@ -604,6 +616,7 @@ def heading_pipeline(
             cal.scale * wheel,
             cal.bias_sigma,
             config.integrity,
+            vertical_bound=car,
         )
         grade, grade_from_accelerometer = _grade_prior(
             t_epoch,
