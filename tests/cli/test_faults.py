@@ -12,11 +12,17 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
+from tests.helpers.heading_table import plain_heading_table
+from tests.helpers.level_track import level_turn
 from vo_doppler.cli import main
-from vo_doppler.commands import gnss_command
+from vo_doppler.commands import correct_command, gnss_command, heading_command, kitti_speed_command
 from vo_doppler.errors import EXIT_FAILURE, EXIT_OK, shown, storage_refused
+from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.images import read_image
+from vo_doppler.io.trajectory import write_kitti, write_tum
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report import run_outputs
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
@@ -27,6 +33,12 @@ NOT_UTF8 = os.fsdecode(b"caf\xe9-\xff")
 def full_disk(*_args, **_kwargs) -> None:
     """A write the system refuses as a full disk does at a buffered file's flush: no file
     named."""
+    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+def half_written(path, *_args, **_kwargs) -> None:
+    """A writer that stores part of its file, then finds the disk full."""
+    Path(path).write_text("t,partial\n0.0,")
     raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
 
@@ -92,6 +104,66 @@ def test_gnss_velocity_on_a_full_disk_is_exit_1_naming_the_output(drive, tmp_pat
     err = capsys.readouterr().err
     assert shown(out) in err and "No space left on device" in err and "internal" not in err
     assert snapshot(out.parent) == before
+
+
+def _full_disk_leaves_no_partial_file(argv, out: Path, module, writers, capsys) -> None:
+    """``argv -o out`` with each of ``module``'s ``writers`` storing part of its file and then
+    finding the disk full: exit 1 naming ``out`` in one line, and in ``out``'s folder nothing
+    (before any run) or the files of the run before as they were, no partial file beside."""
+
+    def fails(before: dict[str, bytes]) -> None:
+        for writer in writers:
+            capsys.readouterr()
+            with pytest.MonkeyPatch.context() as patch:
+                patch.setattr(module, writer, half_written)
+                assert main([*argv, "-o", str(out)]) == EXIT_FAILURE
+            err = capsys.readouterr().err
+            assert shown(out) in err and "No space left on device" in err
+            assert "internal" not in err and len(err.splitlines()) == 1
+            assert sorted(p.name for p in out.parent.iterdir()) == sorted(before)
+            assert snapshot(out.parent) == before
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fails({})
+    assert main([*argv, "-o", str(out)]) == EXIT_OK
+    before = snapshot(out.parent)
+    assert out.name in before
+    fails(before)
+
+
+@pytest.mark.slow
+def test_heading_on_a_full_disk_leaves_no_partial_file(drive, tmp_path, capsys):
+    argv = ["-q", "heading", str(drive / "gnss/rover.obs"), "--nav", str(drive / "gnss/brdc.nav")]
+    argv += ["--can", str(drive / "can/vehicle.log"), "--dbc", str(drive / "can/vehicle.dbc")]
+    argv += ["--yaw-rate", "VEHICLE_DYNAMICS.YAW_RATE", "--time-offset-can", "-315964782"]
+    argv += ["--wheel-speed", "WHEEL_SPEEDS.WHEEL_SPEED_RL,WHEEL_SPEEDS.WHEEL_SPEED_RR"]
+    out = tmp_path / NOT_UTF8 / "heading.csv"
+    writers = ("write_heading_csv", "heading_figure")  # the first file, then the second
+    _full_disk_leaves_no_partial_file(argv, out, heading_command, writers, capsys)
+    assert sorted(p.name for p in out.parent.iterdir()) == ["heading.csv", "heading.png"]
+
+
+def test_correct_on_a_full_disk_leaves_no_partial_file(tmp_path, capsys):
+    track = level_turn()
+    write_tum(tmp_path / "track.tum", track)
+    t = np.arange(0.0, track.t[-1] + 0.05, 0.2)
+    yaw = np.interp(t, track.t, np.unwrap(track.yaw()))
+    write_heading_csv(tmp_path / "h.csv", plain_heading_table(t, yaw_tc=yaw, yaw_conv=yaw))
+    argv = ["-q", "correct", str(tmp_path / "track.tum"), "--heading", str(tmp_path / "h.csv")]
+    argv += ["--world", "level"]
+    out = tmp_path / NOT_UTF8 / "corrected.tum"
+    _full_disk_leaves_no_partial_file(argv, out, correct_command, ("write_tum",), capsys)
+
+
+def test_kitti_speed_on_a_full_disk_leaves_no_partial_file(tmp_path, capsys):
+    t = 0.1 * np.arange(30)
+    positions = np.column_stack([np.zeros(30), np.zeros(30), 8.0 * t])
+    write_kitti(tmp_path / "poses.txt", Trajectory(t, positions, Rotation.identity(30)))
+    np.savetxt(tmp_path / "times.txt", t)
+    argv = ["-q", "kitti-speed", str(tmp_path / "poses.txt")]
+    argv += ["--times", str(tmp_path / "times.txt")]
+    out = tmp_path / NOT_UTF8 / "speed.csv"
+    _full_disk_leaves_no_partial_file(argv, out, kitti_speed_command, ("write_sensor_csv",), capsys)
 
 
 def test_only_storage_refusals_are_the_environments():

@@ -24,6 +24,7 @@ from vo_doppler.fusion.placement import initial_yaw_offset, turned_about_start
 from vo_doppler.geo import wrap_angle
 from vo_doppler.io.calibration import read_camera
 from vo_doppler.io.heading_csv import read_heading_csv
+from vo_doppler.io.output_folder import write_files
 from vo_doppler.io.trajectory import (
     AUTO_FORMAT_RULE,
     TRAJECTORY_FORMATS,
@@ -228,11 +229,8 @@ def run(args: argparse.Namespace) -> int:
         )
     out = result.vehicle if args.body == "vehicle" else camera_trajectory(result.vehicle, extrinsic)
     output = Path(args.output)
-    output.parent.mkdir(parents=True, exist_ok=True)
-    if output.suffix.lower() in (".kitti", ".txt"):
-        write_kitti(output, out)
-    else:
-        write_tum(output, out)
+    writer = write_kitti if output.suffix.lower() in (".kitti", ".txt") else write_tum
+    write_files([(output, lambda path: writer(path, out))])
     summary = {
         "poses": len(out),
         "poses_with_absolute_heading": int(result.has_absolute.sum()),

@@ -13,8 +13,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import logging
-import os
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -36,6 +35,7 @@ from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_position, gnss_vel
 from vo_doppler.gnss.satellite_source import satellite_source
 from vo_doppler.gnss.signals import carrier_frequency
 from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
+from vo_doppler.io.output_folder import write_files
 from vo_doppler.io.receiver_file import read_observation_file
 from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.model.navigation import Navigation
@@ -261,20 +261,6 @@ def _glonass_dropped(obs: Observations, source, systems: str, bands: str | None)
     return present.replace("R", "") if all_glonass else present
 
 
-def _write_outputs(writers: Sequence[tuple[Path, Callable[[Path], None]]]) -> None:
-    """Write each output to a hidden file beside it and move them all in place only once every
-    one is written, so that a failure leaves none of this run's files."""
-    partial = [(path, path.with_name(f".{path.stem}.partial{path.suffix}")) for path, _ in writers]
-    try:
-        for (_, temporary), (_, write) in zip(partial, writers, strict=True):
-            write(temporary)
-        for path, temporary in partial:
-            os.replace(temporary, path)
-    finally:
-        for _, temporary in partial:
-            temporary.unlink(missing_ok=True)
-
-
 def run(args: argparse.Namespace) -> int:
     figure = args.figure or args.output.with_suffix(".png")
     check_output_files(
@@ -346,7 +332,7 @@ def run(args: argparse.Namespace) -> int:
             f"no epoch could be solved (too few satellites with ephemerides): {summary}; "
             f"nothing written ({args.output} and {figure} left as they were)"
         )
-    _write_outputs(outputs)
+    write_files(outputs)
     log.log(
         logging.INFO if valid.all() else logging.WARNING,
         "%s; wrote %s and %s",

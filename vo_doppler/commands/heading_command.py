@@ -33,6 +33,7 @@ from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
 from vo_doppler.heading.pipeline import CalibrationMethod
 from vo_doppler.io.can import read_can_motion
 from vo_doppler.io.heading_csv import write_heading_csv
+from vo_doppler.io.output_folder import write_files
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
@@ -307,11 +308,18 @@ def run(args: argparse.Namespace) -> int:
         source=_signal_source(args, yaw_rate_unit),
     )
     warnings = table.warnings
-    for path in (args.output, figure):
-        path.parent.mkdir(parents=True, exist_ok=True)
-    write_heading_csv(args.output, table)
+    if not table.tc_available.any() and not table.conv_valid.any():
+        raise VoDopplerError(
+            f"no heading could be computed at any epoch: nothing written ({args.output} and "
+            f"{figure} left as they were)"
+        )
     truth_yaw = truth.yaw_at(table.t) if truth is not None else None
-    heading_figure(figure, table, truth_yaw, args.obs.name)
+    write_files(
+        [
+            (args.output, lambda path: write_heading_csv(path, table)),
+            (figure, lambda path: heading_figure(path, table, truth_yaw, args.obs.name)),
+        ]
+    )
     final = final_calibration(table)
     summary = {
         "epochs": len(table),
@@ -330,6 +338,4 @@ def run(args: argparse.Namespace) -> int:
         "warnings": warnings,
     }
     print(json_text(summary))
-    if not table.tc_available.any() and not table.conv_valid.any():
-        raise VoDopplerError("no heading could be computed at any epoch")
     return 0

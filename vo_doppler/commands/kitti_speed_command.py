@@ -11,9 +11,10 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.commands.output_paths import check_output_files
-from vo_doppler.errors import InputError
+from vo_doppler.errors import InputError, shown
 from vo_doppler.eval.reference_speed import speed_from_poses
 from vo_doppler.io.images import read_times
+from vo_doppler.io.output_folder import write_files
 from vo_doppler.io.sensor_csv import SPEED_COLUMN, write_sensor_csv
 from vo_doppler.io.trajectory import read_trajectory
 
@@ -47,10 +48,9 @@ def run(args: argparse.Namespace) -> int:
             args.poses,
         )
     speed = speed_from_poses(truth, args.poses)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    write_sensor_csv(args.output, speed, SPEED_COLUMN)
+    write_files([(args.output, lambda path: write_sensor_csv(path, speed, SPEED_COLUMN))])
     print(
-        f"wrote {args.output}: {len(speed)} samples, {truth.path_length:.1f} m over "
+        f"wrote {shown(args.output)}: {len(speed)} samples, {truth.path_length:.1f} m over "
         f"{float(truth.t[-1] - truth.t[0]):.1f} s"
     )
     return 0

@@ -32,7 +32,7 @@ import re
 import secrets
 import shutil
 import socket
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from fnmatch import fnmatch
 from pathlib import Path
@@ -405,6 +405,24 @@ def staged_output(
             raise OutputError(f"{path}: cannot write the results: {exc.strerror}") from exc
         raise
     swap_in(staging, path, command, inputs)
+
+
+def write_files(writers: Sequence[tuple[Path, Callable[[Path], None]]]) -> None:
+    """Write files that are not in a staged folder: each ``(path, write)`` writes to a hidden
+    file beside ``path`` (the same folder, so that :func:`os.replace` is a rename, and the same
+    suffix, which chooses the format), and all are moved in place only once every one is
+    written. A failure (a full disk) leaves none of them, and the files of an earlier run as
+    they were. Missing parent folders are created."""
+    partial = [(path, path.with_name(f".{path.stem}.partial{path.suffix}")) for path, _ in writers]
+    try:
+        for (path, temporary), (_, write) in zip(partial, writers, strict=True):
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write(temporary)
+        for path, temporary in partial:
+            os.replace(temporary, path)
+    finally:
+        for _, temporary in partial:
+            temporary.unlink(missing_ok=True)
 
 
 def untouched(path: str | Path) -> str:
