@@ -64,6 +64,7 @@ from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.signals import DEFAULT_SYSTEMS, SatelliteSystem
+from vo_doppler.model.timeseries import time_grid
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.frames import vehicle_trajectory
@@ -356,7 +357,7 @@ def correct_all(
     begin, end = max(speed.t[0], yaw_rate.t[0]), min(speed.t[-1], yaw_rate.t[-1])
     if vo_vehicle is not None:
         begin, end = max(begin, vo_vehicle.t[0]), min(end, vo_vehicle.t[-1])
-    t_dr = np.arange(begin, end, 1.0 / config.dead_reckoning_rate_hz)
+    t_dr = time_grid(begin, end, 1.0 / config.dead_reckoning_rate_hz)
     dr = wheel_gyro_track(speed, yaw_rate, t_dr) if len(t_dr) > 1 else None
     usable = usable_tight_heading(table, config.correction.tc_max_sigma_rad)
     tight = (
@@ -553,7 +554,7 @@ def run_without_gnss(
     begin, end = max(speed.t[0], yaw_rate.t[0]), min(speed.t[-1], yaw_rate.t[-1])
     if vo_vehicle is not None:
         begin, end = max(begin, vo_vehicle.t[0]), min(end, vo_vehicle.t[-1])
-    t_dr = np.arange(begin, end, 1.0 / config.dead_reckoning_rate_hz)
+    t_dr = time_grid(begin, end, 1.0 / config.dead_reckoning_rate_hz)
     origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)), None, "the sequence origin (no GNSS)")
     tracks = {Pipeline.VO: vo_vehicle}
     if len(t_dr) > 1:

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import require_shared
+from vo_doppler.gnss.doppler_noise import redundancy_numbers
 from vo_doppler.gnss.doppler_velocity import doppler_rows, solve_velocity, solve_with_fitted_noise
 from vo_doppler.gnss.noise_model import (
     CN0_REFERENCE_DBHZ,
@@ -20,6 +21,7 @@ from vo_doppler.gnss.noise_model import (
 )
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
+from vo_doppler.model.doppler import DopplerRows
 
 RECEIVER = np.array([-3817680.9841, 3562840.0688, 3650158.4543])
 SIGMA_REF, SLOPE, EXPONENT = 0.04, 1.4, 0.6
@@ -136,3 +138,33 @@ def test_nearly_exact_rows_fit_no_law():
     honest = rng.normal(0.0, 1.0, cn0.size) * 10.0 ** (-(cn0 - 45.0) / 20.0)
     law = fit_sigma_law(honest, cn0, elevation)
     assert law is not None and law[1] == pytest.approx(1.0, abs=0.5)
+
+
+def test_a_row_without_redundancy_has_no_normalised_residual():
+    """Four satellites at one elevation and one at the zenith: only the zenith row tells the
+    vertical velocity from the clock drift, so its redundancy number is zero up to rounding and
+    its residual is rounding. It gets none (NaN), not the rounding divided by √1e-6, which
+    moved the fitted σ with the time origin (issue 30); the others keep theirs."""
+    azimuth = np.radians([0.0, 90.0, 180.0, 270.0])
+    elevation = np.radians(30.0)
+    los = np.column_stack(
+        [
+            np.cos(elevation) * np.sin(azimuth),
+            np.cos(elevation) * np.cos(azimuth),
+            np.full(4, np.sin(elevation)),
+        ]
+    )
+    los = np.vstack([los, [0.0, 0.0, 1.0]])
+    rows = DopplerRows(
+        t=np.zeros(5),
+        los=los,
+        sat_velocity=np.zeros((5, 3)),
+        sat_clock_drift=np.zeros(5),
+        range_rate=np.array([0.11, -0.07, 0.05, 0.02, -0.3]),
+        weight=np.full(5, 100.0),
+        sat_id=np.array(["G01", "G02", "G03", "G04", "G05"]),
+        epoch=np.zeros(5, dtype=int),
+    )
+    redundancy = redundancy_numbers(rows, rows.sigma())
+    assert np.isnan(redundancy[4])
+    np.testing.assert_allclose(redundancy[:4], 0.25, atol=1e-9)  # one degree of freedom

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from tests.conftest import require_shared
 from tests.helpers.rinex_text import field, rinex3_epoch, rinex3_header
+from tests.helpers.time_shift import WEEKS_NEAR_1E9_S
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
 from vo_doppler.gnss.atmosphere import klobuchar_delay, troposphere_delay
@@ -18,6 +19,7 @@ from vo_doppler.gnss.spp import nearest_time, receiver_positions, solve_spp
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.model.gnss_solutions import SppSolution
+from vo_doppler.model.timeseries import TIME_TOLERANCE_S
 
 KLOBUCHAR = np.array([1.8626e-08, 2.2352e-08, -1.1921e-07, -5.9605e-08])
 KLOBUCHAR = np.concatenate([KLOBUCHAR, [1.2902e05, 1.6384e05, -1.9661e05, -2.6214e05]])
@@ -86,8 +88,9 @@ epochs = st.lists(st.tuples(st.integers(0, 40), st.booleans()), min_size=1, max_
 
 @given(epochs)
 def test_nearest_valid_fix_is_the_pairwise_argmin(rows):
-    """The nearest valid epoch by binary search is the one the full (epochs × valid) table's
-    argmin picks, ties to the earlier and to the first of equal times included."""
+    """The nearest valid epoch by binary search is the one the full (epochs × valid) table
+    picks: the smallest distance, ties (within TIME_TOLERANCE_S) to the earlier and to the
+    first of equal times."""
     t = np.sort(np.array([step for step, _ in rows], dtype=float) * 0.05)
     valid = np.array([flag for _, flag in rows])
     position = np.column_stack([np.arange(t.size, dtype=float), t, -t])
@@ -98,7 +101,9 @@ def test_nearest_valid_fix_is_the_pairwise_argmin(rows):
         assert np.isnan(out).all()
         return
     good = np.flatnonzero(valid)
-    expected = good[np.abs(t[:, None] - t[good][None, :]).argmin(axis=1)]
+    distance = np.abs(t[:, None] - t[good][None, :])
+    nearest = distance <= distance.min(axis=1, keepdims=True) + TIME_TOLERANCE_S
+    expected = good[nearest.argmax(axis=1)]  # within the tolerance of a tie: the earlier
     assert np.array_equal(out, position[np.where(valid, np.arange(t.size), expected)])
     assert np.array_equal(nearest_time(t[good], t), np.searchsorted(good, expected))
 
@@ -131,3 +136,13 @@ def test_systems_absent_from_the_file_are_an_input_error_naming_those_it_has(tmp
         solve_spp(obs, None, "E")
     with pytest.raises(InputError, match=r"gps_only\.obs"):
         solve_spp(obs, None, "RE")
+
+
+@pytest.mark.parametrize("origin", [0.0, 1425953400.0, 1425953400.0 + WEEKS_NEAR_1E9_S])
+def test_an_epoch_halfway_between_fixes_takes_the_earlier_at_any_time_origin(origin):
+    """20-Hz epochs with every other one fixed: the odd ones lie halfway, and take the earlier
+    fix at GPS seconds near 2.4e9 as at 0, where the rounding of the times made some nearer the
+    later (42 m away on the sample; issue 30)."""
+    steps = np.arange(400)
+    t = origin + 0.05 * steps
+    np.testing.assert_array_equal(nearest_time(t[::2], t), steps // 2)

@@ -13,6 +13,7 @@ from vo_doppler.model.timeseries import (
     increments,
     integral_at,
     sample,
+    time_grid,
     travelled_distance,
 )
 
@@ -67,3 +68,14 @@ def test_increments_sum_to_the_whole_integral(steps, values):
     rate = np.array(values[: len(t)])
     total = cumulative_integral(t, rate)[-1]
     assert np.sum(increments(t, rate, t)) == pytest.approx(total, abs=1e-9)
+
+
+@pytest.mark.parametrize("origin", [0.0, 1425953400.0, 2425687800.0])
+def test_a_time_grid_is_the_same_at_any_time_origin(origin):
+    """``begin + k·step`` at every origin, as many times as ``np.arange`` gives; np.arange's own
+    grid at 2.4e9 s drifts by 1.8e-4 s over 760 steps (issue 30)."""
+    grid = time_grid(origin + 0.013, origin + 38.0, 0.05)
+    assert grid.size == np.arange(0.013, 38.0, 0.05).size == 760
+    np.testing.assert_allclose(grid - origin, 0.013 + 0.05 * np.arange(760), rtol=0, atol=1e-6)
+    assert time_grid(origin + 5.0, origin + 5.0, 0.05).size == 0
+    assert time_grid(origin + 5.0, origin + 4.0, 0.05).size == 0

@@ -9,10 +9,11 @@ from enum import StrEnum
 import numpy as np
 
 from vo_doppler.choices import check_fields, checked
-from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading, relative_times
+from vo_doppler.fusion.heading_blend import BlendConfig, blend_heading
 from vo_doppler.fusion.heading_correction import HeadingReference, correct_heading
 from vo_doppler.fusion.result import CorrectionResult
 from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.timeseries import relative_times
 from vo_doppler.model.trajectory import Trajectory
 
 
@@ -119,7 +120,7 @@ def correct(
     vehicle: Trajectory, heading: AbsoluteHeading, config: CorrectionConfig
 ) -> CorrectionResult:
     """Correct vehicle poses (level world) by ``config.method``, on times relative to the
-    first pose (:func:`~vo_doppler.fusion.heading_blend.relative_times`): the result does not
+    first pose (:func:`~vo_doppler.model.timeseries.relative_times`): the result does not
     depend on the time origin (GPS seconds near 10⁹ or seconds from the start of a log)."""
     origin = float(vehicle.t[0]) if len(vehicle.t) else 0.0
     relative = replace(vehicle, t=relative_times(vehicle.t, origin))

@@ -112,6 +112,7 @@ from vo_doppler.choices import checked
 from vo_doppler.fusion.heading_correction import HeadingReference, chord_starts, headings_at
 from vo_doppler.fusion.result import CorrectionResult
 from vo_doppler.geo import wrap_angle, yaw_of
+from vo_doppler.model.timeseries import TIME_TOLERANCE_S, relative_times
 from vo_doppler.model.trajectory import Trajectory
 
 SIGMA_GRID = np.logspace(-4.0, -1.0, 16)
@@ -402,25 +403,6 @@ def start_indices(t: np.ndarray, correlation_s: np.ndarray, config: BlendConfig)
     ``config.start_spacing_s`` apart."""
     spacing = np.maximum(correlation_s, config.start_spacing_s)
     return decimate(t, spacing)[: config.start_measurements]
-
-
-TIME_TOLERANCE_S = 1e-6
-"""Two times closer than this are taken as equal when spacings are compared: far above the
-rounding of a GPS time near 10⁹ s (2⁻²³ s ≈ 1.2·10⁻⁷ s per value), far below any sampling
-interval, so that a measurement exactly one spacing after the last kept one is kept whatever
-the time origin (at 10⁹ s, ``t_j >= last + gap`` dropped 5 of 30 samples 0.1 s apart)."""
-TIME_DECIMALS = 6
-"""Times relative to a start are rounded to the microsecond (:func:`relative_times`)."""
-
-
-def relative_times(t, origin: float) -> np.ndarray:
-    """``t − origin`` rounded to the microsecond: the same numbers whatever the time origin.
-
-    A time near 10⁹ s (GPS seconds) carries up to 1.2·10⁻⁷ s of rounding, so ``t − origin``
-    differs from the same time counted from the start of a log by that much, and a comparison
-    on the edge (a window of exactly 2 s over 10-Hz poses) could go either way; rounded to the
-    microsecond (no clock stamps finer), both give the same numbers."""
-    return np.round(np.asarray(t, dtype=float) - origin, TIME_DECIMALS)
 
 
 def decimate(t: np.ndarray, spacing_s: np.ndarray) -> np.ndarray:

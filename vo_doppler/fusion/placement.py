@@ -8,10 +8,11 @@ import logging
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from vo_doppler.fusion.heading_blend import BlendConfig, relative_times, vo_direction
+from vo_doppler.fusion.heading_blend import BlendConfig, vo_direction
 from vo_doppler.fusion.heading_correction import headings_at
 from vo_doppler.geo import wrap_angle
 from vo_doppler.model.heading import HeadingTable
+from vo_doppler.model.timeseries import relative_times
 from vo_doppler.model.trajectory import Trajectory
 
 log = logging.getLogger(__name__)

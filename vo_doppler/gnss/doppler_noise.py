@@ -24,6 +24,11 @@ from vo_doppler.robust import nmad
 WINDOW_S = 60.0
 MIN_ROWS = 20
 FLOOR_MPS = 0.02
+MIN_REDUNDANCY = 1e-6
+"""A row whose redundancy number r_i is smaller has no residual to fit a noise on: in an epoch
+with as many satellites as unknowns r_i is zero up to rounding (~1e-15) and so is the residual
+(~1e-8 m for a pseudorange), which divided by √r_i reads as noise of any size: the SPP's
+fitted σ on the sample moved by 46 % when every time was shifted by 10⁹ s (issue 30)."""
 
 
 def fitted_sigma(
@@ -60,7 +65,7 @@ def fitted_sigma(
 
 def redundancy_numbers(rows, sigma: np.ndarray) -> np.ndarray:
     """r_i = 1 − h_ii per row with all of its epoch's rows in the design (NaN without
-    redundancy)."""
+    redundancy, or below ``MIN_REDUNDANCY``)."""
     out = np.full(len(rows), np.nan)
     order = np.argsort(rows.epoch, kind="stable")
     bounds = np.flatnonzero(np.diff(rows.epoch[order])) + 1
@@ -71,5 +76,6 @@ def redundancy_numbers(rows, sigma: np.ndarray) -> np.ndarray:
         weight = sigma[members] ** -2.0
         normal = (H * weight[:, None]).T @ H
         hat = np.einsum("ij,jk,ik->i", H, np.linalg.pinv(normal), H) * weight
-        out[members] = np.clip(1.0 - hat, 1e-6, 1.0)
+        redundancy = 1.0 - hat
+        out[members] = np.where(redundancy >= MIN_REDUNDANCY, np.minimum(redundancy, 1.0), np.nan)
     return out

@@ -19,6 +19,7 @@ from vo_doppler.bounds import RECEIVER_RADIUS
 from vo_doppler.errors import InputError
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.atmosphere import L1_HZ, klobuchar_delay, troposphere_delay
+from vo_doppler.gnss.doppler_noise import MIN_REDUNDANCY
 from vo_doppler.gnss.ephemeris import rotate_earth
 from vo_doppler.gnss.lsq import (
     DEFAULT_ALPHA,
@@ -36,6 +37,7 @@ from vo_doppler.gnss.satellite_source import StateSource, satellite_source
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.model.gnss_solutions import SppSolution
 from vo_doppler.model.observations import Observations, lookup, row_keys
+from vo_doppler.model.timeseries import TIME_TOLERANCE_S
 
 log = logging.getLogger(__name__)
 
@@ -245,7 +247,8 @@ class _EpochFit:
     """One epoch's solution and what the integrity figures and the noise fit need of it:
     ``rows`` the data rows above the mask, their post-fit ``residual`` (m), ``spread`` the
     standard deviation of each residual in units of its σ (√r_i for a kept row, r_i its
-    redundancy number; √(1 + h_ii) for an excluded one, predicted by the others) and
+    redundancy number, NaN below ``MIN_REDUNDANCY``; √(1 + h_ii) for an excluded one,
+    predicted by the others) and
     ``elevation`` (rad); ``design``, ``sigma`` and ``groups`` of the kept rows."""
 
     x: np.ndarray
@@ -329,7 +332,12 @@ def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray) -> _EpochFi
     clock = {s: clocks[i] for i, s in enumerate(model.systems) if present[i]}
     s = sigma[keep_now]
     leverage = np.einsum("ij,jk,ik->i", H, result.covariance, H) / s**2
-    spread = np.sqrt(np.where(used, np.clip(1.0 - leverage, 1e-6, 1.0), 1.0 + leverage))
+    redundancy = np.where(used, 1.0 - leverage, np.nan)
+    spread = np.where(
+        used,
+        np.sqrt(np.where(redundancy >= MIN_REDUNDANCY, np.minimum(redundancy, 1.0), np.nan)),
+        np.sqrt(1.0 + leverage),
+    )
     return _EpochFit(
         x,
         clock,
@@ -440,10 +448,13 @@ def receiver_positions(solution: SppSolution, fallback: np.ndarray | None) -> np
 def nearest_time(sorted_t: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Index into ascending times ``sorted_t`` (non-empty) of the nearest to each of ``t``: on a
     tie the earlier, among equal times the first, as ``argmin`` over all pairs would choose,
-    in O((n + m) log n) time and O(m) memory instead of an (m × n) table."""
+    in O((n + m) log n) time and O(m) memory instead of an (m × n) table. Distances within
+    :data:`~vo_doppler.model.timeseries.TIME_TOLERANCE_S` are a tie: an epoch midway between
+    two fixes takes the earlier whatever the time origin (at GPS seconds shifted by 10⁹ s the
+    rounding of the times chose the later for some, 42 m away on the sample; issue 30)."""
     last = sorted_t.size - 1
     after = np.searchsorted(sorted_t, t)
     before = np.searchsorted(sorted_t, sorted_t[np.maximum(after - 1, 0)])
     after = np.searchsorted(sorted_t, sorted_t[np.minimum(after, last)])
-    use_before = np.abs(t - sorted_t[before]) <= np.abs(t - sorted_t[after])
+    use_before = np.abs(t - sorted_t[before]) <= np.abs(t - sorted_t[after]) + TIME_TOLERANCE_S
     return np.where(use_before, before, after)

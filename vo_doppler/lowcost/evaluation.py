@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 from vo_doppler.geo import EnuFrame
 from vo_doppler.lowcost.gps_reconstruction import reconstruct_track
 from vo_doppler.lowcost.pipeline import DeadReckonConfig, Reference, run_deadreckon
-from vo_doppler.model.timeseries import cumulative_integral
+from vo_doppler.model.timeseries import cumulative_integral, time_grid
 
 
 def heading_run(truth, fixes, gyro, can, window_s: float, k: float | None, body: bool = False):
@@ -41,7 +41,7 @@ def block_rate_errors(t_rate, rate, truth, block_s: float = 5.0) -> np.ndarray:
     """(sensor − truth) heading change per block divided by its length (rad/s): the error of a
     block-mean ε0 taken there."""
     heading = cumulative_integral(t_rate, rate)
-    edges = np.arange(max(t_rate[0], truth.t[0]), min(t_rate[-1], truth.t[-1]) - block_s, block_s)
+    edges = time_grid(max(t_rate[0], truth.t[0]), min(t_rate[-1], truth.t[-1]) - block_s, block_s)
     return np.array(
         [
             (

@@ -1,4 +1,6 @@
-"""Sampled signals: sample, hold, integrate, travelled distance — one edge rule for all.
+"""Sampled signals: sample, hold, integrate, travelled distance — one edge rule for all; and
+the one rule for comparing times whatever their origin (:func:`relative_times`,
+:data:`TIME_TOLERANCE_S`).
 
 **Edge rule.** A signal is known on ``[t[0], t[-1]]`` only. Every function returns NaN at
 query times outside that interval unless the caller names another rule with ``outside``:
@@ -21,6 +23,34 @@ import numpy as np
 
 Outside = Literal["nan", "hold", "extend"]
 OUTSIDE_RULES = ("nan", "hold", "extend")
+
+
+TIME_TOLERANCE_S = 1e-6
+"""Two times closer than this are taken as equal when spacings are compared: far above the
+rounding of a GPS time near 10⁹ s (2⁻²³ s ≈ 1.2·10⁻⁷ s per value), far below any sampling
+interval, so that a measurement exactly one spacing after the last kept one is kept whatever
+the time origin (at 10⁹ s, ``t_j >= last + gap`` dropped 5 of 30 samples 0.1 s apart)."""
+TIME_DECIMALS = 6
+"""Times relative to a start are rounded to the microsecond (:func:`relative_times`)."""
+
+
+def relative_times(t, origin: float) -> np.ndarray:
+    """``t − origin`` rounded to the microsecond: the same numbers whatever the time origin.
+
+    A time near 10⁹ s (GPS seconds) carries up to 1.2·10⁻⁷ s of rounding, so ``t − origin``
+    differs from the same time counted from the start of a log by that much, and a comparison
+    on the edge (a window of exactly 2 s over 10-Hz poses) could go either way; rounded to the
+    microsecond (no clock stamps finer), both give the same numbers."""
+    return np.round(np.asarray(t, dtype=float) - origin, TIME_DECIMALS)
+
+
+def time_grid(begin: float, end: float, step_s: float) -> np.ndarray:
+    """``begin, begin + step_s, …`` before ``end``: the times of ``np.arange(begin, end,
+    step_s)``, each ``begin + k·step_s``. ``np.arange`` steps by ``(begin + step_s) − begin``,
+    which near 10⁹ s carries the rounding of ``begin`` (2.4·10⁻⁷ s at 2·10⁹ s) into every step:
+    a 20-Hz grid over 38 s ended 1.8·10⁻⁴ s off at GPS seconds shifted by 10⁹ s (issue 30)."""
+    count = max(int(np.ceil((end - begin) / step_s)), 0)
+    return begin + step_s * np.arange(count)
 
 
 def _check(outside: str, allowed: tuple[str, ...]) -> None:
