@@ -16,6 +16,8 @@ from vo_doppler.units import UNITS, in_people_units, unit_of
         ("max_yaw_drift_rad_s", "rad/s"),
         ("gate_rad", "rad"),
         ("sigma_distance_rad_per_sqrt_m", "rad/√m"),
+        ("angle_random_walk_rad_per_sqrt_s", "rad/√s"),
+        ("bias_walk_rad_per_s_sqrt_s", "rad/s/√s"),
         ("max_window_m", "m"),
         ("min_speed_mps", "m/s"),
         ("max_speed_drift_mps2", "m/s²"),
@@ -37,7 +39,13 @@ def test_every_suffix_is_distinct_and_only_angles_change_for_people():
     suffixes = [unit.suffix for unit in UNITS]
     assert len(set(suffixes)) == len(suffixes)
     converted = {unit.suffix for unit in UNITS if unit.people_suffix is not None}
-    assert converted == {"_rad", "_rad_s", "_rad_per_sqrt_m"}
+    assert converted == {
+        "_rad",
+        "_rad_s",
+        "_rad_per_sqrt_m",
+        "_rad_per_sqrt_s",
+        "_rad_per_s_sqrt_s",
+    }
 
 
 def test_angles_are_shown_in_degrees_with_their_name():

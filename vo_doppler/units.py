@@ -27,6 +27,8 @@ UNITS: tuple[Unit, ...] = (
     Unit("_rad", "rad", "_deg", "deg", DEGREES_PER_RADIAN),
     Unit("_rad_s", "rad/s", "_deg_s", "deg/s", DEGREES_PER_RADIAN),
     Unit("_rad_per_sqrt_m", "rad/√m", "_deg_per_sqrt_m", "deg/√m", DEGREES_PER_RADIAN),
+    Unit("_rad_per_sqrt_s", "rad/√s", "_deg_per_sqrt_s", "deg/√s", DEGREES_PER_RADIAN),
+    Unit("_rad_per_s_sqrt_s", "rad/s/√s", "_deg_per_s_sqrt_s", "deg/s/√s", DEGREES_PER_RADIAN),
     Unit("_s", "s"),
     Unit("_m", "m"),
     Unit("_mps", "m/s"),

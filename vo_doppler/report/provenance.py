@@ -112,8 +112,6 @@ def version() -> str:
 
 ANGLE_FIELDS = {
     "elevation_mask": " deg",
-    "init_min_parallax": " deg",
-    "triangulation_min_parallax": " deg",
     "prior_gyro_bias_sigma": " deg/s",
     "fixed_gyro_bias": " deg/s",
 }

@@ -39,7 +39,7 @@ class VoConfig:
     0.72/0.92/1.28/1.49 against 0.63/1.04/1.54/0.68 m per 100 m on the sample and seeds 0–2, VO + TC
     0.320/0.206/0.214/0.161 against 0.299/0.183/0.220/0.139, KITTI final-error ratio 0.58."""
     klt_levels: int = 3
-    klt_epsilon: float = 0.01
+    klt_epsilon_px: float = 0.01
     """KLT stop (px); 0.03 took the sample's VO alone from 0.76 to 0.96 m per 100 m."""
     forward_backward_max_px: float = 0.7
     """Largest forward–backward distance of a kept track. The backward pass repeats the forward
@@ -48,10 +48,10 @@ class VoConfig:
     level fewer 1.02, starting at the original points (``OPTFLOW_USE_INITIAL_FLOW``) with two
     levels 1.10."""
     ransac_threshold_px: float = 1.0
-    init_min_parallax: float = np.radians(1.0)
+    init_min_parallax_rad: float = np.radians(1.0)
     """Median parallax (rad) the two-view initialisation needs."""
     init_min_points: int = 60
-    triangulation_min_parallax: float = np.radians(1.0)
+    triangulation_min_parallax_rad: float = np.radians(1.0)
     """Parallax (rad) a new point needs to be triangulated."""
     max_reprojection_px: float = 2.0
     pnp_min_inliers: int = 25
@@ -78,5 +78,5 @@ class VoConfig:
     ba_loss_scale_px: float = 1.5
     ba_fixed_oldest: int = 2
     """Oldest window poses held constant: the gauge (and, with two, the scale) of the window."""
-    min_texture_std: float = 3.0
+    min_texture_std_grey: float = 3.0
     """Images whose grey-level standard deviation is below this are treated as blank."""

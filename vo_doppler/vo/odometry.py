@@ -199,7 +199,7 @@ class VisualOdometry:
             return "unreadable"
         if image.ndim != 2:
             return "not-grey"
-        if float(cv2.meanStdDev(image)[1][0, 0]) < self.config.min_texture_std:
+        if float(cv2.meanStdDev(image)[1][0, 0]) < self.config.min_texture_std_grey:
             return "blank"
         if self._ref_image is not None and image.shape != self._ref_image.shape:
             return "size-changed"
@@ -299,11 +299,11 @@ class VisualOdometry:
             frame.features.points[ib],
             cfg.ransac_threshold_px,
             cfg.max_reprojection_px,
-            cfg.triangulation_min_parallax,
+            cfg.triangulation_min_parallax_rad,
         )
         if (
             two_view is None
-            or two_view.median_parallax < cfg.init_min_parallax
+            or two_view.median_parallax < cfg.init_min_parallax_rad
             or two_view.valid.sum() < cfg.init_min_points
         ):
             return
@@ -402,7 +402,7 @@ class VisualOdometry:
                 older.features.points[ia],
                 frame.features.points[jb],
                 cfg.max_reprojection_px,
-                cfg.triangulation_min_parallax,
+                cfg.triangulation_min_parallax_rad,
             )
             self._landmarks.set(ids[tri.valid], tri.points[tri.valid])
             wanted = np.setdiff1d(wanted, ids)

@@ -42,7 +42,11 @@ class FeatureTracker:
         self._lk_params = {
             "winSize": (config.klt_window_px, config.klt_window_px),
             "maxLevel": config.klt_levels,
-            "criteria": (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 30, config.klt_epsilon),
+            "criteria": (
+                cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT,
+                30,
+                config.klt_epsilon_px,
+            ),
         }
 
     def detect(self, image: np.ndarray, existing: TrackedFeatures) -> TrackedFeatures:
