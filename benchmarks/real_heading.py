@@ -321,7 +321,7 @@ def canyon_inputs(sequence: Sequence, config: RunConfig, after_s: float = CANYON
         CANYON_SATS,
         obs.epoch_time[0] + after_s,
         "G",
-        config.elevation_mask,
+        config.elevation_mask_rad,
         reported_sigma=sequence.doppler_sigma,
     )
 

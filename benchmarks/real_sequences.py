@@ -161,7 +161,7 @@ def gnss_reference(folder: Path, recording: Recording) -> tuple[np.ndarray, np.n
         read_obs(folder / "gnss" / recording.obs),
         read_satellite_states([folder / "gnss" / name for name in recording.nav]),
         config.systems,
-        config.elevation_mask,
+        config.elevation_mask_rad,
     )
     first = np.flatnonzero(gnss.spp.valid)[0]
     lat, lon, height = ecef_to_geodetic(gnss.spp.position_ecef[first])

@@ -459,8 +459,8 @@ def test_a_trajectory_without_a_gnss_epoch_is_placed_by_the_nearest_one_with_a_w
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
-        ({"elevation_mask": 10.0}, r"RunConfig.elevation_mask = 10: .*looks like degrees"),
-        ({"elevation_mask": np.pi / 2}, r"RunConfig.elevation_mask = 1.5708"),
+        ({"elevation_mask_rad": 10.0}, r"RunConfig.elevation_mask_rad = 10: .*looks like degrees"),
+        ({"elevation_mask_rad": np.pi / 2}, r"RunConfig.elevation_mask_rad = 1.5708"),
         ({"dead_reckoning_rate_hz": 0.0}, "RunConfig.dead_reckoning_rate_hz = 0.0"),
     ],
 )
@@ -469,7 +469,7 @@ def test_run_config_refuses_values_out_of_their_domain(arguments, message):
     finding 3)."""
     with pytest.raises(InputError, match=message):
         RunConfig(**arguments)
-    assert RunConfig(elevation_mask=0.0).elevation_mask == 0.0
+    assert RunConfig(elevation_mask_rad=0.0).elevation_mask_rad == 0.0
 
 
 @pytest.fixture(scope="module")

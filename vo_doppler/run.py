@@ -92,7 +92,7 @@ class RunConfig:
 
     systems: str = DEFAULT_SYSTEMS
     """RINEX letters of the GNSS systems used (:class:`SatelliteSystem`)."""
-    elevation_mask: float = np.radians(10.0)
+    elevation_mask_rad: float = np.radians(10.0)
     heading: HeadingPipelineConfig = field(default_factory=HeadingPipelineConfig.auto)
     """The heading stage's settings; by default ``--heading-method auto``'s (robust below
     10 Hz GNSS, snooping from 10 Hz)."""
@@ -105,7 +105,7 @@ class RunConfig:
         naming the field), not as an empty result later: a mask of 10 (degrees given for
         radians) removes every satellite and leaves no heading, silently."""
         checked_letters(SatelliteSystem, self.systems, "RunConfig.systems")
-        check_elevation_mask(self.elevation_mask, "RunConfig.elevation_mask")
+        check_elevation_mask(self.elevation_mask_rad, "RunConfig.elevation_mask_rad")
         rate = self.dead_reckoning_rate_hz
         if not (isinstance(rate, (int, float, np.number)) and math.isfinite(rate) and rate > 0):
             raise InputError(f"RunConfig.dead_reckoning_rate_hz = {rate!r}: expected a rate > 0 Hz")
@@ -402,7 +402,7 @@ def sequence_gnss(
         sequence.observations,
         sequence.navigation,
         config.systems,
-        config.elevation_mask,
+        config.elevation_mask_rad,
         reported_sigma=sequence.doppler_sigma,
         fit_noise=fit_noise,
     )

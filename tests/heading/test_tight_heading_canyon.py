@@ -30,7 +30,9 @@ def test_no_reliable_heading_is_far_outside_its_sigma():
     config = RunConfig()
     obs = sequence.observations
     after = obs.epoch_time[0] + 20.0
-    rows, velocity = emulated_canyon(obs, sequence.navigation, 2, after, "G", config.elevation_mask)
+    rows, velocity = emulated_canyon(
+        obs, sequence.navigation, 2, after, "G", config.elevation_mask_rad
+    )
     table = sequence_heading(sequence, rows, velocity, config.heading)
     assert table.wheel_scale[-1] == 1.0  # no conventional heading calibrated anything
     error = np.abs(wrap_angle(table.yaw_tc - sequence.truth.yaw_at(table.t)))

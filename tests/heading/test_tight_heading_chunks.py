@@ -37,7 +37,7 @@ def heading_inputs(tmp_path_factory):
     sequence = read_sequence(folder)
     run = RunConfig()
     obs = sequence.observations
-    gnss = gnss_velocity(obs, sequence.navigation, run.systems, run.elevation_mask)
+    gnss = gnss_velocity(obs, sequence.navigation, run.systems, run.elevation_mask_rad)
     return (
         obs.epoch_time,
         gnss.rows,

@@ -33,7 +33,7 @@ def comma(tmp_path_factory):
         sequence.observations,
         sequence.navigation,
         config.systems,
-        config.elevation_mask,
+        config.elevation_mask_rad,
         reported_sigma=sequence.doppler_sigma,
     )
     return sequence, gnss, config

@@ -190,7 +190,7 @@ def test_long_tracks_are_thinned_keeping_the_last_pose():
 
 def test_configuration_is_in_degrees_for_people():
     rows = dict(config_rows(RunConfig()))
-    assert rows["elevation_mask"] == "10 deg"
+    assert rows["elevation_mask_deg"] == "10 deg"
     assert rows["heading.gate.max_yaw_jump_deg"] == "2 deg"
     assert rows["heading.gate.max_yaw_drift_deg_s"] == "1 deg/s"
     assert dict(main_settings(RunConfig()))["elevation mask"] == "10.0 deg"

@@ -106,7 +106,7 @@ def run_config(args: argparse.Namespace) -> RunConfig:
     """The :class:`RunConfig` of the options :func:`add_run_options` added (radians inside)."""
     return RunConfig(
         systems=args.systems.upper(),
-        elevation_mask=np.radians(args.elev_mask),
+        elevation_mask_rad=np.radians(args.elev_mask),
         heading=heading_method_config(args.heading_method),
         vo=VoConfig(window_size=args.window),
         correction=correction_config(args),

@@ -111,7 +111,6 @@ def version() -> str:
 
 
 ANGLE_FIELDS = {
-    "elevation_mask": " deg",
     "prior_gyro_bias_sigma": " deg/s",
     "fixed_gyro_bias": " deg/s",
 }
@@ -181,7 +180,7 @@ def main_settings(
     if gnss:
         rows += [
             ("GNSS systems", config.systems),
-            ("elevation mask", f"{np.degrees(config.elevation_mask):.1f} deg"),
+            ("elevation mask", f"{np.degrees(config.elevation_mask_rad):.1f} deg"),
         ]
     if camera:
         rows.append(("VO window", f"{config.vo.window_size} frames"))
