@@ -219,7 +219,7 @@ def test_kalman_with_the_prior_equals_least_squares_with_the_prior():
 
 
 def test_kalman_stays_at_the_prior_without_informative_samples():
-    assert HeadingPipelineConfig().prior_gyro_bias_sigma == PRIOR_GYRO_BIAS_SIGMA
+    assert HeadingPipelineConfig().prior_gyro_bias_sigma_rad_s == PRIOR_GYRO_BIAS_SIGMA
     assert HeadingPipelineConfig().prior_wheel_scale_sigma == PRIOR_WHEEL_SCALE_SIGMA
     kb = GyroBiasKalman(config=GateConfig(min_bias_span_s=0.0))  # the filter alone
     kw = WheelScaleKalman()
@@ -274,7 +274,7 @@ def test_the_kalman_bias_needs_samples_spanning_the_minimum():
     early = t < 3.0
     np.testing.assert_array_equal(cal.bias_estimated, ~early)
     np.testing.assert_array_equal(cal.bias[early], 0.0)
-    np.testing.assert_array_equal(cal.bias_sigma[early], config.prior_gyro_bias_sigma)
+    np.testing.assert_array_equal(cal.bias_sigma[early], config.prior_gyro_bias_sigma_rad_s)
 
 
 def _comma_ground_truth():
@@ -379,7 +379,9 @@ def test_kalman_calibration_starts_from_the_configured_prior():
     m = 5
     t = np.arange(m, dtype=float)
     config = HeadingPipelineConfig(
-        calibration="kalman", prior_gyro_bias_sigma=np.radians(0.2), prior_wheel_scale_sigma=0.01
+        calibration="kalman",
+        prior_gyro_bias_sigma_rad_s=np.radians(0.2),
+        prior_wheel_scale_sigma=0.01,
     )
     out = causal_calibration(
         t, np.full(m, 10.0), np.zeros(m), np.zeros(m, bool), np.full(m, 10.0), np.zeros(m), config

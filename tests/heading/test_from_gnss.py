@@ -52,5 +52,5 @@ def test_a_calibrated_gyro_bias_beyond_a_car_sensor_is_in_the_table_warnings(dri
     # A gyro 5 °/s off turns by other amounts than the course: no turn confirms its sign,
     # and the table says so.
     assert any("its sign could not be checked" in w for w in table.warnings)
-    fixed = _heading(drive, off, fixed_gyro_bias=np.radians(5.0)).warnings
+    fixed = _heading(drive, off, fixed_gyro_bias_rad_s=np.radians(5.0)).warnings
     assert not any(w.startswith("gyro bias") for w in fixed)  # chosen: no check

@@ -102,7 +102,7 @@ def test_tight_gyro_bias_recovers_a_known_bias_from_tight_headings():
     expected = fit.sigma * np.sqrt(config.tight.window_s / 0.1)
     np.testing.assert_allclose(value_sigma, expected, rtol=1e-3)
     # Vague headings do not calibrate; none left: no estimate.
-    vague = np.full(len(t), 2.0 * config.tight_calibration_max_sigma)
+    vague = np.full(len(t), 2.0 * config.tight_calibration_max_sigma_rad)
     assert tight_gyro_bias(t, tight, vague, reliable, phi, speed, config) is None
 
 
@@ -178,7 +178,7 @@ def test_causal_calibration_holds_and_overrides():
     np.testing.assert_allclose(bias[-1], 0.01, atol=1e-12)
     np.testing.assert_allclose(scale[-1], 1.1, atol=1e-12)
     np.testing.assert_array_equal(bias[15:], bias[14])  # held once Doppler is gone
-    fixed = HeadingPipelineConfig(fixed_gyro_bias=0.02, fixed_wheel_scale=0.9)
+    fixed = HeadingPipelineConfig(fixed_gyro_bias_rad_s=0.02, fixed_wheel_scale=0.9)
     cal = causal_calibration(t, speed, yaw, valid, speed, phi, fixed)
     bias, scale = cal.bias, cal.scale
     assert np.all(bias == 0.02) and np.all(scale == 0.9)

@@ -70,7 +70,7 @@ def test_tight_heading_of_an_offset_antenna_is_exact_with_the_lever_arm():
 
 def test_pipeline_applies_the_lever_arm_to_both_headings():
     scenario, antenna_velocity = _offset_antenna(2)
-    exact = HeadingPipelineConfig(fixed_gyro_bias=0.0, fixed_wheel_scale=1.0)
+    exact = HeadingPipelineConfig(fixed_gyro_bias_rad_s=0.0, fixed_wheel_scale=1.0)
     sensors = (SensorSeries(T, scenario.speed), SensorSeries(T, np.full(len(T), OMEGA)))
     valid = np.ones(len(T), dtype=bool)
     args = (T, scenario.rows, antenna_velocity, valid, *sensors, exact)

@@ -3,17 +3,21 @@ GeoJSON, the configuration in degrees, synthetic vs recorded, the definitions.""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 from tests.conftest import REPO_ROOT
 from tests.helpers.heading_table import plain_heading_table
 from vo_doppler.eval.pipelines import PipelineErrors
+from vo_doppler.fusion.correction import CorrectionConfig
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
 from vo_doppler.gnss.doppler_velocity import MIN_SATELLITES
+from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.io.sequence import read_manifest, read_sequence
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
@@ -30,6 +34,7 @@ from vo_doppler.report.run_report import (
 )
 from vo_doppler.report.trajectory_map import lon_lat, map_html, thinned, write_geojson
 from vo_doppler.run import RunConfig
+from vo_doppler.units import unit_of
 
 LAT, LON = 35.6938, 139.7034
 ENU = EnuFrame.from_ecef(geodetic_to_ecef(np.radians(LAT), np.radians(LON), 77.0))
@@ -193,7 +198,47 @@ def test_configuration_is_in_degrees_for_people():
     assert rows["elevation_mask_deg"] == "10 deg"
     assert rows["heading.gate.max_yaw_jump_deg"] == "2 deg"
     assert rows["heading.gate.max_yaw_drift_deg_s"] == "1 deg/s"
+    assert rows["heading.backfill_bias_sigma_deg_s"] == "0.05 deg/s"
+    assert rows["heading.tight_calibration_max_sigma_deg"] == "5 deg"
+    assert rows["heading.fixed_gyro_bias_deg_s"] == "None"
+    assert rows["correction.blend.default_sigma_distance_deg_per_sqrt_m"] == "0.1146 deg/√m"
     assert dict(main_settings(RunConfig()))["elevation mask"] == "10.0 deg"
+
+
+def _angle_fields(config, prefix: str = "") -> dict[str, tuple[float | None, str]]:
+    """Every angle of a configuration by its dotted name in people units: its value in radians
+    and its people unit, found by the unit its name ends in (:func:`vo_doppler.units.unit_of`)."""
+    angles = {}
+    for f in dataclasses.fields(config):
+        value = getattr(config, f.name)
+        if dataclasses.is_dataclass(value):
+            angles |= _angle_fields(value, f"{prefix}{f.name}.")
+        elif (unit := unit_of(f.name)) is not None and unit.people_suffix is not None:
+            shown = prefix + f.name[: -len(unit.suffix)] + unit.people_suffix
+            angles[shown] = value, unit.people_symbol
+    return angles
+
+
+def test_the_full_configuration_table_shows_every_angle_in_degrees():
+    """The report's table (RunConfig, every stage) had raw radians where a hand list of angle
+    fields had not followed a new one: ``heading.backfill_bias_sigma 0.0008727``."""
+    config = RunConfig(
+        heading=HeadingPipelineConfig(fixed_gyro_bias_rad_s=np.radians(0.25)),
+        correction=CorrectionConfig(gate_rad=np.radians(30.0)),
+    )
+    rows = dict(config_rows(config))
+    assert not [name for name in rows if unit_of(name) and unit_of(name).symbol.startswith("rad")]
+    angles = _angle_fields(config)
+    assert len(angles) >= 26
+    for name, (radians, people) in angles.items():
+        if radians is None:
+            assert rows[name] == "None"
+            continue
+        value, symbol = rows[name].split(" ")
+        assert symbol == people and symbol.startswith("deg")
+        assert float(value) == pytest.approx(np.degrees(radians), rel=5e-4)
+    assert rows["heading.fixed_gyro_bias_deg_s"] == "0.25 deg/s"
+    assert rows["correction.gate_deg"] == "30 deg"
 
 
 def test_settings_and_definitions_of_what_did_not_run_are_left_out():

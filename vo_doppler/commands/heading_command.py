@@ -293,7 +293,7 @@ def run(args: argparse.Namespace) -> int:
         method,
         calibration=args.calibration,
         tight=tight,
-        fixed_gyro_bias=None if args.gyro_bias is None else np.radians(args.gyro_bias),
+        fixed_gyro_bias_rad_s=None if args.gyro_bias is None else np.radians(args.gyro_bias),
         fixed_wheel_scale=args.wheel_scale,
     )
     table = heading_from_gnss(

@@ -136,7 +136,7 @@ def heading_from_gnss(
         yaw_rate,
         source,
         scale_calibrated=config.fixed_wheel_scale is None,
-        bias_calibrated=config.fixed_gyro_bias is None,
+        bias_calibrated=config.fixed_gyro_bias_rad_s is None,
     )
     warnings += [w for w in [integrity_rate_warning(epoch_time, config.integrity)] if w]
     for warning in warnings:

@@ -5,7 +5,7 @@ Calibration is causal from its first estimate on: at each GNSS epoch the wheel s
 bias are refreshed from the conventional Doppler speed and course of the epochs so far (stored
 recent data), and the estimates current at an epoch calibrate the sensors from that epoch to the
 next; the epochs before the first estimate (for the gyro bias: the first with σ ≤
-``backfill_bias_sigma``) take the median of the drive's estimates (:func:`backfill_start`).
+``backfill_bias_sigma_rad_s``) take the median of the drive's estimates (:func:`backfill_start`).
 Only conventional velocities precise enough (``calibration_max_velocity_sigma_mps``)
 calibrate: with four satellites and a poor geometry a
 "valid" velocity can be metres per second off. The least-squares estimates are combined with a
@@ -104,11 +104,11 @@ class HeadingPipelineConfig:
     """A conventional speed further than max(these, as m/s and as a fraction) from the raw wheel
     speed does not calibrate: wheel scale errors are a few per cent, a reflected (NLOS) Doppler
     is often far more."""
-    prior_gyro_bias_sigma: float = PRIOR_GYRO_BIAS_SIGMA
+    prior_gyro_bias_sigma_rad_s: float = PRIOR_GYRO_BIAS_SIGMA
     """Spread of an uncalibrated gyro bias about zero (rad/s)."""
     prior_wheel_scale_sigma: float = PRIOR_WHEEL_SCALE_SIGMA
     """Spread of an uncalibrated wheel scale about one."""
-    backfill_bias_sigma: float = float(np.radians(0.05))
+    backfill_bias_sigma_rad_s: float = float(np.radians(0.05))
     """The gyro bias's first estimates with a larger σ (rad/s) give way to the drive's median
     (:func:`backfill_start`): 0.05 °/s held for 10 s turns the dead reckoning by 0.5°, for good
     (docs/design.md, "Sensor calibration"; measured in docs/benchmarks.md, "Error per 100 m on
@@ -116,7 +116,7 @@ class HeadingPipelineConfig:
     tight_calibration: bool = True
     """Where the conventional calibration has no gyro bias estimate, take it from the tightly
     coupled headings of a first pass and solve them again (:func:`tight_gyro_bias`)."""
-    tight_calibration_max_sigma: float = float(np.radians(5.0))
+    tight_calibration_max_sigma_rad: float = float(np.radians(5.0))
     """Tightly coupled headings with a larger σ (rad) do not calibrate. Where nothing has
     calibrated, a two-satellite heading's σ is 3–4°, most of it the prior's 3 % wheel-scale σ:
     an offset that changes only with the satellite geometry, which hardly tilts the bias's
@@ -131,7 +131,7 @@ class HeadingPipelineConfig:
     is shared by every window, which the correction cannot average away. At an even speed the
     rows hardly tell the scale from the grade, and the scale stays at the prior (docs/design.md,
     "Sensor calibration"; measured in docs/benchmarks.md, "A street canyon from the start")."""
-    fixed_gyro_bias: float | None = None
+    fixed_gyro_bias_rad_s: float | None = None
     fixed_wheel_scale: float | None = None
     smoother: HeadingSmootherConfig = field(default_factory=HeadingSmootherConfig)
     """The tight headings combined through the gyro (:mod:`vo_doppler.heading.smoother`)."""
@@ -216,7 +216,7 @@ def _calibrators(config: HeadingPipelineConfig):
         return GyroBiasCalibrator(config.gate), WheelScaleCalibrator(config.gate)
     if config.calibration is CalibrationMethod.KALMAN:
         return (
-            GyroBiasKalman(config=config.gate, prior_sigma=config.prior_gyro_bias_sigma),
+            GyroBiasKalman(config=config.gate, prior_sigma=config.prior_gyro_bias_sigma_rad_s),
             WheelScaleKalman(config=config.gate, prior_sigma=config.prior_wheel_scale_sigma),
         )
     return None, None
@@ -268,7 +268,7 @@ def causal_calibration(
         np.zeros(m, dtype=bool),
     )
     bias_cal, scale_cal = _calibrators(config)
-    current_bias = (0.0, config.prior_gyro_bias_sigma)
+    current_bias = (0.0, config.prior_gyro_bias_sigma_rad_s)
     current_scale = (1.0, config.prior_wheel_scale_sigma)
     for k in range(m):
         if bias_cal is not None:
@@ -279,15 +279,15 @@ def causal_calibration(
             out.bias_estimated[k] = b.valid and b.n_used > 0
             out.scale_estimated[k] = s.valid and s.n_used > 0
             if config.calibration == "ls":
-                current_bias = _with_prior(b, 0.0, config.prior_gyro_bias_sigma)
+                current_bias = _with_prior(b, 0.0, config.prior_gyro_bias_sigma_rad_s)
                 current_scale = _with_prior(s, 1.0, config.prior_wheel_scale_sigma)
             else:
                 current_bias = (b.value, b.sigma) if b.valid else current_bias
                 current_scale = (s.value, s.sigma) if s.valid else current_scale
         out.bias[k], out.bias_sigma[k] = current_bias
         out.scale[k], out.scale_sigma[k] = current_scale
-    if config.fixed_gyro_bias is not None:
-        out.bias[:], out.bias_sigma[:] = config.fixed_gyro_bias, 0.0
+    if config.fixed_gyro_bias_rad_s is not None:
+        out.bias[:], out.bias_sigma[:] = config.fixed_gyro_bias_rad_s, 0.0
         out.bias_estimated[:] = True
     if config.fixed_wheel_scale is not None:
         out.scale[:], out.scale_sigma[:] = config.fixed_wheel_scale, 0.0
@@ -315,7 +315,7 @@ def backfill_start(
     Why the bias's imprecise first estimates go too: a bias error b_e held for T seconds turns
     the dead reckoning by b_e·T for the rest of the drive, which no later estimate undoes. A
     first fit over 3–5 s of a dozen samples has σ 0.1–0.4 °/s
-    (:attr:`HeadingPipelineConfig.backfill_bias_sigma`)."""
+    (:attr:`HeadingPipelineConfig.backfill_bias_sigma_rad_s`)."""
     covered = np.ones(len(cal.bias), dtype=bool) if covered is None else covered
     bias_first = _first_precise(cal.bias_estimated, cal.bias_sigma, max_bias_sigma)
     scale_first = _first_precise(cal.scale_estimated, cal.scale_sigma, np.inf)
@@ -376,7 +376,7 @@ def tight_gyro_bias(
 
     fitted by :func:`~vo_doppler.heading.calibration.estimate_gyro_bias` (its gate and Huber
     line) over the whole drive (post-processing, not causal), on the reliable headings with
-    σ ≤ ``config.tight_calibration_max_sigma``. Each window sees the gyro over only
+    σ ≤ ``config.tight_calibration_max_sigma_rad``. Each window sees the gyro over only
     ``config.tight.window_s``, so a bias error b_e tilts its heading by a fraction of
     b_e·window_s while the slope is fitted over the drive's tens of seconds: the bias the first
     pass used hardly enters. The headings of overlapping windows share their
@@ -385,7 +385,7 @@ def tight_gyro_bias(
     t_epoch = np.asarray(t_epoch, dtype=float)
     sigma = np.nan_to_num(np.asarray(tight_sigma, dtype=float), nan=np.inf)
     informative = np.asarray(tight_reliable, dtype=bool) & (
-        sigma <= config.tight_calibration_max_sigma
+        sigma <= config.tight_calibration_max_sigma_rad
     )
     estimate = estimate_gyro_bias(
         t_epoch, tight_yaw, raw_yaw_angle, wheel_speed, informative, config.gate
@@ -394,7 +394,7 @@ def tight_gyro_bias(
         return None
     per_window = max(config.tight.window_s / float(np.median(np.diff(t_epoch))), 1.0)
     inflated = replace(estimate, sigma=estimate.sigma * float(np.sqrt(per_window)))
-    return _with_prior(inflated, 0.0, config.prior_gyro_bias_sigma)
+    return _with_prior(inflated, 0.0, config.prior_gyro_bias_sigma_rad_s)
 
 
 def _tight_calibration_needed(cal: CalibrationSeries, config: HeadingPipelineConfig) -> bool:
@@ -415,7 +415,7 @@ def tight_wheel_scale(
     combined with the prior; None where the rows do not pin it to
     ``config.tight_scale_max_sigma``. This project's addition, for drives without conventional
     velocities (a street canyon from the start). The windows used are reliable, with
-    σ ≤ ``config.tight_calibration_max_sigma`` and no rejected row.
+    σ ≤ ``config.tight_calibration_max_sigma_rad`` and no rejected row.
 
     The headings of a pass carry its scale's error (a two-satellite heading turns by about the
     relative speed error, in radians), which pulls the fit towards that scale: from the prior's
@@ -431,7 +431,7 @@ def tight_wheel_scale(
     result = solved.result
     informative = (
         result.reliable
-        & (np.nan_to_num(result.sigma, nan=np.inf) <= config.tight_calibration_max_sigma)
+        & (np.nan_to_num(result.sigma, nan=np.inf) <= config.tight_calibration_max_sigma_rad)
         & (result.n_rejected == 0)
     )
     ratio = speed_scale_ratio(**solved.tight_inputs, yaw=result.yaw, informative=informative)
@@ -484,7 +484,7 @@ def _smoothed(
     )
     gyro = GyroAngle(
         solved.tight_inputs["yaw_angle"],
-        float(np.median(bias_sigma)) if bias_sigma.size else config.prior_gyro_bias_sigma,
+        float(np.median(bias_sigma)) if bias_sigma.size else config.prior_gyro_bias_sigma_rad_s,
         walk,
     )
     return smooth_heading(windows, gyro, smoother, config.tight.max_sigma_rad)
@@ -589,7 +589,7 @@ def heading_pipeline(
             raw_angle,
             config,
         ),
-        config.backfill_bias_sigma,
+        config.backfill_bias_sigma_rad_s,
         covered,
     )
 

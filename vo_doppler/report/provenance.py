@@ -15,7 +15,7 @@ from vo_doppler import __version__
 from vo_doppler.errors import shown
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.run import RunConfig
-from vo_doppler.units import DEGREES_PER_RADIAN, in_people_units
+from vo_doppler.units import in_people_units
 
 SYNTHETIC_KEYS = ("scenario", "command")
 """Manifest keys only ``vo-doppler simulate`` writes: their presence marks a simulated drive."""
@@ -110,22 +110,11 @@ def version() -> str:
     return f"vo-doppler {__version__}"
 
 
-ANGLE_FIELDS = {
-    "prior_gyro_bias_sigma": " deg/s",
-    "fixed_gyro_bias": " deg/s",
-}
-"""RunConfig fields held in radians (or rad/s) without a unit suffix: shown in degrees."""
-
-
 def _people_value(name: str, value) -> tuple[str, str]:
     """(name, value) in people units: an angle in degrees, from the unit its name ends in
     (:func:`~vo_doppler.units.in_people_units`: ``gate_rad`` becomes ``gate_deg``)."""
-    unit = ANGLE_FIELDS.get(name)
-    if unit is None:
-        shown, value, symbol = in_people_units(name, value)
-        unit, name = (f" {symbol}" if shown != name else ""), shown
-    elif isinstance(value, float):
-        value = value * DEGREES_PER_RADIAN
+    shown, value, symbol = in_people_units(name, value)
+    unit, name = (f" {symbol}" if shown != name else ""), shown
     if unit and isinstance(value, float) and np.isfinite(value):
         return name, f"{value:.4g}{unit}"
     if isinstance(value, float):
