@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import html
 import io
 import json
 import re
@@ -27,6 +28,7 @@ from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.report.provenance import config_rows
 from vo_doppler.report.trajectory_map import lon_lat
 from vo_doppler.run import (
     PLACEMENT_VERTICAL_SIGMA_M,
@@ -136,6 +138,16 @@ def test_run_writes_every_output(sequence, run_output):
         assert len(np.unique(pixels.reshape(-1, pixels.shape[2]), axis=0)) > 10, name
         assert name == "trajectories.png" or png in embedded, name
     assert "VO + GPS (tightly coupled)" in report and "synthetic data" in report
+    # the full configuration table: the run's RunConfig, every angle in degrees by its name
+    start = report.index("Full configuration")
+    table = report[start : report.index("</details>", start)]
+    shown = dict(re.findall(r"<tr><th>(.*?)</th><td class='text'>(.*?)</td></tr>", table))
+    assert shown == {
+        name: html.escape(value) for name, value in config_rows(RunConfig().for_sequence(recording))
+    }
+    assert shown["heading.backfill_bias_sigma_deg_s"] == "0.05 deg/s"
+    assert shown["heading.tight_calibration_max_sigma_deg"] == "5 deg"
+    assert not [name for name in shown if "_rad" in name]
     available = f"{summary['tight_heading_availability']:.1%}"
     assert f"<th>tightly coupled heading available</th><td class='text'>{available}</td>" in report
 
