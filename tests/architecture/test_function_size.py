@@ -35,8 +35,6 @@ ALLOWED = {
     "vo_doppler/heading/tight_heading.py:build",
     "vo_doppler/gnss/pipeline.py:gnss_velocity",
     "vo_doppler/gnss/receiver_track.py:receiver_track",
-    "vo_doppler/gnss/windowed_line.py:windowed_line_residuals",
-    "vo_doppler/gnss/windowed_line.py:_line_at_epochs",
     "vo_doppler/fusion/heading_blend.py:blend_heading",
     "vo_doppler/fusion/heading_correction.py:correct_heading",
 }

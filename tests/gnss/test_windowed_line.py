@@ -9,6 +9,7 @@ import pytest
 from vo_doppler.geo import wrap_angle
 from vo_doppler.gnss.windowed_line import (
     ConsistencyConfig,
+    LineFit,
     consistency_test,
     windowed_line_residuals,
 )
@@ -20,7 +21,7 @@ def test_line_residuals_are_exact_on_a_line_with_one_outlier():
     values[50] += 0.5
     sigma = np.full(t.size, 0.01)
     usable = np.ones(t.size, bool)
-    residual, variance = windowed_line_residuals(t, values, sigma, usable, 2.0, 5)
+    residual, variance = windowed_line_residuals(t, values, sigma, usable, LineFit(2.0, 5))
     assert residual[50] == pytest.approx(0.5, abs=1e-12)
     # 40 neighbours at ±0.1–2 s: var(c₀) = σ²·Σdt²/(n·Σdt² − (Σdt)²) = σ²/40 (symmetric)
     assert variance[50] == pytest.approx(0.01**2 / 40, rel=1e-9)
@@ -28,13 +29,15 @@ def test_line_residuals_are_exact_on_a_line_with_one_outlier():
     # the outlier's Huber weight k·σ/0.5 leaves at most 1 % of it in a neighbour's line
     assert np.max(np.abs(residual[others])) < 5e-3
     # a slope prior of zero makes the line a constant: the drift shows in the residuals
-    flat, _ = windowed_line_residuals(t, values, sigma, usable, 2.0, 5, slope_sigma=np.zeros(100))
+    flat, _ = windowed_line_residuals(
+        t, values, sigma, usable, LineFit(2.0, 5), slope_sigma=np.zeros(100)
+    )
     assert flat[20] == pytest.approx(0.0, abs=1e-9)  # symmetric window: the drift cancels
     assert flat[5] < -0.005  # the window is cut at the start: the later epochs pull it up
     # without enough neighbours: untested
     lonely = np.zeros(t.size, bool)
     lonely[[10, 40, 90]] = True
-    residual, _ = windowed_line_residuals(t, values, sigma, lonely, 2.0, 1)
+    residual, _ = windowed_line_residuals(t, values, sigma, lonely, LineFit(2.0, 1))
     assert np.isnan(residual).all()
 
 
@@ -42,7 +45,9 @@ def test_angular_residuals_wrap_across_pi():
     t = np.arange(0.0, 5.0, 0.1)
     values = wrap_angle(np.pi - 0.01 + 0.004 * t / 0.1)  # crosses ±π
     usable = np.ones(t.size, bool)
-    residual, _ = windowed_line_residuals(t, values, np.ones(t.size), usable, 1.0, 5, angular=True)
+    residual, _ = windowed_line_residuals(
+        t, values, np.ones(t.size), usable, LineFit(1.0, 5, angular=True)
+    )
     np.testing.assert_allclose(residual, 0.0, atol=1e-9)
 
 

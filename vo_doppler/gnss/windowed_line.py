@@ -85,58 +85,67 @@ class ConsistencyTest:
         return self.decidable & ~self.tested
 
 
+@dataclass(frozen=True)
+class LineFit:
+    """How the line through an epoch's neighbours is fitted (I1): over the other usable epochs
+    within ±``half_window_s``, at least ``min_neighbours`` of them; ``angular``: differences
+    wrapped to (−π, π]; ``degree`` 2 a parabola instead of the line."""
+
+    half_window_s: float
+    min_neighbours: int
+    angular: bool = False
+    degree: int = 1
+
+
+@dataclass(frozen=True)
+class _Samples:
+    """The series tested: times (s), values, their σ and which epochs are usable."""
+
+    t: np.ndarray
+    values: np.ndarray
+    sigma: np.ndarray
+    usable: np.ndarray
+
+
 def windowed_line_residuals(
     t: np.ndarray,
     values: np.ndarray,
     sigma: np.ndarray,
     usable: np.ndarray,
-    half_window_s: float,
-    min_neighbours: int,
-    angular: bool = False,
+    fit: LineFit,
     slope_sigma: np.ndarray | None = None,
-    degree: int = 1,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Each epoch's value minus a robust line through the other usable epochs within
-    ``half_window_s``, at its own time, and the line's variance there (I1): Huber IRLS on the
+    """Each epoch's value minus a robust line through the other usable epochs of its window
+    (``fit``), at its own time, and the line's variance there (I1): Huber IRLS on the
     residuals in units of each value's ``sigma``, from the median (slope zero).
-    ``angular``: differences wrapped to (−π, π]. ``slope_sigma`` (per epoch, units of value per
-    second): a prior N(0, σ²) on the line's slope (none where infinite or not given).
-    ``degree`` 2 fits a parabola instead of the line. NaN where fewer than ``min_neighbours``
+    ``slope_sigma`` (per epoch, units of value per second): a prior N(0, σ²) on the line's
+    slope (none where infinite or not given). NaN where fewer than ``fit.min_neighbours``
     others are usable or the epoch itself is not."""
     t = np.asarray(t, dtype=float)
     values = np.asarray(values, dtype=float)
     sigma = np.asarray(sigma, dtype=float)
     usable = np.asarray(usable, dtype=bool) & np.isfinite(values) & np.isfinite(t)
     usable &= np.isfinite(sigma) & (sigma > 0)
+    samples = _Samples(t, values, sigma, usable)
     slope_sigma = np.full(t.size, np.inf) if slope_sigma is None else np.asarray(slope_sigma)
     slope_precision = np.maximum(slope_sigma, MIN_SLOPE_SIGMA) ** -2.0
     residual, variance = np.full(t.size, np.nan), np.full(t.size, np.nan)
     for start in range(0, t.size, CHUNK_EPOCHS):
         epochs = np.arange(start, min(start + CHUNK_EPOCHS, t.size))
-        line, line_variance, count = _line_at_epochs(
-            epochs,
-            t,
-            values,
-            sigma,
-            usable,
-            half_window_s,
-            angular,
-            slope_precision[epochs],
-            degree,
-        )
-        enough = count >= max(min_neighbours, degree + 1)
+        line, line_variance, count = _line_at_epochs(epochs, samples, fit, slope_precision[epochs])
+        enough = count >= max(fit.min_neighbours, fit.degree + 1)
         residual[epochs] = np.where(enough, line, np.nan)
         variance[epochs] = np.where(enough, line_variance, np.nan)
     return residual, variance
 
 
-def _line_at_epochs(
-    epochs, t, values, sigma, usable, half_window_s, angular, slope_precision, degree
-):
+def _line_at_epochs(epochs, samples: _Samples, fit: LineFit, slope_precision):
     """:func:`windowed_line_residuals` at ``epochs`` (an (epochs × window) block of the other
     usable epochs in each window): weighted normal equations of the polynomial in the time
     offset with the slope prior's precision added to the slope's diagonal; also the number of
     neighbours."""
+    t, values, sigma, usable = samples.t, samples.values, samples.sigma, samples.usable
+    half_window_s, angular, degree = fit.half_window_s, fit.angular, fit.degree
     lo = np.searchsorted(t, t[epochs] - half_window_s, "left")
     hi = np.searchsorted(t, t[epochs] + half_window_s, "right")
     index = lo[:, None] + np.arange(int((hi - lo).max()))
@@ -192,17 +201,8 @@ def consistency_test(
     """Test (I1) of one quantity: ``difference`` is the GNSS value minus the sensor's (course
     minus integrated yaw rate, or speed minus wheel speed), ``sigma`` the GNSS value's σ,
     ``slope_sigma`` the σ of the sensor's drift (:func:`windowed_line_residuals`)."""
-    residual, variance = windowed_line_residuals(
-        t,
-        difference,
-        sigma,
-        usable,
-        config.half_window_s,
-        config.min_neighbours,
-        angular,
-        slope_sigma,
-        config.degree,
-    )
+    fit = LineFit(config.half_window_s, config.min_neighbours, angular, config.degree)
+    residual, variance = windowed_line_residuals(t, difference, sigma, usable, fit, slope_sigma)
     with np.errstate(invalid="ignore"):
         z = residual / np.sqrt(np.asarray(sigma, dtype=float) ** 2 + variance)
     z = np.where(np.isfinite(z), z, np.nan)
