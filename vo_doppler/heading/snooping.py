@@ -68,7 +68,7 @@ c_jᵀWr over (Σ_j w − A_j N⁻¹ A_jᵀ)²); the largest such term over the 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -146,6 +146,77 @@ def _cost_with_biases(normal, S_X, S_T, S_w, grid_size, iterations):
     return minimum_cost(Q, grid_size, iterations)
 
 
+@dataclass(frozen=True)
+class SnoopWindows:
+    """The padded windows (K, R) tested, as in
+    :func:`vo_doppler.heading.tight_heading.solve_windows`: coefficients ``a``, ``b``, reduced
+    observations ``y``, row times ``tau``, a-priori weights ``w`` of the rows in the fit (0
+    elsewhere), ``group`` the satellite index in [0, n_groups); ``calibration_sigma`` the
+    relative speed-scale and gyro-bias (rad/s) standard deviations (K,) each."""
+
+    a: np.ndarray
+    b: np.ndarray
+    y: np.ndarray
+    tau: np.ndarray
+    w: np.ndarray
+    group: np.ndarray
+    n_groups: int
+    calibration_sigma: tuple[np.ndarray, np.ndarray]
+
+    def finite(self) -> SnoopWindows:
+        """The same windows with NaN coefficients (padding) as zeros."""
+        return replace(self, a=np.nan_to_num(self.a), b=np.nan_to_num(self.b))
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(windows, satellite groups)."""
+        return len(self.w), self.n_groups
+
+    @property
+    def flat(self) -> np.ndarray:
+        """Each row's (window, group) as one flat index (:func:`_group_sums`)."""
+        return (np.arange(len(self.w))[:, None] * self.n_groups + self.group).ravel()
+
+    def group_sums(self, values) -> np.ndarray:
+        """Σ per (window, group) of ``values`` (K, R) or (K, R, C)."""
+        return _group_sums(values, self.flat, self.shape)
+
+
+@dataclass(frozen=True)
+class SnoopSettings:
+    """The tests' settings (:class:`vo_doppler.heading.tight_heading.TightHeadingConfig`):
+    the θ₀ grid and Gauss–Newton iterations, the false-alarm probability ``alpha`` per window,
+    the ``identification_odds`` and the smallest redundancy number tested."""
+
+    grid_size: int
+    iterations: int
+    alpha: float
+    identification_odds: float
+    min_redundancy: float
+
+
+@dataclass(frozen=True)
+class _LeastSquares:
+    """The windows' fit without bias parameters: X, T, XᵀWX, XᵀWT, (TᵀWT)⁺, θ₀ and its cost."""
+
+    X: np.ndarray
+    T: np.ndarray
+    XtWX: np.ndarray
+    XtWT: np.ndarray
+    TtWT_pinv: np.ndarray
+    theta: np.ndarray
+    cost: np.ndarray
+
+
+def _least_squares(windows: SnoopWindows, settings: SnoopSettings) -> _LeastSquares:
+    """:class:`_LeastSquares` of ``windows`` (finite coefficients)."""
+    X = np.stack([-windows.a, -windows.b, windows.y], axis=-1)
+    T = np.stack([np.ones_like(windows.tau), -windows.tau], axis=-1)
+    Q0, XtWX, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, windows.w)
+    theta, cost0 = minimum_cost(Q0, settings.grid_size, settings.iterations)
+    return _LeastSquares(X, T, XtWX, XtWT, TtWT_pinv, theta, cost0)
+
+
 @dataclass
 class _Linearised:
     """The least-squares fit linearised at its θ₀ (module docstring): per row the weighted
@@ -162,20 +233,23 @@ class _Linearised:
     N_inv: np.ndarray
 
 
-def _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma):
+def _linearise(windows: SnoopWindows, fit: _LeastSquares) -> _Linearised:
+    """:class:`_Linearised` of the least-squares ``fit`` of ``windows``."""
+    a, b, tau, w, theta = windows.a, windows.b, windows.tau, windows.w, fit.theta
     cos_t, sin_t = np.cos(theta)[:, None], np.sin(theta)[:, None]
     j_theta = -a * sin_t + b * cos_t
     J = np.stack([j_theta, np.ones_like(tau), -tau], axis=-1)
     z = z_of(theta)
-    params = (TtWT_pinv @ (XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
-    residual = (X @ z[:, :, None])[:, :, 0] - np.einsum("krj,kj->kr", T, params)
+    params = (fit.TtWT_pinv @ (fit.XtWT.transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
+    residual = (fit.X @ z[:, :, None])[:, :, 0] - np.einsum("krj,kj->kr", fit.T, params)
     normalised = np.where(w > 0, np.abs(residual) * np.sqrt(w), np.nan)
     # windows without rows give NaN: no scale-up
     mad = np.nan_to_num(nmad(normalised, axis=1, centre=False, skip_nan=True))
     N_inv = np.linalg.pinv(weighted_gram(J, w, J), hermitian=True)
     leverage = np.sum((J @ N_inv) * J, axis=-1) * w
     model_rows = []
-    for m, sigma in zip((a * cos_t + b * sin_t, -tau * j_theta), calibration_sigma, strict=True):
+    errors = (a * cos_t + b * sin_t, -tau * j_theta)
+    for m, sigma in zip(errors, windows.calibration_sigma, strict=True):
         fitted = (J @ (N_inv @ weighted_gram(J, w * m, np.ones_like(m)[..., None])))[..., 0]
         model_rows.append(w * (m - fitted) * sigma[:, None])
     return _Linearised(
@@ -189,71 +263,102 @@ def _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma):
     )
 
 
-def snoop_satellites(
-    a: np.ndarray,
-    b: np.ndarray,
-    y: np.ndarray,
-    tau: np.ndarray,
-    w: np.ndarray,
-    group: np.ndarray,
-    n_groups: int,
-    calibration_sigma: tuple[np.ndarray, np.ndarray],
-    grid_size: int,
-    iterations: int,
-    alpha: float,
-    identification_odds: float,
-    min_redundancy: float,
-    noise: ReceiverNoise | None = None,
-) -> SnoopingResult:
-    """Bias tests of every satellite and every row of every window (module docstring).
+@dataclass(frozen=True)
+class _Statistics:
+    """The test statistics of every satellite (K, n_groups) and row (K, R), which of them are
+    tested, the variance of each satellite's c_jᵀWr and the bias-free θ₀ (and cost) under
+    each satellite's hypothesis."""
 
-    Arrays (K, R) as in :func:`vo_doppler.heading.tight_heading.solve_windows`: coefficients
-    ``a``, ``b``, reduced observations ``y``, row times ``tau``, a-priori weights ``w`` of the
-    rows in the fit (0 elsewhere) and ``group`` the satellite index in [0, n_groups).
-    ``calibration_sigma``: relative speed-scale and gyro-bias (rad/s) standard deviations (K,).
-    ``alpha`` is the false-alarm probability per window, half for the satellite tests and
-    half for the row tests, each half shared among the n tests (Bonferroni: α/(2n)).
-    Satellites and rows whose redundancy number is below ``min_redundancy`` are not tested:
-    so little of a bias would show that the statistic would measure the model's small
-    unmodelled errors rather than the observation. ``noise``: σ₀ and κ of the receiver's
-    noise (default: :func:`receiver_noise` of these windows).
-    """
-    a, b = np.nan_to_num(a), np.nan_to_num(b)
-    K = len(w)
-    shape = (K, n_groups)
-    X, T, XtWX, XtWT, TtWT_pinv, theta, cost0 = _least_squares(
-        a, b, y, tau, w, grid_size, iterations
-    )
-    flat = (np.arange(K)[:, None] * n_groups + group).ravel()
-    S_w = _group_sums(w, flat, shape)
-    S_X = _group_sums(w[..., None] * X, flat, shape)
-    S_T = _group_sums(w[..., None] * T, flat, shape)
-    normal = (XtWX, XtWT, weighted_gram(T, w, T))
+    satellite: np.ndarray
+    row: np.ndarray
+    satellite_ok: np.ndarray
+    row_ok: np.ndarray
+    variance: np.ndarray
+    seen: np.ndarray
+    single_theta: np.ndarray
+    single_cost: np.ndarray
+    sums: tuple
+    """:func:`_satellite_sums` of the windows."""
+
+
+def _statistics(windows, settings, fit, lin, terms, noise) -> _Statistics:
+    """Satellite statistics λ_j (the cost's drop when satellite j gets a bias, over its
+    variance ratio) and row w-tests (module docstring); the noise model ``noise``."""
+    w = windows.w
+    sums = _satellite_sums(windows, fit)
     single_theta, single = _cost_with_biases(
-        normal, S_X[:, :, None], S_T[:, :, None], S_w[:, :, None], grid_size, iterations
+        sums[3],
+        sums[0][:, :, None],
+        sums[1][:, :, None],
+        sums[2][:, :, None],
+        settings.grid_size,
+        settings.iterations,
     )
-    lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma)
-    terms = _satellite_terms(lin, w, group, flat, shape)
-    sat_ok = (S_w > 0) & (terms.redundancy >= min_redundancy)
-    if noise is None:
-        noise = receiver_noise([_sample(lin, terms, sat_ok)])
+    sat_ok = (sums[2] > 0) & (terms.redundancy >= settings.min_redundancy)
     variance = noise.variance(terms)
     row_variance = (
         noise.scale**2 * lin.row_seen
         + noise.correlated**2 * terms.row_correlated
         + sum(m**2 for m in lin.model_rows)
     )
-    row_ok = (w > 0) & (lin.row_seen >= min_redundancy * w)
-    drop = np.clip(cost0[:, None] - single, 0.0, None)
+    row_ok = (w > 0) & (lin.row_seen >= settings.min_redundancy * w)
+    drop = np.clip(fit.cost[:, None] - single, 0.0, None)
     seen = terms.seen
     sat_stat = np.where(sat_ok, drop * seen / np.where(sat_ok, variance, 1.0), 0.0)
     row_stat = np.where(row_ok, lin.weighted_residual**2 / np.where(row_ok, row_variance, 1.0), 0.0)
+    return _Statistics(
+        sat_stat, row_stat, sat_ok, row_ok, variance, seen, single_theta, single, sums
+    )
+
+
+def _satellite_sums(windows: SnoopWindows, fit: _LeastSquares):
+    """Per (window, satellite) Σ w·X, Σ w·T and Σ w, and the windows' normal matrices
+    (XᵀWX, XᵀWT, TᵀWT): what each bias hypothesis adds to the fit."""
+    w = windows.w
+    S_w = windows.group_sums(w)
+    S_X = windows.group_sums(w[..., None] * fit.X)
+    S_T = windows.group_sums(w[..., None] * fit.T)
+    return S_X, S_T, S_w, (fit.XtWX, fit.XtWT, weighted_gram(fit.T, w, fit.T))
+
+
+def snoop_satellites(
+    windows: SnoopWindows, settings: SnoopSettings, noise: ReceiverNoise | None = None
+) -> SnoopingResult:
+    """Bias tests of every satellite and every row of every window (module docstring).
+
+    ``settings.alpha`` is the false-alarm probability per window, half for the satellite tests
+    and half for the row tests, each half shared among the n tests (Bonferroni: α/(2n)).
+    Satellites and rows whose redundancy number is below ``settings.min_redundancy`` are not
+    tested: so little of a bias would show that the statistic would measure the model's small
+    unmodelled errors rather than the observation. ``noise``: σ₀ and κ of the receiver's
+    noise (default: :func:`receiver_noise` of these windows).
+    """
+    windows = windows.finite()
+    fit = _least_squares(windows, settings)
+    lin = _linearise(windows, fit)
+    terms = _satellite_terms(lin, windows.w, windows.group, windows.flat, windows.shape)
+    if noise is None:
+        tested = (windows.group_sums(windows.w) > 0) & (terms.redundancy >= settings.min_redundancy)
+        noise = receiver_noise([_sample(lin, terms, tested)])
+    stats = _statistics(windows, settings, fit, lin, terms, noise)
+    return _decide(windows, settings, fit, stats, noise, (lin, terms))
+
+
+def _decide(windows, settings, fit, stats: _Statistics, noise, linearised) -> SnoopingResult:
+    """The decision on the statistics ``stats`` (module docstring): detection against the
+    Bonferroni-shared critical values, identification by the likelihood-ratio margin, the
+    rows to reject, and the pair hypotheses where a satellite's bias was detected."""
+    lin, terms = linearised
+    w, group, n_groups = windows.w, windows.group, windows.n_groups
+    sat_stat, row_stat = stats.satellite, stats.row
+    sat_ok, row_ok = stats.satellite_ok, stats.row_ok
+    K = len(w)
     n_sat, n_row = np.count_nonzero(sat_ok, axis=1), np.count_nonzero(row_ok, axis=1)
     best_sat, best_row = np.argmax(sat_stat, axis=1), np.argmax(row_stat, axis=1)
     k = np.arange(K)
     sat_max, row_max = sat_stat[k, best_sat], row_stat[k, best_row]
-    row_critical = chi2_isf_1(alpha / (2 * np.maximum(n_row, 1)))
-    sat_critical = chi2_isf_1(alpha / (2 * np.maximum(n_sat, 1)))
+    row_critical = chi2_isf_1(settings.alpha / (2 * np.maximum(n_row, 1)))
+    sat_critical = chi2_isf_1(settings.alpha / (2 * np.maximum(n_sat, 1)))
     detected = (sat_max > sat_critical) | (row_max > row_critical)
     by_row = row_max > sat_max
     suspect = np.where(by_row, group[k, best_row], best_sat)
@@ -262,26 +367,29 @@ def snoop_satellites(
     other_sat = np.where(sat_ok & (np.arange(n_groups) != suspect[:, None]), sat_stat, 0.0)
     other_row = np.where(row_ok & ~own, row_stat, 0.0)
     runner_up = np.maximum(np.max(other_sat, axis=1), np.max(other_row, axis=1, initial=0.0))
-    margin = 2.0 * np.log(identification_odds)
+    margin = 2.0 * np.log(settings.identification_odds)
     identified = largest - runner_up >= margin
     significant_rows = own & (row_stat > row_critical[:, None])
     significant_rows[k, best_row] = True
     reject = np.where(by_row[:, None], significant_rows, own)
     two = np.flatnonzero(detected & ~by_row & (n_sat >= 2))
     if two.size:
+        S_X, S_T, S_w, normal = stats.sums
         pair, pair_identified, pair_wins = _pairs(
             two,
-            (S_X, S_T, S_w, seen / np.where(sat_ok, variance, 1.0), sat_stat, sat_ok),
+            (S_X, S_T, S_w, stats.seen / np.where(sat_ok, stats.variance, 1.0), sat_stat, sat_ok),
             normal,
-            single[two, best_sat[two]],
-            (grid_size, iterations),
-            alpha,
+            stats.single_cost[two, best_sat[two]],
+            (settings.grid_size, settings.iterations),
+            settings.alpha,
             margin,
         )
-        windows = two[pair_wins]
+        windows_won = two[pair_wins]
         chosen = pair[pair_wins]
-        reject[windows] = (group[windows] == chosen[:, :1]) | (group[windows] == chosen[:, 1:])
-        identified[windows] = pair_identified[pair_wins]
+        reject[windows_won] = (group[windows_won] == chosen[:, :1]) | (
+            group[windows_won] == chosen[:, 1:]
+        )
+        identified[windows_won] = pair_identified[pair_wins]
     suspects = sat_ok & (
         (sat_stat > largest[:, None] - margin) | (sat_stat > sat_critical[:, None])
     )
@@ -290,26 +398,17 @@ def snoop_satellites(
         detected=detected,
         identified=identified,
         row_fault=detected & (sat_max <= sat_critical),
-        theta=theta,
+        theta=fit.theta,
         bias_variance=np.max(
-            np.where(sat_ok, (terms.A @ lin.N_inv)[..., 0] ** 2 * variance, 0.0)
-            / np.where(sat_ok, seen, 1.0) ** 2,
+            np.where(sat_ok, (terms.A @ lin.N_inv)[..., 0] ** 2 * stats.variance, 0.0)
+            / np.where(sat_ok, stats.seen, 1.0) ** 2,
             axis=1,
             initial=0.0,
         ),
         min_redundancy=np.min(terms.redundancy, axis=1, initial=1.0),
-        suspect_theta=np.where(suspects, single_theta, np.nan),
+        suspect_theta=np.where(suspects, stats.single_theta, np.nan),
         noise=noise,
     )
-
-
-def _least_squares(a, b, y, tau, w, grid_size, iterations):
-    """The windows' fit without bias parameters: X, T, XᵀWX, XᵀWT, (TᵀWT)⁺, θ₀ and its cost."""
-    X = np.stack([-a, -b, y], axis=-1)
-    T = np.stack([np.ones_like(tau), -tau], axis=-1)
-    Q0, XtWX, XtWT, TtWT_pinv, _ = projected_normal_matrix(X, T, w)
-    theta, cost0 = minimum_cost(Q0, grid_size, iterations)
-    return X, T, XtWX, XtWT, TtWT_pinv, theta, cost0
 
 
 @dataclass
@@ -412,29 +511,14 @@ def _sample(lin: _Linearised, terms: _SatelliteTerms, tested: np.ndarray) -> Noi
     )
 
 
-def noise_statistics(
-    a,
-    b,
-    y,
-    tau,
-    w,
-    group,
-    n_groups: int,
-    calibration_sigma: tuple[np.ndarray, np.ndarray],
-    grid_size: int,
-    iterations: int,
-    min_redundancy: float,
-) -> NoiseSample:
-    """What :func:`receiver_noise` pools from these windows (arrays as in
-    :func:`snoop_satellites`; the same numbers it computes on its first pass). Windows solved
-    in several chunks share one noise model by pooling these over every chunk."""
-    a, b = np.nan_to_num(a), np.nan_to_num(b)
-    X, T, _, XtWT, TtWT_pinv, theta, _ = _least_squares(a, b, y, tau, w, grid_size, iterations)
-    lin = _linearise(a, b, tau, w, X, T, theta, TtWT_pinv, XtWT, calibration_sigma)
-    K = len(w)
-    flat = (np.arange(K)[:, None] * n_groups + group).ravel()
-    terms = _satellite_terms(lin, w, group, flat, (K, n_groups))
-    tested = (_group_sums(w, flat, (K, n_groups)) > 0) & (terms.redundancy >= min_redundancy)
+def noise_statistics(windows: SnoopWindows, settings: SnoopSettings) -> NoiseSample:
+    """What :func:`receiver_noise` pools from these windows (the same numbers
+    :func:`snoop_satellites` computes on its first pass). Windows solved in several chunks
+    share one noise model by pooling these over every chunk."""
+    windows = windows.finite()
+    lin = _linearise(windows, _least_squares(windows, settings))
+    terms = _satellite_terms(lin, windows.w, windows.group, windows.flat, windows.shape)
+    tested = (windows.group_sums(windows.w) > 0) & (terms.redundancy >= settings.min_redundancy)
     return _sample(lin, terms, tested)
 
 

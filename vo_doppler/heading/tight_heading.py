@@ -81,6 +81,8 @@ from vo_doppler.heading.profile import (
 )
 from vo_doppler.heading.snooping import (
     ReceiverNoise,
+    SnoopSettings,
+    SnoopWindows,
     noise_statistics,
     receiver_noise,
     snoop_satellites,
@@ -262,6 +264,18 @@ class _WindowSolution:
     prior_variance: np.ndarray
 
 
+def snoop_settings(config: TightHeadingConfig) -> SnoopSettings:
+    """The data-snooping settings of ``config``
+    (:func:`vo_doppler.heading.snooping.snoop_satellites`)."""
+    return SnoopSettings(
+        config.grid_size,
+        config.gauss_newton_iterations,
+        config.outlier_alpha,
+        config.identification_odds,
+        config.testable_redundancy,
+    )
+
+
 def _fit(X, T, prior, w, config):
     """Huber-weighted fit of padded windows (observation matrix ``X``, design ``T`` of the
     linear parameters and the precision ``prior`` of their prior, a-priori weights ``w``): the
@@ -403,7 +417,7 @@ def solve_windows(
     for rejection in range(config.outlier_passes + 1):
         if not (todo.size and config.outlier_passes):
             break
-        tests = snoop_satellites(
+        window_rows = SnoopWindows(
             a[todo],
             b[todo],
             y[todo],
@@ -412,13 +426,8 @@ def solve_windows(
             group[todo],
             n_groups,
             (scale_sigma[todo], bias_sigma[todo]),
-            config.grid_size,
-            config.gauss_newton_iterations,
-            config.outlier_alpha,
-            config.identification_odds,
-            config.testable_redundancy,
-            noise,
         )
+        tests = snoop_satellites(window_rows, snoop_settings(config), noise)
         noise = tests.noise
         if rejection == 0:
             verifiable_before = tests.min_redundancy >= config.testable_redundancy
@@ -664,21 +673,10 @@ def tight_heading_series(
         samples = []
         for k in chunks:
             y, a, b, tau, w, group, _, _ = padded(k)
-            samples.append(
-                noise_statistics(
-                    a,
-                    b,
-                    y,
-                    tau,
-                    w,
-                    group,
-                    n_groups,
-                    (scale_sigma[k], bias_sigma[k]),
-                    config.grid_size,
-                    config.gauss_newton_iterations,
-                    config.testable_redundancy,
-                )
+            window_rows = SnoopWindows(
+                a, b, y, tau, w, group, n_groups, (scale_sigma[k], bias_sigma[k])
             )
+            samples.append(noise_statistics(window_rows, snoop_settings(config)))
         noise = receiver_noise(samples)
     solutions = []
     for k in chunks:
