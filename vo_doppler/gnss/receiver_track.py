@@ -199,6 +199,40 @@ def receiver_track(
     lat, lon, _ = ecef_to_geodetic(origin)
     rotation = ecef_to_enu_rotation(float(lat), float(lon))
     fix = (fix_ecef - origin) @ rotation.T
+    step, step_variance, linked = _velocity_steps(
+        t, rotation, (velocity_ecef, velocity_covariance, velocity_known), config
+    )
+    # Epochs a chain of finite steps links to a fix; (T1) is singular on the others.
+    component = np.concatenate([[0], np.cumsum(~linked)])
+    connected = (np.bincount(component, weights=fixed) > 0)[component]
+    horizontal = np.maximum(fix_sigma_m / np.sqrt(2.0), config.min_fix_sigma_m)
+    fix_sigma = np.stack([horizontal, horizontal, config.vertical_ratio * horizontal], axis=1)
+    fix_sigma = np.where(fixed[:, None], fix_sigma, np.inf)
+    track, used, state = _robust_track(
+        (fix, fix_sigma, fixed, connected), step, 1.0 / step_variance, config
+    )
+    dt = np.diff(t)[:, None]
+    anchor = fixed[:, None] & (state[0] >= config.anchor_weight)
+    step_sigma = np.sqrt(step_variance)
+    variance = sum(
+        _smoothed_variance(used[:, axis], step_variance[:, axis])
+        + _drift(anchor[:, axis], step_sigma[:, axis]) ** 2
+        for axis in range(3)
+    )
+    sigma = np.where(connected, np.sqrt(variance), np.inf)
+    bound = max(config.trusted_sigma_m, 2.0 * float(np.min(sigma)))
+    trusted = sigma <= bound
+    reach = np.linalg.norm(step, axis=1) + np.linalg.norm(step_sigma, axis=1)
+    reach = np.minimum(reach, config.max_speed_mps * np.abs(dt[:, 0]))
+    source, sigma = _held(t.size, trusted, sigma, np.concatenate([[0.0], np.cumsum(reach)]))
+    return ReceiverTrack(track[source] @ rotation + origin, sigma, ~trusted)
+
+
+def _velocity_steps(t, rotation, velocities, config: TrackConfig):
+    """The steps between epochs in the local frame (``rotation`` from ECEF) integrated from the
+    velocities (ECEF, covariance, known; unknown ones filled, :func:`_filled_velocity`), their
+    variances (inf across a gap) and whether each links its two epochs (T1)."""
+    velocity_ecef, velocity_covariance, velocity_known = velocities
     known = np.asarray(velocity_known, dtype=bool) & np.all(np.isfinite(velocity_ecef), axis=1)
     velocity = np.where(known[:, None], np.nan_to_num(velocity_ecef) @ rotation.T, 0.0)
     covariance = rotation @ np.nan_to_num(np.asarray(velocity_covariance)[:, :3, :3]) @ rotation.T
@@ -214,13 +248,15 @@ def receiver_track(
         linked[:, None], np.maximum(step_variance, MIN_STEP_VARIANCE_M2), np.inf
     )
     step = np.where(linked[:, None], step, 0.0)
-    step_weight = 1.0 / step_variance
-    # Epochs a chain of finite steps links to a fix; (T1) is singular on the others.
-    component = np.concatenate([[0], np.cumsum(~linked)])
-    connected = (np.bincount(component, weights=fixed) > 0)[component]
-    horizontal = np.maximum(fix_sigma_m / np.sqrt(2.0), config.min_fix_sigma_m)
-    fix_sigma = np.stack([horizontal, horizontal, config.vertical_ratio * horizontal], axis=1)
-    fix_sigma = np.where(fixed[:, None], fix_sigma, np.inf)
+    return step, step_variance, linked
+
+
+def _robust_track(fixes, step, step_weight, config: TrackConfig):
+    """(T1) solved per axis with robust weights of the fixes (Huber, then Cauchy passes, their
+    per-axis scale the NMAD of the normalised residuals): the track, the fixes' final weights
+    and the IRLS state (robust weights, scale). ``fixes``: local positions, their per-axis σ,
+    which epochs have one and which a chain of steps links to a fix."""
+    fix, fix_sigma, fixed, connected = fixes
 
     def solve(state):
         """(T1) with the fixes' robust weights and per-axis scale ``state``: the track and
@@ -243,23 +279,10 @@ def receiver_track(
     def normalised_residual(state):
         return (fix - solve(state)[0]) / fix_sigma
 
-    start = (np.ones((t.size, 3)), np.ones(3))
+    start = (np.ones((len(fix), 3)), np.ones(3))
     state = irls(normalised_residual, weigh, start, config.passes - 1)
     track, used = solve(state)
-    anchor = fixed[:, None] & (state[0] >= config.anchor_weight)
-    step_sigma = np.sqrt(step_variance)
-    variance = sum(
-        _smoothed_variance(used[:, axis], step_variance[:, axis])
-        + _drift(anchor[:, axis], step_sigma[:, axis]) ** 2
-        for axis in range(3)
-    )
-    sigma = np.where(connected, np.sqrt(variance), np.inf)
-    bound = max(config.trusted_sigma_m, 2.0 * float(np.min(sigma)))
-    trusted = sigma <= bound
-    reach = np.linalg.norm(step, axis=1) + np.linalg.norm(step_sigma, axis=1)
-    reach = np.minimum(reach, config.max_speed_mps * np.abs(dt[:, 0]))
-    source, sigma = _held(t.size, trusted, sigma, np.concatenate([[0.0], np.cumsum(reach)]))
-    return ReceiverTrack(track[source] @ rotation + origin, sigma, ~trusted)
+    return track, used, state
 
 
 def smoothed_track(
