@@ -137,7 +137,12 @@ def gnss_velocity(
 
     Arguments out of their domain (an elevation mask outside [0, π/2) rad, band digits that are
     not digits or absent from the file, a receiver position off the Earth, an unknown
-    ``range_rate``) are an :class:`InputError` naming the argument."""
+    ``range_rate``) are an :class:`InputError` naming the argument.
+
+    Many parameters because it is the GNSS stage's public entry point: after the observations
+    and satellite states, each argument is one independent option with its default, passed by
+    keyword by ``run.py``, the commands and the tests; gathering them into a configuration is
+    issue 32's open work together with those callers."""
     receiver_ecef = _check_arguments(
         obs, systems, elevation_mask_rad, bands, range_rate, receiver_ecef
     )
@@ -164,19 +169,7 @@ def gnss_velocity(
 
     rows = rows_at(position)
     if receiver_ecef is None:
-        first = solve_velocity(rows, obs.epoch_time)
-        known = first.valid | first.untestable
-        track = smoothed_track(
-            obs.epoch_time,
-            spp.position_ecef,
-            spp.horizontal_sigma_m,
-            first.velocity_ecef,
-            first.covariance,
-            known,
-        )
-        if track is not None:
-            position = track
-            rows = rows_at(position, log_missing=False)  # the first pass logged them
+        position, rows = _along_track(obs.epoch_time, spp, (position, rows), rows_at)
     if fit_noise:
         velocity, rows, models = solve_with_fitted_noise(rows, obs.epoch_time)
     else:
@@ -189,6 +182,27 @@ def gnss_velocity(
             velocity = solve_velocity(rows, obs.epoch_time)
     spp = doppler_consistency(spp, velocity)
     return GnssVelocityResult(velocity, rows, spp, np.asarray(position), models, fit_noise, moving)
+
+
+def _along_track(epoch_time, spp, first_pass, rows_at):
+    """Positions and Doppler rows again from the SPP fixes smoothed along the velocities of
+    ``first_pass`` (positions, rows; :func:`~vo_doppler.gnss.receiver_track.smoothed_track`
+    with the epochs whose velocity is valid or untestable), or ``first_pass`` as it is when no
+    track can be made. ``rows_at``: the rows at given positions."""
+    position, rows = first_pass
+    first = solve_velocity(rows, epoch_time)
+    known = first.valid | first.untestable
+    track = smoothed_track(
+        epoch_time,
+        spp.position_ecef,
+        spp.horizontal_sigma_m,
+        first.velocity_ecef,
+        first.covariance,
+        known,
+    )
+    if track is None:
+        return position, rows
+    return track, rows_at(track, log_missing=False)  # the first pass logged them
 
 
 def gnss_position(
