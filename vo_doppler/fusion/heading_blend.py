@@ -602,15 +602,9 @@ def blend_heading(
     :func:`~vo_doppler.fusion.heading_correction.correct_heading`."""
     reference = checked(HeadingReference, reference, "reference")
     t_heading = np.asarray(t_heading, dtype=float)
-    n_heading = len(t_heading)
-    yaw = np.asarray(yaw_heading, dtype=float).copy()
-    if valid is not None:
-        yaw[~np.asarray(valid, dtype=bool)] = np.nan
-    sigma = np.broadcast_to(
-        np.asarray(np.nan if sigma_heading is None else sigma_heading, dtype=float), (n_heading,)
+    yaw, sigma, correlation = _measured(
+        len(t_heading), (yaw_heading, sigma_heading, valid), correlation_s, config
     )
-    sigma = np.where(np.isfinite(sigma), sigma, config.default_measurement_sigma_rad)
-    correlation = np.broadcast_to(np.asarray(correlation_s, dtype=float), (n_heading,))
     poses = vehicle.matrices
     # Every step on times relative to the first pose: nothing depends on the time origin.
     origin = float(vehicle.t[0]) if len(vehicle.t) else 0.0
@@ -654,14 +648,7 @@ def blend_heading(
         clock_node,
         clock.variance(t, noise.sigma_distance, noise.sigma_turn),
     )
-    turn_step = Rotation.from_euler("z", delta_step[:, None]).as_matrix()
-    steps = np.einsum("nij,nj->ni", turn_step[1:], np.diff(positions, axis=0))
-    corrected_positions = np.concatenate([positions[:1], positions[:1] + np.cumsum(steps, axis=0)])
-    corrected_rotations = Rotation.from_euler("z", delta[:, None]).as_matrix() @ rotations
-    corrected_positions += poses[0, :3, 3] if len(poses) else 0.0
-    corrected = Trajectory(
-        vehicle.t.copy(), corrected_positions, Rotation.from_matrix(corrected_rotations)
-    )
+    corrected = _turned(vehicle, (positions, rotations), delta_step, delta)
     _, has_absolute = headings_at(t, t_heading, yaw, None, config.max_gap_s)
     return CorrectionResult(
         corrected,
@@ -670,4 +657,36 @@ def blend_heading(
         correction_sigma=np.sqrt(variance),
         noise=noise,
         measurements=len(measurements),
+    )
+
+
+def _measured(n_heading, headings, correlation_s, config: BlendConfig):
+    """The absolute headings of :func:`blend_heading` (``headings`` = yaw, σ, valid), NaN where
+    not valid, their σ (``default_measurement_sigma_rad`` where NaN or None) and T_c of (B2),
+    each per epoch."""
+    yaw_heading, sigma_heading, valid = headings
+    yaw = np.asarray(yaw_heading, dtype=float).copy()
+    if valid is not None:
+        yaw[~np.asarray(valid, dtype=bool)] = np.nan
+    sigma = np.broadcast_to(
+        np.asarray(np.nan if sigma_heading is None else sigma_heading, dtype=float), (n_heading,)
+    )
+    sigma = np.where(np.isfinite(sigma), sigma, config.default_measurement_sigma_rad)
+    correlation = np.broadcast_to(np.asarray(correlation_s, dtype=float), (n_heading,))
+    return yaw, sigma, correlation
+
+
+def _turned(vehicle: Trajectory, relative_poses, delta_step, delta) -> Trajectory:
+    """The VO trajectory corrected by the heading offset (B4): each step (positions relative to
+    the first pose, ``relative_poses`` = positions, rotations) turned by the offset at its
+    middle ``delta_step``, each orientation by the offset ``delta`` at its pose."""
+    positions, rotations = relative_poses
+    poses = vehicle.matrices
+    turn_step = Rotation.from_euler("z", delta_step[:, None]).as_matrix()
+    steps = np.einsum("nij,nj->ni", turn_step[1:], np.diff(positions, axis=0))
+    corrected_positions = np.concatenate([positions[:1], positions[:1] + np.cumsum(steps, axis=0)])
+    corrected_rotations = Rotation.from_euler("z", delta[:, None]).as_matrix() @ rotations
+    corrected_positions += poses[0, :3, 3] if len(poses) else 0.0
+    return Trajectory(
+        vehicle.t.copy(), corrected_positions, Rotation.from_matrix(corrected_rotations)
     )
