@@ -30,7 +30,6 @@ ALLOWED = {
     "vo_doppler/heading/tight_heading.py:speed_scale_ratio",
     "vo_doppler/heading/tight_heading.py:_independent_agreement",
     "vo_doppler/heading/tight_heading.py:build",
-    "vo_doppler/fusion/heading_correction.py:correct_heading",
 }
 
 

@@ -130,6 +130,11 @@ def correct_heading(
     is immune to a yaw error of the camera→vehicle extrinsic or to a VO whose motion is skewed
     against its optical axis; the chord keeps the tiny, noisy steps of a vehicle that is
     slowing down or creeping out of the comparison.
+
+    Many parameters because it is the correction's public entry point with [TK18]'s tuning:
+    after the inputs, each argument is one independent setting with its default, passed by
+    keyword (:mod:`vo_doppler.fusion.correction` and the tests); gathering them into a
+    configuration is issue 32's open work together with its caller.
     """
     reference = checked(HeadingReference, reference, "reference")
     poses = vehicle.matrices
