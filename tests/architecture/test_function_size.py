@@ -25,11 +25,7 @@ ALLOWED = {
     "vo_doppler/gnss/doppler_velocity.py:doppler_rows",
     "vo_doppler/gnss/doppler_velocity.py:solve_velocity",
     # this task's own functions, refactored one commit each
-    "vo_doppler/heading/tight_heading.py:solve_windows",
-    "vo_doppler/heading/tight_heading.py:tight_heading_series",
-    "vo_doppler/heading/tight_heading.py:speed_scale_ratio",
     "vo_doppler/heading/tight_heading.py:_independent_agreement",
-    "vo_doppler/heading/tight_heading.py:build",
 }
 
 

@@ -65,7 +65,7 @@ from __future__ import annotations
 
 import warnings
 from bisect import bisect_right
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -353,33 +353,115 @@ def _residual(X, T, XtWT, TtWT_pinv, theta):
     return (X @ z[:, :, None])[:, :, 0] - np.einsum("krj,kj->kr", T, params)
 
 
-def solve_windows(
-    y,
-    a,
-    b,
-    tau,
-    w,
-    config: TightHeadingConfig = TightHeadingConfig(),
-    group=None,
-    scale_sigma=0.0,
-    bias_sigma=0.0,
-    noise: ReceiverNoise | None = None,
-    grade_coefficient=None,
-    grade_prior=(0.0, None),
-    clock_epoch=None,
-):
-    """Solve padded windows at once: arrays (K, R) of reduced observations ``y``, coefficients
+@dataclass(frozen=True)
+class PaddedWindows:
+    """Windows padded to one width, arrays (K, R): reduced observations ``y``, coefficients
     ``a``, ``b`` (model a·cos θ₀ + b·sin θ₀ + ρ₀ − α·τ + c·g), row times ``tau`` relative to
-    the window end and weights ``w`` (0 on padding). Returns a :class:`_WindowSolution`.
+    the window end, weights ``w`` (0 on padding), the satellite ``group`` of each row, the
+    grade coefficient c = −g_up·s_t (how the window's road grade g moves each row: the
+    vertical velocity g·s_t seen along the line of sight) and each row's epoch counted back
+    from the window's newest, ``clock_epoch`` (:func:`linear_design`; None: one clock line)."""
 
-    ``grade_coefficient`` (K, R): c = −g_up·s_t, how the window's road grade g moves each row
-    (the vertical velocity g·s_t seen along the line of sight); g is a linear unknown with the
-    Gaussian prior ``grade_prior`` = (μ, σ) per window or scalars (σ None:
-    ``config.grade_sigma``; :func:`linear_design`). None, or ``config.grade_sigma`` 0: a level
-    road.
+    y: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    tau: np.ndarray
+    w: np.ndarray
+    group: np.ndarray | None = None
+    grade_coefficient: np.ndarray | None = None
+    clock_epoch: np.ndarray | None = None
 
-    ``group`` (K, R) numbers the satellite of each row (default: every row its own), the unit
-    of NLOS rejection: data snooping on the least-squares fit (:mod:`vo_doppler.heading.snooping`)
+
+@dataclass
+class _Snooped:
+    """What data snooping left of the windows (:func:`_snoop_windows`): the rows accepted,
+    which windows are inconsistent and whose largest statistic was a row's (a blunder), the
+    smallest redundancy number and whether the window was verifiable before any repair, the
+    room for one more biased satellite, which windows rejected a reflection (more than one row
+    at once), the θ₀ of the suspects and of the least-squares fit (:func:`_fallback_variance`)
+    and the noise model used."""
+
+    accepted: np.ndarray
+    inconsistent: np.ndarray
+    blunder: np.ndarray
+    min_redundancy: np.ndarray
+    verifiable_before: np.ndarray
+    bias_variance: np.ndarray
+    reflection: np.ndarray
+    suspects: np.ndarray
+    noise: ReceiverNoise | None
+
+
+def _snoop_windows(windows: PaddedWindows, config, calibration_sigma, noise) -> _Snooped:
+    """Data snooping on the least-squares fit of every window (:func:`solve_windows`): reject
+    what is identified and test again, up to ``config.outlier_passes`` times."""
+    a, b, y, tau, w, group = windows.a, windows.b, windows.y, windows.tau, windows.w, windows.group
+    K, R = w.shape
+    if group is None:
+        group = np.broadcast_to(np.arange(R), (K, R))
+    n_groups = int(np.max(group, initial=0)) + 1
+    scale_sigma, bias_sigma = calibration_sigma
+    out = _Snooped(
+        accepted=w > 0,
+        inconsistent=np.zeros(K, dtype=bool),
+        blunder=np.zeros(K, dtype=bool),
+        min_redundancy=np.zeros(K),  # untested windows are not verifiable
+        verifiable_before=np.zeros(K, dtype=bool),
+        bias_variance=np.zeros(K),
+        reflection=np.zeros(K, dtype=bool),
+        suspects=np.full((K, n_groups + 1), np.nan),
+        noise=noise,
+    )
+    todo = np.arange(K)
+    for rejection in range(config.outlier_passes + 1):
+        if not (todo.size and config.outlier_passes):
+            break
+        window_rows = SnoopWindows(
+            a[todo],
+            b[todo],
+            y[todo],
+            tau[todo],
+            w[todo] * out.accepted[todo],
+            group[todo],
+            n_groups,
+            (scale_sigma[todo], bias_sigma[todo]),
+        )
+        tests = snoop_satellites(window_rows, snoop_settings(config), out.noise)
+        out.noise = tests.noise
+        if rejection == 0:
+            out.verifiable_before = tests.min_redundancy >= config.testable_redundancy
+        out.min_redundancy[todo] = tests.min_redundancy
+        out.bias_variance[todo] = tests.bias_variance
+        detected = tests.detected
+        failed = detected if rejection == config.outlier_passes else detected & ~tests.identified
+        out.inconsistent[todo[failed]] = True
+        out.suspects[todo[failed]] = np.column_stack(
+            [tests.suspect_theta[failed], tests.theta[failed]]
+        )
+        out.blunder[todo[failed]] = tests.row_fault[failed]
+        if rejection == config.outlier_passes:
+            break
+        repair = detected & tests.identified
+        todo = todo[repair]
+        out.accepted[todo] &= ~tests.reject[repair]
+        out.reflection[todo] |= np.count_nonzero(tests.reject[repair], axis=1) > 1
+    return out
+
+
+def solve_windows(
+    windows: PaddedWindows,
+    config: TightHeadingConfig = TightHeadingConfig(),
+    calibration_sigma=(0.0, 0.0),
+    noise: ReceiverNoise | None = None,
+    grade_prior=(0.0, None),
+) -> _WindowSolution:
+    """Solve padded ``windows`` at once (a :class:`_WindowSolution`). The road grade g is a
+    linear unknown with the Gaussian prior ``grade_prior`` = (μ, σ) per window or scalars
+    (σ None: ``config.grade_sigma``; :func:`linear_design`). No ``grade_coefficient``, or
+    ``config.grade_sigma`` 0: a level road.
+
+    The windows' ``group`` (default: every row its own) is the unit of NLOS rejection: data
+    snooping on the least-squares fit (:mod:`vo_doppler.heading.snooping`, :func:`_snoop_windows`)
     rejects the biased satellite (or rows, or pair of satellites) it identifies and tests again,
     up to ``config.outlier_passes`` times per window; the robust fit then uses the rows left. A
     significant test that cannot name its satellite, one that still fails after the last pass,
@@ -389,88 +471,38 @@ def solve_windows(
     satellite (:func:`_fallback_variance`). After rejecting more than one row at once (a
     reflection lasts; a lone row is a blunder) the θ₀ variance allows for one more biased
     satellite (``bias_variance`` of :mod:`vo_doppler.heading.snooping`).
-    ``scale_sigma`` and ``bias_sigma`` (per window or scalars) are the calibration
-    uncertainties the tests allow for. ``noise``: σ₀ and κ of the tests (default: pooled over
-    these windows, :func:`vo_doppler.heading.snooping.receiver_noise`).
+    ``calibration_sigma`` = (speed scale σ, gyro bias σ), per window or scalars, are the
+    calibration uncertainties the tests allow for. ``noise``: σ₀ and κ of the tests (default:
+    pooled over these windows, :func:`vo_doppler.heading.snooping.receiver_noise`).
     """
-    K, R = w.shape
+    a, b, y, tau, w = windows.a, windows.b, windows.y, windows.tau, windows.w
+    clock_epoch = windows.clock_epoch
+    K = len(w)
     X = np.stack([-a, -b, y], axis=-1)
-    if config.grade_sigma <= 0:
-        grade_coefficient = None
+    grade_coefficient = None if config.grade_sigma <= 0 else windows.grade_coefficient
     grade_mean, grade_sigma = grade_prior
     grade_sigma = config.grade_sigma if grade_sigma is None else grade_sigma
     T, prior = linear_design(tau, grade_coefficient, (grade_mean, grade_sigma), clock_epoch)
-    if group is None:
-        group = np.broadcast_to(np.arange(R), (K, R))
-    n_groups = int(np.max(group, initial=0)) + 1
-    scale_sigma = np.broadcast_to(np.asarray(scale_sigma, dtype=float), (K,))
-    bias_sigma = np.broadcast_to(np.asarray(bias_sigma, dtype=float), (K,))
-    accepted = w > 0
-    inconsistent = np.zeros(K, dtype=bool)
-    min_redundancy = np.zeros(K)  # untested windows are not verifiable
-    todo = np.arange(K)
-    verifiable_before = np.zeros(K, dtype=bool)
-    bias_variance = np.zeros(K)
-    reflection = np.zeros(K, dtype=bool)
-    suspects = np.full((K, n_groups + 1), np.nan)
-    blunder = np.zeros(K, dtype=bool)
-    for rejection in range(config.outlier_passes + 1):
-        if not (todo.size and config.outlier_passes):
-            break
-        window_rows = SnoopWindows(
-            a[todo],
-            b[todo],
-            y[todo],
-            tau[todo],
-            w[todo] * accepted[todo],
-            group[todo],
-            n_groups,
-            (scale_sigma[todo], bias_sigma[todo]),
-        )
-        tests = snoop_satellites(window_rows, snoop_settings(config), noise)
-        noise = tests.noise
-        if rejection == 0:
-            verifiable_before = tests.min_redundancy >= config.testable_redundancy
-        min_redundancy[todo] = tests.min_redundancy
-        bias_variance[todo] = tests.bias_variance
-        detected = tests.detected
-        failed = detected if rejection == config.outlier_passes else detected & ~tests.identified
-        inconsistent[todo[failed]] = True
-        suspects[todo[failed]] = np.column_stack([tests.suspect_theta[failed], tests.theta[failed]])
-        blunder[todo[failed]] = tests.row_fault[failed]
-        if rejection == config.outlier_passes:
-            break
-        repair = detected & tests.identified
-        todo = todo[repair]
-        accepted[todo] &= ~tests.reject[repair]
-        reflection[todo] |= np.count_nonzero(tests.reject[repair], axis=1) > 1
+    calibration_sigma = tuple(
+        np.broadcast_to(np.asarray(v, dtype=float), (K,)) for v in calibration_sigma
+    )
+    snooped = _snoop_windows(windows, config, calibration_sigma, noise)
+    accepted = snooped.accepted
     fit = _fit(X, T, prior, w * accepted, config)
-    weights, theta, cost = fit["weights"], fit["theta"], fit["cost"]
+    theta, cost = fit["theta"], fit["cost"]
     z, dz = z_of(theta), dz_of(theta)
     params = (fit["TtWT_pinv"] @ (fit["XtWT"].transpose(0, 2, 1) @ z[:, :, None]))[:, :, 0]
     n_obs = np.count_nonzero(w > 0, axis=1)
     n_used = np.count_nonzero(accepted, axis=1)
     # A repair must not leave a window unverifiable that was verifiable: what remains has to be
     # able to reveal a bias (exclusion, then detection).
-    lost = verifiable_before & (min_redundancy < config.testable_redundancy)
+    lost = snooped.verifiable_before & (snooped.min_redundancy < config.testable_redundancy)
     lost &= n_used < n_obs
-    inconsistent |= lost
-    fallback = inconsistent & blunder & ~lost
-    # the prior is one pseudo-observation of the parameter it adds
-    dof = n_used + (prior is not None) - (1 + fit["rank_t"])
-    used_w = np.where(accepted, w, 0.0)
-    mean_w = np.sum(used_w, axis=1) / np.maximum(n_used, 1)
-    floor = config.sigma_floor_mps**2 * mean_w
-    posterior = np.where(dof > 0, np.maximum(cost, 0) / np.maximum(dof, 1), 1.0)
-    # Fallback: the Huber weights hide the fault that could not be named, so the scatter is
-    # judged with the a-priori weights (the least-squares variance factor at the robust θ₀).
-    robust = np.flatnonzero(fallback & (dof > 0))
-    Q_prior = projected_normal_matrix(
-        X[robust], T[robust], used_w[robust], None if prior is None else [v[robust] for v in prior]
-    )[0]
-    unweighted = quadratic(Q_prior, z[robust], z[robust]) / dof[robust]
-    posterior[robust] = np.maximum(posterior[robust], unweighted)
-    variance_factor = np.maximum(posterior, floor)
+    inconsistent = snooped.inconsistent | lost
+    fallback = inconsistent & snooped.blunder & ~lost
+    variance_factor = _variance_factor(
+        (X, T, prior), np.where(accepted, w, 0.0), fit, fallback, config
+    )
     Q = fit["Q"]
     return _WindowSolution(
         theta=theta,
@@ -488,14 +520,37 @@ def solve_windows(
         n_rejected=n_obs - n_used,
         inconsistent=inconsistent,
         fallback=fallback,
-        min_redundancy=min_redundancy,
+        min_redundancy=snooped.min_redundancy,
         repair_variance=np.where(
             fallback,
-            _fallback_variance(suspects, theta, bias_variance),
-            np.where(reflection, bias_variance, 0.0),
+            _fallback_variance(snooped.suspects, theta, snooped.bias_variance),
+            np.where(snooped.reflection, snooped.bias_variance, 0.0),
         ),
-        **_error_gains(a, b, tau, T, prior, weights, theta, clock_epoch is None),
+        **_error_gains(a, b, tau, T, prior, fit["weights"], theta, clock_epoch is None),
     )
+
+
+def _variance_factor(model, used_w, fit, fallback, config) -> np.ndarray:
+    """The a-posteriori variance factor s² of each window's robust fit (``model`` = X, T and
+    the grade prior; ``used_w`` the a-priori weights of the rows used), at least the floor
+    ``sigma_floor_mps``². Fallback windows: the Huber weights hide the fault that could not be
+    named, so the scatter is judged with the a-priori weights (the least-squares variance
+    factor at the robust θ₀) where that is larger."""
+    X, T, prior = model
+    cost, z = fit["cost"], z_of(fit["theta"])
+    n_used = np.count_nonzero(used_w > 0, axis=1)
+    # the prior is one pseudo-observation of the parameter it adds
+    dof = n_used + (prior is not None) - (1 + fit["rank_t"])
+    mean_w = np.sum(used_w, axis=1) / np.maximum(n_used, 1)
+    floor = config.sigma_floor_mps**2 * mean_w
+    posterior = np.where(dof > 0, np.maximum(cost, 0) / np.maximum(dof, 1), 1.0)
+    robust = np.flatnonzero(fallback & (dof > 0))
+    Q_prior = projected_normal_matrix(
+        X[robust], T[robust], used_w[robust], None if prior is None else [v[robust] for v in prior]
+    )[0]
+    unweighted = quadratic(Q_prior, z[robust], z[robust]) / dof[robust]
+    posterior[robust] = np.maximum(posterior[robust], unweighted)
+    return np.maximum(posterior, floor)
 
 
 def _fallback_variance(suspects, theta, bias_variance):
@@ -640,6 +695,11 @@ def tight_heading_series(
     ``speed_scale_sigma`` and ``gyro_bias_sigma`` of that epoch describe: without it, the rows of
     a window at the start of a drive carry the prior's scale and bias while its σ is already
     the first estimate's (measured: 1.8° off at σ 0.39° on a simulated drive's fifth second).
+
+    Many parameters because it is the heading stage's solver entry point: after the rows and
+    the per-epoch sensors, each argument is an independent optional input, passed by keyword
+    (``heading/pipeline.py`` shares them with :func:`speed_scale_ratio` as one dict); gathering
+    them into an input dataclass is issue 32's open work together with that caller.
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     speed = np.asarray(speed, dtype=float)
@@ -651,55 +711,58 @@ def tight_heading_series(
         raise ValueError("epoch times must be strictly increasing")
     if m == 0:
         return _unavailable(t_epoch)
-    windows = _WindowRows.build(
-        rows,
-        t_epoch,
-        speed,
-        yaw_angle,
-        lever_velocity,
-        grade_prior,
-        calibration,
-        config,
-        bias_sigma,
-    )
-    n_sat_epoch = windows.n_sat_epoch
+    sensors = _EpochSensors(t_epoch, speed, yaw_angle, lever_velocity, grade_prior, calibration)
+    windows = _WindowRows.build(rows, sensors, config, bias_sigma)
     if windows.empty:
-        return _unavailable(t_epoch, n_sat_epoch)
-    width, n_groups, padded = windows.width, windows.n_groups, windows.padded
-    size = windows_per_chunk(width, n_groups, config)
+        return _unavailable(t_epoch, windows.n_sat_epoch)
+    solution = _solve_in_chunks(windows, config, (scale_sigma, bias_sigma))
+    model_variance = _model_variance(solution, (scale_sigma, bias_sigma), config)
+    gyro = (yaw_angle, bias_sigma)
+    n_sat_epoch = windows.n_sat_epoch
+    return _decide(solution, model_variance, t_epoch, speed, gyro, n_sat_epoch, windows, config)
+
+
+def _solve_in_chunks(windows: _WindowRows, config, calibration_sigma) -> _WindowSolution:
+    """Every window solved (:func:`solve_windows`) in chunks of as many as fit in
+    ``config.chunk_bytes`` (:func:`windows_per_chunk`), with one receiver noise model pooled
+    over every chunk (:func:`vo_doppler.heading.snooping.noise_statistics`) when there are
+    several; ``calibration_sigma`` = (speed scale σ, gyro bias σ) per epoch."""
+    scale_sigma, bias_sigma = calibration_sigma
+    m = len(windows.length)
+    size = windows_per_chunk(windows.width, windows.n_groups, config)
     chunks = [np.arange(start, min(start + size, m)) for start in range(0, m, size)]
     noise = None
     if len(chunks) > 1 and config.outlier_passes:
         samples = []
         for k in chunks:
-            y, a, b, tau, w, group, _, _ = padded(k)
+            padded = windows.padded(k)
             window_rows = SnoopWindows(
-                a, b, y, tau, w, group, n_groups, (scale_sigma[k], bias_sigma[k])
+                padded.a,
+                padded.b,
+                padded.y,
+                padded.tau,
+                padded.w,
+                padded.group,
+                windows.n_groups,
+                (scale_sigma[k], bias_sigma[k]),
             )
             samples.append(noise_statistics(window_rows, snoop_settings(config)))
         noise = receiver_noise(samples)
-    solutions = []
-    for k in chunks:
-        y, a, b, tau, w, group, grade_coefficient, clock_epoch = padded(k)
-        solutions.append(
-            solve_windows(
-                y,
-                a,
-                b,
-                tau,
-                w,
-                config,
-                group,
-                scale_sigma[k],
-                bias_sigma[k],
-                noise,
-                grade_coefficient,
-                windows.grade_at(k),
-                clock_epoch if windows.per_epoch_clock else None,
-            )
+    solutions = [
+        solve_windows(
+            windows.padded(k), config, (scale_sigma[k], bias_sigma[k]), noise, windows.grade_at(k)
         )
-    solution = _concatenate(solutions)
-    model_variance = (
+        for k in chunks
+    ]
+    return _concatenate(solutions)
+
+
+def _model_variance(solution: _WindowSolution, calibration_sigma, config) -> np.ndarray:
+    """The part of var θ₀ the Doppler noise does not cover: the speed scale's and gyro bias's
+    calibration σ (``calibration_sigma``, per epoch) and the clock drift's random walk through
+    their gains, a repair's allowance, and the grade prior's share where s² < 1."""
+    scale_sigma, bias_sigma = calibration_sigma
+    return (
         (solution.scale_gain * scale_sigma) ** 2
         + (solution.bias_gain * bias_sigma) ** 2
         + solution.clock_walk_gain * config.clock_drift_walk_mps**2
@@ -708,8 +771,6 @@ def tight_heading_series(
         # grade prior's part is set by its own σ: where s² < 1 it is restored to full size
         + np.clip(1.0 - solution.variance_factor, 0.0, None) * solution.prior_variance
     )
-    gyro = (yaw_angle, bias_sigma)
-    return _decide(solution, model_variance, t_epoch, speed, gyro, n_sat_epoch, windows, config)
 
 
 MIN_SCALE_WINDOWS = 10
@@ -756,12 +817,14 @@ def speed_scale_ratio(
     normal matrix with the prior), whose weighted mean is added in quadrature. With the two
     highest satellites, whose lines of sight are mostly vertical, that part dominates: the grade
     and the speed scale trade off.
+
+    Many parameters because it takes :func:`tight_heading_series`'s inputs by the same keywords
+    (see there) plus the headings.
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     speed, yaw_angle = np.asarray(speed, dtype=float), np.asarray(yaw_angle, dtype=float)
-    windows = _WindowRows.build(
-        rows, t_epoch, speed, yaw_angle, lever_velocity, grade_prior, calibration, config
-    )
+    sensors = _EpochSensors(t_epoch, speed, yaw_angle, lever_velocity, grade_prior, calibration)
+    windows = _WindowRows.build(rows, sensors, config)
     candidates = np.flatnonzero(np.asarray(informative, dtype=bool) & np.isfinite(yaw))
     chosen, last = [], -np.inf
     for k in candidates:
@@ -771,15 +834,16 @@ def speed_scale_ratio(
     if windows.empty or len(chosen) < MIN_SCALE_WINDOWS:
         return None
     chosen = np.asarray(chosen)
-    y, a, b, tau, w, _, grade_coefficient, clock_epoch = windows.padded(chosen)
+    padded = windows.padded(chosen)
+    y, a, b, tau, w = padded.y, padded.a, padded.b, padded.tau, padded.w
     theta = yaw[chosen][:, None]
     X = np.stack([-(a * np.cos(theta) + b * np.sin(theta)), y], axis=-1)
     use_grade = config.grade_sigma > 0
     T, prior = linear_design(
         tau,
-        grade_coefficient if use_grade else None,
+        padded.grade_coefficient if use_grade else None,
         windows.grade_at(chosen),
-        clock_epoch if windows.per_epoch_clock else None,
+        padded.clock_epoch,
     )
     if prior is not None:
         prior = (prior[0][..., 1:], prior[1], prior[2])
@@ -805,6 +869,20 @@ def speed_scale_ratio(
 
 
 @dataclass(frozen=True)
+class _EpochSensors:
+    """Per epoch (as :func:`tight_heading_series`'s arguments): times (s), speed (m/s), the
+    integrated calibrated yaw rate Φ (rad), the antenna's lever velocity, the grade prior
+    (μ, σ) and the causal calibration (k, b, B) or None."""
+
+    t_epoch: np.ndarray
+    speed: np.ndarray
+    yaw_angle: np.ndarray
+    lever_velocity: np.ndarray | float
+    grade_prior: tuple
+    calibration: tuple[np.ndarray, np.ndarray, np.ndarray] | None
+
+
+@dataclass(frozen=True)
 class _WindowRows:
     """The Doppler rows matched to epochs, each window's rows on demand (:meth:`padded`) and
     the grade prior per epoch (:meth:`grade_at`); arguments as :func:`tight_heading_series`'s."""
@@ -825,18 +903,12 @@ class _WindowRows:
     n_groups: int
 
     @classmethod
-    def build(
-        cls,
-        rows,
-        t_epoch,
-        speed,
-        yaw_angle,
-        lever_velocity,
-        grade_prior,
-        calibration,
-        config,
-        gyro_bias_sigma=0.0,
-    ) -> _WindowRows:
+    def build(cls, rows, sensors: _EpochSensors, config, gyro_bias_sigma=0.0) -> _WindowRows:
+        """The ``rows`` matched to the epochs of ``sensors``, each window's length
+        (:func:`window_lengths`, with the gyro bias σ per epoch) and the rows it holds."""
+        t_epoch, speed, yaw_angle = sensors.t_epoch, sensors.speed, sensors.yaw_angle
+        lever_velocity, grade_prior = sensors.lever_velocity, sensors.grade_prior
+        calibration = sensors.calibration
         m = len(t_epoch)
         lever = np.broadcast_to(np.asarray(lever_velocity, dtype=float), (m, 2))
         grade_sigma = config.grade_sigma if grade_prior[1] is None else grade_prior[1]
@@ -897,9 +969,10 @@ class _WindowRows:
         """(μ, σ) of the grade prior of windows ``k``."""
         return self.grade[0][k], self.grade[1][k]
 
-    def padded(self, k: np.ndarray):
-        """:func:`_padded_rows` of windows ``k``."""
-        return _padded_rows(
+    def padded(self, k: np.ndarray) -> PaddedWindows:
+        """:func:`_padded_rows` of windows ``k``; their rows' epochs (``clock_epoch``) only
+        with one clock drift per epoch."""
+        padded = _padded_rows(
             self.rows,
             self.per_row,
             self.index,
@@ -909,6 +982,7 @@ class _WindowRows:
             self.per_epoch,
             self.width,
         )
+        return padded if self.per_epoch_clock else replace(padded, clock_epoch=None)
 
 
 def window_lengths(
@@ -1019,8 +1093,7 @@ def windows_per_chunk(width: int, n_groups: int, config: TightHeadingConfig) -> 
 def _padded_rows(rows, per_row, index, row_epoch, k, bounds, per_epoch, width):
     """The rows of windows ``k`` padded to ``width`` (the widest window of the series, so that
     a window's arrays, and so its solution, do not depend on the chunk it is solved in):
-    y, a, b, τ, w, the satellite group and the grade coefficient c = −g_up·s_t of
-    :func:`solve_windows`."""
+    :class:`PaddedWindows`."""
     (y_all, row_group), (lo, hi) = per_row, bounds
     t_epoch, speed, yaw_angle, lever, scale, bias, bias_integral = per_epoch
     slot = lo[k][:, None] + np.arange(width)[None, :]
@@ -1046,7 +1119,7 @@ def _padded_rows(rows, per_row, index, row_epoch, k, bounds, per_epoch, width):
     group = np.where(w > 0, row_group[row], 0)
     grade_coefficient = np.where(w > 0, -rows.los[row, 2] * window_speed, 0.0)
     clock_epoch = np.where(w > 0, k[:, None] - epoch, 0)
-    return y, a, b, tau, w, group, grade_coefficient, clock_epoch
+    return PaddedWindows(y, a, b, tau, w, group, grade_coefficient, clock_epoch)
 
 
 def antenna_offset_velocity(yaw_rate: np.ndarray, lever_arm_m) -> np.ndarray:
