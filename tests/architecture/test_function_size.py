@@ -24,8 +24,6 @@ ALLOWED = {
     "vo_doppler/heading/integrity.py:conventional_integrity",
     "vo_doppler/gnss/doppler_velocity.py:doppler_rows",
     "vo_doppler/gnss/doppler_velocity.py:solve_velocity",
-    # this task's own functions, refactored one commit each
-    "vo_doppler/heading/tight_heading.py:_independent_agreement",
 }
 
 

@@ -8,6 +8,7 @@ import pytest
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.tight_heading import (
+    HeadingSeries,
     TightHeadingConfig,
     _independent_agreement,
     tight_heading_series,
@@ -35,7 +36,12 @@ def test_the_threshold_combines_both_sigmas_and_the_propagated_gyro_bias():
         yaw = np.array([1.0, 1.0, 1.3 + offset, 1.3])
         every = np.ones(4, bool)
         agree = _independent_agreement(
-            every, every, yaw, sigma, every, t, (yaw_angle, bias_sigma), fixed_windows(t), config
+            every,
+            every,
+            HeadingSeries(yaw, sigma, every, t),
+            (yaw_angle, bias_sigma),
+            fixed_windows(t),
+            config,
         )
         # Epochs 0 and 1 have no window before theirs; epoch 3 refers to epoch 1 as well.
         np.testing.assert_array_equal(agree, [True, True, expected, True])
@@ -49,13 +55,18 @@ def test_unavailable_epochs_are_never_the_reference():
     sigma = np.full(6, 0.01)
     available = np.array([True, False, True, True, True, True])
     agree = _independent_agreement(
-        available, available, yaw, sigma, available, t, gyro, fixed_windows(t), config
+        available,
+        available,
+        HeadingSeries(yaw, sigma, available, t),
+        gyro,
+        fixed_windows(t),
+        config,
     )
     np.testing.assert_array_equal(agree, available)
     every = np.ones(6, bool)
     # Epoch 1 has no window before it; epoch 3 refers to it and disagrees.
     agree = _independent_agreement(
-        every, every, yaw, sigma, every, t, gyro, fixed_windows(t), config
+        every, every, HeadingSeries(yaw, sigma, every, t), gyro, fixed_windows(t), config
     )
     np.testing.assert_array_equal(agree, [True, True, True, False, True, True])
 
@@ -68,10 +79,7 @@ def test_a_wrong_reliable_heading_cannot_lock_the_right_ones_out():
     agree = _independent_agreement(
         every,
         every,
-        yaw,
-        np.full(20, 0.01),
-        every,
-        t,
+        HeadingSeries(yaw, np.full(20, 0.01), every, t),
         (np.zeros(20), np.zeros(20)),
         fixed_windows(t),
         config,
@@ -96,7 +104,7 @@ def test_a_vague_reference_confirms_nothing_and_the_window_must_verify_itself():
     ):
         sigma = np.array([sigma_reference, 0.01])
         agree = _independent_agreement(
-            every, verifiable, yaw, sigma, every, t, gyro, fixed_windows(t), config
+            every, verifiable, HeadingSeries(yaw, sigma, every, t), gyro, fixed_windows(t), config
         )
         np.testing.assert_array_equal(agree, [True, expected])
 
@@ -117,10 +125,7 @@ def test_the_first_windows_of_a_drive_verify_themselves_or_a_later_window_confir
         agree = _independent_agreement(
             every,
             verifiable,
-            np.array(yaw),
-            sigma,
-            every,
-            np.array(t),
+            HeadingSeries(np.array(yaw), sigma, every, np.array(t)),
             gyro,
             fixed_windows(t),
             config,
@@ -141,7 +146,7 @@ def test_the_gyro_drift_since_the_reference_counts_towards_its_vagueness():
     for bias_sigma, expected in ((0.0159, True), (0.0161, False)):
         gyro = (np.zeros(2), np.full(2, bias_sigma))
         agree = _independent_agreement(
-            every, first_only, yaw, sigma, every, t, gyro, fixed_windows(t), config
+            every, first_only, HeadingSeries(yaw, sigma, every, t), gyro, fixed_windows(t), config
         )
         np.testing.assert_array_equal(agree, [True, expected])
 

@@ -1208,10 +1208,7 @@ def _decide(
     reliable = _independent_agreement(
         _reliability(yaw, sigma, available, yaw_angle, t_epoch, config),
         verifiable,
-        yaw,
-        sigma,
-        available,
-        t_epoch,
+        HeadingSeries(yaw, sigma, available, t_epoch),
         (yaw_angle, bias_sigma),
         windows.length,
         config,
@@ -1275,9 +1272,18 @@ def _reliability(yaw, sigma, available, yaw_angle, t_epoch, config):
     return available & (reach >= config.reliability_min_span_s) & consensus
 
 
-def _independent_agreement(
-    consistent, verifiable, yaw, sigma, available, t_epoch, gyro, window_s, config
-):
+@dataclass(frozen=True)
+class HeadingSeries:
+    """The window headings per epoch: yaw θ (rad), its σ (rad), whether it is available, and
+    the epoch times (s)."""
+
+    yaw: np.ndarray
+    sigma: np.ndarray
+    available: np.ndarray
+    t_epoch: np.ndarray
+
+
+def _independent_agreement(consistent, verifiable, headings: HeadingSeries, gyro, window_s, config):
     """Reliability: the epochs of ``consistent`` (the consecutive-epoch rule,
     :func:`_reliability`) whose heading also agrees with an informative heading from a window
     that shares no row with theirs, or whose own window is ``verifiable``.
@@ -1298,6 +1304,7 @@ def _independent_agreement(
     window with one reflected satellite among too few to test it fits that satellite exactly,
     and only another window can reveal it.
     """
+    yaw, available, t_epoch = headings.yaw, headings.available, headings.t_epoch
     reliable = np.zeros(len(yaw), dtype=bool)
     later = _next_available(available, t_epoch, window_s)
     available_epochs = np.flatnonzero(available)
@@ -1311,11 +1318,11 @@ def _independent_agreement(
         last_reliable = reliable_epochs[n - 1] if n else -1
         fresh = last_reliable >= 0 and t_epoch[k] - t_epoch[last_reliable] <= config.prior_max_age_s
         j = last_reliable if fresh else last_available
-        agrees = _agrees(k, j, yaw, sigma, t_epoch, gyro, config)
+        agrees = _agrees(k, j, headings, gyro, config)
         if agrees is None:
             j = later[k]
             ahead = j >= 0 and t_epoch[j] - t_epoch[k] <= config.prior_max_age_s
-            agrees = _agrees(k, j, yaw, sigma, t_epoch, gyro, config) if ahead else None
+            agrees = _agrees(k, j, headings, gyro, config) if ahead else None
             agrees = bool(verifiable[k] or agrees)
         reliable[k] = agrees
         if agrees:
@@ -1335,11 +1342,12 @@ def _next_available(available, t_epoch, window_s):
     return np.where(candidates[position] >= first, candidates[position], -1)
 
 
-def _agrees(k, j, yaw, sigma, t_epoch, gyro, config):
+def _agrees(k, j, headings: HeadingSeries, gyro, config):
     """Whether θ_k agrees with the reference θ_j propagated by the gyro (None when there is no
     reference or it is not informative; :func:`_independent_agreement`)."""
     if j < 0:
         return None
+    yaw, sigma, t_epoch = headings.yaw, headings.sigma, headings.t_epoch
     yaw_angle, bias_sigma = gyro
     reference_variance = sigma[j] ** 2 + (bias_sigma[k] * (t_epoch[k] - t_epoch[j])) ** 2
     if not reference_variance <= config.reference_max_sigma_rad**2:
