@@ -15,7 +15,6 @@ from matplotlib.image import imread
 from scipy.spatial.transform import Rotation
 
 from tests.helpers.velocity import velocity_solution
-from vo_doppler import run as run_module
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame, wrap_angle
@@ -34,11 +33,9 @@ from vo_doppler.run import (
     PLACEMENT_VERTICAL_SIGMA_M,
     AntennaTrack,
     RunConfig,
-    _malloc_trim,
     antenna_track,
     initial_yaw_offset,
     level_with_yaw,
-    release_free_heap,
     run_sequence,
 )
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
@@ -204,25 +201,6 @@ def test_heading_short_frame_policy_is_checked_by_the_parser(tmp_path):
     with pytest.raises(SystemExit) as exit_info:
         main(["heading", "x.obs", "--nav", "x.nav", "--can-short-frames", "guess", "-o", "h.csv"])
     assert exit_info.value.code == 2
-
-
-def test_release_free_heap_calls_malloc_trim_with_no_padding(monkeypatch):
-    calls = []
-    monkeypatch.setattr(run_module, "_malloc_trim", lambda: calls.append)
-    assert release_free_heap() is None
-    assert calls == [0]
-
-
-def test_release_free_heap_does_nothing_without_malloc_trim(monkeypatch):
-    monkeypatch.setattr(run_module, "_malloc_trim", lambda: None)
-    assert release_free_heap() is None
-
-
-def test_release_free_heap_runs_with_this_c_library():
-    trim = _malloc_trim()
-    assert trim is None or callable(trim)
-    assert _malloc_trim() is trim  # looked up once
-    assert release_free_heap() is None
 
 
 def _heading_table(t, yaw_tc, tc_usable, yaw_conv=None, conv_valid=None) -> HeadingTable:

@@ -23,8 +23,6 @@ stage 2's, on a recording with or without GNSS (:func:`run_with_given_heading`).
 
 from __future__ import annotations
 
-import ctypes
-import functools
 import logging
 import math
 from collections.abc import Callable, Iterable
@@ -58,6 +56,7 @@ from vo_doppler.gnss.spp import EARTH_SURFACE_M, nearest_time
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.lowcost.dead_reckoning import wheel_gyro_track
+from vo_doppler.memory import release_free_heap
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.heading import HeadingTable
@@ -465,21 +464,6 @@ def vehicle_vo(
     vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
     release_free_heap()
     return vo, vo_vehicle
-
-
-@functools.cache
-def _malloc_trim() -> Callable[[int], int] | None:
-    return getattr(ctypes.CDLL(None), "malloc_trim", None)
-
-
-def release_free_heap() -> None:
-    """Give the C heap's free memory back to the system (glibc's ``malloc_trim``; nothing
-    elsewhere). After a stage frees its large NumPy temporaries glibc keeps much of them
-    resident: its mmap threshold rises to the largest block freed, so later large arrays come
-    from the heap, whose free pages are returned only from its top."""
-    trim = _malloc_trim()
-    if trim is not None:
-        trim(0)
 
 
 def run_sequence(

@@ -1,18 +1,14 @@
-"""Releasing a written figure: its reference cycles are collected, and when the caller froze
-what was alive, what survives the collection is frozen too (later passes skip it). The
-evaluation against a ground truth that covers part of the drive, none of it, or a path that
-does not move: every other output is written, and the summary says what was not evaluated. The
-map and the GeoJSON show the trajectories as written, and the summary their absolute errors.
+"""The evaluation against a ground truth that covers part of the drive, none of it, or a path
+that does not move: every other output is written, and the summary says what was not evaluated.
+The map and the GeoJSON show the trajectories as written, and the summary their absolute errors.
 Every scalar of the summary has a label for the report. A drive without any tightly coupled
 heading fails, saying plainly when the vehicle never moved."""
 
 from __future__ import annotations
 
 import dataclasses
-import gc
 import html
 import json
-import weakref
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -25,13 +21,11 @@ from vo_doppler.io.sequence import InputReport, read_sequence
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report import run_outputs
-from vo_doppler.report.figure import new_figure
 from vo_doppler.report.run_outputs import (
     FACT_FORMATS,
     NOT_FACTS,
     SUMMARY_FILE,
     readable_facts,
-    release_figures,
     require_tight_heading,
     result_checks,
     summarise,
@@ -40,40 +34,6 @@ from vo_doppler.report.run_outputs import (
 from vo_doppler.run import RunConfig, run_sequence
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 from vo_doppler.vo.odometry import VoStats
-
-
-def _tracked(value: object) -> bool:
-    """Whether the collector's passes walk ``value`` (frozen objects are left out)."""
-    return any(o is value for o in gc.get_objects())
-
-
-def _garbage_figure() -> weakref.ref:
-    fig = new_figure(figsize=(2, 2))
-    fig.subplots().plot([0.0, 1.0])
-    return weakref.ref(fig)
-
-
-def test_under_a_freeze_the_figure_is_freed_and_the_survivors_frozen():
-    gc.freeze()
-    try:
-        survivor = [[]]
-        figure = _garbage_figure()
-        assert _tracked(survivor) and figure() is not None
-        release_figures()
-        assert figure() is None
-        assert not _tracked(survivor)
-    finally:
-        gc.unfreeze()
-    assert _tracked(survivor)
-
-
-def test_without_a_freeze_nothing_is_frozen():
-    survivor = [[]]
-    figure = _garbage_figure()
-    release_figures()
-    assert figure() is None
-    assert gc.get_freeze_count() == 0
-    assert _tracked(survivor)
 
 
 @pytest.fixture(scope="module")

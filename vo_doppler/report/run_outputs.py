@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import gc
 import logging
 from pathlib import Path
 
@@ -22,6 +21,7 @@ from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.io.sequence import InputReport
 from vo_doppler.io.trajectory import write_tum
+from vo_doppler.memory import release_cycles
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import travelled_distance
 from vo_doppler.report.heading_figure import build_heading_figure
@@ -46,7 +46,7 @@ from vo_doppler.report.run_report import (
     write_run_report,
 )
 from vo_doppler.report.trajectory_map import TRUTH, write_geojson
-from vo_doppler.run import Pipeline, RunConfig, RunResult, release_free_heap
+from vo_doppler.run import Pipeline, RunConfig, RunResult
 
 SUMMARY_FILE = "summary.json"
 MAX_PROBLEMS_PER_FILE = 20
@@ -263,20 +263,6 @@ def driven_m(result: RunResult) -> float:
     return float(travelled_distance(speed.t, np.abs(speed.value), speed.t[-1:])[0])
 
 
-def release_figures() -> None:
-    """Free the figures already written: a matplotlib figure is a web of reference cycles that
-    only the cycle collector frees, and its freed buffers go back to the system only on request
-    (:func:`vo_doppler.run.release_free_heap`).
-
-    When the caller froze what was alive (``vo-doppler run`` does, until it ends), what is
-    alive after the collection is frozen too: mostly matplotlib's modules, imported by the
-    first figure, which each later pass would otherwise walk again."""
-    gc.collect()
-    if gc.get_freeze_count():
-        gc.freeze()
-    release_free_heap()
-
-
 def write_run_outputs(
     sequence: Sequence,
     result: RunResult,
@@ -337,14 +323,14 @@ def write_run_outputs(
     trajectories_figure(
         out / "trajectories.png", result.trajectories, truth, f"{sequence.name}: as written"
     )
-    release_figures()
+    release_cycles()
     write_geojson(out / "trajectories.geojson", report.tracks, TRACK_LABELS, sequence.enu)
     if table is not None:
         report.heading_figure = png_data_uri(
             build_heading_figure(table, truth_yaw, sequence.name, result.tc_usable),
             out / "heading.png",
         )
-        release_figures()
+        release_cycles()
     covered = summary.get("vehicle_signal_epochs")
     used = summary.get("tight_heading_used_with_vehicle_signals")
     if used is None:  # no epoch with vehicle signals: the share of every epoch
@@ -402,7 +388,7 @@ def evaluate_into(
     report.error_figure = png_data_uri(
         build_error_per_100m_figure(per_100m, sequence.name), out / "error_per_100m.png"
     )
-    release_figures()
+    release_cycles()
     heading_t0 = float(table.t[0]) if table is not None and len(table) else 0.0
     if table is None:  # no GNSS: the time axis starts with the ground truth
         heading_t0 = float(truth.t[0])
@@ -410,7 +396,7 @@ def evaluate_into(
         build_heading_error_figure(shown, truth, heading_t0, sequence.name),
         out / "heading_error.png",
     )
-    release_figures()
+    release_cycles()
     if table is not None:
         report.worst = worst_reliable_tight_errors(table, result.tc_usable, truth.yaw_at(table.t))
     path_length = max(e.path_length_m for e in errors.values())
