@@ -22,7 +22,8 @@ from vo_doppler.eval.pipelines import evaluate_pipelines
 from vo_doppler.fusion.correction import CorrectionConfig
 from vo_doppler.fusion.heading_blend import BlendConfig
 from vo_doppler.model.sequence import Sequence
-from vo_doppler.run import Pipeline, RunConfig, RunResult, correct_all
+from vo_doppler.run import Pipeline, RunConfig, RunResult
+from vo_doppler.run_stages import sequence_trajectories
 from vo_doppler.vo.frames import vehicle_trajectory
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -44,7 +45,7 @@ def evaluate_methods(
     """Per method, ``evaluate_pipelines`` of the same pipeline run corrected by that method."""
     evaluated = {}
     for name, config in methods.items():
-        trajectories = correct_all(
+        trajectories, _ = sequence_trajectories(
             inputs,
             result.heading,
             vehicle_trajectory(result.vo.trajectory, inputs.camera.T_vehicle_camera),

@@ -31,7 +31,7 @@ from rich.table import Table
 from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
-from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_gnss, sequence_heading
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -38,7 +38,7 @@ from vo_doppler.heading.tight_heading import antenna_offset_velocity, tight_head
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.run import RunConfig, sequence_gnss
+from vo_doppler.run_stages import RunConfig, sequence_gnss
 
 ROOT = Path(__file__).resolve().parents[1]
 CLEAN_SIGMAS = 4.0

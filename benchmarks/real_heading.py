@@ -80,7 +80,8 @@ from benchmarks.real_sequences import (
 from benchmarks.sequence_runs import read_with_truth, run_sequences
 from vo_doppler.choices import values
 from vo_doppler.eval.pipelines import evaluate_pipelines
-from vo_doppler.fusion.correction import usable_tight_heading
+from vo_doppler.fusion.antenna_track import AntennaTrack
+from vo_doppler.fusion.pipelines import Pipeline
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.heading.pipeline import CalibrationMethod, HeadingPipelineConfig
@@ -89,13 +90,11 @@ from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.run import (
-    AntennaTrack,
-    Pipeline,
+from vo_doppler.run_stages import (
     RunConfig,
-    correct_all,
     sequence_gnss,
     sequence_heading,
+    sequence_trajectories,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -332,8 +331,7 @@ def dead_reckoning_figures(sequence: Sequence, table: HeadingTable, config: RunC
     the time the ground truth covers."""
     speed = table.calibrated_speed(sequence.wheel_speed)
     origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)))  # the figures align the starts
-    trajectories = correct_all(sequence, table, None, speed, origin, config)
-    usable = usable_tight_heading(table, config.correction.tc_max_sigma_rad)
+    trajectories, usable = sequence_trajectories(sequence, table, None, speed, origin, config)
     errors, _, _ = evaluate_pipelines(trajectories, table, usable, sequence.truth)
     return {str(name): errors[name].error_per_100m_m for name in DEAD_RECKONING if name in errors}
 

@@ -190,7 +190,7 @@ def _needs_no_unit(kind) -> bool:
 
 def test_every_configuration_field_has_a_unit_rule():
     configurations = _configurations()
-    assert {"vo_doppler.run.RunConfig", "vo_doppler.sim.can_bus.CanSimConfig"} <= set(
+    assert {"vo_doppler.run_stages.RunConfig", "vo_doppler.sim.can_bus.CanSimConfig"} <= set(
         configurations
     )
     assert len(configurations) >= 19

@@ -30,9 +30,10 @@ ALLOWED: dict[str, set[str]] = {
     "io": BASE | {"io"},
     "checks": BASE,
     "sim": BASE | STAGES | {"io", "sim"},
-    "run": BASE | STAGES | {"checks", "io"},
-    "report": BASE | STAGES | {"checks", "io", "run", "report"},
-    "batch": BASE | STAGES | {"io", "run", "report"},
+    "run_stages": BASE | STAGES | {"io"},
+    "run": BASE | STAGES | {"checks", "io", "run_stages"},
+    "report": BASE | STAGES | {"checks", "io", "run", "run_stages", "report"},
+    "batch": BASE | STAGES | {"io", "run", "run_stages", "report"},
 }
 """Layer → the layers it may import. Commands and the CLI may import anything."""
 

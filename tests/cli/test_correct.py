@@ -12,9 +12,9 @@ from scipy.spatial.transform import Rotation
 
 from tests.helpers.heading_table import plain_heading_table
 from tests.helpers.level_track import level_turn
-from vo_doppler import run as run_module
 from vo_doppler.cli import main
 from vo_doppler.commands import correct_command
+from vo_doppler.fusion import pipelines
 from vo_doppler.fusion.placement import initial_yaw_offset, turned_about_start
 from vo_doppler.geo import wrap_angle
 from vo_doppler.io.heading_csv import write_heading_csv
@@ -127,8 +127,9 @@ def test_poses_before_the_first_absolute_heading_start_with_it(
 
 
 def test_correct_and_run_start_a_trajectory_by_one_rule():
-    """`run` imports the same function (no second copy to drift apart)."""
-    assert run_module.initial_yaw_offset is initial_yaw_offset
+    """`run`'s trajectories (`fusion.pipelines.correct_all`) start by the same function (no
+    second copy to drift apart)."""
+    assert pipelines.initial_yaw_offset is initial_yaw_offset
     assert correct_command.initial_yaw_offset is initial_yaw_offset
 
 

@@ -12,7 +12,7 @@ import pytest
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.io.sequence import read_sequence
-from vo_doppler.run import RunConfig, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_heading
 
 pytestmark = pytest.mark.slow
 

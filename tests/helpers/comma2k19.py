@@ -9,7 +9,7 @@ from vo_doppler.gnss.pipeline import GnssVelocityResult
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.sequence import Sequence
-from vo_doppler.run import RunConfig, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_heading
 
 COMMA = "comma2k19_example1"
 SP3 = f"{COMMA}/Sta20124_1400_1845.sp3"

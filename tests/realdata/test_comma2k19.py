@@ -16,11 +16,12 @@ from benchmarks.real_heading import (
 )
 from tests.conftest import require_shared
 from tests.helpers.comma2k19 import COMMA, checked_conventional_figures, imported_comma2k19
+from vo_doppler.fusion.antenna_track import antenna_track
 from vo_doppler.geo import ecef_to_enu_rotation
 from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.io.comma2k19 import read_vehicle_poses
 from vo_doppler.model.timeseries import sample
-from vo_doppler.run import RunConfig, antenna_track, correct_all, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_heading, sequence_trajectories
 
 pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
 
@@ -106,7 +107,7 @@ def test_trajectories_start_where_the_car_was(comma):
     assert np.nanmedian(np.linalg.norm(antenna.position[:, :2] - expected, axis=1)) < 1.0
     table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
     speed = table.calibrated_speed(sequence.wheel_speed)
-    trajectories = correct_all(sequence, table, None, speed, antenna, config)
+    trajectories, _ = sequence_trajectories(sequence, table, None, speed, antenna, config)
     assert len(trajectories) == 3
     for trajectory in trajectories.values():
         start = [np.interp(trajectory.t[0], truth.t, truth.positions[:, i]) for i in (0, 1)]

@@ -19,7 +19,7 @@ from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.observations import Observations, ObsHeader
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
-from vo_doppler.run import RunConfig, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_heading
 
 T0 = 404100.0
 CODES = ("D1C", "S1C")

@@ -11,7 +11,7 @@ import pytest
 from benchmarks.real_heading import truth_velocity
 from tests.helpers.comma2k19 import checked_conventional_figures, imported_comma2k19
 from vo_doppler.report.run_outputs import doppler_noise_summary
-from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_gnss, sequence_heading
 
 pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
 

@@ -16,7 +16,7 @@ from vo_doppler.heading.tight_heading import tight_heading_series
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_gnss, sequence_heading
 
 pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
 

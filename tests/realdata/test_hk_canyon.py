@@ -18,7 +18,7 @@ from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import sample
-from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_gnss, sequence_heading
 
 pytestmark = pytest.mark.slow
 

@@ -16,6 +16,7 @@ EXPORTS: dict[str, str] = {
     "DopplerRows": "doppler",
     "ReportedSigma": "doppler_sigma",
     "SppSolution": "gnss_solutions",
+    "GivenHeading": "given_heading",
     "VelocitySolution": "gnss_solutions",
     "HeadingTable": "heading",
     "NavRecords": "navigation",
@@ -38,6 +39,7 @@ EXPORTS: dict[str, str] = {
 __all__ = [
     "Camera",
     "DopplerRows",
+    "GivenHeading",
     "HeadingTable",
     "NavRecords",
     "Navigation",
@@ -63,6 +65,7 @@ if TYPE_CHECKING:
     from vo_doppler.model.camera import Camera
     from vo_doppler.model.doppler import DopplerRows
     from vo_doppler.model.doppler_sigma import ReportedSigma
+    from vo_doppler.model.given_heading import GivenHeading
     from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
     from vo_doppler.model.heading import HeadingTable
     from vo_doppler.model.navigation import Navigation, NavRecords
