@@ -58,6 +58,7 @@ import traceback
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
@@ -75,9 +76,9 @@ from vo_doppler.io.output_folder import (
     remove_cut_off_staging,
     swap_in,
 )
-from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
 from vo_doppler.io.tables import write_csv_and_parquet
-from vo_doppler.model.time_span import TimeSpan, trim_sequence
+from vo_doppler.job import require_tight_heading, run_recording
+from vo_doppler.model.time_span import TimeSpan
 from vo_doppler.report.batch_summary import (
     COLUMNS,
     overall_row,
@@ -85,14 +86,8 @@ from vo_doppler.report.batch_summary import (
     write_batch_html,
 )
 from vo_doppler.report.json_text import json_text
-from vo_doppler.report.run_outputs import (
-    SUMMARY_FILE,
-    input_warnings,
-    require_tight_heading,
-    result_checks,
-    write_run_outputs,
-)
-from vo_doppler.run import RunConfig, run_sequence
+from vo_doppler.report.run_outputs import SUMMARY_FILE
+from vo_doppler.run import RunConfig
 
 log = logging.getLogger(__name__)
 
@@ -291,26 +286,9 @@ def _run_job(job: RecordingJob, staging: Path) -> dict:
         folder = shown = job.source
     else:
         folder, shown = job.prepare(job.source, staging / PREPARED), job.out / PREPARED
-    sequence, report = read_sequence_with_report(folder)
-    interval = None
-    if not job.span.whole:
-        sequence, interval = trim_sequence(sequence, job.span)
-    warnings = input_warnings(sequence, report)
-    for text in warnings:
-        log.warning("%s", text)
-    result = run_sequence(sequence, job.config)
-    checks = result_checks(sequence, report, result, warnings)
-    summary = write_run_outputs(
-        sequence,
-        result,
-        job.config,
-        staging,
-        checks,
-        read_manifest(folder),
-        span=None if interval is None else interval.to_dict(),
-    )
-    require_tight_heading(result, shown, job.out)
-    return summary
+    job_output = run_recording(folder, job.config, lambda: nullcontext(staging), job.span)
+    require_tight_heading(job_output.result, shown, job.out)
+    return job_output.summary
 
 
 def process_recording(job: RecordingJob) -> RecordingOutcome:

@@ -33,7 +33,8 @@ ALLOWED: dict[str, set[str]] = {
     "run_stages": BASE | STAGES | {"io"},
     "run": BASE | STAGES | {"checks", "io", "run_stages"},
     "report": BASE | STAGES | {"checks", "io", "run", "run_stages", "report"},
-    "batch": BASE | STAGES | {"io", "run", "run_stages", "report"},
+    "job": BASE | STAGES | {"io", "run", "run_stages", "report"},
+    "batch": BASE | STAGES | {"io", "run", "run_stages", "report", "job"},
 }
 """Layer → the layers it may import. Commands and the CLI may import anything."""
 
@@ -96,3 +97,45 @@ def test_a_back_edge_is_caught(tmp_path):
 )
 def test_layer_of(module, layer):
     assert layer_of(module) == layer
+
+
+PLACEMENT = {
+    "AntennaTrack",
+    "antenna_track",
+    "_height_sigma",
+    "PLACEMENT_VERTICAL_SIGMA_M",
+    "ORIGIN_HEIGHT",
+    "level_with_yaw",
+    "_placing_rows",
+    "_carried",
+    "weighted_median",
+    "PLACEMENT_SPAN_S",
+    "PLACEMENT_MIN_FIXES",
+    "yaw_offset",
+    "initial_yaw_offset",
+    "dead_reckoning",
+    "correct_all",
+}
+"""The trajectory placement maths (issue 32): the fusion layer's, not the main job's."""
+RUN_MAX_LINES = 250
+
+
+def defined_names(path: Path) -> set[str]:
+    """The names a module defines at its top level (functions, classes, assignments)."""
+    names = set()
+    for node in ast.parse(path.read_text(), str(path)).body:
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            names |= {target.id for target in targets if isinstance(target, ast.Name)}
+    return names
+
+
+def test_the_placement_maths_live_in_fusion_and_run_py_stays_an_orchestrator():
+    fusion = set().union(*(defined_names(p) for p in (PACKAGE / "fusion").glob("*.py")))
+    assert fusion >= PLACEMENT
+    orchestrators = ("run.py", "run_stages.py", "job.py", "batch.py")
+    for name in orchestrators:
+        assert defined_names(PACKAGE / name) & PLACEMENT == set(), name
+    assert len((PACKAGE / "run.py").read_text().splitlines()) <= RUN_MAX_LINES

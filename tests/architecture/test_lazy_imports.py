@@ -16,6 +16,7 @@ MAIN_JOB = (
     "vo_doppler.commands.run_command",
     "vo_doppler.run",
     "vo_doppler.report.run_outputs",
+    "vo_doppler.job",
     "vo_doppler.batch",
 )
 

@@ -8,8 +8,8 @@ import gc
 
 import pytest
 
+from vo_doppler import job
 from vo_doppler.cli import main
-from vo_doppler.commands import run_command
 from vo_doppler.errors import EXIT_INTERNAL
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
@@ -27,7 +27,7 @@ def test_the_collector_is_frozen_during_the_stages_and_unfrozen_after(tmp_path, 
         frozen_during.append(gc.get_freeze_count())
         raise RuntimeError("stage failed")
 
-    monkeypatch.setattr(run_command, "run_sequence", failing_stages)
+    monkeypatch.setattr(job, "run_sequence", failing_stages)  # the one job run and batch run
     assert gc.get_freeze_count() == 0
     assert main(["run", str(drive), "-o", str(tmp_path / "out")]) == EXIT_INTERNAL
     assert frozen_during and frozen_during[0] > 0

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import gc
 import logging
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -25,18 +26,12 @@ from vo_doppler.commands.satellite_options import add_selection_options
 from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError, shown
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
-from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.output_folder import RUN, check_output_folder, staged_output, untouched
-from vo_doppler.io.sequence import manifest_inputs, read_manifest, read_sequence_with_report
-from vo_doppler.model.time_span import trim_sequence
-from vo_doppler.report.run_outputs import (
-    input_warnings,
-    require_tight_heading,
-    result_checks,
-    write_run_outputs,
-)
+from vo_doppler.io.sequence import manifest_inputs
+from vo_doppler.job import require_tight_heading, run_recording
+from vo_doppler.model.sequence import Sequence
 from vo_doppler.report.run_report import TABLE_COLUMNS, table_cell
-from vo_doppler.run import GivenHeading, RunConfig, RunResult, run_sequence
+from vo_doppler.run import RunConfig, RunResult
 from vo_doppler.vo.config import VoConfig
 
 log = logging.getLogger(__name__)
@@ -120,8 +115,6 @@ def run(args: argparse.Namespace) -> int:
     except BaseException:
         log.error("%s", untouched(args.output))
         raise
-    finally:
-        gc.unfreeze()
     require_tight_heading(result, args.sequence, args.output)
     return 0
 
@@ -141,46 +134,39 @@ def sequence_inputs(sequence: Path) -> list[Path]:
 
 
 def run_and_write(args: argparse.Namespace) -> RunResult:
-    """Read, check, run and write the outputs in place (all or nothing)."""
-    inputs, report = read_sequence_with_report(args.sequence, args.allow_outside_paths)
-    span, part = None, time_span(args)
-    if not part.whole:
-        inputs, interval = trim_sequence(inputs, part)
-        span = interval.to_dict()
-    given = None
-    if args.heading is not None:
-        given = GivenHeading(read_heading_csv(args.heading), str(args.heading))
-    warnings = input_warnings(inputs, report)
-    for text in warnings:
-        log.warning("%s", text)
-    config = run_config(args)
+    """Read, check, run and write the outputs in place (all or nothing:
+    :func:`vo_doppler.job.run_recording` into a staged output), showing the inputs, the VO's
+    progress and the figures on the console."""
     console = Console(width=None if sys.stdout.isatty() else 150)
-    epochs = len(inputs.observations.epoch_time) if inputs.has_gnss else "no"
-    console.print(
-        f"{inputs.name}: {len(inputs.image_paths)} images, {epochs} GNSS epochs, "
-        f"{len(inputs.wheel_speed)} wheel and {len(inputs.yaw_rate)} yaw-rate samples"
-    )
-    # What is alive now (the imported modules, the inputs; after the stages, their results)
-    # stays to the end of the command: the cycle collector's full passes (automatic, and after
-    # each figure) skip it until ``run`` unfreezes it.
-    gc.freeze()
-    with Progress(console=console, transient=True) as progress:
-        task = progress.add_task("visual odometry", total=len(inputs.image_paths))
-        result = run_sequence(inputs, config, lambda _: progress.advance(task), given=given)
-    gc.freeze()
-    checks = result_checks(inputs, report, result, warnings)
-    with staged_output(args.output, RUN, run_inputs(args)) as out:
-        summary = write_run_outputs(
-            inputs, result, config, out, checks, read_manifest(args.sequence), span=span
+
+    @contextmanager
+    def progress(inputs: Sequence) -> Iterator[Callable[[int], None]]:
+        epochs = len(inputs.observations.epoch_time) if inputs.has_gnss else "no"
+        console.print(
+            f"{inputs.name}: {len(inputs.image_paths)} images, {epochs} GNSS epochs, "
+            f"{len(inputs.wheel_speed)} wheel and {len(inputs.yaw_rate)} yaw-rate samples"
         )
-    if result.vo is None:
-        console.print(f"{inputs.name} has no camera: only the non-visual pipelines ran")
-    print_summary(console, summary)
+        with Progress(console=console, transient=True) as bar:
+            task = bar.add_task("visual odometry", total=len(inputs.image_paths))
+            yield lambda _: bar.advance(task)
+
+    job = run_recording(
+        args.sequence,
+        run_config(args),
+        lambda: staged_output(args.output, RUN, run_inputs(args)),
+        time_span(args),
+        args.heading,
+        args.allow_outside_paths,
+        progress,
+    )
+    if job.result.vo is None:
+        console.print(f"{job.sequence.name} has no camera: only the non-visual pipelines ran")
+    print_summary(console, job.summary)
     console.print(
         f"wrote {shown(args.output)}/report.html (open it in a browser) and the trajectories, "
         "figures"
     )
-    return result
+    return job.result
 
 
 def print_summary(console: Console, summary: dict) -> None:

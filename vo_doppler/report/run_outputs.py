@@ -4,19 +4,13 @@
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.errors import InputError
 from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
-from vo_doppler.eval.pipelines import (
-    absolute_position_errors,
-    epochs_within,
-    evaluate_pipelines,
-    evaluation_warnings,
-)
+from vo_doppler.eval.pipelines import epochs_within
+from vo_doppler.eval.run_evaluation import evaluate_run
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.io.sequence import InputReport
@@ -50,8 +44,6 @@ from vo_doppler.run import Pipeline, RunConfig, RunResult
 
 SUMMARY_FILE = "summary.json"
 MAX_PROBLEMS_PER_FILE = 20
-
-log = logging.getLogger(__name__)
 
 FACT_FORMATS = {
     "gnss_epochs": ("GNSS epochs", "{:d}"),
@@ -347,53 +339,36 @@ def write_run_outputs(
 def evaluate_into(
     summary: dict, report: RunReport, sequence: Sequence, result: RunResult, out: Path
 ) -> None:
-    """Evaluate the trajectories against the sequence's ground truth into ``summary``
+    """The evaluation of the trajectories against the sequence's ground truth
+    (:func:`~vo_doppler.eval.run_evaluation.evaluate_run`) into ``summary``
     (``absolute_position_error`` of the trajectories as written, ``evaluation`` of them moved
-    to the truth, and ``warnings`` for what it could not evaluate) and ``report`` (tables, the
-    map's layer of the trajectories as evaluated, figures written to ``out``).
-
-    The evaluation never costs the run its other outputs: when it fails, the failure becomes a
-    warning and the rest is written without it."""
+    to the truth, and ``warnings`` for what it could not evaluate or its failure) and
+    ``report`` (tables, the map's layer of the trajectories as evaluated, figures written to
+    ``out``)."""
     truth, table = sequence.truth, result.heading
-    warnings = summary.setdefault("warnings", [])
-    try:
-        absolute = {
-            name: found
-            for name, trajectory in result.trajectories.items()
-            if (found := absolute_position_errors(trajectory, truth)) is not None
+    found = evaluate_run(result.trajectories, table, result.tc_usable, truth, sequence.vehicle_span)
+    summary.setdefault("warnings", []).extend(found.warnings)
+    report.warnings += found.warnings
+    if found.absolute:
+        summary["absolute_position_error"] = {
+            name: e.to_dict() for name, e in found.absolute.items()
         }
-        errors, per_100m, shown = evaluate_pipelines(
-            result.trajectories, table, result.tc_usable, truth, sequence.vehicle_span
-        )
-        found = evaluation_warnings(result.trajectories, errors, truth)
-    except Exception as exc:  # a bug in the evaluation must not lose the trajectories
-        log.debug("the evaluation failed", exc_info=True)
-        found = [
-            f"the evaluation against the ground truth failed ({type(exc).__name__}: {exc}; a "
-            "bug, please report it): the trajectories and figures are written without it"
-        ]
-        absolute, errors, per_100m, shown = {}, {}, {}, {}
-    for text in found:
-        log.warning("%s", text)
-    warnings += found
-    report.warnings += found
-    if absolute:
-        summary["absolute_position_error"] = {name: e.to_dict() for name, e in absolute.items()}
-        report.absolute = absolute
+        report.absolute = found.absolute
+    errors = found.errors
     if not errors:
         return
     summary["evaluation"] = {name: e.to_dict() for name, e in errors.items()}
     report.errors = errors
-    report.evaluated_tracks = shown
+    report.evaluated_tracks = found.shown
     report.error_figure = png_data_uri(
-        build_error_per_100m_figure(per_100m, sequence.name), out / "error_per_100m.png"
+        build_error_per_100m_figure(found.per_100m, sequence.name), out / "error_per_100m.png"
     )
     release_cycles()
     heading_t0 = float(table.t[0]) if table is not None and len(table) else 0.0
     if table is None:  # no GNSS: the time axis starts with the ground truth
         heading_t0 = float(truth.t[0])
     report.heading_error_figure = png_data_uri(
-        build_heading_error_figure(shown, truth, heading_t0, sequence.name),
+        build_heading_error_figure(found.shown, truth, heading_t0, sequence.name),
         out / "heading_error.png",
     )
     release_cycles()
@@ -404,52 +379,4 @@ def evaluate_into(
         "KITTI translation error: "
         + segment_lengths_note(segment_lengths_that_fit(path_length), path_length)
         + "."
-    )
-
-
-def require_tight_heading(result: RunResult, folder: Path, out: Path) -> None:
-    """A run whose tightly coupled heading was unavailable at every epoch failed: raise the
-    project's error naming the recording (after its outputs were written to ``out``, to show
-    why). A heading is a direction of travel: when the vehicle never moved (:func:`standstill`)
-    the message says so rather than blame the heading. A recording without GNSS has no heading
-    to require, nor has a run on a given heading (``result.heading_source``: the library
-    required a valid one)."""
-    if result.heading is None or result.heading_source or result.heading.tc_available.any():
-        return
-    kept = f"(the other results are in {out})"
-    still = standstill(result)
-    if still is not None:
-        raise InputError(f"{still}, so no Doppler heading exists {kept}", folder)
-    raise InputError(
-        f"the tightly coupled heading was unavailable at every epoch {kept}",
-        folder,
-    )
-
-
-def standstill(result: RunResult, config: RunConfig | None = None) -> str | None:
-    """Why the drive has no heading when the wheel speed never reaches the tightly coupled
-    heading's minimum speed (``config.heading.tight.min_speed_mps``; the default config when
-    None), in words: the vehicle never moved, with both speeds' maxima, or the GNSS Doppler
-    speed contradicting the wheels (above the conventional heading's minimum at valid epochs);
-    None when the wheels did move."""
-    heading = (config or RunConfig()).heading
-    wheel_limit, gnss_limit = heading.tight.min_speed_mps, heading.conventional_min_speed_mps
-    wheel = np.abs(result.calibrated_speed.value)
-    wheel_max = float(np.max(wheel)) if wheel.size else 0.0
-    if wheel_max >= wheel_limit:
-        return None
-    velocity = result.gnss.velocity
-    gnss = np.hypot(velocity.velocity_enu[:, 0], velocity.velocity_enu[:, 1])[velocity.valid]
-    gnss_max = float(np.max(gnss)) if gnss.size else None
-    wheels = f"the wheel speed stays below {wheel_limit:g} m/s throughout (at most {wheel_max:.2f})"
-    if gnss_max is None:
-        return f"the vehicle never moved by its wheels: {wheels}; no GNSS Doppler speed is valid"
-    if gnss_max < gnss_limit:
-        return (
-            f"the vehicle never moved: {wheels} and the GNSS Doppler speed below {gnss_limit:g} "
-            f"m/s at every valid epoch (at most {gnss_max:.2f})"
-        )
-    return (
-        f"the wheels never moved: {wheels}, while the GNSS Doppler speed reaches "
-        f"{gnss_max:.2f} m/s (is the wheel-speed signal, or its unit, right?)"
     )
