@@ -2,7 +2,7 @@
 to their recording, resumable, and one aggregate table.
 
 Each recording ``SOURCE`` writes what ``vo-doppler run`` writes into ``OUT/<name>/``
-(:func:`vo_doppler.report.run_outputs.write_run_outputs`), a log (``run.log``) and, last, its
+(:func:`vo_doppler.job.run_recording`, the job ``run`` runs), a log (``run.log``) and, last, its
 completion marker ``OUT/<name>/batch_done.json``: written atomically (a temporary file renamed
 over it) only after every output, with the fingerprint of the recording's inputs and of the
 configuration. A batch started again with ``resume=True`` skips every recording whose marker
