@@ -54,6 +54,7 @@ FACT_FORMATS = {
     "conventional_heading_valid": ("conventional heading valid (every integrity test)", "{:.1%}"),
     "tight_heading_availability": ("tightly coupled heading available", "{:.1%}"),
     "tight_heading_reliable": ("tightly coupled heading reliable (gyro-consistent)", "{:.1%}"),
+    "tight_heading_method": ("tightly coupled heading settings (--heading-method)", "{}"),
     "tight_heading_used": ("tightly coupled heading used by the correction", "{:.1%}"),
     "vehicle_signal_epochs": (
         "GNSS epochs with vehicle signals (wheel speed and yaw rate)",
