@@ -95,6 +95,7 @@ UNITLESS: dict[str, str] = {
     "huber_passes": "passes",
     "cauchy_passes": "passes",
     "min_support": "agreeing windows (Σ w_j/n_j)",
+    "max_variance_factor": "ratio of residual scale to σ",
     "reliability_epochs": "epochs",
     "reliability_min_epochs": "epochs",
     "min_neighbours": "epochs",

@@ -176,3 +176,14 @@ def test_rts_pass_matches_filterpy():
 def test_angle_random_walk_from_sample_noise():
     """White rate noise of σ per sample every Δt integrates to σ·√Δt per √s."""
     assert angle_random_walk(0.01, 0.1) == pytest.approx(0.01 * np.sqrt(0.1), rel=1e-12)
+
+
+def test_windows_the_gyro_does_not_link_give_a_large_variance_factor():
+    """Course and yaw apart (a pedestrian: the offset jumps by 60° every 20 s): λ far above the
+    pipeline's limit of 3, which then keeps the windows' own headings."""
+    t, phi, truth = drive(1.0)
+    noise = np.random.default_rng(6).normal(0.0, 1.0 * DEG, len(t))
+    jumping = truth + np.radians(60.0) * ((t // 20) % 3) + noise
+    result = smooth(t, wrap_angle(jumping), 1.0 * DEG, 2.0, phi)
+    assert result.variance_factor > 3 * CONFIG.max_variance_factor
+    assert smooth(t, truth + noise, 1.0 * DEG, 2.0, phi).variance_factor < 1.5

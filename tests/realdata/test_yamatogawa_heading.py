@@ -16,6 +16,8 @@ figures are asserted as what they are (see test_two_second_window_is_too_short_a
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -27,6 +29,7 @@ from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.conventional import heading_from_velocity
 from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
+from vo_doppler.heading.smoother import HeadingSmootherConfig
 from vo_doppler.heading.tight_heading import TightHeadingConfig
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.rinex_nav import read_nav
@@ -141,6 +144,8 @@ def test_heading_cli_on_the_walk(walk, tmp_path):
             "60",
             "--window-s",
             "8",
+            "--heading-method",
+            "snooping",
             "--gt",
             str(tmp_path / "truth.tum"),
             "-o",
@@ -208,6 +213,8 @@ def test_heading_cli_from_a_can_log(walk, tmp_path):
         "60",
         "--window-s",
         "8",
+        "--heading-method",
+        "snooping",
         "-o",
         str(out),
         "--can",
@@ -232,3 +239,31 @@ def test_heading_cli_from_a_can_log(walk, tmp_path):
     with pytest.raises(SystemExit) as usage:  # --dbc etc. missing: a usage error
         main([*args[:-12], "--can", str(tmp_path / "car.log")])
     assert usage.value.code == 2
+
+
+def test_the_robust_method_keeps_the_windows_where_the_gyro_does_not_link_them(walk):
+    """A walker's course leaves the body's yaw at every stop: the smoother's variance factor
+    is far above its limit, and the robust method keeps its windows' headings with a warning
+    (it gave no heading at all before the limit)."""
+    robust = HeadingPipelineConfig.robust()
+    table = heading_pipeline(
+        walk["t"],
+        walk["rows"].in_enu(),
+        walk["conventional"].velocity_enu,
+        walk["conventional"].valid,
+        walk["speed"],
+        walk["yaw_rate"],
+        robust,
+    )
+    windows_only = heading_pipeline(
+        walk["t"],
+        walk["rows"].in_enu(),
+        walk["conventional"].velocity_enu,
+        walk["conventional"].valid,
+        walk["speed"],
+        walk["yaw_rate"],
+        replace(robust, smoother=HeadingSmootherConfig()),
+    )
+    assert [w for w in table.warnings if w.startswith("heading smoother:")]
+    np.testing.assert_array_equal(table.tc_available, windows_only.tc_available)
+    assert table.tc_available.mean() > 0.7

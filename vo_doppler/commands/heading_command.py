@@ -285,7 +285,9 @@ def run(args: argparse.Namespace) -> int:
     else:
         start = obs.epoch_time[0] + args.max_sats_after
         rows, conventional = emulated_canyon(obs, nav, args.max_sats, start, systems, mask)
-    method = heading_method_config(args.heading_method)
+    # auto resolved first, so that --window-s and --no-nlos-rejection change the settings
+    # that run (for_rate would otherwise replace them with the robust ones)
+    method = heading_method_config(args.heading_method).for_rate(obs.epoch_time)
     tight = replace(method.tight, window_s=args.window_s)
     if args.no_nlos_rejection:
         tight = replace(tight, outlier_passes=0)

@@ -139,8 +139,8 @@ def heading_from_gnss(
         bias_calibrated=config.fixed_gyro_bias_rad_s is None,
     )
     warnings += [w for w in [integrity_rate_warning(epoch_time, config.integrity)] if w]
-    for warning in warnings:
+    for warning in table.warnings + warnings:
         log.warning("%s", warning)
-    table.warnings = warnings
+    table.warnings = table.warnings + warnings
     table.clock_residual_offset_s = estimate.residual_s
     return table

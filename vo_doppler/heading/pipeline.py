@@ -666,6 +666,15 @@ def heading_pipeline(
             solved = solve(cal)
     result, integrity = solved.result, solved.integrity
     tight = _smoothed(solved, yaw_rate, cal, covered, config) if config.smoother.enabled else None
+    warnings = []
+    if tight is not None and tight.variance_factor > config.smoother.max_variance_factor:
+        warnings.append(
+            f"heading smoother: the windows disagree with the gyro-propagated heading by "
+            f"{tight.variance_factor:.1f} times their σ (above "
+            f"{config.smoother.max_variance_factor:g}): the gyro does not link them (course "
+            "and yaw apart?); the windows' own headings are kept"
+        )
+        tight = None
     return HeadingTable(
         t=t_epoch,
         yaw_tc=result.yaw if tight is None else tight.yaw,
@@ -692,4 +701,5 @@ def heading_pipeline(
         grade_from_accelerometer=solved.grade_from_accelerometer,
         calibration=calibration_summary(cal, covered),
         method=config.method,
+        warnings=warnings,
     )

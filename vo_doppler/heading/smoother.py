@@ -64,6 +64,11 @@ class HeadingSmootherConfig:
     cauchy_passes: int = 3
     consensus_span_s: float = 20.0
     """Half-width of the consensus that starts the weights and judges reliability."""
+    max_variance_factor: float = 3.0
+    """Largest λ at which the smoother's premise holds (the gyro links the windows: the
+    offset changes slowly); beyond it the heading stage keeps the windows' own headings and
+    says so (real canyons at 1 Hz give 1.5–1.6; a pedestrian, whose walking course leaves the
+    body's yaw at every step and stop, 20)."""
     reliable_max_sigma_rad: float = float(np.radians(2.0))
     min_support: float = 2.0
     """Independent agreeing windows (Σ w_j/n_j) a reliable heading needs around it."""
