@@ -74,7 +74,10 @@ def walk():
 
 
 def _run(walk, window_s):
-    config = HeadingPipelineConfig(tight=TightHeadingConfig(window_s=window_s))
+    return _with_config(walk, HeadingPipelineConfig(tight=TightHeadingConfig(window_s=window_s)))
+
+
+def _with_config(walk, config):
     return heading_pipeline(
         walk["t"],
         walk["rows"].in_enu(),
@@ -246,24 +249,8 @@ def test_the_robust_method_keeps_the_windows_where_the_gyro_does_not_link_them(w
     is far above its limit, and the robust method keeps its windows' headings with a warning
     (it gave no heading at all before the limit)."""
     robust = HeadingPipelineConfig.robust()
-    table = heading_pipeline(
-        walk["t"],
-        walk["rows"].in_enu(),
-        walk["conventional"].velocity_enu,
-        walk["conventional"].valid,
-        walk["speed"],
-        walk["yaw_rate"],
-        robust,
-    )
-    windows_only = heading_pipeline(
-        walk["t"],
-        walk["rows"].in_enu(),
-        walk["conventional"].velocity_enu,
-        walk["conventional"].valid,
-        walk["speed"],
-        walk["yaw_rate"],
-        replace(robust, smoother=HeadingSmootherConfig()),
-    )
+    table = _with_config(walk, robust)
+    windows_only = _with_config(walk, replace(robust, smoother=HeadingSmootherConfig()))
     assert [w for w in table.warnings if w.startswith("heading smoother:")]
     np.testing.assert_array_equal(table.tc_available, windows_only.tc_available)
     assert table.tc_available.mean() > 0.7
