@@ -3,9 +3,10 @@
 
 Every seed comes from the real recordings in ``../shared/data``: the SP3 file of the comma2k19
 day as distributed, a RINEX clock file holding that file's clocks, a UBX log made of the
-Yamatogawa receiver's own measurements (RXM-RAWX), its broadcast ephemerides (RXM-SFRBX) and
-fixes at its surveyed position (NAV-PVT), both Android logs, the GSDC table, an OXTS folder
-holding the comma2k19 receiver's fixes and a slice of the comma2k19 raw measurement array.
+Yamatogawa receiver's own measurements (RXM-RAWX), its broadcast ephemerides (RXM-SFRBX, with
+two GLONASS satellites' strings added) and fixes at its surveyed position (NAV-PVT), both
+Android logs, the GSDC table, an OXTS folder holding the comma2k19 receiver's fixes and a
+slice of the comma2k19 raw measurement array.
 Formats that are folders or binary arrays are fuzzed through a text or one-file form that
 ``read`` unpacks (see each family). Registered by ``families.py`` with::
 
@@ -22,6 +23,7 @@ import numpy as np
 from pyubx2 import UBXMessage
 
 from tests.conftest import shared_data_dir
+from tests.helpers import glonass_strings as glo
 from tests.helpers.lnav import encode_ephemeris, sfrbx
 from tests.helpers.precise_text import calendar, clock_text
 from vo_doppler.io.android import read_gnsslogger
@@ -162,13 +164,27 @@ def _ephemerides(t0: float, prns: set[int]) -> list[bytes]:
     return messages
 
 
+def _glonass_strings(t0: float) -> list[bytes]:
+    """RXM-SFRBX messages of GLONASS strings 1–4 of two satellites (the test helper's record,
+    tb the quarter hour after ``t0``): the log carries no GLONASS, these make the seed hold
+    the string decoder's input too."""
+    toc = glo.tb_quarter_hour(t0)
+    return [
+        glo.ubx_sfrbx(slot, channel, string)
+        for slot, channel in ((3, -5), (14, 2))
+        for string in glo.encode_strings(slot, toc, glo.example_at(toc))
+    ]
+
+
 def ubx_seed() -> bytes:
-    """The first epochs of the Yamatogawa receiver's RINEX file as the UBX log it came from."""
+    """The first epochs of the Yamatogawa receiver's RINEX file as the UBX log it came from,
+    with two GLONASS satellites' strings."""
     obs = read_obs(_shared(f"{YAMATOGAWA}/yamatogawa_rover.obs"))
     x, y, z = obs.header.approx_position
     lat = float(np.degrees(np.arctan2(z, np.hypot(x, y) * (1 - 0.00669438))))
     lon = float(np.degrees(np.arctan2(y, x)))
     out = _ephemerides(float(obs.epoch_time[0]), set(obs.prn[obs.system == "G"].tolist()))
+    out += _glonass_strings(float(obs.epoch_time[0]))
     for t in obs.epoch_time[:UBX_EPOCHS]:
         here = (obs.time == t) & (obs.system == "G")
         rows: dict[int, dict[str, float]] = {}

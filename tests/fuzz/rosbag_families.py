@@ -1,9 +1,10 @@
 """Fuzz families of the ROS bag importer (``vo-doppler import rosbag``): a ROS 1 ``.bag`` and
 a ROS 2 bag as one ``.mcap`` or ``.db3`` file, written with rosbags' writers from a slice of
 the repository's sample sequence (3 images, 2 s of IMU and speed, 10 GNSS epochs with every
-ephemeris, the ground truth's fixes and poses), once with gnss_comm and once with ublox_msgs
-raw GNSS; and ``rosbag_can``: the slice's IMU and its wheel speeds as ``can_msgs/Frame``
-frames of the simulator's DBC (a ROS 1 ``.bag`` and a ROS 2 ``.mcap``), imported with that DBC.
+ephemeris and one GLONASS record added, the ground truth's fixes and poses), once with
+gnss_comm and once with ublox_msgs raw GNSS (GLONASS strings in RxmSFRBX); and
+``rosbag_can``: the slice's IMU and its wheel speeds as ``can_msgs/Frame`` frames of the
+simulator's DBC (a ROS 1 ``.bag`` and a ROS 2 ``.mcap``), imported with that DBC.
 ``read`` imports the mutated bag into a temporary folder and reads that folder back
 as ``run`` would, so whatever the importer accepts must also be a readable sequence. Registered
 by ``families.py`` with::
@@ -22,9 +23,12 @@ import cantools
 import numpy as np
 
 from tests.conftest import REPO_ROOT
+from tests.helpers.glonass_strings import example_at, tb_quarter_hour
 from tests.helpers.rosbag_writer import SmallBag, frame_fields, ros_ns, write_sequence_bag
+from vo_doppler.io.glonass_strings import GLONASS_NAMES
 from vo_doppler.io.rosbag_import import RosbagOptions, import_rosbag
 from vo_doppler.io.sequence import read_manifest, read_sequence
+from vo_doppler.model.navigation import Navigation, NavRecords, concat_records
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.sim.can_bus import DBC_PATH, WHEEL_MESSAGE, WHEEL_SPEED_SIGNALS, WHEELS
@@ -56,6 +60,7 @@ def _slice():
     keep = np.flatnonzero((truth.t >= start) & (truth.t <= end))
     return replace(
         seq,
+        navigation=_with_glonass(seq.navigation, start),
         image_paths=seq.image_paths[:3],
         image_times=seq.image_times[:3],
         yaw_rate=series(seq.yaw_rate),
@@ -64,6 +69,21 @@ def _slice():
         observations=observations,
         truth=Trajectory(truth.t[keep], truth.positions[keep], truth.orientations[keep]),
     )
+
+
+def _with_glonass(navigation: Navigation, start: float) -> Navigation:
+    """The navigation with one GLONASS record (the test helper's, tb the quarter hour after
+    ``start``): the sample has none, and the ublox seeds then carry GLONASS strings."""
+    toc = tb_quarter_hour(start)
+    params = example_at(toc) | {"channel": -3.0}
+    record = NavRecords(
+        np.array(["R"]),
+        np.array([5], dtype=np.int16),
+        np.array([toc]),
+        {name: np.array([params.get(name, np.nan)]) for name in GLONASS_NAMES},
+        np.zeros(1, dtype=np.int64),
+    )
+    return replace(navigation, glonass=concat_records(navigation.glonass, record))
 
 
 def _bag_bytes(flavour: str, gnss: str, compressed: bool) -> bytes:

@@ -13,7 +13,8 @@ Topics (ROS times are the GPS times as Unix UTC times: GPS − 315964800 s − t
   the wheel speed);
 - raw GNSS, ``gnss_comm`` (``/gnss/meas`` GnssMeasMsg per epoch, ``/gnss/ephem`` GnssEphemMsg,
   ``/gnss/iono`` StampedFloat64Array) or ``ublox_msgs`` (``/ublox/rxmraw`` RxmRAWX per epoch,
-  ``/ublox/rxmsfrb`` RxmSFRBX: GPS LNAV subframes 1–3 of each GPS ephemeris); a GNSS message's
+  ``/ublox/rxmsfrb`` RxmSFRBX: GPS LNAV subframes 1–3 of each GPS ephemeris, GLONASS strings
+  1–4 of each GLONASS one); a GNSS message's
   receive time is its epoch + ``GNSS_LATENCY_S``;
 - ``/fix`` (NavSatFix of the GNSS antenna on the ground truth, every 10th pose: its first is
   the simulator's RINEX approximate position) and ``/ground_truth`` (Odometry in the ENU frame
@@ -30,6 +31,7 @@ from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Writer2
 from scipy.spatial.transform import Rotation
 
+from tests.helpers.glonass_strings import encode_strings, sfrbx_words
 from tests.helpers.lnav import encode_ephemeris
 from vo_doppler.geo import ecef_to_geodetic
 from vo_doppler.io.gps_lnav import URA_METERS
@@ -382,51 +384,92 @@ def _gnss_comm_ephemerides(out: SmallBag, nav) -> None:
         )
 
 
-def _ublox(out: SmallBag, seq) -> None:
+ROS2_UBLOX_NAMES = {
+    "prMes": "pr_mes",
+    "cpMes": "cp_mes",
+    "doMes": "do_mes",
+    "gnssId": "gnss_id",
+    "svId": "sv_id",
+    "sigId": "sig_id",
+    "freqId": "freq_id",
+    "prStdev": "pr_stdev",
+    "cpStdev": "cp_stdev",
+    "doStdev": "do_stdev",
+    "trkStat": "trk_stat",
+    "reserved3": "reserved1",
+    "rcvTOW": "rcv_tow",
+    "leapS": "leap_s",
+    "numMeas": "num_meas",
+    "recStat": "rec_stat",
+    "numWords": "num_words",
+}
+"""ublox_msgs' ROS 1 field names → its ROS 2 ones."""
+
+
+def _ublox_fields(out: SmallBag, fields: dict) -> dict:
+    return {ROS2_UBLOX_NAMES.get(k, k): v for k, v in fields.items()} if out.ros2 else fields
+
+
+def ublox_rawx(out: SmallBag, t: float, measurements: list[dict]) -> None:
+    """One ``/ublox/rxmraw`` RxmRAWX of epoch ``t`` (GPS) received ``GNSS_LATENCY_S`` later;
+    ``measurements``: RxmRAWX_Meas fields by their ROS 1 names."""
     ros2 = out.ros2
     Meas = out.types["ublox_msgs/msg/RxmRAWXMeas" if ros2 else "ublox_msgs/msg/RxmRAWX_Meas"]
-    Rawx = out.types["ublox_msgs/msg/RxmRAWX"]
+    meas = [Meas(**_ublox_fields(out, fields)) for fields in measurements]
+    week = int(t // SECONDS_PER_WEEK)
+    fields = {
+        "rcvTOW": t - week * SECONDS_PER_WEEK,
+        "week": week,
+        "leapS": 18,
+        "numMeas": len(meas),
+        "recStat": 1,
+        "version": 1,
+        "reserved1": np.zeros(2, np.uint8),
+        "meas": meas,
+    }
+    receive = ros_ns(t + GNSS_LATENCY_S)
+    if ros2:
+        fields["header"] = out.header(receive)
+    message = out.types["ublox_msgs/msg/RxmRAWX"](**_ublox_fields(out, fields))
+    out.write("/ublox/rxmraw", "ublox_msgs/msg/RxmRAWX", receive, message)
 
-    def name(camel: str, snake: str) -> str:
-        return snake if ros2 else camel
 
+def ublox_sfrbx(out: SmallBag, t: float, gnss_id: int, sv_id: int, freq_id: int, words) -> None:
+    """One ``/ublox/rxmsfrb`` RxmSFRBX received at ``t`` (GPS)."""
+    fields = {"gnssId": gnss_id, "svId": sv_id, "freqId": freq_id, "numWords": len(words)}
+    fields |= {"reserved0": 0, "chn": 1, "version": 2, "reserved1": 0}
+    fields["dwrd"] = np.asarray(words, dtype=np.uint32)
+    if out.ros2:
+        fields["header"] = out.header(ros_ns(t))
+    message = out.types["ublox_msgs/msg/RxmSFRBX"](**_ublox_fields(out, fields))
+    out.write("/ublox/rxmsfrb", "ublox_msgs/msg/RxmSFRBX", ros_ns(t), message)
+
+
+def _ublox(out: SmallBag, seq) -> None:
     for t, sats in _epochs(seq.observations):
         meas = []
         for system, prn, values in sats:
             if "D1C" not in values:
                 continue
-            fields = {
-                name("prMes", "pr_mes"): values.get("C1C", 0.0),
-                name("cpMes", "cp_mes"): 0.0,
-                name("doMes", "do_mes"): values["D1C"],
-                name("gnssId", "gnss_id"): UBX_GNSS_ID[system],
-                name("svId", "sv_id"): prn,
-                name("sigId", "sig_id"): 0,
-                name("freqId", "freq_id"): 0,
-                "locktime": 1000,
-                "cno": round(values.get("S1C", 0.0)),
-                name("prStdev", "pr_stdev"): 3,
-                name("cpStdev", "cp_stdev"): 0,
-                name("doStdev", "do_stdev"): 4,
-                name("trkStat", "trk_stat"): 1 if "C1C" in values else 0,
-                name("reserved3", "reserved1"): 0,
-            }
-            meas.append(Meas(**fields))
-        week = int(t // SECONDS_PER_WEEK)
-        fields = {
-            name("rcvTOW", "rcv_tow"): t - week * SECONDS_PER_WEEK,
-            "week": week,
-            name("leapS", "leap_s"): 18,
-            name("numMeas", "num_meas"): len(meas),
-            name("recStat", "rec_stat"): 1,
-            "version": 1,
-            "reserved1": np.zeros(2, np.uint8),
-            "meas": meas,
-        }
-        receive = ros_ns(t + GNSS_LATENCY_S)
-        if ros2:
-            fields["header"] = out.header(receive)
-        out.write("/ublox/rxmraw", "ublox_msgs/msg/RxmRAWX", receive, Rawx(**fields))
+            meas.append(
+                {
+                    "prMes": values.get("C1C", 0.0),
+                    "cpMes": 0.0,
+                    "doMes": values["D1C"],
+                    "gnssId": UBX_GNSS_ID[system],
+                    "svId": prn,
+                    "sigId": 0,
+                    "freqId": 0,
+                    "locktime": 1000,
+                    "cno": round(values.get("S1C", 0.0)),
+                    "prStdev": 3,
+                    "cpStdev": 0,
+                    "doStdev": 4,
+                    "trkStat": 1 if "C1C" in values else 0,
+                    "reserved3": 0,
+                }
+            )
+        ublox_rawx(out, t, meas)
     _sfrbx(out, seq.navigation)
 
 
@@ -439,22 +482,20 @@ def lnav_dict(kepler, k: int) -> dict[str, float]:
 
 
 def _sfrbx(out: SmallBag, nav) -> None:
-    Sfrbx = out.types["ublox_msgs/msg/RxmSFRBX"]
+    """GPS LNAV subframes 1–3 of each GPS record and GLONASS strings 1–4 of each GLONASS one,
+    sent from 30 s before its reference time, a subframe or string a second."""
     kepler = nav.kepler
     for k in np.flatnonzero(kepler.system == "G"):
         t = float(kepler.toc[k])
         for n, words in enumerate(encode_ephemeris(lnav_dict(kepler, k), int(t % 604800) // 6)):
-            dwrd = np.array([(w << 6) | 0x15 for w in words], dtype=np.uint32)
-            names = (
-                ("gnss_id", "sv_id", "freq_id", "num_words")
-                if out.ros2
-                else ("gnssId", "svId", "freqId", "numWords")
-            )
-            fields = dict(zip(names, (0, int(kepler.prn[k]), 0, 10), strict=True))
-            fields.update(reserved0=0, chn=1, version=2, reserved1=0, dwrd=dwrd)
-            if out.ros2:
-                fields["header"] = out.header(ros_ns(t + n))
-            out.write("/ublox/rxmsfrb", "ublox_msgs/msg/RxmSFRBX", ros_ns(t + n), Sfrbx(**fields))
+            ublox_sfrbx(out, t + n, 0, int(kepler.prn[k]), 0, [(w << 6) | 0x15 for w in words])
+    glonass = nav.glonass
+    for k in range(len(glonass)):
+        params = {name: float(values[k]) for name, values in glonass.params.items()}
+        t, slot = float(glonass.toc[k]), int(glonass.prn[k])
+        for n, string in enumerate(encode_strings(slot, t, params)):
+            freq_id = int(params["channel"]) + 7
+            ublox_sfrbx(out, t - 30.0 + n, 6, slot, freq_id, sfrbx_words(string))
 
 
 def _truth(out: SmallBag, seq) -> None:

@@ -1,14 +1,20 @@
 """GLONASS navigation in ROS bags: gnss_comm ``GnssGloEphemMsg`` records come back from the
 imported sequence's ``gnss/brdc.nav`` field by field (RINEX 3.04 precision, epoch in UTC);
-u-blox ``RxmSFRBX`` GLONASS strings, which the import does not decode, are named in a warning
-instead of being dropped silently."""
+u-blox ``RxmSFRBX`` GLONASS strings come back the same way, at the values the strings carry."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tests.helpers.rosbag_writer import SmallBag, bag_path, ros_ns
+from tests.helpers.glonass_strings import (
+    encode_strings,
+    example_at,
+    quantised,
+    sfrbx_words,
+    tb_quarter_hour,
+)
+from tests.helpers.rosbag_writer import SmallBag, bag_path, ros_ns, ublox_rawx, ublox_sfrbx
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.io.rinex_write import gps_calendar, rounded_nav_value
@@ -45,8 +51,6 @@ RAWX_MEAS = "prMes cpMes doMes gnssId svId sigId freqId locktime cno prStdev cpS
 RAWX_MEAS += " trkStat reserved3"
 RAWX_MEAS_VALUES = (2.1e7, 0.0, -1000.5, 6, 5, 0, 7 + CHANNEL, 1000, 40, 3, 0, 4, 1, 0)
 """An R05 measurement on channel −3 (ublox_msgs' ROS 1 field names)."""
-RAWX = "rcvTOW week leapS numMeas recStat version reserved1 meas"
-SFRBX = "gnssId svId reserved0 freqId numWords chn version reserved1 dwrd"
 
 
 def _named(names: str, values) -> dict:
@@ -138,30 +142,46 @@ def test_glonass_ephemerides_come_back_from_the_navigation_file(tmp_path, flavou
     assert read_obs(tmp_path / "seq" / "gnss" / "rover.obs").header.glonass_channels == {5: CHANNEL}
 
 
-def test_glonass_navigation_strings_of_ublox_are_named_not_dropped(tmp_path):
-    """RxmSFRBX carries GLONASS strings (gnssId 6) the import does not decode: the warning says
-    so, with the count, and what to give instead."""
-    with SmallBag(tmp_path / "ublox.bag", "ros1") as bag:
+@pytest.mark.parametrize("flavour", ["ros1", "mcap"])
+def test_glonass_strings_of_ublox_come_back_from_the_navigation_file(tmp_path, flavour):
+    """RxmSFRBX GLONASS strings 1–4 of R05 (channel −3) and R12 (channel 4), encoded from the
+    records above (tb on a quarter hour of UTC, the frame 15 min before): the navigation file
+    holds them at the values the strings carry, to its D19.12 digits; a Galileo page, which is
+    not decoded, is named in a warning with its count."""
+    toc = tb_quarter_hour(T0)
+    channels = {5: CHANNEL, 12: 4}
+    sent = {}
+    path = bag_path(tmp_path, flavour, "ublox")
+    with SmallBag(path, flavour) as bag:
         times = T0 + np.arange(0.0, 3.0, 0.1)
         bag.imu(times, 0.1)
         bag.twist(times, 5.0)
-        types = bag.types
-        meas = types["ublox_msgs/msg/RxmRAWX_Meas"](**_named(RAWX_MEAS, RAWX_MEAS_VALUES))
         for t in T0 + np.arange(3.0):
-            values = (t - WEEK * SECONDS_PER_WEEK, WEEK, 18, 1, 1, 1, np.zeros(2, np.uint8), [meas])
-            rawx = types["ublox_msgs/msg/RxmRAWX"](**_named(RAWX, values))
-            bag.write("/ublox/rxmraw", "ublox_msgs/msg/RxmRAWX", ros_ns(t), rawx)
-            for gnss_id in (6, 6, 6, 2):  # three GLONASS strings, one Galileo page
-                values = (gnss_id, 5, 0, 7 + CHANNEL, 4, 1, 2, 0, np.arange(4, dtype=np.uint32))
-                sfrbx = types["ublox_msgs/msg/RxmSFRBX"](**_named(SFRBX, values))
-                bag.write("/ublox/rxmsfrb", "ublox_msgs/msg/RxmSFRBX", ros_ns(t), sfrbx)
-    summary = import_rosbag(tmp_path / "ublox.bag", tmp_path / "seq", RosbagOptions(origin=ORIGIN))
-    assert summary.ephemerides == 0
+            ublox_rawx(bag, t, [_named(RAWX_MEAS, RAWX_MEAS_VALUES)])
+            ublox_sfrbx(bag, t, 2, 11, 0, np.arange(8))
+        for slot, (pos, vel, acc, tau_n, gamma, age) in EPHEMERIDES.items():
+            params = example_at(toc) | {"minus_tau_n": -tau_n, "gamma_n": gamma, "age": age}
+            params |= dict(zip(("x", "y", "z", "vx", "vy", "vz"), (*pos, *vel), strict=True))
+            params |= dict(zip(("ax", "ay", "az"), acc, strict=True))
+            params["channel"] = channels[slot]
+            sent[slot] = quantised(params)
+            for n, string in enumerate(encode_strings(slot, toc, params)):
+                words = sfrbx_words(string)
+                ublox_sfrbx(bag, T0 + 0.5 + n, 6, slot, channels[slot] + 7, words)
+    summary = import_rosbag(path, tmp_path / "seq", RosbagOptions(origin=ORIGIN))
+    assert summary.ephemerides == 2
+    glonass = read_nav(tmp_path / "seq" / "gnss" / "brdc.nav").glonass
+    assert glonass.prn.tolist() == [5, 12] and glonass.toc.tolist() == [toc, toc]
+    for k, slot in enumerate((5, 12)):
+        for name in ("x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"):
+            assert glonass[name][k] == rounded_nav_value(sent[slot][name] / 1000.0) * 1000.0
+        for name in ("minus_tau_n", "gamma_n", "frame_time", "health", "channel", "age"):
+            assert glonass[name][k] == rounded_nav_value(sent[slot][name]), name
+    assert glonass["frame_time"][0] == (toc - 18.0 - 900.0) % SECONDS_PER_WEEK
     assert (
-        "/ublox/rxmsfrb: navigation data of other systems not decoded (3 Galileo, 9 GLONASS "
-        "messages; only GPS LNAV is): those satellites have no ephemeris in the sequence, so "
+        "/ublox/rxmsfrb: navigation data of other systems not decoded (3 Galileo messages; "
+        "only GPS LNAV and GLONASS are): those satellites have no ephemeris in the sequence, so "
         "their measurements are not used; add a RINEX navigation file of the day to gnss.nav "
         "for them" in summary.warnings
     )
-    assert any("no ephemeris in the bag" in text for text in summary.warnings)
-    assert (tmp_path / "seq" / "gnss" / "rover.obs").is_file()
+    assert read_obs(tmp_path / "seq" / "gnss" / "rover.obs").header.glonass_channels == {5: CHANNEL}

@@ -11,6 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pyubx2 import UBXMessage
 
+from tests.helpers import glonass_strings as glo
 from tests.helpers.lnav import EXAMPLE, encode_ephemeris, quantised, sfrbx
 from vo_doppler.errors import InputError
 from vo_doppler.gnss.ephemeris import satellite_states
@@ -118,6 +119,43 @@ def test_sfrbx_subframes_give_the_ephemeris_and_its_orbit(tmp_path):
     assert np.all(np.abs(radius - expected["sqrt_a"] ** 2) < 0.02 * expected["sqrt_a"] ** 2)
     speed = np.linalg.norm(states.velocity, axis=1)
     assert np.all((speed > 2500.0) & (speed < 4000.0))
+
+
+def test_glonass_strings_give_the_ephemeris_and_its_orbit(tmp_path):
+    """Strings 1–4 of R03 (channel −5, as RXM-RAWX tracks it) in RXM-SFRBX messages: one record
+    at the values the strings carry, tb on its GPS time; a string whose check fails is named
+    by its byte offset and the satellite is taken from its next frame."""
+    toc = glo.tb_quarter_hour(WEEK * 604800.0 + TOW)
+    params = glo.example_at(toc) | {"channel": -5.0}
+    strings = glo.encode_strings(3, toc, params)
+    broken = glo.ubx_sfrbx(3, -5, strings[1] ^ 0b11 << 30)
+    frames = [glo.ubx_sfrbx(3, -5, s) for s in strings]
+    data = rawx(TOW) + frames[0] + broken + b"".join(frames[2:]) + b"".join(frames)
+    recording = read_ubx(write(tmp_path, data))
+    glonass = recording.navigation.glonass
+    assert glonass.prn.tolist() == [3] and glonass.toc.tolist() == [toc]
+    assert glonass.line[0] == len(rawx(TOW)) + 2 * len(frames[0]) + 5 * len(frames[0])
+    for name, value in glo.quantised(params).items():
+        assert glonass[name][0] == value, name
+    offset = len(rawx(TOW)) + len(frames[0])
+    assert any(
+        f"byte {offset}: 1 GLONASS strings or ephemerides refused (the first: R03, string "
+        "fails the Hamming check)" in p
+        for p in recording.problems
+    )
+    t = toc + np.array([-900.0, 0.0, 900.0])
+    states = satellite_states(recording.navigation, "R", 3, t)
+    assert states.valid.all()
+    radius = np.linalg.norm(states.position, axis=1)
+    np.testing.assert_allclose(radius, np.linalg.norm([params[a] for a in "xyz"]), rtol=2e-3)
+
+
+def test_glonass_strings_without_a_gps_time_are_named(tmp_path):
+    toc = glo.tb_quarter_hour(WEEK * 604800.0 + TOW)
+    strings = glo.encode_strings(3, toc, glo.example_at(toc))
+    recording = read_ubx(write(tmp_path, b"".join(glo.ubx_sfrbx(3, -5, s) for s in strings)))
+    assert len(recording.navigation.glonass) == 0
+    assert "byte 0: GLONASS strings without a GPS time: not decoded" in recording.problems[0]
 
 
 def test_nav_pvt_whose_utc_disagrees_with_itow_is_skipped(tmp_path):

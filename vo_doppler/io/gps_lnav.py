@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vo_doppler.bounds import GPS_ECCENTRICITY, GPS_INCLINATION, GPS_SQRT_A
-from vo_doppler.io.rinex_nav import GLONASS_FIELDS, KEPLER_FIELDS
+from vo_doppler.io.rinex_nav import KEPLER_FIELDS
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.navigation import NavRecords
 
@@ -36,7 +36,6 @@ PREAMBLE = 0x8B
 URA_METERS = (2.4, 3.4, 4.85, 6.85, 9.65, 13.65, 24.0, 48.0, 96.0, 192.0, 384.0, 768.0)
 URA_METERS += (1536.0, 3072.0, 6144.0, np.nan)
 KEPLER_NAMES = (*(name for group in KEPLER_FIELDS for name in group), "toe")
-GLONASS_NAMES = tuple(name for group in GLONASS_FIELDS for name in group)
 
 # (name, first ICD bit, [(first bit, n bits) …] most significant part first, signed, scale)
 _SUBFRAME_FIELDS: dict[int, tuple[tuple[str, tuple[tuple[int, int], ...], bool, float], ...]] = {
@@ -238,14 +237,3 @@ def _nearest(reference: float, seconds_of_week: float) -> float:
     delta = seconds_of_week - np.mod(reference, SECONDS_PER_WEEK)
     delta -= SECONDS_PER_WEEK * np.round(delta / SECONDS_PER_WEEK)
     return float(reference + delta)
-
-
-def empty_glonass() -> NavRecords:
-    """A GLONASS record table with no rows (the UBX reader decodes GPS LNAV only)."""
-    return NavRecords(
-        np.zeros(0, dtype="U1"),
-        np.zeros(0, dtype=np.int16),
-        np.zeros(0),
-        {name: np.zeros(0) for name in GLONASS_NAMES},
-        np.zeros(0, dtype=np.int64),
-    )

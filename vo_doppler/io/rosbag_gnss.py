@@ -34,7 +34,10 @@ satellite's entry): it is not in the observations. ``RxmRAWX`` carries its time:
 (:mod:`vo_doppler.io.ubx`: signal codes, LLI from the lock time and half-cycle flag, the value
 ranges; a ROS 1 definition without ``sigId`` is read as signal 0, the L1 C/A of an M8);
 ``RxmSFRBX`` → GPS LNAV subframes 1–3 decoded into ephemerides (:mod:`vo_doppler.io.gps_lnav`),
-the week from the RAWX messages; other systems' navigation data are counted, not decoded;
+the week from the RAWX messages, and GLONASS strings 1–4 (``gnssId`` 6, ``svId`` the slot,
+``freqId`` − 7 the frequency number) into GLONASS records
+(:mod:`vo_doppler.io.glonass_strings`), their day from the first RAWX epoch; other systems'
+navigation data (Galileo, BeiDou, QZSS, SBAS) are counted, not decoded;
 ``doStdev`` (0.002·2ⁿ Hz) × wavelength → the Doppler σ.
 """
 
@@ -44,7 +47,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from vo_doppler.io.glonass_strings import GlonassAssembler, sfrbx_string
 from vo_doppler.io.gps_lnav import KEPLER_NAMES, LnavAssembler, subframe_id
+from vo_doppler.io.rinex_common import prn_in_range
 from vo_doppler.io.rinex_nav import KEPLER_FIELDS
 from vo_doppler.io.rinex_write import GlonassRecord, KeplerRecord
 from vo_doppler.io.rosbag_bag import Bag
@@ -490,7 +495,9 @@ def read_ublox(bag: Bag, rawx_topic: str, sfrbx_topic: str | None) -> BagGnss:
                     sigma.append((raw.time[k], sat, raw.code[k], raw.sigma_value[k] * lam))
     if not raw.time:
         raise bag.error(rawx_topic, 0, "no RxmRAWX measurement in the topic")
-    ephemerides = _sfrbx_ephemerides(bag, sfrbx_topic, raw.week, problems) if sfrbx_topic else []
+    ephemerides = (
+        _sfrbx_ephemerides(bag, sfrbx_topic, raw.week, epochs[0], problems) if sfrbx_topic else []
+    )
     observations = raw.observations(bag.path, problems)
     epoch_time = np.unique(np.concatenate([observations.epoch_time, epochs]))
     observations = replace(  # epochs without a measurement kept (RxmRAWX carries their time)
@@ -506,13 +513,23 @@ def read_ublox(bag: Bag, rawx_topic: str, sfrbx_topic: str | None) -> BagGnss:
     )
 
 
-def _sfrbx_ephemerides(bag: Bag, topic: str, week: int | None, problems: list[str]):
+def _sfrbx_ephemerides(bag: Bag, topic: str, week: int | None, reference: float, problems):
+    """GPS LNAV and GLONASS ephemerides of the RxmSFRBX topic (module docstring)."""
     assembler = LnavAssembler.new()
-    n_other = 0
+    glonass = GlonassAssembler(reference)
+    n_other = n_slot = 0
     foreign: dict[str, int] = {}
     for index, _, message in bag.messages(topic):
         words = [int(w) for w in np.asarray(get(message, "dwrd", ()), dtype=np.int64).ravel()]
         gnss = int(get(message, "gnssId", 0))
+        if gnss == 6 and len(words) >= 3:
+            slot, signal = int(get(message, "svId", 0)), int(get(message, "sigId", 0) or 0)
+            if prn_in_range("R", slot):
+                channel = int(get(message, "freqId", 0)) - 7
+                glonass.add(slot, channel, sfrbx_string(words), index, signal)
+            else:
+                n_slot += 1
+            continue
         if gnss != 0:
             system = SYSTEMS.get(gnss, f"gnssId {gnss}")
             foreign[system] = foreign.get(system, 0) + 1
@@ -527,17 +544,26 @@ def _sfrbx_ephemerides(bag: Bag, topic: str, week: int | None, problems: list[st
             n_other += 1
     if n_other:
         problems.append(f"{topic}: {n_other} GPS subframes without ephemeris (4-5, L2C, L5)")
+    if n_slot:
+        problems.append(f"{topic}: {n_slot} GLONASS strings of an unknown slot skipped")
+    if glonass.rejected:
+        index, slot, why = glonass.rejected[0]
+        problems.append(
+            f"{topic}: {len(glonass.rejected)} GLONASS strings or ephemerides refused (the "
+            f"first: message {index}, R{slot:02d}, {why})"
+        )
     if foreign:
         counts = ", ".join(f"{n} {SYSTEM_NAMES.get(s, s)}" for s, n in sorted(foreign.items()))
         problems.append(
             f"{topic}: navigation data of other systems not decoded ({counts} messages; only "
-            "GPS LNAV is): those satellites have no ephemeris in the sequence, so their "
-            "measurements are not used; add a RINEX navigation file of the day to gnss.nav "
-            "for them"
+            "GPS LNAV and GLONASS are): those satellites have no ephemeris in the sequence, so "
+            "their measurements are not used; add a RINEX navigation file of the day to "
+            "gnss.nav for them"
         )
     records = assembler.navrecords()
-    out = []
+    out: list[KeplerRecord | GlonassRecord] = []
     for k in range(len(records)):
         params = {name: float(records[name][k]) for name in KEPLER_NAMES if name != "toe"}
         out.append(KeplerRecord("G", int(records.prn[k]), float(records.toc[k]), params))
+    out.extend(GlonassRecord(slot, toc, params) for slot, toc, params, _ in glonass.records)
     return out

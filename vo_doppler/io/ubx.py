@@ -1,4 +1,5 @@
-"""u-blox UBX binary logs (pyubx2): raw measurements, GPS ephemerides, the receiver's own fixes.
+"""u-blox UBX binary logs (pyubx2): raw measurements, GPS and GLONASS ephemerides, the receiver's
+own fixes.
 
 Framing (u-blox interface description, "UBX frame structure"): sync 0xB5 0x62, class, id,
 little-endian length, payload, 8-bit Fletcher checksum over class…payload. The stream is
@@ -23,9 +24,12 @@ Physical bounds come from :mod:`vo_doppler.bounds`.
 - RXM-SFRBX → GPS L1 C/A LNAV subframes 1–3 decoded into ephemerides
   (:mod:`vo_doppler.io.gps_lnav`); the data bits of each word are bits 29…6 of ``dwrd``, its
   parity bits 5…0: a subframe failing the LNAV parity check is skipped, and so is an ephemeris
-  off any GPS orbit (both named by byte offset in ``problems``).
+  off any GPS orbit (both named by byte offset in ``problems``); GLONASS strings 1–4
+  (the first three words of ``dwrd``, ``svId`` the slot, ``freqId`` − 7 the frequency number)
+  decoded into GLONASS records (:mod:`vo_doppler.io.glonass_strings`), their day from the first
+  RXM-RAWX epoch (or NAV-PVT fix); refused strings and records counted in one problem.
   Not decoded: GPS subframes 4–5 (almanac, ionosphere, UTC), and every other system's
-  navigation data (Galileo I/NAV, BeiDou D1/D2, GLONASS strings, QZSS, SBAS); they are counted.
+  navigation data (Galileo I/NAV, BeiDou D1/D2, QZSS, SBAS); they are counted.
 - NAV-PVT → :class:`ReceiverSolution`; the time is the GPS time whose second of week is iTOW,
   nearest to the message's UTC date and time plus the leap seconds of that date; a message
   whose two times disagree by more than 2 s, or without a valid date, is skipped, and so is one
@@ -56,12 +60,13 @@ from vo_doppler.bounds import (
     VELOCITY_COMPONENT,
 )
 from vo_doppler.errors import InputError
-from vo_doppler.io.gps_lnav import LnavAssembler, empty_glonass, parity_error, subframe_id
+from vo_doppler.io.glonass_strings import GlonassAssembler, sfrbx_string
+from vo_doppler.io.gps_lnav import LnavAssembler, parity_error, subframe_id
 from vo_doppler.io.obs_rows import observations_from_rows
 from vo_doppler.io.rinex_common import prn_in_range
 from vo_doppler.io.textfile import regular_file
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK, calendar_to_gps_seconds, utc_to_gps_seconds
-from vo_doppler.model.navigation import Navigation
+from vo_doppler.model.navigation import Navigation, NavRecords
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.receiver_solution import ReceiverSolution
 from vo_doppler.model.row_sigma import RowSigma
@@ -131,7 +136,7 @@ _PARSE_ERRORS = (UBXParseError, UBXMessageError, UBXTypeError, ValueError, struc
 
 @dataclass(frozen=True)
 class UbxRecording:
-    """What a UBX log holds: observations (None without RXM-RAWX), GPS ephemerides, the
+    """What a UBX log holds: observations (None without RXM-RAWX), GPS and GLONASS ephemerides, the
     receiver's fixes, the receiver-reported σ per observation row, and skipped-data messages."""
 
     observations: Observations | None
@@ -266,6 +271,7 @@ def _read_stream(stream: BinaryIO, path: Path) -> UbxRecording:
     raw = _RawxRows()
     pvt: list[dict[str, float]] = []
     subframes: list[tuple[int, int, tuple[int, ...]]] = []
+    strings: list[tuple[int, int, int, int, int]] = []
     n_other_nav = 0
     for offset, cls, mid, frame in frames(stream, path, problems):
         if (cls, mid) not in (RAWX, SFRBX, PVT):
@@ -293,12 +299,18 @@ def _read_stream(stream: BinaryIO, path: Path) -> UbxRecording:
                 _problem(problems, path, offset, f"GPS subframe of SV {message.svId}: {why}")
                 continue
             subframes.append((offset, message.svId, tuple(w >> 6 for w in words30)))
+        elif message.gnssId == 6 and message.numWords >= 3:
+            words = [getattr(message, f"dwrd_{k:02d}") for k in range(1, 4)]
+            string = sfrbx_string(words)
+            strings.append((offset, message.svId, message.freqId - 7, message.sigId, string))
         else:
             n_other_nav += 1
-    if not (raw.time or pvt or subframes):
+    if not (raw.time or pvt or subframes or strings):
         raise InputError("no UBX RXM-RAWX, RXM-SFRBX or NAV-PVT message", path)
     week = raw.week if raw.week is not None else _week_of(pvt)
-    navigation = _navigation(subframes, week, path, problems, n_other_nav)
+    reference = raw.time[0] if raw.time else (pvt[0]["t"] if pvt else None)
+    glonass = _glonass(strings, reference, path, problems)
+    navigation = _navigation(subframes, week, path, problems, n_other_nav, glonass)
     observations = raw.observations(path, problems) if raw.time else None
     return UbxRecording(
         observations, navigation, _solution(pvt), raw.sigma(), tuple(problems), path
@@ -501,8 +513,38 @@ def _solution(pvt: list[dict[str, float]]) -> ReceiverSolution:
     )
 
 
-def _navigation(subframes, week: int | None, path: Path, problems, n_other: int) -> Navigation:
-    """GPS ephemerides from the LNAV subframes (needs a full week from RAWX or NAV-PVT)."""
+def _glonass(strings, reference: float | None, path: Path, problems) -> NavRecords:
+    """GLONASS ephemerides from the strings (their day needs a GPS time from RAWX or NAV-PVT);
+    refused strings and records counted in one problem naming the first."""
+    assembler = GlonassAssembler(np.nan if reference is None else reference)
+    if strings and reference is None:
+        _problem(problems, path, strings[0][0], "GLONASS strings without a GPS time: not decoded")
+        strings = []
+    n_slot = 0
+    for offset, slot, channel, signal, string in strings:
+        if prn_in_range("R", slot):
+            assembler.add(slot, channel, string, offset, signal)
+        else:
+            n_slot += 1
+    if n_slot:
+        _problem(problems, path, 0, f"{n_slot} GLONASS strings of an unknown slot skipped")
+    if assembler.rejected:
+        offset, slot, why = assembler.rejected[0]
+        _problem(
+            problems,
+            path,
+            offset,
+            f"{len(assembler.rejected)} GLONASS strings or ephemerides refused (the first: "
+            f"R{slot:02d}, {why})",
+        )
+    return assembler.navrecords()
+
+
+def _navigation(
+    subframes, week: int | None, path: Path, problems, n_other: int, glonass: NavRecords
+) -> Navigation:
+    """GPS ephemerides from the LNAV subframes (needs a full week from RAWX or NAV-PVT) and the
+    GLONASS ones."""
     assembler = LnavAssembler.new()
     n_not_ephemeris = 0
     if subframes and week is None:
@@ -523,4 +565,4 @@ def _navigation(subframes, week: int | None, path: Path, problems, n_other: int)
             f"not decoded: {n_not_ephemeris} GPS subframes 4-5 or without preamble, "
             f"{n_other} navigation messages of other systems or signals",
         )
-    return Navigation(assembler.navrecords(), empty_glonass(), problems=tuple(problems))
+    return Navigation(assembler.navrecords(), glonass, problems=tuple(problems))
