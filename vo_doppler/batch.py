@@ -75,6 +75,7 @@ from vo_doppler.io.output_folder import (
     open_output_folder,
     remove_cut_off_staging,
     swap_in,
+    write_files,
 )
 from vo_doppler.io.tables import write_csv_and_parquet
 from vo_doppler.job import require_tight_heading, run_recording
@@ -252,16 +253,6 @@ def fingerprint(
     return digest.hexdigest()
 
 
-def _write_atomically(path: Path, text: str) -> None:
-    """Write ``text`` to a temporary file beside ``path``, flush it to disk, rename it over."""
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with temporary.open("w") as stream:
-        stream.write(text)
-        stream.flush()
-        os.fsync(stream.fileno())
-    os.replace(temporary, path)
-
-
 def finished(job: RecordingJob) -> dict | None:
     """The marker of a recording finished with the job's fingerprint whose outputs are all still
     there and whose last run did not fail, else None. A :data:`FAILED_LOG` says the last run
@@ -379,7 +370,8 @@ def _done(job: RecordingJob, staging: Path, summary: dict, seconds: float) -> Re
         "outputs": outputs,
         "summary": summary,
     }
-    _write_atomically(staging / MARKER, json_text(marker, indent=2))
+    text = json_text(marker, indent=2)
+    write_files([(staging / MARKER, lambda path: path.write_text(text))])
     return RecordingOutcome(job.name, job.source, Status.DONE, seconds, summary)
 
 

@@ -29,6 +29,7 @@ from vo_doppler.io.output_folder import (
     remove_cut_off_staging,
     staged_output,
     untouched,
+    write_files,
     written_by,
 )
 
@@ -380,3 +381,24 @@ def test_a_batch_cut_off_before_its_aggregate_is_recognised_by_its_recordings(tm
     (out / "batch_summary.csv").write_text("recording\n")
     (out / "notes").mkdir()
     assert written_by(out, "batch") == (True, [])
+
+
+def test_write_files_moves_every_file_in_only_once_all_are_written(tmp_path):
+    earlier = tmp_path / "a.csv"
+    earlier.write_text("earlier")
+
+    def refused(path):
+        path.write_text("half")
+        raise OSError(28, "No space left on device")
+
+    with pytest.raises(OSError):
+        write_files([(earlier, lambda path: path.write_text("new")), (tmp_path / "b.csv", refused)])
+    assert earlier.read_text() == "earlier"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.csv"]
+    nested = tmp_path / "c" / "d.csv"
+    write_files(
+        [(earlier, lambda path: path.write_text("new")), (nested, lambda p: p.write_text(p.suffix))]
+    )
+    assert earlier.read_text() == "new"
+    assert nested.read_text() == ".csv"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["a.csv", "c", "d.csv"]

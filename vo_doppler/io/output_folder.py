@@ -411,13 +411,16 @@ def write_files(writers: Sequence[tuple[Path, Callable[[Path], None]]]) -> None:
     """Write files that are not in a staged folder: each ``(path, write)`` writes to a hidden
     file beside ``path`` (the same folder, so that :func:`os.replace` is a rename, and the same
     suffix, which chooses the format), and all are moved in place only once every one is
-    written. A failure (a full disk) leaves none of them, and the files of an earlier run as
-    they were. Missing parent folders are created."""
+    written and flushed to disk. A failure (a full disk) leaves none of them, and the files of
+    an earlier run as they were; after a crash or power loss each file is either the earlier
+    one or the whole new one. Missing parent folders are created."""
     partial = [(path, path.with_name(f".{path.stem}.partial{path.suffix}")) for path, _ in writers]
     try:
         for (path, temporary), (_, write) in zip(partial, writers, strict=True):
             path.parent.mkdir(parents=True, exist_ok=True)
             write(temporary)
+            with temporary.open("rb+") as stream:
+                os.fsync(stream.fileno())
         for path, temporary in partial:
             os.replace(temporary, path)
     finally:
