@@ -15,6 +15,7 @@ from matplotlib.image import imread
 
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
+from vo_doppler.io.gnss_results_csv import read_velocity_csv
 from vo_doppler.io.heading_csv import COLUMNS as HEADING_COLUMNS
 from vo_doppler.io.heading_csv import OPTIONAL_COLUMNS as HEADING_OPTIONAL
 from vo_doppler.io.heading_csv import read_heading_csv
@@ -60,7 +61,7 @@ def test_run_writes_every_output(sequence, run_output):
     recording = read_sequence(sequence)
     written = sorted(p.name for p in run_output.iterdir() if not p.name.startswith("."))
     expected = [*CAMERA_TRAJECTORIES.values(), *DR_TRAJECTORIES.values(), *FIGURES]
-    expected += ["heading.csv", "report.html", "summary.json", "trajectories.geojson"]
+    expected += ["heading.csv", "report.html", "summary.json", "trajectories.geojson", "vel.csv"]
     assert written == sorted(expected)
     manifest = json.loads((run_output / ".vo-doppler-output.json").read_text())
     assert manifest["command"] == "run" and manifest["entries"] == written
@@ -102,6 +103,12 @@ def test_run_writes_every_output(sequence, run_output):
     assert summary["tight_heading_availability"] == pytest.approx(
         np.mean(np.isfinite(table.yaw_tc)), abs=1e-12
     )
+    # the conventional velocity, valid by the car's tests: the table's verdict, epoch by epoch
+    velocity = read_velocity_csv(run_output / "vel.csv")
+    np.testing.assert_allclose(velocity.t, table.t, rtol=0, atol=5e-4)
+    assert not np.any(velocity.valid & ~table.conv_gnss_valid & (velocity.speed_mps > 1.0))
+    moving_valid = velocity.valid & (velocity.speed_mps > 3.0)
+    np.testing.assert_array_equal(moving_valid, table.conv_valid & (velocity.speed_mps > 3.0))
 
     # the tracks on the map are the trajectories written, in longitude and latitude
     features = json.loads((run_output / "trajectories.geojson").read_text())["features"]

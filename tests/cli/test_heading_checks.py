@@ -9,6 +9,7 @@ import json
 import pytest
 
 from vo_doppler.cli import main
+from vo_doppler.io.gnss_results_csv import read_velocity_csv
 
 GPS_MINUS_UNIX_S = -315964782.0
 
@@ -23,14 +24,14 @@ def kmh_drive(tmp_path_factory):
     return folder
 
 
-def _heading(folder, offset_s: float, out, capsys, caplog) -> dict:
+def _heading(folder, offset_s: float, out, capsys, caplog, extra=()) -> dict:
     capsys.readouterr()
     caplog.clear()
     argv = ["-q", "heading", str(folder / "gnss/rover.obs"), "--nav", str(folder / "gnss/brdc.nav")]
     argv += ["--can", str(folder / "can/vehicle.log"), "--dbc", str(folder / "can/vehicle.dbc")]
     argv += ["--yaw-rate", "VEHICLE_DYNAMICS.YAW_RATE"]
     argv += ["--wheel-speed", "WHEEL_SPEEDS.WHEEL_SPEED_RL,WHEEL_SPEEDS.WHEEL_SPEED_RR"]
-    argv += ["--time-offset-can", f"{offset_s}", "-o", str(out)]
+    argv += ["--time-offset-can", f"{offset_s}", "-o", str(out), *extra]
     assert main(argv) == 0
     summary = json.loads(capsys.readouterr().out)
     for warning in summary["warnings"]:
@@ -44,6 +45,30 @@ def test_a_wheel_scale_far_from_one_is_a_warning(kmh_drive, tmp_path, capsys, ca
     assert summary["wheel_scale"] == pytest.approx(1 / 3.6, abs=0.02)
     (warning,) = [w for w in summary["warnings"] if w.startswith("wheel scale")]
     assert f"wheel scale: the calibration gives {summary['wheel_scale']:.3f}" in warning
+
+
+@pytest.mark.slow
+def test_the_car_checked_velocity_is_written_when_asked(kmh_drive, tmp_path, capsys, caplog):
+    """``--vel``: the conventional velocity with the car's verdict (design (I1c)), the share the
+    summary gives; without ``--vel`` nothing else is written."""
+    vel = tmp_path / "v.csv"
+    summary = _heading(
+        kmh_drive, GPS_MINUS_UNIX_S, tmp_path / "h.csv", capsys, caplog, ["--vel", str(vel)]
+    )
+    velocity = read_velocity_csv(vel)
+    assert summary["vel"] == str(vel)
+    assert summary["conv_velocity_valid"] == pytest.approx(velocity.valid.mean(), abs=1e-12)
+    assert 0.5 < velocity.valid.mean() < 1.0
+    assert velocity.valid[velocity.speed_mps > 3.0].mean() > 0.9  # open sky
+    plain = _heading(kmh_drive, GPS_MINUS_UNIX_S, tmp_path / "p.csv", capsys, caplog)
+    assert plain["vel"] is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "h.csv",
+        "h.png",
+        "p.csv",
+        "p.png",
+        "v.csv",
+    ]
 
 
 @pytest.mark.slow

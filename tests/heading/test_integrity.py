@@ -5,15 +5,21 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.helpers.heading_table import plain_heading_table
+from tests.helpers.velocity import velocity_solution
 from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.gnss.doppler_velocity import solve_velocity
 from vo_doppler.gnss.windowed_line import ConsistencyConfig, epochs_in_window
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.integrity import (
+    AT_REST_MAX_MPS,
+    car_checked_velocity,
     car_vertical_bound,
     conventional_integrity,
     course_protection,
     integrity_rate_warning,
+    rest_speed_bound,
+    velocity_integrity,
 )
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.model.doppler import DopplerRows
@@ -152,17 +158,19 @@ def _courses(rate_hz: float, fault_deg: float = 0.0):
     return t, wrap_angle(course), yaw - 1.3, fault
 
 
-def _judged(t, course, angle, valid=None, wheel=8.0):
+def _judged(
+    t, course, angle, valid=None, wheel=8.0, speed=8.0, course_sigma=STATED_SIGMA, speed_sigma=0.3
+):
     n = t.size
     return conventional_integrity(
         t,
         np.ones(n, bool) if valid is None else valid,
         course,
-        np.full(n, STATED_SIGMA),
+        np.full(n, course_sigma),
         angle,
-        np.full(n, 8.0),
-        np.full(n, 0.3),
-        np.full(n, wheel),
+        np.broadcast_to(speed, n),
+        np.full(n, speed_sigma),
+        np.broadcast_to(wheel, n),
         np.full(n, 1e-4),
     )
 
@@ -256,3 +264,76 @@ def test_a_velocity_climbing_beyond_a_cars_road_is_not_valid_whatever_its_sigma(
     )
     assert not result.valid[60] and np.isnan(result.course.z[60])  # not tested: not usable
     assert result.valid[bound].all()
+
+
+def test_the_rest_bound_is_the_rayleigh_quantile_of_the_measured_rest_noise():
+    """Exact: speeds whose median is m give σ = m / √(2 ln 2) and the bound σ·√(−2 ln 0.01);
+    up to half of them faulty leave it; too few epochs or noisy rest give the fixed cap."""
+    speed = np.full(21, 0.05)
+    speed[:10] = 5.0  # ten faulty fixes among 21 epochs at rest
+    sigma = 0.05 / np.sqrt(2.0 * np.log(2.0))
+    expected = sigma * np.sqrt(-2.0 * np.log(0.01))
+    assert rest_speed_bound(speed, np.ones(21, bool)) == pytest.approx(expected, rel=1e-12)
+    assert expected == pytest.approx(0.1289, abs=1e-4)
+    assert rest_speed_bound(speed, np.arange(21) < 9) == AT_REST_MAX_MPS  # nine epochs
+    assert rest_speed_bound(np.full(30, 0.5), np.ones(30, bool)) == AT_REST_MAX_MPS
+    healthy = np.hypot(*np.random.default_rng(4).normal(0.0, 0.03, (2, 20000)))
+    bound = rest_speed_bound(healthy, np.ones(healthy.size, bool))
+    assert np.mean(healthy > bound) == pytest.approx(0.01, abs=0.003)
+
+
+@pytest.mark.parametrize("rate_hz", RATES_HZ)
+def test_a_velocity_at_rest_is_valid_within_the_rest_noise_and_moving_by_the_course_bound(
+    rate_hz,
+):
+    """A drive at any rate: 20 s at rest (speeds 0.02–0.06 m/s, one fix pulled to 0.5 m/s),
+    then 8 m/s with an 8° course fault of 3 s. At rest the velocity is valid within the rest
+    bound (the course is undefined there, and the course table says not valid), moving the
+    course bound judges it as it judges the course; without wheels the GNSS verdict stays."""
+    t, course, angle, fault = _courses(rate_hz, fault_deg=8.0)
+    rest = t < 20.0
+    rng = np.random.default_rng(7)
+    speed = np.where(rest, rng.uniform(0.02, 0.06, t.size), 8.0)
+    pulled = int(np.argmin(np.abs(t - 10.0)))
+    speed[pulled] = 0.5
+    wheel = np.where(rest, 0.0, 8.0)
+    n = t.size
+    integrity = _judged(t, course, angle, ~rest, wheel, speed)
+    checked = velocity_integrity(integrity, np.ones(n, bool), speed, wheel)
+    assert 0.06 < checked.rest_bound_mps < 0.12
+    expected_rest = rest & (np.arange(n) != pulled)
+    np.testing.assert_array_equal(checked.valid[rest], expected_rest[rest])
+    np.testing.assert_array_equal(checked.valid[~rest], integrity.valid[~rest])
+    assert not checked.valid[fault].any() and checked.valid[~rest & ~fault].mean() > 0.8
+    without_wheels = velocity_integrity(integrity, ~fault, speed, np.full(n, np.nan))
+    np.testing.assert_array_equal(without_wheels.valid, ~fault)
+
+
+def test_a_slow_cars_course_may_be_as_uncertain_as_the_rest_noise():
+    """At 0.5 m/s a course 10° off is 0.09 m/s across the track, within the rest bound: the
+    velocity is valid though the course (5° alert limit) is not; at 8 m/s it is neither."""
+    t = np.arange(0.0, 60.0)
+    n = t.size
+    yaw = np.zeros(n)
+    course = np.where(t == 30.0, np.radians(10.0), 0.0)
+    result = {}
+    for speed_mps in (0.5, 8.0):
+        speed = np.full(n, speed_mps)
+        integrity = _judged(t, course, yaw, None, speed, speed, np.radians(12.0), 0.05)
+        checked = velocity_integrity(integrity, np.ones(n, bool), speed, speed)
+        assert not integrity.valid[30]
+        result[speed_mps] = checked.valid[30]
+    assert result == {0.5: True, 8.0: False}
+
+
+def test_the_checked_velocity_carries_the_tables_verdict_only():
+    t = np.arange(5.0)
+    velocity = velocity_solution(t, np.tile([3.0, 4.0, 0.1], (5, 1)))
+    verdict = np.array([1, 0, 1, 0, 0], bool)
+    checked = car_checked_velocity(velocity, plain_heading_table(t, conv_velocity_valid=verdict))
+    np.testing.assert_array_equal(checked.valid, verdict)
+    np.testing.assert_array_equal(checked.velocity_enu, velocity.velocity_enu)
+    assert car_checked_velocity(velocity, plain_heading_table(t)) is velocity
+    shorter = plain_heading_table(t[:4], conv_velocity_valid=verdict[:4])
+    with pytest.raises(ValueError, match="4 epochs, the velocity 5"):
+        car_checked_velocity(velocity, shorter)

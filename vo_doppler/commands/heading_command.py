@@ -30,8 +30,10 @@ from vo_doppler.errors import InputError, VoDopplerError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
+from vo_doppler.heading.integrity import car_checked_velocity
 from vo_doppler.heading.pipeline import CalibrationMethod
 from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.gnss_csv import write_velocity_csv
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.output_folder import write_files
 from vo_doppler.io.rinex_obs import read_obs
@@ -135,6 +137,12 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--gt", type=Path, help="ground truth TUM (GPS time, z-up world)")
     parser.add_argument("-o", "--output", type=Path, required=True, help="heading CSV")
     parser.add_argument("--figure", type=Path, help="PNG (default: next to the CSV)")
+    parser.add_argument(
+        "--vel",
+        type=Path,
+        help="also write the conventional velocity as vel.csv with its valid column after the "
+        "car's gyro and wheel tests (docs/outputs.md; not written by default)",
+    )
     add_span_options(parser, "first observation epoch")
     parser.add_check(sensor_options_problem)
     defaults = {option: parser.get_default(_dest(option)) for option in CAN_ONLY_OPTIONS}
@@ -266,8 +274,11 @@ def _local_frame(receiver_ecef: np.ndarray, obs) -> EnuFrame:
 def run(args: argparse.Namespace) -> int:
     figure = args.figure or args.output.with_suffix(".png")
     sensor_files = (args.can, args.dbc, args.yaw_rate_csv, args.speed_csv, args.gt)
+    outputs = {"output": args.output, "figure": figure}
+    if args.vel is not None:
+        outputs["vel"] = args.vel
     check_output_files(
-        {"output": args.output, "figure": figure},
+        outputs,
         [args.obs, *satellite_inputs(args), *sensor_files],
     )
     speed, yaw_rate, yaw_rate_unit = _sensors(args)
@@ -316,18 +327,21 @@ def run(args: argparse.Namespace) -> int:
             f"{figure} left as they were)"
         )
     truth_yaw = truth.yaw_at(table.t) if truth is not None else None
-    write_files(
-        [
-            (args.output, lambda path: write_heading_csv(path, table)),
-            (figure, lambda path: heading_figure(path, table, truth_yaw, args.obs.name)),
-        ]
-    )
+    files = [
+        (args.output, lambda path: write_heading_csv(path, table)),
+        (figure, lambda path: heading_figure(path, table, truth_yaw, args.obs.name)),
+    ]
+    if args.vel is not None:
+        velocity = car_checked_velocity(conventional, table)
+        files.append((args.vel, lambda path: write_velocity_csv(path, velocity)))
+    write_files(files)
     final = final_calibration(table)
     summary = {
         "epochs": len(table),
         "tc_available": float(table.tc_available.mean()),
         "tc_reliable": float(table.tc_reliable.mean()),
         "conv_valid": float(table.conv_valid.mean()),
+        "conv_velocity_valid": float(np.mean(table.conv_velocity_valid)),
         "rejected_rows": int(table.rejected_rows.sum()),
         "epochs_with_rejection": int(np.count_nonzero(table.rejected_rows)),
         "tc_verifiable": float(table.tc_verifiable.mean()),
@@ -337,6 +351,7 @@ def run(args: argparse.Namespace) -> int:
         "calibration": None if table.calibration is None else table.calibration.to_dict(),
         "output": str(args.output),
         "figure": str(figure),
+        "vel": None if args.vel is None else str(args.vel),
         "warnings": warnings,
     }
     print(json_text(summary))

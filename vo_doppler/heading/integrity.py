@@ -27,7 +27,7 @@ it sees faults of one epoch, this one faults of a few seconds.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -38,6 +38,8 @@ from vo_doppler.gnss.windowed_line import (
     consistency_test,
     epochs_in_window,
 )
+from vo_doppler.model.gnss_solutions import VelocitySolution
+from vo_doppler.model.heading import HeadingTable
 
 SENSOR_TEST = ConsistencyConfig()
 """±5 s, α = 0.001 per test, at least 5 neighbours."""
@@ -55,6 +57,10 @@ p95 within 5°). Hong Kong canyon drive at 1 Hz, moving epochs valid / p95: 37 %
 53 % / 5.0° at 8°, 65 % / 6.9° at 15° (docs/design.md (I1a))."""
 PROTECTION_QUANTILE = 1.96
 """The bound holds the course error at 95 % (two-sided) where the reference's σ is honest."""
+REST_FALSE_ALARM = 0.01
+"""Share of a standing receiver's healthy velocities beyond :func:`rest_speed_bound`."""
+MIN_REST_EPOCHS = 10
+"""Fewer epochs at rest measure no rest noise: the bound is then ``AT_REST_MAX_MPS``."""
 
 
 @dataclass(frozen=True)
@@ -67,6 +73,17 @@ class ConventionalIntegrity:
     speed: ConsistencyTest | None
     valid: np.ndarray
     untested: np.ndarray
+    tested: np.ndarray | None = None
+    """The epochs the tests took: valid so far and within the car's vertical bound."""
+
+
+@dataclass(frozen=True)
+class VelocityIntegrity:
+    """The conventional velocity's own verdict (:func:`velocity_integrity`): ``valid`` per
+    epoch and the rest bound it used (m/s)."""
+
+    valid: np.ndarray
+    rest_bound_mps: float
 
 
 def car_vertical_bound(velocity_enu: np.ndarray) -> np.ndarray:
@@ -79,6 +96,21 @@ def car_vertical_bound(velocity_enu: np.ndarray) -> np.ndarray:
     bound = VERTICAL_GATE * np.sqrt((GRADE_SIGMA * speed) ** 2 + VERTICAL_FLOOR_MPS**2)
     with np.errstate(invalid="ignore"):
         return np.abs(v[..., 2]) <= bound
+
+
+def rest_speed_bound(speed: np.ndarray, at_rest: np.ndarray) -> float:
+    """The horizontal speed (m/s) a standing receiver's healthy velocities stay below but for
+    a share ``REST_FALSE_ALARM``, measured on the epochs ``at_rest`` (design (I1c)): with
+    equal independent noise σ on east and north the speed is Rayleigh distributed,
+    σ = median / √(2 ln 2) (robust while fewer than half of the epochs are faulty), and the
+    bound is σ·√(−2 ln α), at most ``AT_REST_MAX_MPS``; ``AT_REST_MAX_MPS`` itself with fewer
+    than ``MIN_REST_EPOCHS`` epochs."""
+    speed = np.asarray(speed, dtype=float)[np.asarray(at_rest, dtype=bool)]
+    speed = speed[np.isfinite(speed)]
+    if speed.size < MIN_REST_EPOCHS:
+        return AT_REST_MAX_MPS
+    sigma = float(np.median(speed)) / np.sqrt(2.0 * np.log(2.0))
+    return min(sigma * np.sqrt(-2.0 * np.log(REST_FALSE_ALARM)), AT_REST_MAX_MPS)
 
 
 def course_protection(course: ConsistencyTest, quantile: float = PROTECTION_QUANTILE) -> np.ndarray:
@@ -142,7 +174,55 @@ def conventional_integrity(
     untested = valid & unjudged & np.isfinite(yaw_angle) & np.isfinite(wheel_speed)
     at_rest = np.abs(np.nan_to_num(np.asarray(wheel_speed, dtype=float), nan=np.inf))
     failed |= (at_rest < WHEEL_AT_REST_MPS) & (np.nan_to_num(speed, nan=0.0) > AT_REST_MAX_MPS)
-    return ConventionalIntegrity(course, speed_test, valid & ~failed & ~untested, untested)
+    return ConventionalIntegrity(course, speed_test, valid & ~failed & ~untested, untested, valid)
+
+
+def velocity_integrity(
+    integrity: ConventionalIntegrity,
+    gnss_valid: np.ndarray,
+    speed: np.ndarray,
+    wheel_speed: np.ndarray,
+    course_alert_limit: float = COURSE_ALERT_LIMIT,
+) -> VelocityIntegrity:
+    """Whether each conventional velocity (its horizontal ``speed``, m/s) is valid, design
+    (I1c); ``gnss_valid``: the GNSS stage's verdict within the car's vertical bound. Where the
+    calibrated ``wheel_speed`` stands (``WHEEL_AT_REST_MPS``): a velocity ``gnss_valid`` whose
+    speed is within :func:`rest_speed_bound`. Where the car moves: an epoch the tests of
+    ``integrity`` judged that passed the speed and course tests (I1) and whose cross-track
+    error the gyro bounds, s·PL_k ≤ max(s·AL, v_rest) (I1a with the rest noise as its floor: a
+    slow car's course may be as uncertain as the noise of a standing receiver makes it).
+    Where the sensors do not cover the epoch: ``gnss_valid``."""
+    gnss_valid = np.asarray(gnss_valid, dtype=bool)
+    speed = np.asarray(speed, dtype=float)
+    wheel = np.asarray(wheel_speed, dtype=float)
+    at_rest = np.abs(np.nan_to_num(wheel, nan=np.inf)) < WHEEL_AT_REST_MPS
+    bound = rest_speed_bound(speed, gnss_valid & at_rest)
+    with np.errstate(invalid="ignore"):
+        resting = at_rest & (speed <= bound)
+    moving = integrity.valid.copy()
+    if integrity.tested is not None and integrity.course is not None:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            limit = np.maximum(course_alert_limit, bound / speed)
+            failed = integrity.course.failed | (course_protection(integrity.course) > limit)
+        if integrity.speed is not None:
+            failed = failed | integrity.speed.failed
+        moving = integrity.tested & ~failed & ~integrity.untested
+    valid = gnss_valid & np.where(at_rest, resting, moving | ~np.isfinite(wheel))
+    return VelocityIntegrity(valid, bound)
+
+
+def car_checked_velocity(solution: VelocitySolution, table: HeadingTable) -> VelocitySolution:
+    """``solution`` (the conventional velocity ``table`` was made from) with ``valid`` the
+    car's verdict, ``table.conv_velocity_valid`` (design (I1c)): the ``vel.csv`` of ``run`` and
+    of ``heading --vel``. Unchanged where the table has no such verdict."""
+    if table.conv_velocity_valid is None:
+        return solution
+    if len(solution.t) != len(table.t):
+        raise ValueError(
+            f"the heading table has {len(table.t)} epochs, the velocity {len(solution.t)}: "
+            "not the velocity it was made from"
+        )
+    return replace(solution, valid=np.asarray(table.conv_velocity_valid, dtype=bool))
 
 
 def integrity_rate_warning(t: np.ndarray, config: ConsistencyConfig = SENSOR_TEST) -> str | None:

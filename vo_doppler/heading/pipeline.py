@@ -48,6 +48,7 @@ from vo_doppler.heading.integrity import (
     ConventionalIntegrity,
     car_vertical_bound,
     conventional_integrity,
+    velocity_integrity,
 )
 from vo_doppler.heading.smoother import (
     GyroAngle,
@@ -696,6 +697,9 @@ def heading_pipeline(
         if tight is None
         else 2.0 * config.smoother.consensus_span_s,
         conv_gnss_valid=conv_ok,
+        conv_velocity_valid=velocity_integrity(
+            integrity, valid & car, np.hypot(velocity[:, 0], velocity[:, 1]), cal.scale * wheel
+        ).valid,
         sigma_conv_gnss=_sigma_where(conventional_yaw_sigma, conv_ok),
         grade_prior_sigma=solved.grade[1],
         grade_from_accelerometer=solved.grade_from_accelerometer,

@@ -82,6 +82,10 @@ class HeadingTable:
     sigma_conv_gnss: np.ndarray | None = None
     """Standard deviation (rad) of the conventional heading from the velocity solution alone,
     NaN where unknown or not ``conv_gnss_valid``."""
+    conv_velocity_valid: np.ndarray | None = None
+    """The conventional velocity (its speed and, away from rest, its cross-track error) valid
+    after the car's sensors' tests (docs/design.md (I1c)); the ``valid`` column of ``vel.csv``
+    in the outputs of ``run`` and ``heading --vel``. None where not computed."""
     grade_prior_sigma: np.ndarray | None = None
     """σ of the road-grade prior of the tight window ending at each epoch (rise over run)."""
     grade_from_accelerometer: np.ndarray | None = None

@@ -11,6 +11,8 @@ import numpy as np
 from vo_doppler.eval.metrics import segment_lengths_note, segment_lengths_that_fit
 from vo_doppler.eval.pipelines import epochs_within
 from vo_doppler.eval.run_evaluation import evaluate_run
+from vo_doppler.heading.integrity import car_checked_velocity
+from vo_doppler.io.gnss_csv import write_velocity_csv
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.satellite_states import state_problems
 from vo_doppler.io.sequence import InputReport
@@ -286,6 +288,9 @@ def write_run_outputs(
         write_tum(out / file, trajectory)
     if result.heading is not None:
         write_heading_csv(out / "heading.csv", result.heading)
+        if result.gnss is not None and not result.heading_source:
+            velocity = car_checked_velocity(result.gnss.velocity, result.heading)
+            write_velocity_csv(out / "vel.csv", velocity)
     summary = summarise(result, sequence.vehicle_span)
     summary["heading_correction"] = correction_label(config)
     summary["placement_heights"] = result.antenna.height_source
