@@ -28,6 +28,8 @@ from vo_doppler.units import UNITS, in_people_units, unit_of
         ("max_window_m", "m"),
         ("min_speed_mps", "m/s"),
         ("max_speed_drift_mps2", "m/s²"),
+        ("clock_bias_walk_m_per_sqrt_s", "m/√s"),
+        ("clock_drift_walk_mps_per_sqrt_s", "m/s/√s"),
         ("yaw_rate_bias_dps", "deg/s"),
         ("cn0_zenith_dbhz", "dB-Hz"),
         ("nlos_loss_db", "dB"),

@@ -33,6 +33,8 @@ UNITS: tuple[Unit, ...] = (
     Unit("_m", "m"),
     Unit("_mps", "m/s"),
     Unit("_mps2", "m/s²"),
+    Unit("_m_per_sqrt_s", "m/√s"),
+    Unit("_mps_per_sqrt_s", "m/s/√s"),
     Unit("_hz", "Hz"),
     Unit("_px", "pixels"),
     Unit("_grey", "grey levels (0–255)"),

@@ -78,18 +78,22 @@ def test_clock_drift_random_walk_is_inside_sigma():
         1,
         rotate=False,
     )
-    walk_mps = 0.03
+    walk_mps_per_sqrt_s = 0.03
     rng = np.random.default_rng(3)
-    drift = np.concatenate([[0.0], np.cumsum(rng.normal(0.0, walk_mps * np.sqrt(np.diff(T))))])
+    drift = np.concatenate(
+        [[0.0], np.cumsum(rng.normal(0.0, walk_mps_per_sqrt_s * np.sqrt(np.diff(T))))]
+    )
     rows = dataclasses.replace(scenario.rows)
     rows.range_rate = rows.range_rate + drift[np.searchsorted(T, rows.t)]
     args = (rows, scenario.t_epoch, scenario.speed, scenario.yaw_angle)
-    result = tight_heading_series(*args, TightHeadingConfig(clock_drift_walk_mps=walk_mps))
+    result = tight_heading_series(
+        *args, TightHeadingConfig(clock_drift_walk_mps_per_sqrt_s=walk_mps_per_sqrt_s)
+    )
     error = np.degrees(np.abs(wrap_angle(result.yaw - scenario.yaw)))[result.available]
     assert result.available.mean() > 0.4
     assert np.max(error) > 3.0
     assert np.all(_normalised_errors(scenario, result) <= 2.0)
-    ignored = tight_heading_series(*args, TightHeadingConfig(clock_drift_walk_mps=0.0))
+    ignored = tight_heading_series(*args, TightHeadingConfig(clock_drift_walk_mps_per_sqrt_s=0.0))
     assert np.max(_normalised_errors(scenario, ignored)) > 4.0
 
 

@@ -172,7 +172,7 @@ def test_a_1_hz_realistic_canyon_from_the_command_line_is_a_sequence_run_reads(t
     assert manifest["gnss"]["rate_hz"] == 1.0
     assert "--canyon-realism real" in manifest["command"]
     assert manifest["truth"]["gnss"]["canyon"]["scatter_loss_db"] == 20.0
-    assert manifest["truth"]["gnss"]["clock_drift_walk_mps"] == 0.17
+    assert manifest["truth"]["gnss"]["clock_drift_walk_mps_per_sqrt_s"] == 0.17
     assert main(["-q", "run", str(seq), "-o", str(out)]) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["gnss_epochs"] == 41

@@ -164,7 +164,7 @@ class TightHeadingConfig:
     clock_epoch_interval_s: float = np.inf
     """From this epoch interval (median, s) on each epoch has its own clock drift
     (:func:`clock_per_epoch`)."""
-    clock_drift_walk_mps: float = 0.01
+    clock_drift_walk_mps_per_sqrt_s: float = 0.01
     """Random walk of the receiver clock drift (m/s per √s) that the linear model leaves out."""
     grade_sigma: float = 0.05
     """Standard deviation of the zero-mean Gaussian prior on the road grade g = tan γ (rise over
@@ -678,7 +678,8 @@ def tight_heading_series(
     rate) are given per epoch; rows are matched to epochs by time. ``speed_scale_sigma``
     (relative) and ``gyro_bias_sigma`` (rad/s), per epoch or scalars, are the uncertainties of
     the calibration behind them; they enter the heading's standard deviation together with
-    the Doppler noise and the clock-drift random walk (``config.clock_drift_walk_mps``).
+    the Doppler noise and the clock-drift random walk
+    (``config.clock_drift_walk_mps_per_sqrt_s``).
 
     ``lever_velocity`` (m, 2) or a scalar: the antenna's velocity relative to the vehicle
     origin in the vehicle frame (along, across) = ω × r = (−ω·r_y, ω·r_x) for an antenna at
@@ -765,7 +766,7 @@ def _model_variance(solution: _WindowSolution, calibration_sigma, config) -> np.
     return (
         (solution.scale_gain * scale_sigma) ** 2
         + (solution.bias_gain * bias_sigma) ** 2
-        + solution.clock_walk_gain * config.clock_drift_walk_mps**2
+        + solution.clock_walk_gain * config.clock_drift_walk_mps_per_sqrt_s**2
         + solution.repair_variance
         # s²/info scales the whole var θ₀ by the Doppler rows' variance factor s², but the
         # grade prior's part is set by its own σ: where s² < 1 it is restored to full size

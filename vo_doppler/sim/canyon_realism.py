@@ -31,8 +31,9 @@ are biased at once. This module models the physics behind it, per (epoch, satell
   coefficient k(C/N0) of σ² = σ_th² + (k·speed)² measured on the real drive.
 * **Thermal noise.** σ_th² = σ_floor² + (σ_45·10^((45 − C/N0)/20))²: the tracking-loop noise
   (∝ (C/N0)^−½) on top of a floor the real receiver shows even at 45 dB-Hz.
-* **Receiver clock.** A TCXO whose drift is a random walk of ``clock_drift_walk_mps`` per √s
-  (0.17 m/s between 1-Hz epochs on the real drive).
+* **Receiver clock.** A TCXO whose drift is a random walk of
+  ``clock_drift_walk_mps_per_sqrt_s`` (m/s per √s: 0.17 m/s between 1-Hz epochs on the real
+  drive).
 
 :func:`real_canyon_config` gives the settings that reproduce the real drive's figures on the
 simulator's default city (tests/sim/test_canyon_realism.py checks them).
@@ -99,7 +100,7 @@ def real_canyon_config(base: GnssSimConfig) -> GnssSimConfig:
         cn0_horizon_dbhz=28.0,
         tracking_threshold_dbhz=22.0,
         sigma_range_rate_mps=0.02,
-        clock_drift_walk_mps=0.17,
+        clock_drift_walk_mps_per_sqrt_s=0.17,
     )
 
 

@@ -85,8 +85,8 @@ class GnssSimConfig:
     tracking_threshold_dbhz: float = 28.0
     clock_bias0_s: float | None = None
     clock_drift0_mps: float | None = None
-    clock_drift_walk_mps: float = 0.01
-    clock_bias_walk_m: float = 0.1
+    clock_drift_walk_mps_per_sqrt_s: float = 0.01
+    clock_bias_walk_m_per_sqrt_s: float = 0.1
     canyon: CanyonRealism | None = None
     """The real canyon's diffraction, scattering and noise floor
     (:mod:`vo_doppler.sim.canyon_realism`; None: the geometric canyon)."""
@@ -102,14 +102,15 @@ class ReceiverClock:
 
 
 def receiver_clock(n: int, dt: float, config: GnssSimConfig, rng: np.random.Generator):
-    """Drift: random walk (σ = ``clock_drift_walk_mps``/c per √s); bias: trapezoidal integral
-    of the drift; a separate random walk (``clock_bias_walk_m`` per √s) for the pseudorange."""
+    """Drift: random walk (σ = ``clock_drift_walk_mps_per_sqrt_s``/c per √s); bias: trapezoidal
+    integral of the drift; a separate random walk (``clock_bias_walk_m_per_sqrt_s``) for the
+    pseudorange."""
     drift0 = config.clock_drift0_mps if config.clock_drift0_mps is not None else rng.normal(0, 60.0)
     bias0 = config.clock_bias0_s if config.clock_bias0_s is not None else rng.uniform(-3e-4, 3e-4)
-    steps = rng.normal(0.0, config.clock_drift_walk_mps * np.sqrt(dt), n - 1)
+    steps = rng.normal(0.0, config.clock_drift_walk_mps_per_sqrt_s * np.sqrt(dt), n - 1)
     drift = (drift0 + np.concatenate([[0.0], np.cumsum(steps)])) / SPEED_OF_LIGHT
     bias = bias0 + np.concatenate([[0.0], np.cumsum(0.5 * (drift[1:] + drift[:-1]) * dt)])
-    walk = rng.normal(0.0, config.clock_bias_walk_m * np.sqrt(dt), n - 1)
+    walk = rng.normal(0.0, config.clock_bias_walk_m_per_sqrt_s * np.sqrt(dt), n - 1)
     return ReceiverClock(bias, drift, np.concatenate([[0.0], np.cumsum(walk)]))
 
 
