@@ -157,9 +157,11 @@ HEADING_SIGMA_DEG = SignalBounds(1.0e-9, 180.0, "°")
 """A heading's standard deviation: positive; beyond 180° it says nothing about a direction."""
 HEADING_DEG = SignalBounds(-360.0, 360.0, "°")
 """A heading or course in degrees as anyone writes it."""
-WHEEL_SCALE = SignalBounds(0.5, 2.0, "")
-"""Wheel-speed scale: tyre radius, load and wear change it by a few per cent; a factor beyond
-2 is a wrong unit (km/h read as m/s is 3.6), not a calibration."""
+WHEEL_SCALE = SignalBounds(1.0e-3, 1.0e3, "")
+"""Wheel-speed scale as the calibration writes it: tyre radius, load and wear change it by a
+few per cent, and a wrong unit (km/h read as m/s gives 0.278, mph 0.447) is absorbed by it
+with a warning, the headings still right; from mm/s to km/s read as m/s, not zero or
+negative."""
 DOP = SignalBounds(1.0e-3, 1.0e4, "")
 """A dilution of precision: positive (0.5 with very many satellites); beyond 1e4 the geometry
 says nothing."""

@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from vo_doppler.cli import main
 from vo_doppler.io.gnss_results_csv import read_velocity_csv
+from vo_doppler.io.heading_csv import read_heading_csv
 
 GPS_MINUS_UNIX_S = -315964782.0
 
@@ -50,7 +52,8 @@ def test_a_wheel_scale_far_from_one_is_a_warning(kmh_drive, tmp_path, capsys, ca
 @pytest.mark.slow
 def test_the_car_checked_velocity_is_written_when_asked(kmh_drive, tmp_path, capsys, caplog):
     """``--vel``: the conventional velocity with the car's verdict (design (I1c)), the share the
-    summary gives; without ``--vel`` nothing else is written."""
+    summary gives, moving the table's conventional verdict; without ``--vel`` nothing else is
+    written."""
     vel = tmp_path / "v.csv"
     summary = _heading(
         kmh_drive, GPS_MINUS_UNIX_S, tmp_path / "h.csv", capsys, caplog, ["--vel", str(vel)]
@@ -59,7 +62,11 @@ def test_the_car_checked_velocity_is_written_when_asked(kmh_drive, tmp_path, cap
     assert summary["vel"] == str(vel)
     assert summary["conv_velocity_valid"] == pytest.approx(velocity.valid.mean(), abs=1e-12)
     assert 0.5 < velocity.valid.mean() < 1.0
-    assert velocity.valid[velocity.speed_mps > 3.0].mean() > 0.9  # open sky
+    fast = velocity.speed_mps > 3.0
+    assert velocity.valid[fast].mean() > 0.9  # open sky
+    # the table written with the km/h wheels' scale (0.287) reads back (correct reads it too)
+    table = read_heading_csv(tmp_path / "h.csv")
+    np.testing.assert_array_equal(velocity.valid[fast], table.conv_valid[fast])
     plain = _heading(kmh_drive, GPS_MINUS_UNIX_S, tmp_path / "p.csv", capsys, caplog)
     assert plain["vel"] is None
     assert sorted(p.name for p in tmp_path.iterdir()) == [

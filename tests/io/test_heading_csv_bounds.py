@@ -39,6 +39,7 @@ BAD = [
     ("conv_hdop", "-1"),
     ("wheel_scale", "0"),
     ("wheel_scale", "-1"),
+    ("wheel_scale", "5e3"),
     ("n_obs_window", "-5"),
     ("n_sat_epoch", "1e30"),
     ("rejected_rows", "2.5"),
@@ -47,6 +48,14 @@ BAD = [
     ("tc_reliable", "2"),
     ("conv_gnss_valid", "-1"),
 ]
+
+
+@pytest.mark.parametrize("scale", ["0.287", "0.447", "3.6"])
+def test_a_wheel_scale_the_calibration_gives_for_a_wrong_unit_reads(tmp_path, scale):
+    """``heading`` on wheel speeds in km/h warns and writes the scale it calibrated (0.287 on
+    the simulated km/h drive); its headings are right, so ``correct`` must read the file."""
+    table = read_heading_csv(write(tmp_path, rows_with("wheel_scale", scale)))
+    assert table.wheel_scale[1] == float(scale)
 
 
 @pytest.mark.parametrize(("column", "value"), BAD)
