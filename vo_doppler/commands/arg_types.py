@@ -1,4 +1,5 @@
-"""Argument types shared by several commands (argparse ``type=`` callables)."""
+"""Argument types shared by several commands (argparse ``type=`` callables), and the options
+that several commands define alike."""
 
 from __future__ import annotations
 
@@ -138,3 +139,15 @@ def lever_arm(components: tuple[int, ...] = (2, 3)) -> Callable[[str], tuple[flo
         return values
 
     return parse
+
+
+def add_yaw_rate_sign(group) -> None:
+    """``--yaw-rate-sign`` (+1 or −1, default +1) of a CAN yaw-rate signal: −1 makes a bus that
+    reports clockwise-positive yaw rate counter-clockwise positive, as the project's yaw is."""
+    group.add_argument(
+        "--yaw-rate-sign",
+        type=float,
+        choices=(1.0, -1.0),
+        default=1.0,
+        help="-1 when the bus reports clockwise-positive yaw rate",
+    )

@@ -11,6 +11,7 @@ import numpy as np
 
 from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import (
+    add_yaw_rate_sign,
     finite_float,
     lever_arm,
     non_negative_float,
@@ -66,13 +67,7 @@ def register(subparsers, summary: str) -> None:
     sensors.add_argument("--dbc", type=Path, help="DBC file decoding the CAN log's signals")
     sensors.add_argument("--yaw-rate", help="MESSAGE.SIGNAL of the yaw rate")
     sensors.add_argument("--wheel-speed", help="MESSAGE.SIGNAL[,MESSAGE.SIGNAL...] (averaged)")
-    sensors.add_argument(
-        "--yaw-rate-sign",
-        type=float,
-        choices=(1.0, -1.0),
-        default=1.0,
-        help="-1 when the bus reports clockwise-positive yaw rate",
-    )
+    add_yaw_rate_sign(sensors)
     sensors.add_argument("--can-channel", help="only frames of this channel/bus")
     sensors.add_argument(
         "--can-short-frames",

@@ -10,7 +10,7 @@ import logging
 import sys
 from pathlib import Path
 
-from vo_doppler.commands.arg_types import number_in
+from vo_doppler.commands.arg_types import add_yaw_rate_sign, number_in
 from vo_doppler.commands.simulate_command import _origin as origin
 from vo_doppler.io.comma2k19_import import import_comma2k19
 from vo_doppler.io.kitti_raw_import import CAMERAS as KITTI_CAMERAS
@@ -98,9 +98,10 @@ def _register_rosbag(kinds) -> None:
         help="a ROS 1 .bag or a ROS 2 bag (sqlite3 or MCAP)",
         description="Write the images (sensor_msgs/Image as PNG, CompressedImage as sent) with "
         "their times, the calibration (CameraInfo, or --calib; the extrinsic from /tf_static), "
-        "the yaw rate (sensor_msgs/Imu: the axis given or estimated from gravity) and speed "
-        "(TwistStamped or Odometry linear.x, or with --dbc the wheel-speed signals of a "
-        "can_msgs/Frame topic), the forward acceleration, raw GNSS (gnss_comm "
+        "the yaw rate (sensor_msgs/Imu: the axis given or estimated from gravity, or with --dbc "
+        "the yaw-rate signal of a can_msgs/Frame topic) and speed (TwistStamped or Odometry "
+        "linear.x, or with --dbc the wheel-speed signals of a can_msgs/Frame topic), the forward "
+        "acceleration, raw GNSS (gnss_comm "
         "GnssMeasMsg + GnssEphemMsg, or ublox_msgs RxmRAWX + RxmSFRBX) as RINEX observations "
         "and navigation, NavSatFix fixes (the origin), ground truth (--ground-truth) and "
         "sequence.yaml. Topics are found by type (--list-topics shows which) or named. ROS "
@@ -138,7 +139,9 @@ def _register_rosbag(kinds) -> None:
         help="Odometry / PoseStamped (poses in the ENU frame of the origin) or NavSatFix: "
         "written as ground_truth.tum (never taken by default)",
     )
-    can = bag.add_argument_group("wheel speed from a CAN topic (instead of a speed topic)")
+    can = bag.add_argument_group(
+        "wheel speed and yaw rate from a CAN topic (instead of a speed topic and the IMU's gyro)"
+    )
     can.add_argument(
         "--dbc", type=Path, metavar="FILE", help="DBC (or other cantools database) of the bus"
     )
@@ -149,6 +152,14 @@ def _register_rosbag(kinds) -> None:
         "WHEEL_SPEEDS.WHEEL_SPEED_RL,WHEEL_SPEEDS.WHEEL_SPEED_RR); the DBC unit is converted "
         "to m/s",
     )
+    can.add_argument(
+        "--yaw-rate",
+        metavar="MSG.SIG",
+        help="the DBC's yaw-rate signal (e.g. VEHICLE_DYNAMICS.YAW_RATE), counter-clockwise "
+        "(turning left) positive after --yaw-rate-sign; the DBC unit (deg/s, rad/s) is "
+        "converted to rad/s; the IMU, if any, then gives the forward acceleration only",
+    )
+    add_yaw_rate_sign(can)
     timing = bag.add_argument_group("time")
     timing.add_argument(
         "--stamps",
@@ -268,6 +279,8 @@ def rosbag_options(args: argparse.Namespace) -> RosbagOptions:
         can_topic=args.can_topic,
         dbc=args.dbc,
         wheel_speed=args.wheel_speed,
+        yaw_rate=args.yaw_rate,
+        yaw_rate_sign=args.yaw_rate_sign,
         gnss_topic=args.gnss_topic,
         ephemeris_topics=tuple(args.ephemeris_topic) if args.ephemeris_topic else None,
         iono_topic=args.iono_topic,
@@ -295,14 +308,15 @@ def run_rosbag(args: argparse.Namespace) -> int:
         args.parser.error("-o/--output is required (unless --list-topics)")
     summary = import_rosbag(args.bag, args.output, options)
     log.info(
-        "wrote %s: %d images, %d GNSS epochs, %d ephemerides, %d IMU samples (yaw rate: %s), "
-        "%d speed samples (%s), %d ground-truth poses; times: %s stamps, %s (GPS − ROS = %.3f "
-        "s); camera extrinsic: %s",
+        "wrote %s: %d images, %d GNSS epochs, %d ephemerides, %d yaw-rate samples (%s; IMU yaw "
+        "axis %s), %d speed samples (%s), %d ground-truth poses; times: %s stamps, %s (GPS − ROS "
+        "= %.3f s); camera extrinsic: %s",
         summary.folder,
         summary.images,
         summary.gnss_epochs,
         summary.ephemerides,
-        summary.imu_samples,
+        summary.yaw_rate_samples,
+        summary.yaw_rate_source,
         summary.yaw_axis,
         summary.speed_samples,
         summary.speed_source,

@@ -15,7 +15,11 @@ shows what would be used) or named by options:
 - ``sensor_msgs/Imu`` → ``vehicle/yaw_rate.csv`` (counter-clockwise positive, rad/s) from the
   gyro axis given by ``--imu-yaw-axis`` (``z``, ``-z``, ``x`` …) or estimated: the axis along
   which the mean specific force is largest is the vertical, and its sign says up (+g) or down;
-  without accelerometer data, the gyro axis of largest RMS, sign +, with a warning;
+  without accelerometer data, the gyro axis of largest RMS, sign +, with a warning; or, with a
+  DBC (``--dbc FILE --yaw-rate MSG.SIG [--yaw-rate-sign -1]``), the yaw-rate signal of a
+  ``can_msgs/Frame`` topic (the DBC unit to rad/s, −1 for a bus reporting clockwise-positive
+  yaw rate), the IMU then used for the forward acceleration only (a bag without an IMU has
+  none);
   ``imu/forward_acceleration.csv`` from the horizontal accelerometer axis given by
   ``--imu-forward-axis`` or estimated (the signed horizontal axis whose specific force,
   averaged over 1 s, best matches the speed's change over that second; none when even the best
@@ -64,7 +68,7 @@ from vo_doppler.io.doppler_sigma import write_doppler_sigma
 from vo_doppler.io.output_folder import check_output_folder, open_output_folder
 from vo_doppler.io.rinex_write import observation_epochs, write_nav, write_obs
 from vo_doppler.io.rosbag_bag import KIND_NAMES, Bag, Topic
-from vo_doppler.io.rosbag_can import read_can_speed
+from vo_doppler.io.rosbag_can import read_can_signals
 from vo_doppler.io.rosbag_gnss import BagGnss, read_gnss_comm, read_ublox
 from vo_doppler.io.rosbag_types import field as get
 from vo_doppler.io.sensor_csv import (
@@ -158,6 +162,10 @@ class RosbagOptions:
     wheel_speed: str | None = None
     """``MSG.A,MSG.B``: the DBC's wheel-speed signals (averaged); the speed then comes from the
     CAN topic."""
+    yaw_rate: str | None = None
+    """``MSG.SIG``: the DBC's yaw-rate signal; the yaw rate then comes from the CAN topic."""
+    yaw_rate_sign: float = 1.0
+    """−1 when the bus reports clockwise-positive yaw rate."""
     gnss_topic: str | None = None
     ephemeris_topics: tuple[str, ...] | None = None
     iono_topic: str | None = None
@@ -176,12 +184,20 @@ class RosbagOptions:
 
     def problem(self) -> str | None:
         """Options that contradict each other (a usage error), else None."""
-        if (self.dbc is None) != (self.wheel_speed is None):
-            return "--dbc FILE and --wheel-speed MSG.SIG[,MSG.SIG] go together"
+        signals = self.wheel_speed is not None or self.yaw_rate is not None
+        if self.dbc is not None and not signals:
+            return (
+                "--dbc FILE needs the signals to decode: --wheel-speed MSG.SIG[,MSG.SIG] and/or "
+                "--yaw-rate MSG.SIG"
+            )
+        if self.dbc is None and signals:
+            return "--wheel-speed and --yaw-rate are signals of a DBC: give --dbc FILE"
         if self.dbc is None and self.can_topic is not None:
-            return "--can-topic needs --dbc FILE and --wheel-speed (its wheel-speed signals)"
-        if self.dbc is not None and self.speed_topic is not None:
-            return "--speed-topic and --dbc both give the speed: keep one"
+            return "--can-topic needs --dbc FILE and its signals (--wheel-speed, --yaw-rate)"
+        if self.wheel_speed is not None and self.speed_topic is not None:
+            return "--speed-topic and --wheel-speed both give the speed: keep one"
+        if self.yaw_rate is None and self.yaw_rate_sign != 1.0:
+            return "--yaw-rate-sign needs --yaw-rate MSG.SIG (the CAN yaw rate it applies to)"
         return None
 
 
@@ -193,9 +209,10 @@ class RosbagImportSummary:
     images: int
     gnss_epochs: int
     ephemerides: int
-    imu_samples: int
+    yaw_rate_samples: int
     speed_samples: int
     speed_source: str
+    yaw_rate_source: str
     ground_truth_poses: int
     clock: str
     gps_minus_ros_s: float
@@ -225,10 +242,11 @@ def discover(
         "ground_truth": options.ground_truth_topic,
         "tf": options.tf_topic,
     }
-    unused = "speed" if options.dbc is not None else "can"
+    unused = {"speed"} if options.wheel_speed is not None else set()
+    unused |= {"can"} if options.dbc is None else set()
     for kind, name in given.items():
         if name is None:
-            if kind in AUTO_KINDS and kind != unused:
+            if kind in AUTO_KINDS and kind not in unused:
                 found = [t.name for t in topics if t.msgtype in KINDS[kind] and t.count]
                 if kind == "speed":  # a Twist topic before an Odometry one
                     found.sort(key=lambda n: by_name[n].msgtype == "nav_msgs/msg/Odometry")
@@ -686,25 +704,40 @@ def import_rosbag(
             pairs = _gnss_pairs(bag, str(chosen["gnss"]), timing)
         offset, clock_text = clock_offset(options, start, pairs, bag_path)
         timing.offset = offset
-        imu_t, gyro, accel = _read_imu(bag, str(chosen["imu"]), timing)
+        can = None
         if options.dbc is not None:
-            can = read_can_speed(
-                bag, str(chosen["can"]), timing.time, options.dbc, str(options.wheel_speed)
+            can = read_can_signals(
+                bag,
+                str(chosen["can"]),
+                timing.time,
+                options.dbc,
+                options.wheel_speed,
+                options.yaw_rate,
+                options.yaw_rate_sign,
             )
-            speed, speed_source = can.speed, can.source
             warnings += can.warnings
+        if can is not None and can.speed is not None:
+            speed, speed_source = can.speed, can.speed_source
         else:
             speed = _read_speed(bag, str(chosen["speed"]), timing)
             speed_source = f"topic {chosen['speed']}: twist linear.x"
-        up, up_text = yaw_axis(gyro, accel, options.imu_yaw_axis)
-        k, sign = _axis(up)
-        yaw_rate = SensorSeries(imu_t, sign * gyro[:, k])
-        ahead, ahead_text = forward_axis(imu_t, accel, up, speed, options.imu_forward_axis)
-        acceleration = None
-        if ahead != "none":
-            k, sign = _axis(ahead)
-            good = np.isfinite(accel[:, k])
-            acceleration = SensorSeries(imu_t[good], sign * accel[good, k])
+        up, up_text, ahead, ahead_text = "none", "no IMU topic", "none", "no IMU topic"
+        acceleration = yaw_rate = None
+        yaw_rate_source = "none"
+        if "imu" in chosen:
+            imu_t, gyro, accel = _read_imu(bag, str(chosen["imu"]), timing)
+            up, up_text = yaw_axis(gyro, accel, options.imu_yaw_axis)
+            k, sign = _axis(up)
+            yaw_rate = SensorSeries(imu_t, sign * gyro[:, k])
+            yaw_rate_source = f"topic {chosen['imu']}: gyro {up}"
+            ahead, ahead_text = forward_axis(imu_t, accel, up, speed, options.imu_forward_axis)
+            if ahead != "none":
+                k, sign = _axis(ahead)
+                good = np.isfinite(accel[:, k])
+                acceleration = SensorSeries(imu_t[good], sign * accel[good, k])
+        if can is not None and can.yaw_rate is not None:
+            yaw_rate, yaw_rate_source = can.yaw_rate, can.yaw_rate_source
+        assert yaw_rate is not None  # _require_motion: an IMU topic or --yaw-rate
         fixes = _read_fixes(bag, str(chosen["fix"]), timing) if "fix" in chosen else None
         origin = _origin(options, fixes, bag, chosen, timing)
         enu = EnuFrame(np.radians(origin[0]), np.radians(origin[1]), origin[2])
@@ -770,6 +803,7 @@ def import_rosbag(
         "gps_minus_ros_s": offset,
         "imu_yaw_axis": f"{up}: {up_text}",
         "imu_forward_axis": f"{ahead}: {ahead_text}",
+        "yaw_rate": yaw_rate_source,
         "speed": speed_source,
         "camera_extrinsic": extrinsic_from,
         "antenna_lever_arm": lever_arm_from,
@@ -787,6 +821,7 @@ def import_rosbag(
         len(yaw_rate),
         len(speed),
         speed_source,
+        yaw_rate_source,
         len(truth) if truth is not None else 0,
         clock_text,
         offset,
@@ -799,28 +834,29 @@ def import_rosbag(
 
 
 def _require_motion(topics: list[Topic], chosen: dict, options: RosbagOptions, path: Path):
-    """An :class:`InputError` unless the bag gives a yaw rate (an IMU topic) and a speed (a
-    speed topic, or a CAN topic when a DBC is given), saying what is missing."""
-    if "imu" not in chosen:
-        raise InputError(
-            "the sequence needs a yaw rate: the bag has no sensor_msgs/Imu topic (see "
-            "--list-topics)",
-            path,
-        )
+    """An :class:`InputError` unless the bag gives a yaw rate (an IMU topic, or a CAN topic
+    with ``--yaw-rate``) and a speed (a speed topic, or a CAN topic with ``--wheel-speed``),
+    saying what is missing."""
+    can = [t.name for t in topics if t.msgtype in KINDS["can"] and t.count]
     if options.dbc is not None and "can" not in chosen:
         raise InputError(
             "--dbc is given but the bag has no can_msgs/Frame topic (see --list-topics)", path
         )
-    if options.dbc is None and "speed" not in chosen:
-        can = [t.name for t in topics if t.msgtype in KINDS["can"] and t.count]
-        hint = (
-            f"; its CAN topic {can[0]} gives one with --dbc FILE --wheel-speed MSG.SIG"
-            if can
-            else ""
+
+    def hint(option: str) -> str:
+        return f"; its CAN topic {can[0]} gives one with --dbc FILE {option} MSG.SIG" if can else ""
+
+    if options.yaw_rate is None and "imu" not in chosen:
+        raise InputError(
+            "the sequence needs a yaw rate: the bag has no sensor_msgs/Imu topic"
+            f"{hint('--yaw-rate')} (see --list-topics)",
+            path,
         )
+    if options.wheel_speed is None and "speed" not in chosen:
         raise InputError(
             "the sequence needs a speed: the bag has no TwistStamped, "
-            f"TwistWithCovarianceStamped or Odometry topic{hint} (see --list-topics)",
+            f"TwistWithCovarianceStamped or Odometry topic{hint('--wheel-speed')} (see "
+            "--list-topics)",
             path,
         )
 
