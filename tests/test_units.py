@@ -154,7 +154,6 @@ UNITLESS: dict[str, str] = {
     "reliability_n_sigma": "in σ",
     # names, letters and units in the name itself
     "systems": "RINEX system letters (choices.checked_letters)",
-    "image_format": "a file format",
     "method": "the name of the heading settings (HeadingPipelineConfig.method)",
     "channel": "a CAN interface name",
     "fps": "frames per second: the unit is the name",

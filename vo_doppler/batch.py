@@ -64,6 +64,7 @@ from enum import StrEnum
 from pathlib import Path
 
 from vo_doppler import __version__
+from vo_doppler.choices import checked
 from vo_doppler.errors import InputError, UsageError, VoDopplerError, storage_refused
 from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
 from vo_doppler.io.output_folder import (
@@ -97,7 +98,6 @@ LOG_FILE = "run.log"
 FAILED_LOG = "failed_run.log"
 """The log of a run that failed before its outputs, beside the earlier results it left."""
 PREPARED = "prepared"
-EXECUTORS = ("local", "ray")
 TABLE_NAME = "batch_summary"
 PARENT_POLL_S = 0.5
 WHOLE = TimeSpan()
@@ -105,6 +105,13 @@ WHOLE = TimeSpan()
 
 Prepare = Callable[[Path, Path], Path]
 """``prepare(source, work_dir) -> sequence folder``: imports a raw recording (module docstring)."""
+
+
+class Executor(StrEnum):
+    """Where the recordings run (module docstring)."""
+
+    LOCAL = "local"
+    RAY = "ray"
 
 
 class Status(StrEnum):
@@ -537,7 +544,7 @@ def plan(
 def run_batch(
     folders: Iterable[Path],
     out: Path,
-    executor: str = "local",
+    executor: Executor | str = Executor.LOCAL,
     workers: int | None = None,
     resume: bool = False,
     config: RunConfig | None = None,
@@ -558,8 +565,7 @@ def run_batch(
     each recording as ``run`` resolves it: a recording it does not fit fails with the usage
     error (category ``usage-error``, exit status 2), the others run.
     """
-    if executor not in EXECUTORS:
-        raise InputError(f"unknown executor {executor!r} (choose from {', '.join(EXECUTORS)})")
+    executor = checked(Executor, executor, "executor")
     if workers is not None and workers < 1:
         raise InputError(f"workers must be at least 1, got {workers}")
     config = config or RunConfig()
@@ -583,7 +589,7 @@ def run_batch(
         if on_outcome:
             on_outcome(outcome)
     if todo:
-        if executor == "ray":
+        if executor is Executor.RAY:
             stream = ray_outcomes(todo, workers, ray_address)
         else:
             stream = local_outcomes(todo, workers or default_workers(len(todo)))

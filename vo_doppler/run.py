@@ -35,7 +35,7 @@ import numpy as np
 from vo_doppler.checks import check_vehicle_overlap, check_yaw_rate_unit, origin_warning
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.antenna_track import AntennaTrack, antenna_track
-from vo_doppler.fusion.correction import absolute_heading
+from vo_doppler.fusion.correction import HeadingSource, absolute_heading
 from vo_doppler.fusion.pipelines import Pipeline, dead_reckoning
 from vo_doppler.fusion.placement import level_with_yaw
 from vo_doppler.gnss.pipeline import GnssVelocityResult
@@ -186,7 +186,7 @@ def run_with_given_heading(
     :class:`InputError` when no valid heading of the table lies within the recording."""
     table = given.table
     check_yaw_rate_unit(sequence.yaw_rate, sequence.wheel_speed, sequence.vehicle_source)
-    tight_source = "tc" if given.has_tight else "tc+conv"
+    tight_source = HeadingSource.TC if given.has_tight else HeadingSource.TC_CONV
     valid = absolute_heading(table, tight_source, config.correction).valid
     times = np.concatenate([sequence.image_times, sequence.wheel_speed.t])
     if sequence.has_gnss:

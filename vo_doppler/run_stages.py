@@ -14,7 +14,7 @@ import numpy as np
 from vo_doppler.choices import checked_letters
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.antenna_track import AntennaTrack
-from vo_doppler.fusion.correction import CorrectionConfig
+from vo_doppler.fusion.correction import CorrectionConfig, HeadingSource
 from vo_doppler.fusion.pipelines import Pipeline, correct_all, dead_reckoning
 from vo_doppler.gnss.pipeline import GnssVelocityResult, check_elevation_mask, gnss_velocity
 from vo_doppler.heading.from_gnss import heading_from_gnss
@@ -149,7 +149,7 @@ def sequence_trajectories(
     antenna: AntennaTrack,
     config: RunConfig,
     yaw_rate: SensorSeries | None = None,
-    tight_source: str = "tc",
+    tight_source: HeadingSource | str = HeadingSource.TC,
 ) -> tuple[dict[Pipeline, Trajectory], np.ndarray]:
     """The fusion stage on a recording: the dead reckoning of the calibrated wheel ``speed``
     and ``yaw_rate`` (default: the sequence's, less the table's gyro bias) over the VO's time

@@ -3,9 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import importlib
+import pkgutil
+from enum import StrEnum
 
 import pytest
 
+import vo_doppler
+from vo_doppler.choices import values
 from vo_doppler.cli import build_parser
 from vo_doppler.commands.help_format import (
     OptionsParser,
@@ -140,3 +145,38 @@ def test_a_failed_check_is_a_usage_error_after_parsing(capsys):
     assert stop.value.code == 2
     assert "p: error: --yes contradicts --up y" in capsys.readouterr().err
     assert seen == ["-y", "y"]
+
+
+AXIS_CHOICES = {"--up", "--imu-yaw-axis", "--imu-forward-axis"}
+"""Options whose choices are axis names (``-y``, ``z``, ...) of an axis table, with ``auto``."""
+
+
+def _choice_sets() -> dict[tuple[str, ...], type[StrEnum]]:
+    """The values of every ``StrEnum`` of the package, to the enum."""
+    sets = {}
+    for info in pkgutil.walk_packages(vo_doppler.__path__, "vo_doppler."):
+        for value in vars(importlib.import_module(info.name)).values():
+            if isinstance(value, type) and issubclass(value, StrEnum) and value is not StrEnum:
+                sets[values(value)] = value
+    return sets
+
+
+def test_every_choice_of_words_is_an_enums_values_and_its_default_a_member():
+    sets = _choice_sets()
+    from_enums, missing = set(), []
+    for name, parser in PARSERS.items():
+        for action in _options(parser):
+            choices = tuple(action.choices or ())
+            if not choices or not all(isinstance(c, str) for c in choices):
+                continue
+            if set(action.option_strings) & AXIS_CHOICES:
+                continue
+            if choices not in sets:
+                missing.append(f"{name} {action.option_strings}")
+                continue
+            from_enums.add(sets[choices])
+            assert sets[choices](action.default) in sets[choices]
+            assert type(action.default) is str, f"{name} {action.option_strings}"
+    assert missing == [], "string choices that are no StrEnum's values (choices.values)"
+    names = {kind.__name__ for kind in from_enums}
+    assert {"TrajectoryFormat", "World", "Executor", "RangeRateSource", "ShortFrames"} <= names

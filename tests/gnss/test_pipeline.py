@@ -47,7 +47,10 @@ come before any solution (no navigation data is needed for them to fail)."""
         ({"elevation_mask_rad": float("nan")}, "elevation_mask_rad = nan"),
         ({"bands": "x"}, "bands: expected RINEX band digits 1-9"),
         ({"bands": "5"}, r"bands = '5': the file has no Doppler .* \(it has bands 1\)"),
-        ({"range_rate": "bogus"}, "range_rate = 'bogus': use one of doppler, phase"),
+        (
+            {"range_rate": "bogus"},
+            "^range_rate: unknown range rate source 'bogus'; choose from doppler, phase$",
+        ),
         ({"receiver_ecef": np.zeros(3)}, "receiver_ecef is .*, 0 m from the Earth's centre"),
         ({"receiver_ecef": np.full(3, np.nan)}, "receiver_ecef is .*, nan m from"),
         ({"receiver_ecef": np.ones((2, 3)) * 4e6}, r"receiver_ecef has shape \(2, 3\)"),

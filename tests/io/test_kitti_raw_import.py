@@ -184,7 +184,9 @@ def test_bad_oxts_or_image_names_stop_the_import_before_writing(tmp_path):
     (drive / "image_00" / "data" / "0000000020.png").write_bytes(b"x")
     with pytest.raises(InputError, match=r"0000000020.png: frame 20 has no timestamp"):
         import_kitti_raw(drive, tmp_path / "seq")
-    with pytest.raises(InputError, match=r"unknown camera 'image_9'"):
+    with pytest.raises(
+        InputError, match=r"^camera: unknown kitti camera 'image_9'; choose from image_00, image_01"
+    ):
         import_kitti_raw(drive, tmp_path / "seq", camera="image_9")
 
 

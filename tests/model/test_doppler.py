@@ -1,11 +1,14 @@
 """DopplerRows owns its per-row arrays: sorted on construction, they stay sorted whatever the
-caller does to its arrays."""
+caller does to its arrays; their frame is a member of VectorFrame."""
 
 from __future__ import annotations
 
-import numpy as np
+import dataclasses
 
-from vo_doppler.model.doppler import DopplerRows
+import numpy as np
+import pytest
+
+from vo_doppler.model.doppler import DopplerRows, VectorFrame
 
 ROW_ARRAYS = ("t", "los", "sat_velocity", "sat_clock_drift", "range_rate", "weight", "sat_id")
 
@@ -33,3 +36,11 @@ def test_rows_sorted_on_construction_are_copies_in_time_order():
         getattr(rows, name)[0] = getattr(rows, name)[1]  # each its own writeable array
     rows.weight[1] = 9.0
     assert rows.sat_clock_drift[1] == 0.5 and rows.weight[0] == 1.0
+
+
+def test_the_frame_is_a_member_and_an_unknown_one_is_refused():
+    rows = rows_of(np.array([0.0, 1.0]), np.zeros(2), np.ones(2))
+    ecef = dataclasses.replace(rows, frame="ecef")
+    assert rows.frame is VectorFrame.ENU and ecef.frame is VectorFrame.ECEF
+    with pytest.raises(ValueError, match=r"^frame must be one of ecef, enu, not 'ECEF'$"):
+        dataclasses.replace(rows, frame="ECEF")

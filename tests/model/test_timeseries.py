@@ -52,8 +52,10 @@ def test_the_three_edge_rules_of_an_integral():
 def test_empty_records_and_unknown_rules():
     assert np.isnan(sample(np.zeros(0), np.zeros(0), [1.0])).all()
     assert np.isnan(integral_at(np.zeros(0), np.zeros(0), [1.0])).all()
-    with pytest.raises(ValueError, match="outside='extend'"):
+    with pytest.raises(ValueError, match=r"^outside='extend': use one of nan, hold$"):
         sample(T, V, QUERY, outside="extend")
+    with pytest.raises(ValueError, match=r"^outside='zero': use one of nan, hold, extend$"):
+        integral_at(T, V, QUERY, outside="zero")
     with pytest.raises(ValueError, match="3 times but 2 values"):
         cumulative_integral(T, V[:2])
 

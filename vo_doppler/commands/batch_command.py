@@ -11,7 +11,8 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from vo_doppler.batch import EXECUTORS, RecordingOutcome, Status, read_list, run_batch
+from vo_doppler.batch import Executor, RecordingOutcome, Status, read_list, run_batch
+from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import positive_int
 from vo_doppler.commands.run_command import add_run_options, run_config
 from vo_doppler.commands.span_options import add_span_options, time_span
@@ -51,8 +52,8 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     parser.add_argument(
         "--executor",
-        choices=EXECUTORS,
-        default="local",
+        choices=values(Executor),
+        default=Executor.LOCAL.value,
         help="local: a process pool on this machine; ray: Ray tasks "
         "(pip install 'vo-doppler[ray]')",
     )

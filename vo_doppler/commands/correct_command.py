@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import logging
+from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,7 @@ from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.output_folder import write_files
 from vo_doppler.io.trajectory import (
     AUTO_FORMAT_RULE,
-    TRAJECTORY_FORMATS,
+    TrajectoryFormat,
     read_trajectory,
     trajectory_format,
     write_kitti,
@@ -39,14 +40,21 @@ from vo_doppler.report.json_text import json_text
 from vo_doppler.time_hints import FRAME_NUMBER_FIX, time_base_check
 from vo_doppler.vo.frames import (
     MAX_ROAD_CLIMB,
-    WORLDS,
     WRONG_WORLD_FRACTION,
+    World,
     camera_trajectory,
     steep_path_fraction,
     vehicle_trajectory,
 )
 
 log = logging.getLogger(__name__)
+
+
+class Body(StrEnum):
+    """The poses ``--body`` writes: the vehicle's, or the camera's through the extrinsic."""
+
+    VEHICLE = "vehicle"
+    CAMERA = "camera"
 
 
 def register(subparsers, summary: str) -> None:
@@ -72,8 +80,8 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--calib", help="camera calibration (YAML with T_vehicle_camera)")
     parser.add_argument(
         "--format",
-        choices=TRAJECTORY_FORMATS,
-        default="auto",
+        choices=values(TrajectoryFormat),
+        default=TrajectoryFormat.AUTO.value,
         help=f"trajectory file format (auto: {AUTO_FORMAT_RULE}; the extension is not used)",
     )
     parser.add_argument(
@@ -97,15 +105,15 @@ def register(subparsers, summary: str) -> None:
     )
     parser.add_argument(
         "--world",
-        choices=WORLDS,
-        default="first_camera",
+        choices=values(World),
+        default=World.FIRST_CAMERA.value,
         help="the input's world: the first camera's frame (what VO systems write) or already "
         "level, z up",
     )
     parser.add_argument(
         "--body",
-        choices=("vehicle", "camera"),
-        default="vehicle",
+        choices=values(Body),
+        default=Body.VEHICLE.value,
         help="write vehicle or camera poses",
     )
     parser.add_argument(
@@ -128,9 +136,9 @@ def times_of_a_tum_trajectory(args: argparse.Namespace) -> str | None:
         fmt = trajectory_format(args.trajectory, args.format)
     except VoDopplerError:
         return None
-    if fmt != "tum":
+    if fmt is not TrajectoryFormat.TUM:
         return None
-    given = "--format tum" if args.format == "tum" else f"{args.trajectory} is TUM"
+    given = "--format tum" if args.format == TrajectoryFormat.TUM else f"{args.trajectory} is TUM"
     return (
         f"--times applies to a KITTI trajectory only, but {given}: a TUM trajectory carries "
         "its own times (drop --times)"
@@ -151,7 +159,7 @@ def _frame_number_fix(args: argparse.Namespace) -> str:
     from: a KITTI file read without ``--times``, a ``--times`` file, or a TUM file's column."""
     if args.times is not None:
         return f"{args.times} holds frame numbers, not the images' times: give the times file"
-    if trajectory_format(args.trajectory, args.format) == "kitti":
+    if trajectory_format(args.trajectory, args.format) is TrajectoryFormat.KITTI:
         return FRAME_NUMBER_FIX
     return (
         "a TUM trajectory keeps its own times: write the images' times in its first column "
@@ -160,9 +168,10 @@ def _frame_number_fix(args: argparse.Namespace) -> str:
 
 
 OTHER_WORLD = {
-    "first_camera": "already level, z up (e.g. ENU, as run's trajectory_*.tum): give --world level",
-    "level": "camera poses in the first camera's frame (what VO systems write): give --world "
-    "first_camera",
+    World.FIRST_CAMERA: "already level, z up (e.g. ENU, as run's trajectory_*.tum): give "
+    "--world level",
+    World.LEVEL: "camera poses in the first camera's frame (what VO systems write): give "
+    "--world first_camera",
 }
 
 
@@ -227,7 +236,11 @@ def run(args: argparse.Namespace) -> int:
             ),
             args.heading,
         )
-    out = result.vehicle if args.body == "vehicle" else camera_trajectory(result.vehicle, extrinsic)
+    out = (
+        result.vehicle
+        if args.body == Body.VEHICLE
+        else camera_trajectory(result.vehicle, extrinsic)
+    )
     output = Path(args.output)
     writer = write_kitti if output.suffix.lower() in (".kitti", ".txt") else write_tum
     write_files([(output, lambda path: writer(path, out))])

@@ -41,10 +41,10 @@ from vo_doppler.eval.metrics import (
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.gnss_results_csv import read_position_csv, read_velocity_csv
 from vo_doppler.io.heading_csv import read_heading_csv
-from vo_doppler.io.trajectory import AUTO_FORMAT_RULE, TRAJECTORY_FORMATS, read_trajectory
+from vo_doppler.io.trajectory import AUTO_FORMAT_RULE, TrajectoryFormat, read_trajectory
 from vo_doppler.io.truth_csv import (
     AUTO_TRUTH_RULE,
-    TRUTH_FORMATS,
+    TruthFormat,
     read_ground_truth,
     sequence_origin,
 )
@@ -91,8 +91,8 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("ground_truth", help="ground-truth trajectory (TUM or KITTI)")
     parser.add_argument(
         "--format",
-        choices=TRAJECTORY_FORMATS,
-        default="auto",
+        choices=values(TrajectoryFormat),
+        default=TrajectoryFormat.AUTO.value,
         help=f"trajectory file format (auto: {AUTO_FORMAT_RULE}; the extension is not used)",
     )
     parser.add_argument(
@@ -116,7 +116,7 @@ def register(subparsers, summary: str) -> None:
 def run(args: argparse.Namespace) -> int:
     estimate = read_trajectory(args.estimate, args.format)
     truth = read_trajectory(args.ground_truth, args.format)
-    kitti_rows = args.format == "kitti" or (
+    kitti_rows = args.format == TrajectoryFormat.KITTI or (
         np.array_equal(estimate.t, np.arange(len(estimate)))
         and np.array_equal(truth.t, np.arange(len(truth)))
     )
@@ -242,8 +242,8 @@ def gnss_parser(prog: str) -> OptionsParser:
     )
     parser.add_argument(
         "--truth-format",
-        choices=TRUTH_FORMATS,
-        default="auto",
+        choices=values(TruthFormat),
+        default=TruthFormat.AUTO.value,
         help=f"format of --truth (auto: {AUTO_TRUTH_RULE})",
     )
     where = parser.add_mutually_exclusive_group()

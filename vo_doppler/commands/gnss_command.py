@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import band_digits
 from vo_doppler.commands.output_paths import check_output_files
 from vo_doppler.commands.satellite_options import (
@@ -31,7 +32,7 @@ from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError, VoDopplerError, shown
 from vo_doppler.gnss.doppler_velocity import doppler_codes
 from vo_doppler.gnss.ephemeris import GLONASS_MAX_AGE_S, KEPLER_MAX_AGE_S
-from vo_doppler.gnss.pipeline import RANGE_RATE_SOURCES, gnss_position, gnss_velocity
+from vo_doppler.gnss.pipeline import RangeRateSource, gnss_position, gnss_velocity
 from vo_doppler.gnss.satellite_source import satellite_source
 from vo_doppler.gnss.signals import carrier_frequency
 from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
@@ -80,8 +81,8 @@ def register(subparsers, summary: str) -> None:
     )
     velocity.add_argument(
         "--range-rate",
-        choices=RANGE_RATE_SOURCES,
-        default="doppler",
+        choices=values(RangeRateSource),
+        default=RangeRateSource.DOPPLER.value,
         help="'phase': carrier-phase rate instead of the logged Doppler",
     )
     velocity.set_defaults(func=run)
@@ -95,7 +96,7 @@ def _check_range_rates(obs: Observations, systems: str, bands: str | None, sourc
     systems and bands (Doppler; carrier phase for 'phase'), naming those it has and, for a
     file without Doppler but with carrier phase, ``--range-rate phase`` (instead of failing
     later at every epoch for want of satellites)."""
-    letter, what = ("L", "carrier phase") if source == "phase" else ("D", "Doppler")
+    letter, what = ("L", "carrier phase") if source == RangeRateSource.PHASE else ("D", "Doppler")
     if _codes(obs, systems, bands, letter):
         return
     available = [
@@ -105,7 +106,7 @@ def _check_range_rates(obs: Observations, systems: str, bands: str | None, sourc
     ]
     chosen = f"systems {systems!r}" + (f", bands {bands!r}" if bands else "")
     hint = ""
-    if source != "phase" and _codes(obs, systems, bands, "L"):
+    if source != RangeRateSource.PHASE and _codes(obs, systems, bands, "L"):
         hint = (
             "; it has carrier phase ("
             + " ".join(_codes(obs, systems, bands, "L"))
@@ -270,10 +271,10 @@ def run(args: argparse.Namespace) -> int:
     part = time_span(args)
     if not part.whole:
         obs = trim(obs, part.resolve(obs.epoch_time, "observation epochs"))
-    range_rate = getattr(args, "range_rate", "doppler")
+    range_rate = getattr(args, "range_rate", RangeRateSource.DOPPLER)
     if args.gnss_command == "velocity":
         _check_range_rates(obs, args.systems, args.bands, range_rate)
-        if range_rate == "phase":
+        if range_rate == RangeRateSource.PHASE:
             obs = with_phase_doppler_codes(obs)
     nav = satellite_states(args) if args.nav or args.orbits else embedded
     if nav is None:

@@ -33,7 +33,7 @@ from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
 from vo_doppler.heading.integrity import car_checked_velocity
 from vo_doppler.heading.pipeline import CalibrationMethod
-from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.can import ShortFrames, read_can_motion
 from vo_doppler.io.gnss_csv import write_velocity_csv
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.output_folder import write_files
@@ -71,8 +71,8 @@ def register(subparsers, summary: str) -> None:
     sensors.add_argument("--can-channel", help="only frames of this channel/bus")
     sensors.add_argument(
         "--can-short-frames",
-        choices=("skip", "pad"),
-        default="skip",
+        choices=values(ShortFrames),
+        default=ShortFrames.SKIP.value,
         help="frames shorter than their DBC length: skip them or zero-pad them, for logs that "
         "drop trailing zero bytes",
     )

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from enum import StrEnum
 
+from vo_doppler.choices import values
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 
 
@@ -23,7 +24,7 @@ class HeadingMethod(StrEnum):
 def add_heading_method_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--heading-method",
-        choices=[m.value for m in HeadingMethod],
+        choices=values(HeadingMethod),
         default=HeadingMethod.AUTO.value,
         help="tight heading: snooping (2-s windows, reflected satellites detected and named; "
         "tuned at 10-20 Hz), robust (noise model measured from the data, robust fit, windows "

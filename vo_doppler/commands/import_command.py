@@ -10,12 +10,19 @@ import logging
 import sys
 from pathlib import Path
 
+from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import add_yaw_rate_sign, number_in
 from vo_doppler.commands.simulate_command import _origin as origin
 from vo_doppler.io.comma2k19_import import import_comma2k19
-from vo_doppler.io.kitti_raw_import import CAMERAS as KITTI_CAMERAS
-from vo_doppler.io.kitti_raw_import import import_kitti_raw
-from vo_doppler.io.rosbag_import import AXES, RosbagOptions, import_rosbag, list_topics
+from vo_doppler.io.kitti_raw_import import KittiCamera, import_kitti_raw
+from vo_doppler.io.rosbag_import import (
+    AXES,
+    RosbagOptions,
+    RosClock,
+    StampSource,
+    import_rosbag,
+    list_topics,
+)
 from vo_doppler.io.smartloc_import import import_smartloc
 
 log = logging.getLogger(__name__)
@@ -60,8 +67,8 @@ def register(subparsers, summary: str) -> None:
     kitti.add_argument("drive", type=Path, help="drive folder (YYYY_MM_DD_drive_NNNN_sync)")
     kitti.add_argument(
         "--camera",
-        choices=KITTI_CAMERAS,
-        default="image_00",
+        choices=values(KittiCamera),
+        default=KittiCamera.IMAGE_00.value,
         help="the camera folder (image_00/01 grey, image_02/03 colour)",
     )
     kitti.add_argument("-o", "--output", type=Path, required=True, help="sequence folder")
@@ -163,14 +170,14 @@ def _register_rosbag(kinds) -> None:
     timing = bag.add_argument_group("time")
     timing.add_argument(
         "--stamps",
-        choices=("header", "receive"),
-        default="header",
+        choices=values(StampSource),
+        default=StampSource.HEADER.value,
         help="message time: header.stamp, or the time the bag recorded it",
     )
     timing.add_argument(
         "--clock",
-        choices=("utc", "gnss"),
-        default="utc",
+        choices=values(RosClock),
+        default=RosClock.UTC.value,
         help="ROS time → GPS time: utc (ROS time is Unix UTC time, leap seconds added) or "
         "gnss (estimated from the raw GNSS messages' times)",
     )

@@ -12,6 +12,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import (
     finite_float,
     frame_rate,
@@ -27,15 +28,16 @@ from vo_doppler.errors import InputError
 from vo_doppler.io.output_folder import check_output_folder
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 from vo_doppler.sim.camera_effects import CameraEffects
-from vo_doppler.sim.canyon_realism import REALISM_LEVELS, real_canyon_config
+from vo_doppler.sim.canyon_realism import RealismLevel, real_canyon_config
 from vo_doppler.sim.urban_canyon import (
     MAX_DURATION_S,
-    SCENARIOS,
     CityConfig,
+    Scenario,
     UrbanCanyonConfig,
     simulate_urban_canyon,
     too_few_frames,
 )
+from vo_doppler.sim.vo_sequence import ImageFormat
 from vo_doppler.vo.batch import MIN_VO_FRAMES
 
 
@@ -149,7 +151,12 @@ def register(subparsers, summary: str) -> None:
         "write camera images, RINEX 3 observations + navigation, a candump CAN log + DBC, "
         "ground truth and sequence.yaml (deterministic per seed).",
     )
-    parser.add_argument("--scenario", choices=SCENARIOS, default="urban-canyon", help="the drive")
+    parser.add_argument(
+        "--scenario",
+        choices=values(Scenario),
+        default=Scenario.URBAN_CANYON.value,
+        help="the drive",
+    )
     parser.add_argument(
         "--duration",
         type=number_in(0.0, MAX_DURATION_S, low_open=True, unit="s"),
@@ -165,7 +172,12 @@ def register(subparsers, summary: str) -> None:
         help=f"camera rate (Hz); over --duration at least {MIN_VO_FRAMES} frames (VO needs them)",
     )
     parser.add_argument("--size", type=_int_pair, default=defaults.image_size_px, help="W,H px")
-    parser.add_argument("--image-format", choices=("png", "jpg"), default="png", help="images")
+    parser.add_argument(
+        "--image-format",
+        choices=values(ImageFormat),
+        default=defaults.image_format.value,
+        help="images",
+    )
     parser.add_argument(
         "--jpeg-quality",
         type=int_in(1, 100),
@@ -269,8 +281,8 @@ def register(subparsers, summary: str) -> None:
     parser.add_argument("--no-noise", action="store_true", help="noise-free GNSS observations")
     parser.add_argument(
         "--canyon-realism",
-        choices=REALISM_LEVELS,
-        default=REALISM_LEVELS[0],
+        choices=values(RealismLevel),
+        default=RealismLevel.GEOMETRIC.value,
         help="geometric: direct rays and specular facade reflections; real: the "
         "canyon measured on a u-blox M8T in Hong Kong (diffraction over the roofs, diffuse "
         "scattering whose Doppler error grows with speed and weakness, C/N0 22-44 dB-Hz, a "
@@ -358,7 +370,7 @@ def _command_line(args: argparse.Namespace) -> str:
     for flag in ("no_images", "no_noise"):
         if getattr(args, flag):
             words.append("--" + flag.replace("_", "-"))
-    if args.canyon_realism != REALISM_LEVELS[0]:
+    if args.canyon_realism != RealismLevel.GEOMETRIC:
         words += ["--canyon-realism", args.canyon_realism]
     return shlex.join([*words, "-o", str(args.output)])
 
@@ -373,7 +385,7 @@ def run(args: argparse.Namespace) -> int:
         nlos=args.nlos,
         noise=not args.no_noise,
     )
-    if args.canyon_realism == "real":
+    if args.canyon_realism == RealismLevel.REAL:
         gnss = real_canyon_config(gnss)
     config = replace(
         defaults,

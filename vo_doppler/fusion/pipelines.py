@@ -12,6 +12,7 @@ import numpy as np
 from vo_doppler.fusion.antenna_track import AntennaTrack
 from vo_doppler.fusion.correction import (
     CorrectionConfig,
+    HeadingSource,
     absolute_heading,
     conventional_absolute_heading,
     correct,
@@ -60,7 +61,7 @@ def correct_all(
     antenna: AntennaTrack,
     correction: CorrectionConfig,
     lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0),
-    tight_source: str = "tc",
+    tight_source: HeadingSource | str = HeadingSource.TC,
 ) -> tuple[dict[Pipeline, Trajectory], np.ndarray]:
     """The VO (``vo_vehicle``) and the dead reckoning (``dr``, :func:`dead_reckoning`), each
     alone and corrected by the conventional and by the tightly coupled heading (vehicle poses,
@@ -77,7 +78,9 @@ def correct_all(
     tight = tight_absolute_heading(table, correction)
     conventional = conventional_absolute_heading(table)
     correcting = (
-        tight if tight_source == "tc" else absolute_heading(table, tight_source, correction)
+        tight
+        if tight_source == HeadingSource.TC
+        else absolute_heading(table, tight_source, correction)
     )
     trajectories: dict[Pipeline, Trajectory] = {}
     names = (

@@ -10,9 +10,11 @@ import logging
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.choices import checked
 from vo_doppler.fusion.antenna_track import AntennaTrack
+from vo_doppler.fusion.correction import HeadingSource
 from vo_doppler.fusion.heading_blend import BlendConfig, vo_direction
-from vo_doppler.fusion.heading_correction import headings_at
+from vo_doppler.fusion.heading_correction import HeadingReference, headings_at
 from vo_doppler.geo import wrap_angle
 from vo_doppler.gnss.spp import nearest_time
 from vo_doppler.model.heading import HeadingTable
@@ -25,9 +27,9 @@ INITIAL_HEADING_SPAN_S = 5.0
 """Seconds of absolute headings, from the first, whose median starts every trajectory."""
 
 START_SOURCES = {
-    "tc+conv": ("tc", "conv", "tc_vague"),
-    "tc": ("tc", "tc_vague"),
-    "conv": ("conv",),
+    HeadingSource.TC_CONV: ("tc", "conv", "tc_vague"),
+    HeadingSource.TC: ("tc", "tc_vague"),
+    HeadingSource.CONV: ("conv",),
 }
 """For each heading source of ``correct`` (``run`` uses "tc+conv"), the headings that may start
 a trajectory, in order of preference (:func:`initial_yaw_offset`)."""
@@ -37,7 +39,7 @@ def yaw_offset(
     trajectory: Trajectory,
     t: np.ndarray,
     yaw: np.ndarray,
-    reference: str = "course",
+    reference: HeadingReference | str = HeadingReference.COURSE,
     min_chord_m: float = BlendConfig.min_chord_m,
     max_gap_s: float = BlendConfig.max_gap_s,
 ) -> float:
@@ -58,11 +60,15 @@ def yaw_offset(
     t = relative_times(np.asarray(t, dtype=float), origin)
     yaw = np.asarray(yaw, dtype=float)
     differences = np.zeros(0)
-    if reference == "course":
+    if checked(HeadingReference, reference, "reference") is HeadingReference.COURSE:
         poses = trajectory.matrices
         positions = poses[:, :3, 3] - poses[0, :3, 3]
         t_direction, yaw_direction = vo_direction(
-            relative_times(trajectory.t, origin), positions, poses[:, :3, :3], "course", min_chord_m
+            relative_times(trajectory.t, origin),
+            positions,
+            poses[:, :3, :3],
+            HeadingReference.COURSE,
+            min_chord_m,
         )
         absolute, inside = headings_at(t_direction, t, yaw, None, max_gap_s)
         differences = wrap_angle(absolute[inside] - yaw_direction[inside])
@@ -76,8 +82,8 @@ def initial_yaw_offset(
     tc_usable: np.ndarray,
     trajectory: Trajectory,
     span_s: float = INITIAL_HEADING_SPAN_S,
-    source: str = "tc+conv",
-    reference: str = "course",
+    source: HeadingSource | str = HeadingSource.TC_CONV,
+    reference: HeadingReference | str = HeadingReference.COURSE,
 ) -> float:
     """Rotation about z that starts a trajectory with the absolute heading.
 
@@ -92,8 +98,7 @@ def initial_yaw_offset(
     correction compares them (:func:`yaw_offset`: the trajectory's 'course' or its
     'orientation' yaw); ``run`` and ``correct`` pass their correction's.
     """
-    if source not in START_SOURCES:
-        raise ValueError(f"unknown heading source {source!r} ({', '.join(START_SOURCES)})")
+    source = checked(HeadingSource, source, "source")
     candidates = {
         "tc": (table.yaw_tc, tc_usable),
         "conv": (table.yaw_conv, table.conv_valid),

@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 
 from vo_doppler.bounds import RECEIVER_RADIUS
+from vo_doppler.choices import checked
 from vo_doppler.errors import InputError
 from vo_doppler.gnss.doppler_velocity import (
     DopplerRows,
@@ -48,7 +50,14 @@ class GnssVelocityResult:
     before the final solution."""
 
 
-RANGE_RATE_SOURCES = ("doppler", "phase")
+class RangeRateSource(StrEnum):
+    """Where :func:`gnss_velocity` takes each satellite's range rate from (``gnss velocity
+    --range-rate``)."""
+
+    DOPPLER = "doppler"
+    """The logged Doppler."""
+    PHASE = "phase"
+    """The carrier-phase rate (:func:`~vo_doppler.gnss.phase_rate.carrier_phase_doppler`)."""
 
 
 def check_elevation_mask(value: float, name: str = "elevation_mask_rad") -> float:
@@ -72,13 +81,12 @@ def _check_arguments(
     systems: str,
     elevation_mask_rad: float,
     bands: str | None,
-    range_rate: str,
+    range_rate: RangeRateSource | str,
     receiver_ecef: np.ndarray | None,
 ) -> np.ndarray | None:
     """An :class:`InputError` naming the first argument of :func:`gnss_velocity` out of its
     domain (each would leave no valid epoch, without a word); ``receiver_ecef`` as an array."""
-    if range_rate not in RANGE_RATE_SOURCES:
-        raise InputError(f"range_rate = {range_rate!r}: use one of {', '.join(RANGE_RATE_SOURCES)}")
+    checked(RangeRateSource, range_rate, "range_rate")
     check_elevation_mask(elevation_mask_rad)
     if bands is not None:
         problem = bands_problem(bands)
@@ -117,7 +125,7 @@ def gnss_velocity(
     systems: str = "GREJC",
     elevation_mask_rad: float = np.deg2rad(10.0),
     bands: str | None = None,
-    range_rate: str = "doppler",
+    range_rate: RangeRateSource | str = RangeRateSource.DOPPLER,
     receiver_ecef: np.ndarray | None = None,
     reported_sigma: ReportedSigma | None = None,
     fit_noise: bool = False,
@@ -153,7 +161,7 @@ def gnss_velocity(
         if receiver_ecef is not None
         else receiver_positions(spp, fallback)
     )
-    measured = carrier_phase_doppler(obs) if range_rate == "phase" else obs
+    measured = carrier_phase_doppler(obs) if range_rate == RangeRateSource.PHASE else obs
 
     def rows_at(position, log_missing=True):
         return doppler_rows(

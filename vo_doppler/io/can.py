@@ -33,6 +33,7 @@ import warnings
 from array import array
 from collections import Counter
 from dataclasses import dataclass, field
+from enum import StrEnum
 from pathlib import Path
 
 import can
@@ -46,6 +47,7 @@ from vo_doppler.bounds import (
     SignalBounds,
     too_many_out_of_range,
 )
+from vo_doppler.choices import checked
 from vo_doppler.errors import InputError
 from vo_doppler.io.textfile import (
     MAX_LINE_CHARS,
@@ -444,16 +446,22 @@ def check_dbc(dbc_path: str | Path, yaw_rate: str, wheel_speed: str) -> None:
         raise SignalError(str(exc), dbc_path) from exc
 
 
+class ShortFrames(StrEnum):
+    """What is done with frames shorter than their DBC length (module docstring)."""
+
+    SKIP = "skip"
+    PAD = "pad"
+    """Zero-padded, for logs known to drop trailing zero bytes."""
+
+
 class _StreamDecoder:
     """Decodes frames one at a time into compact per-message arrays (time, line, one value per
     referenced signal), counting short, undecodable and foreign-channel frames."""
 
     def __init__(self, db, refs, channel, report, short_frames, source):
-        if short_frames not in ("skip", "pad"):
-            raise ValueError(f"short_frames must be 'skip' or 'pad', not {short_frames!r}")
         self.channel = channel
         self.report = report
-        self.short_frames = short_frames
+        self.short_frames = checked(ShortFrames, short_frames, "short_frames")
         self.source = source
         self.first_short: tuple[float, int, int, int] | None = None
         self.undecodable: Counter[int] = Counter(report.undecodable_by_id)
@@ -473,7 +481,7 @@ class _StreamDecoder:
         if len(payload) < message.length:
             if self.first_short is None:
                 self.first_short = (t, frame_id, len(payload), message.length)
-            if self.short_frames == "skip":
+            if self.short_frames is ShortFrames.SKIP:
                 self.report.n_short_skipped += 1
                 return
             payload = payload + bytes(message.length - len(payload))
@@ -526,7 +534,7 @@ class _StreamDecoder:
         report = self.report
         if self.first_short is not None:
             t, frame_id, length, expected = self.first_short
-            skip = self.short_frames == "skip"
+            skip = self.short_frames is ShortFrames.SKIP
             log.warning(
                 "%s: %d frames shorter than their DBC length %s (first at t = %.6f s: id 0x%X, "
                 "%d of %d bytes)%s",
@@ -549,7 +557,7 @@ def decode_signals(
     refs: list[SignalRef],
     channel: str | None = None,
     report: CanDecodeReport | None = None,
-    short_frames: str = "skip",
+    short_frames: ShortFrames | str = ShortFrames.SKIP,
 ) -> dict[SignalRef, SensorSeries]:
     """Decode the referenced signals to SI units; one series per reference, sorted by time.
 
@@ -594,7 +602,7 @@ def decode_motion(
     yaw_rate_offset_s: float = 0.0,
     speed_offset_s: float = 0.0,
     channel: str | None = None,
-    short_frames: str = "skip",
+    short_frames: ShortFrames | str = ShortFrames.SKIP,
 ) -> CanMotion:
     """Yaw rate and speed from decoded frames, in SI, time-shifted by per-sensor offsets.
 
@@ -733,7 +741,7 @@ def read_can_motion(
     yaw_rate_offset_s: float = 0.0,
     speed_offset_s: float = 0.0,
     channel: str | None = None,
-    short_frames: str = "skip",
+    short_frames: ShortFrames | str = ShortFrames.SKIP,
     forward_acceleration: str | None = None,
 ) -> CanMotion:
     """Read a CAN log and decode yaw rate (``MSG.SIG``), mean wheel speed (``MSG.A,MSG.B``) and,

@@ -41,11 +41,13 @@ import logging
 import re
 import shutil
 from dataclasses import dataclass
+from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
 import yaml
 
+from vo_doppler.choices import checked
 from vo_doppler.errors import InputError
 from vo_doppler.io.calibration import checked_camera, write_camera_yaml
 from vo_doppler.io.kitti_oxts import match_frame_files, read_oxts, read_timestamps
@@ -61,7 +63,6 @@ log = logging.getLogger(__name__)
 CAM_TO_CAM = "calib_cam_to_cam.txt"
 IMU_TO_VELO = "calib_imu_to_velo.txt"
 VELO_TO_CAM = "calib_velo_to_cam.txt"
-CAMERAS = ("image_00", "image_01", "image_02", "image_03")
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 TIMES = "times.txt"
 CALIB = "calib.yaml"
@@ -73,10 +74,19 @@ MAX_CONDITION = 1e12
 _KEY = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*):(.*)$")
 
 
+class KittiCamera(StrEnum):
+    """A KITTI raw drive's camera folder: two grey cameras, then two colour ones."""
+
+    IMAGE_00 = "image_00"
+    IMAGE_01 = "image_01"
+    IMAGE_02 = "image_02"
+    IMAGE_03 = "image_03"
+
+
 @dataclass(frozen=True)
 class KittiImportSummary:
     folder: Path
-    camera: str
+    camera: KittiCamera
     images: int
     image_timestamps: int
     oxts_rows: int
@@ -88,14 +98,13 @@ class KittiImportSummary:
 
 
 def import_kitti_raw(
-    drive: str | Path, output: str | Path, camera: str = "image_00"
+    drive: str | Path, output: str | Path, camera: KittiCamera | str = KittiCamera.IMAGE_00
 ) -> KittiImportSummary:
     """Write the sequence folder ``output`` from the KITTI raw drive folder ``drive`` (module
     docstring). ``output`` is checked first (new, empty or an earlier import's, not holding the
     drive), and every input is read before anything is written."""
     drive, output = Path(drive), Path(output)
-    if camera not in CAMERAS:
-        raise InputError(f"unknown camera {camera!r}: one of {', '.join(CAMERAS)}")
+    camera = checked(KittiCamera, camera, "camera")
     if not drive.is_dir():
         raise InputError("the KITTI raw drive is not a folder", drive)
     for folder in (camera, "oxts"):
@@ -143,11 +152,11 @@ def import_kitti_raw(
         "name": drive.name,
         "source": f"KITTI raw drive {drive} (vo-doppler import kitti-raw)",
         "origin": origin_entry(origin),
-        "camera": {"images": camera, "times": TIMES, "calib": CALIB, "time_offset_s": 0.0},
+        "camera": {"images": camera.value, "times": TIMES, "calib": CALIB, "time_offset_s": 0.0},
         "vehicle": {"yaw_rate": YAW_RATE_CSV, "wheel_speed": SPEED_CSV, "time_offset_s": 0.0},
         "ground_truth": {"trajectory": GROUND_TRUTH},
         "kitti": {
-            "camera": camera,
+            "camera": camera.value,
             "rectified": rectified,
             "intrinsics_from": f"{CAM_TO_CAM}: "
             + (f"P_rect_{camera[-2:]}" if rectified else f"K_{camera[-2:]}, D_{camera[-2:]}"),

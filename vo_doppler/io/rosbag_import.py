@@ -54,6 +54,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field, replace
+from enum import StrEnum
 from pathlib import Path
 
 import cv2
@@ -61,6 +62,7 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.choices import check_fields
 from vo_doppler.errors import InputError, UsageError
 from vo_doppler.geo import EnuFrame, geodetic_to_ecef
 from vo_doppler.io.calibration import checked_camera, read_camera, write_camera_yaml
@@ -149,6 +151,23 @@ ENCODINGS = {  # ROS image encoding → (numpy dtype, channels, OpenCV conversio
 }
 
 
+class StampSource(StrEnum):
+    """A message's time (``--stamps``, module docstring): its ``header.stamp`` (the reception
+    time for a message without one), or the time the bag recorded it."""
+
+    HEADER = "header"
+    RECEIVE = "receive"
+
+
+class RosClock(StrEnum):
+    """How ROS time goes to GPS time (``--clock``, module docstring)."""
+
+    UTC = "utc"
+    """ROS time is Unix UTC time: the leap seconds are added."""
+    GNSS = "gnss"
+    """Estimated from the raw GNSS messages' epochs and ROS times."""
+
+
 @dataclass(frozen=True)
 class RosbagOptions:
     """Topic choices (None: found by type), time handling and IMU axes (module docstring)."""
@@ -172,8 +191,8 @@ class RosbagOptions:
     fix_topic: str | None = None
     ground_truth_topic: str | None = None
     tf_topic: str | None = None
-    stamps: str = "header"
-    clock: str = "utc"
+    stamps: StampSource = StampSource.HEADER
+    clock: RosClock = RosClock.UTC
     clock_offset_s: float | None = None
     imu_yaw_axis: str = "auto"
     imu_forward_axis: str = "auto"
@@ -181,6 +200,9 @@ class RosbagOptions:
     calib: Path | None = None
     vehicle_frame: str = "base_link"
     gnss_frame: str | None = None
+
+    def __post_init__(self) -> None:
+        check_fields(self, stamps=StampSource, clock=RosClock)
 
     def problem(self) -> str | None:
         """Options that contradict each other (a usage error), else None."""
@@ -216,7 +238,7 @@ class RosbagImportSummary:
     ground_truth_poses: int
     clock: str
     gps_minus_ros_s: float
-    stamps: str
+    stamps: StampSource
     yaw_axis: str
     forward_axis: str
     extrinsic_from: str
@@ -303,14 +325,14 @@ class _Timing:
     ``offset`` (GPS − ROS, s) is set. The whole seconds of stamp and offset are added as
     integers, so that a GPS time comes out as exactly as a float64 holds it."""
 
-    def __init__(self, stamps: str) -> None:
+    def __init__(self, stamps: StampSource) -> None:
         self.stamps = stamps
         self.offset = 0.0
         self.used: dict[str, set[str]] = {}
 
     def time(self, topic: str, receive_ns: int, message) -> float:
         header = get(message, "header")
-        if self.stamps == "header" and header is not None:
+        if self.stamps is StampSource.HEADER and header is not None:
             stamp = get(header, "stamp")
             sec, nanosec = int(get(stamp, "sec", 0)), int(get(stamp, "nanosec", 0))
             if sec > 0 or nanosec > 0:
@@ -651,7 +673,7 @@ def clock_offset(
     """GPS − ROS time (s) and how it was found (``path``, the bag, named in an error)."""
     if options.clock_offset_s is not None:
         return float(options.clock_offset_s), "given (--clock-offset)"
-    if options.clock == "gnss":
+    if options.clock is RosClock.GNSS:
         if gnss_pairs is None or not len(gnss_pairs):
             raise InputError("--clock gnss needs a raw GNSS topic (its epochs and ROS times)", path)
         offset = float(np.median(gnss_pairs[:, 0] - gnss_pairs[:, 1]))
@@ -700,7 +722,7 @@ def import_rosbag(
         start = bag.start_s()
         gnss = _gnss(bag, chosen)
         pairs = None
-        if "gnss" in chosen and options.clock == "gnss" and options.clock_offset_s is None:
+        if "gnss" in chosen and options.clock is RosClock.GNSS and options.clock_offset_s is None:
             pairs = _gnss_pairs(bag, str(chosen["gnss"]), timing)
         offset, clock_text = clock_offset(options, start, pairs, bag_path)
         timing.offset = offset

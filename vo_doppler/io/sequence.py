@@ -19,10 +19,11 @@ from typing import Any
 import numpy as np
 
 from vo_doppler.bounds import TIME_OFFSET, lever_arm_problem
+from vo_doppler.choices import allowed, values
 from vo_doppler.errors import InputError, ManifestError, shown
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import read_camera
-from vo_doppler.io.can import CanDecodeReport, SignalError, read_can_motion
+from vo_doppler.io.can import CanDecodeReport, ShortFrames, SignalError, read_can_motion
 from vo_doppler.io.doppler_sigma import read_doppler_sigma
 from vo_doppler.io.images import check_image_size, list_images, read_times
 from vo_doppler.io.rinex_obs import read_obs
@@ -373,9 +374,12 @@ def _sensor_csv(
 def _can_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
     """The ``can`` section: the log decoded with its DBC."""
     can_offset = m.time_offset("can")
-    short_frames = m.string("can", "short_frames", "skip")
-    if short_frames not in ("skip", "pad"):
-        raise m.error("can.short_frames", f"can.short_frames is {short_frames!r}, not skip or pad")
+    short_frames = m.string("can", "short_frames", ShortFrames.SKIP.value)
+    if short_frames not in values(ShortFrames):
+        raise m.error(
+            "can.short_frames",
+            f"can.short_frames is {short_frames!r}, not one of {allowed(ShortFrames)}",
+        )
     sign = m.number("can", "yaw_rate_sign", 1.0)
     if sign not in (1.0, -1.0):
         raise m.error("can.yaw_rate_sign", f"{sign:g} is not +1 or -1")

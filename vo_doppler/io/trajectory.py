@@ -8,11 +8,13 @@ must be rotations (orthonormal within 1e-3, determinant +1) before they are re-o
 from __future__ import annotations
 
 from array import array
+from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from vo_doppler.choices import checked
 from vo_doppler.errors import InputError
 from vo_doppler.io.textfile import read_text
 from vo_doppler.model.trajectory import Trajectory
@@ -100,40 +102,50 @@ def write_kitti(path: str | Path, trajectory: Trajectory) -> None:
     np.savetxt(path, rows, fmt="%.9e")
 
 
-TRAJECTORY_FORMATS = ("auto", "tum", "kitti")
-"""The ``fmt`` values of :func:`read_trajectory` (and of the commands' ``--format``)."""
+class TrajectoryFormat(StrEnum):
+    """The ``fmt`` of :func:`read_trajectory` (and of the commands' ``--format``)."""
+
+    AUTO = "auto"
+    """By :data:`AUTO_FORMAT_RULE`."""
+    TUM = "tum"
+    KITTI = "kitti"
+
+
 AUTO_FORMAT_RULE = "by the number of columns of the first data row, TUM 8, KITTI 12"
 """How ``auto`` tells the format. Not by the extension: TUM and KITTI files are both commonly
 ``.txt`` (KITTI's ``00.txt``, TUM's ``groundtruth.txt``), while the column counts never
 overlap."""
 
 
-def read_trajectory(path: str | Path, fmt: str = "auto", times=None) -> Trajectory:
+def read_trajectory(
+    path: str | Path, fmt: TrajectoryFormat | str = TrajectoryFormat.AUTO, times=None
+) -> Trajectory:
     """Read TUM or KITTI; ``auto`` picks :data:`AUTO_FORMAT_RULE`."""
     path = Path(path)
-    fmt = trajectory_format(path, fmt)
-    if fmt == "tum":
+    if trajectory_format(path, fmt) is TrajectoryFormat.TUM:
         return read_tum(path)
-    if fmt == "kitti":
-        return read_kitti(path, times)
-    raise ValueError(f"unknown trajectory format {fmt!r} (expected tum, kitti or auto)")
+    return read_kitti(path, times)
 
 
-def trajectory_format(path: str | Path, fmt: str = "auto") -> str:
-    """``fmt``, or for "auto" the format of ``path`` by the number of columns of its first data
-    row: "tum" (8) or "kitti" (12); anything else is an :class:`InputError`."""
-    return _sniff_format(Path(path)) if fmt == "auto" else fmt
+def trajectory_format(
+    path: str | Path, fmt: TrajectoryFormat | str = TrajectoryFormat.AUTO
+) -> TrajectoryFormat:
+    """``fmt`` (a :class:`~vo_doppler.choices.ChoiceError` if it is none), or for "auto" the
+    format of ``path`` by the number of columns of its first data row: "tum" (8) or "kitti"
+    (12); anything else is an :class:`InputError`."""
+    fmt = checked(TrajectoryFormat, fmt, "fmt")
+    return _sniff_format(Path(path)) if fmt is TrajectoryFormat.AUTO else fmt
 
 
-def _sniff_format(path: Path) -> str:
+def _sniff_format(path: Path) -> TrajectoryFormat:
     for line in read_text(path, "trajectory file").splitlines():
         stripped = line.strip()
         if stripped and not stripped.startswith("#"):
             n = len(stripped.replace(",", " ").split())
             if n == 8:
-                return "tum"
+                return TrajectoryFormat.TUM
             if n == 12:
-                return "kitti"
+                return TrajectoryFormat.KITTI
             raise InputError(
                 f"cannot tell the trajectory format: first row has {n} fields "
                 "(TUM has 8, KITTI 12)",

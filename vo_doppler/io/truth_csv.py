@@ -23,10 +23,12 @@ import csv
 import io
 import re
 from dataclasses import dataclass
+from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.choices import checked
 from vo_doppler.errors import InputError
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.sequence import Manifest, read_manifest
@@ -35,8 +37,17 @@ from vo_doppler.io.trajectory import read_tum
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK, unix_to_gps_seconds
 from vo_doppler.model.ground_truth import GroundTruth
 
-TRUTH_FORMATS = ("auto", "tum", "latlon", "gsdc")
-"""The ``fmt`` values of :func:`read_ground_truth` (``eval gnss --truth-format``)."""
+
+class TruthFormat(StrEnum):
+    """The ``fmt`` of :func:`read_ground_truth` (``eval gnss --truth-format``)."""
+
+    AUTO = "auto"
+    """By :data:`AUTO_TRUTH_RULE`."""
+    TUM = "tum"
+    LATLON = "latlon"
+    GSDC = "gsdc"
+
+
 AUTO_TRUTH_RULE = (
     "by the first line: a GSDC header (UnixTimeMillis), a header with gps_time_s (lat/lon "
     "CSV), or a data row of 8 fields (TUM) or 5 (GPS week, seconds of week, lat, lon, h)"
@@ -118,26 +129,26 @@ def increasing_times(t: np.ndarray, lines: np.ndarray, path: Path, what: str) ->
         )
 
 
-def truth_format(text: str, path: Path) -> str:
+def truth_format(text: str, path: Path) -> TruthFormat:
     """The truth format of a file's ``text`` by :data:`AUTO_TRUTH_RULE`."""
     for line in text.splitlines():
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
             continue
         if "UnixTimeMillis" in stripped or "LatitudeDegrees" in stripped:
-            return "gsdc"
+            return TruthFormat.GSDC
         fields = [f for f in _SEPARATORS.split(stripped) if f]
         if "gps_time_s" in fields:
-            return "latlon"
+            return TruthFormat.LATLON
         try:
             numeric = bool([float(f) for f in fields])
         except ValueError:
             numeric = False
         if numeric:
             if len(fields) == 8:
-                return "tum"
+                return TruthFormat.TUM
             if len(fields) == 5:
-                return "latlon"
+                return TruthFormat.LATLON
         raise InputError(
             f"cannot tell the ground-truth format from its first line ({len(fields)} fields): "
             f"expected {AUTO_TRUTH_RULE}",
@@ -147,22 +158,22 @@ def truth_format(text: str, path: Path) -> str:
 
 
 def read_ground_truth(
-    path: str | Path, fmt: str = "auto", origin: EnuFrame | None = None
+    path: str | Path, fmt: TruthFormat | str = TruthFormat.AUTO, origin: EnuFrame | None = None
 ) -> GroundTruth:
     """Read a ground-truth file (module docstring); ``origin`` is the ENU frame of a TUM file's
     positions (None: positions are still read, but cannot be compared with geodetic ones), and
     the frame the CSV kinds are put in (None: their first row)."""
+    fmt = checked(TruthFormat, fmt, "fmt")
     path = Path(path)
     text = read_text(path, "ground-truth file")
-    fmt = truth_format(text, path) if fmt == "auto" else fmt
-    if fmt == "tum":
+    if fmt is TruthFormat.AUTO:
+        fmt = truth_format(text, path)
+    if fmt is TruthFormat.TUM:
         trajectory = read_tum(path)
         return GroundTruth(trajectory.t, trajectory.positions, origin, None, "TUM")
-    if fmt == "latlon":
+    if fmt is TruthFormat.LATLON:
         return _read_latlon(text, path, origin)
-    if fmt == "gsdc":
-        return _read_gsdc(text, path, origin)
-    raise ValueError(f"unknown ground-truth format {fmt!r} (expected one of {TRUTH_FORMATS})")
+    return _read_gsdc(text, path, origin)
 
 
 def _read_latlon(text: str, path: Path, origin: EnuFrame | None) -> GroundTruth:

@@ -18,12 +18,18 @@ row's receiver position, :meth:`DopplerRows.in_enu`, what the heading solvers ta
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields, replace
+from enum import StrEnum
 
 import numpy as np
 
 from vo_doppler.geo import ecef_to_enu_rotation, ecef_to_geodetic
 
-FRAMES = ("ecef", "enu")
+
+class VectorFrame(StrEnum):
+    """Where a :class:`DopplerRows`' vectors live (module docstring)."""
+
+    ECEF = "ecef"
+    ENU = "enu"
 
 
 @dataclass
@@ -46,7 +52,7 @@ class DopplerRows:
     range_rate: np.ndarray
     weight: np.ndarray
     sat_id: np.ndarray
-    frame: str = "enu"
+    frame: VectorFrame = VectorFrame.ENU
     epoch: np.ndarray | None = None
     system: np.ndarray | None = None
     prn: np.ndarray | None = None
@@ -65,8 +71,10 @@ class DopplerRows:
     missing: tuple[str, ...] = field(default=())
 
     def __post_init__(self) -> None:
-        if self.frame not in FRAMES:
-            raise ValueError(f"frame must be one of {FRAMES}, not {self.frame!r}")
+        if self.frame not in tuple(VectorFrame):
+            allowed = ", ".join(VectorFrame)
+            raise ValueError(f"frame must be one of {allowed}, not {self.frame!r}")
+        self.frame = VectorFrame(self.frame)
         self.t = np.asarray(self.t, dtype=float).reshape(-1)
         n = len(self.t)
         self.los = np.asarray(self.los, dtype=float).reshape(n, 3)
@@ -109,10 +117,10 @@ class DopplerRows:
 
     def in_enu(self) -> DopplerRows:
         """The rows with their vectors turned into the ENU frame at each row's receiver."""
-        if self.frame == "enu":
+        if self.frame is VectorFrame.ENU:
             return self
         if len(self) == 0:
-            return replace(self, frame="enu")
+            return replace(self, frame=VectorFrame.ENU)
         positions, inverse = np.unique(self.receiver_ecef, axis=0, return_inverse=True)
         lat, lon, _ = ecef_to_geodetic(positions)
         rotations = np.stack(
@@ -130,5 +138,5 @@ class DopplerRows:
             los=turn(self.los),
             sat_velocity=turn(self.sat_velocity),
             sat_position=None,
-            frame="enu",
+            frame=VectorFrame.ENU,
         )

@@ -17,12 +17,18 @@ two samples of the integral). Times are seconds, sorted non-decreasing.
 
 from __future__ import annotations
 
-from typing import Literal
+from enum import StrEnum
 
 import numpy as np
 
-Outside = Literal["nan", "hold", "extend"]
-OUTSIDE_RULES = ("nan", "hold", "extend")
+
+class Outside(StrEnum):
+    """The edge rules (module docstring)."""
+
+    NAN = "nan"
+    HOLD = "hold"
+    EXTEND = "extend"
+    """Integrals only."""
 
 
 TIME_TOLERANCE_S = 1e-6
@@ -53,31 +59,35 @@ def time_grid(begin: float, end: float, step_s: float) -> np.ndarray:
     return begin + step_s * np.arange(count)
 
 
-def _check(outside: str, allowed: tuple[str, ...]) -> None:
+def _check(outside: Outside | str, allowed: tuple[Outside, ...]) -> None:
     if outside not in allowed:
         raise ValueError(f"outside={outside!r}: use one of {', '.join(allowed)}")
 
 
-def sample(t: np.ndarray, value: np.ndarray, t_query, outside: Outside = "nan") -> np.ndarray:
+def sample(
+    t: np.ndarray, value: np.ndarray, t_query, outside: Outside | str = Outside.NAN
+) -> np.ndarray:
     """Linear interpolation of ``value`` at ``t_query`` (``outside``: "nan" or "hold")."""
-    _check(outside, ("nan", "hold"))
+    _check(outside, (Outside.NAN, Outside.HOLD))
     t = np.asarray(t, dtype=float)
     t_query = np.asarray(t_query, dtype=float)
     if t.size == 0:
         return np.full(t_query.shape, np.nan)
     out = np.interp(t_query, t, np.asarray(value, dtype=float))
-    if outside == "nan":
+    if outside == Outside.NAN:
         out[(t_query < t[0]) | (t_query > t[-1])] = np.nan
     return out
 
 
-def hold(t: np.ndarray, value: np.ndarray, t_query, outside: Outside = "nan") -> np.ndarray:
+def hold(
+    t: np.ndarray, value: np.ndarray, t_query, outside: Outside | str = Outside.NAN
+) -> np.ndarray:
     """Sample-and-hold (zero order): the last sample at or before each query time.
 
     Before the first sample: NaN, or the first value with ``outside="hold"``; after the last
     sample the last value is held only with ``outside="hold"``.
     """
-    _check(outside, ("nan", "hold"))
+    _check(outside, (Outside.NAN, Outside.HOLD))
     t = np.asarray(t, dtype=float)
     value = np.asarray(value)
     t_query = np.asarray(t_query, dtype=float)
@@ -85,7 +95,7 @@ def hold(t: np.ndarray, value: np.ndarray, t_query, outside: Outside = "nan") ->
         return np.full(t_query.shape, np.nan)
     index = np.searchsorted(t, t_query, side="right") - 1
     out = value[np.clip(index, 0, t.size - 1)].astype(float)
-    if outside == "nan":
+    if outside == Outside.NAN:
         out[(t_query < t[0]) | (t_query > t[-1])] = np.nan
     return out
 
@@ -103,16 +113,18 @@ def cumulative_integral(t: np.ndarray, rate: np.ndarray, initial: float = 0.0) -
     return initial + np.concatenate([[0.0], np.cumsum(steps)])
 
 
-def integral_at(t: np.ndarray, rate: np.ndarray, t_query, outside: Outside = "nan") -> np.ndarray:
+def integral_at(
+    t: np.ndarray, rate: np.ndarray, t_query, outside: Outside | str = Outside.NAN
+) -> np.ndarray:
     """The integral of ``rate`` since ``t[0]`` at ``t_query`` (module docstring for ``outside``)."""
-    _check(outside, OUTSIDE_RULES)
+    _check(outside, tuple(Outside))
     t = np.asarray(t, dtype=float)
     rate = np.asarray(rate, dtype=float)
     t_query = np.asarray(t_query, dtype=float)
     if t.size == 0:
         return np.full(t_query.shape, np.nan)
     total = cumulative_integral(t, rate)
-    if outside != "extend":
+    if outside != Outside.EXTEND:
         return sample(t, total, t_query, outside)
     out = np.interp(t_query, t, total)
     before, after = t_query < t[0], t_query > t[-1]
@@ -122,12 +134,14 @@ def integral_at(t: np.ndarray, rate: np.ndarray, t_query, outside: Outside = "na
 
 
 def travelled_distance(
-    t: np.ndarray, speed: np.ndarray, t_query, outside: Outside = "nan"
+    t: np.ndarray, speed: np.ndarray, t_query, outside: Outside | str = Outside.NAN
 ) -> np.ndarray:
     """Distance travelled since ``t[0]`` at each query time: the integral of the speed."""
     return integral_at(t, speed, t_query, outside)
 
 
-def increments(t: np.ndarray, rate: np.ndarray, t_query, outside: Outside = "nan") -> np.ndarray:
+def increments(
+    t: np.ndarray, rate: np.ndarray, t_query, outside: Outside | str = Outside.NAN
+) -> np.ndarray:
     """The integral of ``rate`` between consecutive query times, (N − 1,)."""
     return np.diff(integral_at(t, rate, t_query, outside))

@@ -42,6 +42,7 @@ simulator's default city (tests/sim/test_canyon_realism.py checks them).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from enum import StrEnum
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -49,9 +50,14 @@ import numpy as np
 if TYPE_CHECKING:
     from vo_doppler.sim.gnss_observations import Boxes, GnssSimConfig
 
-REALISM_LEVELS = ("geometric", "real")
-"""``simulate --canyon-realism`` choices: the geometric canyon (direct rays and specular facade
-reflections) and the canyon measured on real receivers (this module)."""
+
+class RealismLevel(StrEnum):
+    """``simulate --canyon-realism``."""
+
+    GEOMETRIC = "geometric"
+    """Direct rays and specular facade reflections."""
+    REAL = "real"
+    """The canyon measured on real receivers (this module: :func:`real_canyon_config`)."""
 
 
 @dataclass(frozen=True)

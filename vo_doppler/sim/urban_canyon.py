@@ -56,6 +56,7 @@ import shutil
 import time
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field, replace
+from enum import StrEnum
 from pathlib import Path
 
 import cv2
@@ -63,6 +64,7 @@ import numpy as np
 import yaml
 from rich.progress import track
 
+from vo_doppler.choices import check_fields
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import write_camera_yaml
 from vo_doppler.io.output_folder import open_output_folder
@@ -97,6 +99,7 @@ from vo_doppler.sim.gnss_observations import (
 from vo_doppler.sim.scene import city_scene
 from vo_doppler.sim.traffic import TrafficConfig, add_traffic
 from vo_doppler.sim.vo_sequence import (
+    ImageFormat,
     VehicleMotion,
     VoPlan,
     drive,
@@ -109,7 +112,14 @@ from vo_doppler.vo.batch import MIN_VO_FRAMES
 
 log = logging.getLogger(__name__)
 
-SCENARIOS = ("urban-canyon",)
+
+class Scenario(StrEnum):
+    """``simulate --scenario``: the drives the simulator knows."""
+
+    URBAN_CANYON = "urban-canyon"
+    """A closed loop through a city of tall buildings (module docstring)."""
+
+
 DEFAULT_START_GPS_S = REFERENCE_EPOCH + 2 * 3600.0 + 600.0
 """2025-03-14 02:10:00 GPST."""
 SHINJUKU = (35.69380, 139.70340, 77.0)
@@ -195,7 +205,7 @@ class UrbanCanyonConfig:
     stop_duration_s: float = 4.0
     fps: float = 15.0
     image_size_px: tuple[int, int] = (640, 360)
-    image_format: str = "png"
+    image_format: ImageFormat = ImageFormat.PNG
     jpeg_quality: int = 90
     image_noise_grey: float = 2.0
     """Gaussian pixel noise (grey levels) of the clean rendering (``camera_effects`` None)."""
@@ -213,6 +223,9 @@ class UrbanCanyonConfig:
     leap_seconds: int = 18
     gnss: GnssSimConfig = field(default_factory=GnssSimConfig)
     can: CanSimConfig = field(default_factory=CanSimConfig)
+
+    def __post_init__(self) -> None:
+        check_fields(self, image_format=ImageFormat)
 
 
 @dataclass(frozen=True)
@@ -461,7 +474,7 @@ def _render(out: Path, config, scene, camera, vehicle, times: np.ndarray, progre
     frames = camera_frames(config, scene, camera, vehicle, times)
     if progress:
         frames = track(frames, total=len(times), description="rendering")
-    suffix = ".jpg" if config.image_format == "jpg" else ".png"
+    suffix = f".{config.image_format}"
     params = [cv2.IMWRITE_JPEG_QUALITY, config.jpeg_quality] if suffix == ".jpg" else []
     names = set()
     for k, image in enumerate(frames):
@@ -508,7 +521,7 @@ def _stats(config, truth: VehicleMotion, gnss: GnssSimulation, frames, can_frame
 
 
 def _write_manifest(out: Path, config, command, camera, camera_offset, stats) -> dict[str, str]:
-    suffix = "jpg" if config.image_format == "jpg" else "png"
+    suffix = config.image_format.value
     files = {
         "images": "image_0",
         "times": "times.txt",
@@ -534,7 +547,7 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
     manifest = {
         "format": "vo-doppler-sequence/1",
         "name": out.name,
-        "scenario": "urban-canyon",
+        "scenario": Scenario.URBAN_CANYON.value,
         "seed": config.seed,
         "duration_s": config.duration_s,
         "command": command,

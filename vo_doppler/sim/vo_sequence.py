@@ -21,12 +21,14 @@ import argparse
 import logging
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
+from enum import StrEnum
 from pathlib import Path
 
 import cv2
 import numpy as np
 from rich.progress import track
 
+from vo_doppler.choices import checked, values
 from vo_doppler.io.calibration import write_camera_yaml
 from vo_doppler.io.trajectory import write_kitti, write_tum
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD, Camera
@@ -37,6 +39,15 @@ from vo_doppler.sim.scene import CityLayout, Scene, city_scene
 log = logging.getLogger(__name__)
 
 CAMERA_HEIGHT_M = 1.5
+
+
+class ImageFormat(StrEnum):
+    """The image files a simulation writes (also their suffix)."""
+
+    PNG = "png"
+    """Lossless."""
+    JPG = "jpg"
+    """Smaller; its quality is the writer's setting."""
 
 
 def synthetic_camera(width: int = 640, height: int = 360) -> Camera:
@@ -301,7 +312,7 @@ def generate_vo_sequence(
     fps: float = 10.0,
     seed: int = 0,
     progress: bool = False,
-    image_format: str = "png",
+    image_format: ImageFormat | str = ImageFormat.PNG,
     **options,
 ) -> VoPlan:
     """Render a sequence to ``out_dir`` (layout in the module docstring) and return its plan.
@@ -310,8 +321,7 @@ def generate_vo_sequence(
     about half that). Numbered frames left in ``image_0`` by an earlier, longer run are removed
     so that the folder holds exactly this sequence.
     """
-    if image_format not in ("png", "jpg"):
-        raise ValueError(f"image_format must be png or jpg, not {image_format!r}")
+    image_format = checked(ImageFormat, image_format, "image_format")
     out = Path(out_dir)
     image_dir = out / "image_0"
     image_dir.mkdir(parents=True, exist_ok=True)
@@ -319,7 +329,7 @@ def generate_vo_sequence(
     frames = render_frames(plan)
     if progress:
         frames = track(frames, total=len(plan.times), description="rendering")
-    params = [cv2.IMWRITE_JPEG_QUALITY, 95] if image_format == "jpg" else []
+    params = [cv2.IMWRITE_JPEG_QUALITY, 95] if image_format is ImageFormat.JPG else []
     names = set()
     for k, image in enumerate(frames):
         path = image_dir / f"{k:06d}.{image_format}"
@@ -376,7 +386,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--stop", type=float, action="append", default=[], help="stop at this distance (m)"
     )
-    parser.add_argument("--format", choices=("png", "jpg"), default="png", help="image files")
+    parser.add_argument(
+        "--format", choices=values(ImageFormat), default=ImageFormat.PNG.value, help="image files"
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     generate_vo_sequence(

@@ -8,12 +8,25 @@ that the camera poses' world is already z-up (e.g. ENU), so only the extrinsic i
 
 from __future__ import annotations
 
+from enum import StrEnum
+
 import numpy as np
 
+from vo_doppler.choices import checked
 from vo_doppler.model.camera import CAMERA_TO_VEHICLE_FORWARD
 from vo_doppler.model.trajectory import Trajectory
 
-WORLDS = ("first_camera", "level")
+
+class World(StrEnum):
+    """The world of the camera poses given to :func:`vehicle_trajectory` (``correct
+    --world``)."""
+
+    FIRST_CAMERA = "first_camera"
+    """The first camera's frame (OpenCV axes), what VO systems write."""
+    LEVEL = "level"
+    """Already level, z up (e.g. ENU)."""
+
+
 MAX_ROAD_CLIMB = np.radians(30.0)
 """Steeper than any road (58 % grade): a vehicle track climbing so is in a wrongly oriented
 world."""
@@ -27,14 +40,13 @@ poses read as ``level``)."""
 def vehicle_trajectory(
     camera: Trajectory,
     T_vehicle_camera: np.ndarray = CAMERA_TO_VEHICLE_FORWARD,
-    world: str = "first_camera",
+    world: World | str = World.FIRST_CAMERA,
 ) -> Trajectory:
     """Vehicle poses T_w_veh = T_w_cam · T_veh_cam⁻¹, re-expressed in the first vehicle frame
     for ``world="first_camera"``."""
-    if world not in WORLDS:
-        raise ValueError(f"unknown world {world!r} ({' or '.join(WORLDS)})")
+    world = checked(World, world, "world")
     poses = camera.matrices @ np.linalg.inv(np.asarray(T_vehicle_camera, dtype=float))
-    if world == "first_camera" and len(poses):
+    if world is World.FIRST_CAMERA and len(poses):
         poses = np.linalg.inv(poses[0]) @ poses
     return Trajectory.from_matrices(camera.t.copy(), poses)
 
