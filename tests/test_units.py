@@ -31,6 +31,7 @@ from vo_doppler.units import UNITS, in_people_units, unit_of
         ("clock_bias_walk_m_per_sqrt_s", "m/√s"),
         ("clock_drift_walk_mps_per_sqrt_s", "m/s/√s"),
         ("yaw_rate_bias_dps", "deg/s"),
+        ("yaw_bias_walk_dps_per_sqrt_s", "deg/s/√s"),
         ("cn0_zenith_dbhz", "dB-Hz"),
         ("nlos_loss_db", "dB"),
     ],

@@ -44,11 +44,13 @@ UNITS: tuple[Unit, ...] = (
     Unit("_per_km", "per km"),
     Unit("_deg", "deg"),
     Unit("_dps", "deg/s"),
+    Unit("_dps_per_sqrt_s", "deg/s/√s"),
     Unit("_kmh", "km/h"),
 )
-"""Every unit suffix, SI and radians first. The last three are people units, for the
+"""Every unit suffix, SI and radians first. The last four are people units, for the
 simulator's settings of devices that work in them (an elevation mask in degrees, a CAN bus's
-yaw rate in deg/s and wheel speed in km/h); the library's own settings use the SI ones."""
+yaw rate in deg/s, its bias's random walk and wheel speed in km/h); the library's own settings
+use the SI ones."""
 
 
 def unit_of(name: str) -> Unit | None:

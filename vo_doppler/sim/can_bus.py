@@ -52,7 +52,7 @@ class CanSimConfig:
     wheel_scale_error: float = 0.02
     wheel_noise_kmh: float = 0.05
     yaw_rate_bias_dps: float = 0.3
-    yaw_bias_walk_dps: float = 0.003
+    yaw_bias_walk_dps_per_sqrt_s: float = 0.003
     yaw_rate_noise_dps: float = 0.05
     long_accel_bias_mps2: float = 0.1
     long_accel_noise_mps2: float = 0.03
@@ -127,7 +127,7 @@ def simulate_can(
     wheel_kmh = np.maximum(wheel_kmh, 0.0)
 
     motion = vehicle_at(t_dyn)
-    walk = rng.normal(0.0, config.yaw_bias_walk_dps * np.sqrt(config.period_s), n)
+    walk = rng.normal(0.0, config.yaw_bias_walk_dps_per_sqrt_s * np.sqrt(config.period_s), n)
     bias = config.yaw_rate_bias_dps + np.concatenate([[0.0], np.cumsum(walk[1:])])
     yaw_dps = np.degrees(motion.yaw_rate) + bias + rng.normal(0.0, config.yaw_rate_noise_dps, n)
     long_accel = np.gradient(motion.speed, t_dyn) if n > 1 else np.zeros(n)

@@ -600,7 +600,7 @@ def _write_manifest(out: Path, config, command, camera, camera_offset, stats) ->
             "traffic": _plain(asdict(config.traffic)) if config.camera_effects else None,
             "wheel_scale_error": config.can.wheel_scale_error,
             "yaw_rate_bias_dps": config.can.yaw_rate_bias_dps,
-            "yaw_bias_walk_dps_per_sqrt_s": config.can.yaw_bias_walk_dps,
+            "yaw_bias_walk_dps_per_sqrt_s": config.can.yaw_bias_walk_dps_per_sqrt_s,
             "yaw_rate_noise_dps": config.can.yaw_rate_noise_dps,
             "long_accel_bias_mps2": config.can.long_accel_bias_mps2,
             "long_accel_noise_mps2": config.can.long_accel_noise_mps2,
