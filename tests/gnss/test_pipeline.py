@@ -10,7 +10,7 @@ import pytest
 from tests.conftest import require_shared
 from tests.gnss.test_phase_rate import _obs
 from vo_doppler.errors import InputError
-from vo_doppler.gnss.pipeline import check_elevation_mask, gnss_velocity
+from vo_doppler.gnss.pipeline import check_elevation_mask, gnss_position, gnss_velocity
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rinex_obs import read_obs
 
@@ -65,6 +65,12 @@ def test_arguments_out_of_their_domain_are_input_errors_naming_them(arguments, m
     3), or a bare ValueError."""
     with pytest.raises(InputError, match=message):
         gnss_velocity(OBS, None, "G", **arguments)
+
+
+@pytest.mark.parametrize("solve", [gnss_velocity, gnss_position])
+def test_systems_other_than_rinex_letters_are_refused_naming_the_letter(solve):
+    with pytest.raises(InputError, match=r"^systems = 'Gx': unknown satellite system 'x'; choose"):
+        solve(OBS, None, "Gx")
 
 
 @pytest.mark.parametrize("value", [0.0, np.radians(10.0), np.nextafter(np.pi / 2, 0)])

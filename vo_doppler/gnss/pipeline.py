@@ -10,7 +10,7 @@ from enum import StrEnum
 import numpy as np
 
 from vo_doppler.bounds import RECEIVER_RADIUS
-from vo_doppler.choices import checked
+from vo_doppler.choices import checked, checked_letters
 from vo_doppler.errors import InputError
 from vo_doppler.gnss.doppler_velocity import (
     DopplerRows,
@@ -30,6 +30,7 @@ from vo_doppler.gnss.spp import receiver_positions, solve_spp
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import SppSolution, VelocitySolution
 from vo_doppler.model.observations import Observations
+from vo_doppler.model.signals import DEFAULT_SYSTEMS, SatelliteSystem
 
 
 @dataclass(frozen=True)
@@ -86,6 +87,7 @@ def _check_arguments(
 ) -> np.ndarray | None:
     """An :class:`InputError` naming the first argument of :func:`gnss_velocity` out of its
     domain (each would leave no valid epoch, without a word); ``receiver_ecef`` as an array."""
+    checked_letters(SatelliteSystem, systems, "systems")
     checked(RangeRateSource, range_rate, "range_rate")
     check_elevation_mask(elevation_mask_rad)
     if bands is not None:
@@ -122,7 +124,7 @@ def _check_arguments(
 def gnss_velocity(
     obs: Observations,
     source: StateSource,
-    systems: str = "GREJC",
+    systems: str = DEFAULT_SYSTEMS,
     elevation_mask_rad: float = np.deg2rad(10.0),
     bands: str | None = None,
     range_rate: RangeRateSource | str = RangeRateSource.DOPPLER,
@@ -143,9 +145,10 @@ def gnss_velocity(
     given their speed share (:mod:`vo_doppler.gnss.moving_noise`) and the velocity solved
     again.
 
-    Arguments out of their domain (an elevation mask outside [0, π/2) rad, band digits that are
-    not digits or absent from the file, a receiver position off the Earth, an unknown
-    ``range_rate``) are an :class:`InputError` naming the argument.
+    Arguments out of their domain (``systems`` other than RINEX system letters, an elevation
+    mask outside [0, π/2) rad, band digits that are not digits or absent from the file, a
+    receiver position off the Earth, an unknown ``range_rate``) are an :class:`InputError`
+    naming the argument.
 
     Many parameters because it is the GNSS stage's public entry point: after the observations
     and satellite states, each argument is one independent option with its default, passed by
@@ -216,7 +219,7 @@ def _along_track(epoch_time, spp, first_pass, rows_at):
 def gnss_position(
     obs: Observations,
     source: StateSource,
-    systems: str = "GREJC",
+    systems: str = DEFAULT_SYSTEMS,
     elevation_mask_rad: float = np.deg2rad(10.0),
 ) -> SppSolution:
     """Single-point fixes (:func:`~vo_doppler.gnss.spp.solve_spp`: fitted pseudorange σ,
@@ -224,6 +227,7 @@ def gnss_position(
     velocities of :func:`gnss_velocity` where the file has Doppler of ``systems``
     (:mod:`~vo_doppler.gnss.position_check`: a fix inconsistent with its neighbours is not
     valid, the σ scaled to the scatter); without Doppler, the fixes' own tests alone."""
+    checked_letters(SatelliteSystem, systems, "systems")
     check_elevation_mask(elevation_mask_rad)
     if not doppler_codes(obs, systems):
         return solve_spp(obs, source, systems, elevation_mask_rad)

@@ -37,6 +37,7 @@ from vo_doppler.gnss.satellite_source import StateSource, satellite_source
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.model.gnss_solutions import SppSolution
 from vo_doppler.model.observations import Observations, lookup, row_keys
+from vo_doppler.model.signals import DEFAULT_SYSTEMS
 from vo_doppler.model.timeseries import TIME_TOLERANCE_S
 
 log = logging.getLogger(__name__)
@@ -102,7 +103,7 @@ def elevation_azimuth(
 def solve_spp(
     obs: Observations,
     source: StateSource,
-    systems: str = "GREJC",
+    systems: str = DEFAULT_SYSTEMS,
     elevation_mask_rad: float = np.deg2rad(10.0),
     fit_noise: bool = True,
     alpha: float = DEFAULT_ALPHA,
