@@ -32,8 +32,9 @@ first half only). Figures:
   as the GNSS stage flags them with its σ (vel.csv of ``vo-doppler gnss``), and as ``run`` and
   ``heading`` flag them in heading.csv after the gyro and wheel test, with that table's σ
   (``heading.integrity``, docs/design.md (I1));
-* standstill: the valid epochs' horizontal speed (vel.csv, and heading.csv's flags): how many
-  exceed 0.2 m/s, p95 and max;
+* standstill: the valid epochs' horizontal speed as ``gnss velocity``'s vel.csv and as
+  ``run``'s vel.csv flag them (the car's verdict, docs/design.md (I1c)): how many exceed
+  0.2 m/s, p95 and max;
 * calibration: the heading stage's wheel scale and gyro bias at the last epoch the vehicle
   signals cover, against the values that fit the ground truth with the same models
   (scale = Σ w·v / Σ w², bias = slope of ∫ω − ψ_truth);
@@ -84,6 +85,7 @@ from vo_doppler.fusion.antenna_track import AntennaTrack
 from vo_doppler.fusion.pipelines import Pipeline
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import emulated_canyon
+from vo_doppler.heading.integrity import car_checked_velocity
 from vo_doppler.heading.pipeline import CalibrationMethod, HeadingPipelineConfig
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.heading import HeadingTable
@@ -199,12 +201,13 @@ def conventional_figures(sequence: Sequence, velocity, table: HeadingTable | Non
 
 def standstill_figures(sequence: Sequence, velocity, table: HeadingTable | None = None) -> dict:
     """The horizontal speed of the conventional velocity's valid epochs while the truth stands
-    (speed below ``STANDSTILL_MPS``): as vel.csv flags them, or with ``table`` as heading.csv
-    does. The true speed is zero, so the speed is the error."""
+    (speed below ``STANDSTILL_MPS``): as ``gnss velocity``'s vel.csv flags them, or with
+    ``table`` as ``run``'s vel.csv does (the car's verdict, docs/design.md (I1c)). The true
+    speed is zero, so the speed is the error."""
     standing = truth_speed(sequence, velocity.t) < STANDSTILL_MPS
     valid = velocity.valid & standing
     if table is not None:
-        valid &= table.conv_valid
+        valid = car_checked_velocity(velocity, table).valid & standing
     speed = np.linalg.norm(velocity.velocity_enu[:, :2], axis=1)
     return {
         "standstill_epochs": int(standing.sum()),
