@@ -30,7 +30,8 @@ shows what would be used) or named by options:
   (:mod:`vo_doppler.io.rosbag_can`);
 - raw GNSS (:mod:`vo_doppler.io.rosbag_gnss`) → ``gnss/rover.obs`` (RINEX 3.04; its approximate
   position the first NavSatFix fix, else the origin), and
-  ``gnss/brdc.nav`` when the bag holds ephemerides (GLONASS ones from ``GnssGloEphemMsg``),
+  ``gnss/brdc.nav`` when the bag holds ephemerides (GLONASS ones from ``GnssGloEphemMsg`` or
+  the GLONASS strings of ``RxmSFRBX``),
   ``gnss/doppler_sigma.csv`` when the receiver reported Doppler σ;
 - the GNSS antenna lever arm (``gnss.antenna_lever_arm_m``) from ``/tf_static``: the vehicle
   frame → ``--gnss-frame`` or the NavSatFix topic's ``frame_id``; 0 without one;
