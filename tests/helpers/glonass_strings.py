@@ -10,7 +10,12 @@ from __future__ import annotations
 import numpy as np
 from pyubx2 import UBXMessage
 
-from vo_doppler.model.gpstime import SECONDS_PER_DAY, days_from_civil, gps_minus_utc
+from vo_doppler.model.gpstime import (
+    SECONDS_PER_DAY,
+    days_from_civil,
+    gps_minus_utc,
+    utc_to_gps_seconds,
+)
 
 KM = 1000.0
 SCALES = {  # RINEX name (SI) → LSB
@@ -158,6 +163,7 @@ def example_at(toc: float, frame_before_s: float = 900.0) -> dict[str, float]:
 
 
 def tb_quarter_hour(gps: float) -> float:
-    """The GPS time of the tb (a quarter hour of UTC) at or after ``gps``."""
-    leap = float(gps_minus_utc(gps))
-    return float(np.ceil((gps - leap) / 900.0) * 900.0 + leap)
+    """The GPS time of the tb (a quarter hour of UTC) at or after ``gps``, with the leap seconds
+    in force at that quarter hour (a leap second between ``gps`` and it counts)."""
+    quarter = np.ceil((gps - float(gps_minus_utc(gps))) / 900.0) * 900.0
+    return float(utc_to_gps_seconds(quarter))

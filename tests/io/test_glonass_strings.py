@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from tests.helpers.glonass_strings import (
@@ -203,6 +203,19 @@ _COMPONENT = st.floats(-1.0, 1.0, allow_nan=False)
 
 
 @settings(max_examples=200, deadline=None)
+@example(  # the first tb after the leap second of 2005-12-31 (GPS - UTC 13 -> 14 s)
+    direction=(1.0, 0.0, 0.0),
+    radius_km=25_500.0,
+    velocity=(0.0, 0.0, 0.0),
+    acceleration=(0.0, 0.0, 0.0),
+    clock=(0.0, 0.0),
+    days=1092,
+    quarter=0,
+    frame_before=0,
+    slot=1,
+    channel=0,
+    age=0,
+)
 @given(
     direction=st.tuples(_COMPONENT, _COMPONENT, _COMPONENT).filter(
         lambda v: np.linalg.norm(v) > 0.1
