@@ -39,7 +39,12 @@ from vo_doppler.gnss.continuity import continuity_checked
 from vo_doppler.gnss.doppler_noise import fitted_sigma
 from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion, minimal_detectable_shift
 from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models, modelled_sigma
-from vo_doppler.gnss.satellite_source import StateSource, satellite_source, transmit_states
+from vo_doppler.gnss.satellite_source import (
+    SatelliteSource,
+    StateSource,
+    satellite_source,
+    transmit_states,
+)
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.gnss.spp import elevation_azimuth
 from vo_doppler.model.doppler import DopplerRows
@@ -84,11 +89,13 @@ def doppler_rows(
     systems: str = "GREJC",
     bands: str | None = None,
     elevation_mask_rad: float = np.deg2rad(10.0),
-    sigma0: float = SIGMA_RANGE_RATE_MPS,
     reported_sigma: ReportedSigma | None = None,
     log_missing: bool = True,
 ) -> DopplerRows:
-    """Doppler rows of the chosen systems/bands with satellite states and geometry.
+    """Doppler rows of the chosen systems/bands with satellite states and geometry: the terms
+    of docs/design.md (1)–(2) per row, weighted by the receiver's ``reported_sigma`` where it
+    gives one, else by the C/N0 and elevation model (:func:`range_rate_sigma`, σ₀
+    ``SIGMA_RANGE_RATE_MPS``).
 
     ``receiver_ecef``: (3,) or one position per observation epoch (E, 3; NaN rows are skipped).
     Satellite states are taken at signal transmission (travel time from the geometric range) in
@@ -98,28 +105,12 @@ def doppler_rows(
     repeat the warning).
     """
     source = satellite_source(source)
-    n_epochs = obs.epoch_time.size
-    receiver = np.broadcast_to(np.asarray(receiver_ecef, dtype=float), (n_epochs, 3))
-    channels = {**source.glonass_channels(), **obs.header.glonass_channels}
-    keep = np.zeros(len(obs), dtype=bool)
-    for system in systems:
-        for code in doppler_codes(obs, system, bands):
-            keep |= obs.mask(system, code)
-    sel = obs.subset(keep & np.isfinite(obs.value))
-    code_names = np.array(obs.codes, dtype="U3")[sel.code] if len(sel) else np.zeros(0, "U3")
-    wavelength = np.full(len(sel), np.nan)
-    cn0 = np.full(len(sel), np.nan)
-    for code in np.unique(code_names):
-        rows = code_names == code
-        wavelength[rows] = wavelengths(
-            sel.system[rows], sel.prn[rows], str(code), channels, obs.header.version
-        )
-        cn0[rows] = _signal_strength(obs, sel, rows, strength_code(str(code)))
+    receiver = np.broadcast_to(np.asarray(receiver_ecef, dtype=float), (obs.epoch_time.size, 3))
+    sel, code_names = _doppler_observations(obs, systems, bands)
+    wavelength, cn0 = _wavelength_and_strength(obs, sel, code_names, source)
     epoch = np.searchsorted(obs.epoch_time, sel.time)
     position = receiver[epoch]
-    has_position = np.isfinite(position).all(axis=1)
-    n_no_wavelength = int((~np.isfinite(wavelength)).sum())
-    usable = np.isfinite(wavelength) & has_position
+    usable = np.isfinite(wavelength) & np.isfinite(position).all(axis=1)
     states, _ = transmit_states(
         source,
         sel.system[usable],
@@ -130,22 +121,13 @@ def doppler_rows(
     no_eph = np.zeros(len(sel), dtype=bool)
     no_eph[np.flatnonzero(usable)[~states.valid]] = True
     missing = _missing_messages(sel, no_eph)
+    los, elevation, azimuth = _line_of_sight(states.position, position[usable])
     if log_missing:
-        for message in missing:
-            log.warning("satellite %s skipped", message)
-    vector = states.position - position[usable]
-    los = vector / np.linalg.norm(vector, axis=1, keepdims=True)
-    elevation, azimuth = elevation_azimuth(position[usable], los)
+        _log_skipped(missing, elevation[states.valid], elevation_mask_rad)
     good = states.valid & (elevation >= elevation_mask_rad)
-    n_below = int((states.valid & ~good).sum())
-    if log_missing and n_below and not good.any():
-        log.warning(
-            "every Doppler row lies below the elevation mask of %.1f° (the highest satellite "
-            "at %.1f°): no row is left",
-            np.degrees(elevation_mask_rad),
-            np.degrees(np.max(elevation[states.valid])),
-        )
     idx = np.flatnonzero(usable)[good]
+    kept = sel.subset(idx)
+    model_sigma = range_rate_sigma(cn0[idx], elevation[good], SIGMA_RANGE_RATE_MPS)
     return DopplerRows(
         t=sel.time[idx],
         epoch=epoch[idx],
@@ -158,24 +140,74 @@ def doppler_rows(
         sat_velocity=states.velocity[good],
         sat_clock_drift=SPEED_OF_LIGHT * states.clock_drift[good],
         range_rate=-wavelength[idx] * sel.value[idx],
-        weight=_row_sigma(
-            range_rate_sigma(cn0[idx], elevation[good], sigma0),
-            reported_sigma,
-            sel.subset(idx),
-            code_names[idx],
-        )
-        ** -2.0,
-        sat_id=sel.subset(idx).satellites(),
+        weight=_row_sigma(model_sigma, reported_sigma, kept, code_names[idx]) ** -2.0,
+        sat_id=kept.satellites(),
         frame="ecef",
         cn0=cn0[idx],
         elevation=elevation[good],
         azimuth=azimuth[good],
         receiver_ecef=position[idx],
         n_no_ephemeris=int(no_eph.sum()),
-        n_no_wavelength=n_no_wavelength,
-        n_below_mask=n_below,
+        n_no_wavelength=int((~np.isfinite(wavelength)).sum()),
+        n_below_mask=int((states.valid & ~good).sum()),
         missing=missing,
     )
+
+
+def _doppler_observations(
+    obs: Observations, systems: str, bands: str | None
+) -> tuple[Observations, np.ndarray]:
+    """The finite Doppler observations of the ``systems`` (and ``bands``,
+    :func:`doppler_codes`), and each one's observable code."""
+    keep = np.zeros(len(obs), dtype=bool)
+    for system in systems:
+        for code in doppler_codes(obs, system, bands):
+            keep |= obs.mask(system, code)
+    sel = obs.subset(keep & np.isfinite(obs.value))
+    code_names = np.array(obs.codes, dtype="U3")[sel.code] if len(sel) else np.zeros(0, "U3")
+    return sel, code_names
+
+
+def _wavelength_and_strength(
+    obs: Observations, sel: Observations, code_names: np.ndarray, source: SatelliteSource
+) -> tuple[np.ndarray, np.ndarray]:
+    """Carrier wavelength (m) and C/N0 (dB-Hz) of each observation of ``sel``, NaN where
+    unknown (a GLONASS satellite's channel from the file's header, else from ``source``)."""
+    channels = {**source.glonass_channels(), **obs.header.glonass_channels}
+    wavelength = np.full(len(sel), np.nan)
+    cn0 = np.full(len(sel), np.nan)
+    for code in np.unique(code_names):
+        rows = code_names == code
+        wavelength[rows] = wavelengths(
+            sel.system[rows], sel.prn[rows], str(code), channels, obs.header.version
+        )
+        cn0[rows] = _signal_strength(obs, sel, rows, strength_code(str(code)))
+    return wavelength, cn0
+
+
+def _line_of_sight(
+    sat_position: np.ndarray, receiver: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unit line of sight G (receiver → satellite, ECEF; docs/design.md (1)), elevation and
+    azimuth (rad) of each row."""
+    vector = sat_position - receiver
+    los = vector / np.linalg.norm(vector, axis=1, keepdims=True)
+    elevation, azimuth = elevation_azimuth(receiver, los)
+    return los, elevation, azimuth
+
+
+def _log_skipped(missing: tuple[str, ...], elevation: np.ndarray, mask_rad: float) -> None:
+    """Warn of the satellites skipped without ephemeris (``missing``), and when every row with
+    one (their ``elevation``) lies below the elevation mask."""
+    for message in missing:
+        log.warning("satellite %s skipped", message)
+    if elevation.size and not np.any(elevation >= mask_rad):
+        log.warning(
+            "every Doppler row lies below the elevation mask of %.1f° (the highest satellite "
+            "at %.1f°): no row is left",
+            np.degrees(mask_rad),
+            np.degrees(np.max(elevation)),
+        )
 
 
 def _row_sigma(model, reported: ReportedSigma | None, sel: Observations, codes) -> np.ndarray:
@@ -345,12 +377,11 @@ def doppler_velocity(
     obs: Observations,
     source: StateSource,
     receiver_ecef: np.ndarray,
-    sigma0: float = SIGMA_RANGE_RATE_MPS,
     **row_options,
 ) -> tuple[VelocitySolution, DopplerRows]:
     """Rows (``doppler_rows`` with ``row_options``: systems, bands, elevation_mask_rad,
     reported_sigma) and the per-epoch solution (``solve_velocity``) in one call."""
-    rows = doppler_rows(obs, source, receiver_ecef, sigma0=sigma0, **row_options)
+    rows = doppler_rows(obs, source, receiver_ecef, **row_options)
     return solve_velocity(rows, obs.epoch_time), rows
 
 
