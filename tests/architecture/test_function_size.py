@@ -22,7 +22,6 @@ ALLOWED = {
     "vo_doppler/heading/pipeline.py:heading_pipeline",
     "vo_doppler/heading/from_gnss.py:heading_from_gnss",
     "vo_doppler/heading/integrity.py:conventional_integrity",
-    "vo_doppler/gnss/doppler_velocity.py:solve_velocity",
 }
 
 

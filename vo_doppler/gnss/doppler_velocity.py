@@ -30,14 +30,19 @@ has one or two degrees of freedom), but the wrong velocity then rarely stays hor
 from __future__ import annotations
 
 import logging
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from vo_doppler.geo import SPEED_OF_LIGHT, ecef_to_enu_rotation, ecef_to_geodetic
 from vo_doppler.gnss.continuity import continuity_checked
 from vo_doppler.gnss.doppler_noise import fitted_sigma
-from vo_doppler.gnss.lsq import DEFAULT_ALPHA, lsq_with_exclusion, minimal_detectable_shift
+from vo_doppler.gnss.lsq import (
+    DEFAULT_ALPHA,
+    LsqResult,
+    lsq_with_exclusion,
+    minimal_detectable_shift,
+)
 from vo_doppler.gnss.noise_model import NoiseModel, fit_noise_models, modelled_sigma
 from vo_doppler.gnss.satellite_source import (
     SatelliteSource,
@@ -243,23 +248,11 @@ def solve_velocity(
     epoch_time: np.ndarray,
     alpha: float = DEFAULT_ALPHA,
 ) -> VelocitySolution:
-    """Weighted LS velocity + clock drift per epoch with iterated chi-square FDE."""
+    """Weighted LS velocity + clock drift per epoch (docs/design.md (2)) with iterated
+    chi-square FDE; each solved epoch's σ, DOP, protection (2c) and tests (2a)
+    (:meth:`_VelocityColumns.store`), then the course continuity test (2b)."""
     n = epoch_time.size
-    velocity = np.full((n, 3), np.nan)
-    velocity_enu = np.full((n, 3), np.nan)
-    drift = np.full(n, np.nan)
-    covariance = np.full((n, 4, 4), np.nan)
-    dop = np.full((n, 5), np.nan)
-    n_sat = np.zeros(n, dtype=np.int64)
-    n_obs = np.zeros(n, dtype=np.int64)
-    n_excluded = np.zeros(n, dtype=np.int64)
-    rms = np.full(n, np.nan)
-    valid = np.zeros(n, dtype=bool)
-    verified = np.zeros(n, dtype=bool)
-    untestable = np.zeros(n, dtype=bool)
-    horizontal_sigma = np.full((n, 2), np.nan)
-    vertical_sigma = np.full(n, np.nan)
-    protection = np.full(n, np.nan)
+    columns = _VelocityColumns.unsolved(n)
     order = np.argsort(rows.epoch, kind="stable")
     bounds = np.searchsorted(rows.epoch[order], np.arange(n + 1))
     y_all = rows.reduced()
@@ -268,58 +261,136 @@ def solve_velocity(
     for k in range(n):
         r = order[bounds[k] : bounds[k + 1]]
         if np.unique(satellite[r]).size < MIN_SATELLITES:
-            n_sat[k] = np.unique(satellite[r]).size
+            columns.n_sat[k] = np.unique(satellite[r]).size
             continue
         H = np.hstack([-rows.los[r], np.ones((r.size, 1))])
         result = lsq_with_exclusion(H, y_all[r], sigma_all[r], satellite[r], MIN_SATELLITES, alpha)
-        n_sat[k] = np.unique(satellite[r][result.used]).size if result.valid else 0
-        if not result.valid:
-            continue
-        velocity[k] = result.x[:3]
-        drift[k] = result.x[3]
-        covariance[k] = result.covariance
-        n_obs[k] = int(result.used.sum())
-        n_excluded[k] = int((~result.used).sum())
-        rms[k] = float(np.sqrt(np.mean(result.residuals[result.used] ** 2)))
-        lat, lon, _ = ecef_to_geodetic(rows.receiver_ecef[r[0]])
-        rotation = ecef_to_enu_rotation(float(lat), float(lon))
-        velocity_enu[k] = rotation @ result.x[:3]
+        columns.n_sat[k] = np.unique(satellite[r][result.used]).size if result.valid else 0
+        if result.valid:
+            lat, lon, _ = ecef_to_geodetic(rows.receiver_ecef[r[0]])
+            rotation = ecef_to_enu_rotation(float(lat), float(lon))
+            columns.store(k, _EpochFit(H, sigma_all[r], satellite[r], result, rotation), alpha)
+    return continuity_checked(columns.solution(epoch_time, rows.n_no_ephemeris))
+
+
+@dataclass(frozen=True)
+class _EpochFit:
+    """One epoch's weighted least-squares problem (2) and its solution after the exclusion."""
+
+    design: np.ndarray
+    """H, one row [−G, 1] per Doppler row."""
+    sigma: np.ndarray
+    """σ of each row (m/s)."""
+    satellite: np.ndarray
+    """Each row's satellite, the unit of the exclusion."""
+    result: LsqResult
+    rotation: np.ndarray
+    """ECEF → ENU at the receiver."""
+
+
+@dataclass
+class _VelocityColumns:
+    """:func:`solve_velocity`'s per-epoch results, filled epoch by epoch (NaN, 0 or False where
+    no velocity is solved); the fields of :class:`VelocitySolution`."""
+
+    velocity_ecef: np.ndarray
+    velocity_enu: np.ndarray
+    clock_drift_mps: np.ndarray
+    covariance: np.ndarray
+    dop: np.ndarray
+    n_sat: np.ndarray
+    n_obs: np.ndarray
+    n_excluded: np.ndarray
+    residual_rms_mps: np.ndarray
+    verified: np.ndarray
+    untestable: np.ndarray
+    speed_course_sigma: np.ndarray
+    """σ of the horizontal speed (m/s) and of the course (rad), :func:`speed_course_sigma`."""
+    vertical_sigma_mps: np.ndarray
+    horizontal_protection_mps: np.ndarray
+
+    @classmethod
+    def unsolved(cls, n: int) -> _VelocityColumns:
+        """Columns for ``n`` epochs, none solved."""
+
+        def nan(*shape: int) -> np.ndarray:
+            return np.full((n, *shape), np.nan)
+
+        def zeros(dtype) -> np.ndarray:
+            return np.zeros(n, dtype=dtype)
+
+        return cls(
+            velocity_ecef=nan(3),
+            velocity_enu=nan(3),
+            clock_drift_mps=nan(),
+            covariance=nan(4, 4),
+            dop=nan(5),
+            n_sat=zeros(np.int64),
+            n_obs=zeros(np.int64),
+            n_excluded=zeros(np.int64),
+            residual_rms_mps=nan(),
+            verified=zeros(bool),
+            untestable=zeros(bool),
+            speed_course_sigma=nan(2),
+            vertical_sigma_mps=nan(),
+            horizontal_protection_mps=nan(),
+        )
+
+    def store(self, k: int, fit: _EpochFit, alpha: float) -> None:
+        """Epoch ``k``'s solution with its σ, DOP, protection level (2c) and tests: verified
+        with redundancy, the chi-square test passed and a plausible vertical velocity (2a);
+        untestable with four satellites and a plausible vertical velocity."""
+        result, rotation, used = fit.result, fit.rotation, fit.result.used
+        self.velocity_ecef[k] = result.x[:3]
+        self.clock_drift_mps[k] = result.x[3]
+        self.covariance[k] = result.covariance
+        self.n_obs[k] = int(used.sum())
+        self.n_excluded[k] = int((~used).sum())
+        self.residual_rms_mps[k] = float(np.sqrt(np.mean(result.residuals[used] ** 2)))
+        self.velocity_enu[k] = rotation @ result.x[:3]
         covariance_enu = rotation @ result.covariance[:3, :3] @ rotation.T
-        dop[k] = _dop(H[result.used], rotation)
-        horizontal_sigma[k] = speed_course_sigma(velocity_enu[k], covariance_enu)
-        vertical_sigma[k] = np.sqrt(covariance_enu[2, 2])
-        kept = result.used
+        self.dop[k] = _dop(fit.design[used], rotation)
+        self.speed_course_sigma[k] = speed_course_sigma(self.velocity_enu[k], covariance_enu)
+        self.vertical_sigma_mps[k] = np.sqrt(covariance_enu[2, 2])
         shift = minimal_detectable_shift(
-            H[kept], sigma_all[r][kept], satellite[r][kept], result.covariance, result.dof, alpha
+            fit.design[used],
+            fit.sigma[used],
+            fit.satellite[used],
+            result.covariance,
+            result.dof,
+            alpha,
         )
-        protection[k] = _horizontal_protection(shift[:, :3], rotation)
-        plausible = vertical_velocity_plausible(velocity_enu[k], covariance_enu)
-        verified[k] = result.passed and n_sat[k] > MIN_SATELLITES and plausible
-        untestable[k] = (
-            n_sat[k] == MIN_SATELLITES and (result.dof == 0 or result.passed) and plausible
+        self.horizontal_protection_mps[k] = _horizontal_protection(shift[:, :3], rotation)
+        plausible = vertical_velocity_plausible(self.velocity_enu[k], covariance_enu)
+        n_sat = self.n_sat[k]
+        self.verified[k] = result.passed and n_sat > MIN_SATELLITES and plausible
+        self.untestable[k] = (
+            n_sat == MIN_SATELLITES and (result.dof == 0 or result.passed) and plausible
         )
-        valid[k] = verified[k]
-    solution = VelocitySolution(
-        t=epoch_time,
-        velocity_ecef=velocity,
-        velocity_enu=velocity_enu,
-        clock_drift_mps=drift,
-        covariance=covariance,
-        dop=dop,
-        n_sat=n_sat,
-        n_obs=n_obs,
-        n_excluded=n_excluded,
-        residual_rms_mps=rms,
-        valid=valid,
-        n_no_ephemeris=rows.n_no_ephemeris,
-        verified=verified,
-        untestable=untestable,
-        speed_sigma_mps=horizontal_sigma[:, 0],
-        course_sigma_rad=horizontal_sigma[:, 1],
-        vertical_sigma_mps=vertical_sigma,
-        horizontal_protection_mps=protection,
-    )
-    return continuity_checked(solution)
+
+    def solution(self, t: np.ndarray, n_no_ephemeris: int) -> VelocitySolution:
+        """The columns as a solution at epochs ``t``, valid where verified (before the
+        continuity test)."""
+        return VelocitySolution(
+            t=t,
+            velocity_ecef=self.velocity_ecef,
+            velocity_enu=self.velocity_enu,
+            clock_drift_mps=self.clock_drift_mps,
+            covariance=self.covariance,
+            dop=self.dop,
+            n_sat=self.n_sat,
+            n_obs=self.n_obs,
+            n_excluded=self.n_excluded,
+            residual_rms_mps=self.residual_rms_mps,
+            valid=self.verified.copy(),
+            n_no_ephemeris=n_no_ephemeris,
+            verified=self.verified,
+            untestable=self.untestable,
+            speed_sigma_mps=self.speed_course_sigma[:, 0],
+            course_sigma_rad=self.speed_course_sigma[:, 1],
+            vertical_sigma_mps=self.vertical_sigma_mps,
+            horizontal_protection_mps=self.horizontal_protection_mps,
+        )
 
 
 def _horizontal_protection(shift_ecef: np.ndarray, rotation: np.ndarray) -> float:
