@@ -27,6 +27,7 @@ from vo_doppler.fusion.correction import usable_tight_heading
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.model.timeseries import sample
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.run import RunConfig
 
 TURN_RATE_DPS = 3.0
@@ -50,8 +51,7 @@ def evaluate(folder, _results_dir=None, _console=None) -> dict:
             obs.epoch_time,
             gnss.rows,
             gnss.velocity,
-            inputs.wheel_speed,
-            inputs.yaw_rate,
+            VehicleSignals(inputs.wheel_speed, inputs.yaw_rate),
             inputs.enu,
             config.heading,
             lever,

@@ -94,13 +94,10 @@ def sequence_heading(
         sequence.observations.epoch_time,
         rows,
         velocity,
-        sequence.wheel_speed,
-        sequence.yaw_rate,
+        sequence.vehicle_signals,
         sequence.enu,
         config,
         sequence.antenna_lever_arm_m,
-        sequence.forward_acceleration,
-        sequence.vehicle_source,
     )
 
 

@@ -20,7 +20,6 @@ MANY = "Many parameters because"
 # removed when its function is split, grouped into input dataclasses or states its reason.
 ALLOWED = {
     "vo_doppler/heading/pipeline.py:heading_pipeline",
-    "vo_doppler/heading/from_gnss.py:heading_from_gnss",
     "vo_doppler/heading/integrity.py:conventional_integrity",
 }
 

@@ -11,6 +11,7 @@ from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_signals import VehicleSignals
 
 pytestmark = pytest.mark.slow
 
@@ -28,8 +29,7 @@ def _heading(drive, yaw_rate: SensorSeries, **config):
         sequence.observations.epoch_time,
         gnss.rows,
         gnss.velocity,
-        sequence.wheel_speed,
-        yaw_rate,
+        VehicleSignals(sequence.wheel_speed, yaw_rate),
         sequence.enu,
         HeadingPipelineConfig(**config),
     )

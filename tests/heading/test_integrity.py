@@ -24,6 +24,7 @@ from vo_doppler.heading.integrity import (
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.sim.doppler_rows import gyro_from_heading, line_of_sight
 
 FRAME = EnuFrame(np.radians(35.69), np.radians(139.70), 40.0)
@@ -98,7 +99,9 @@ def test_reflections_that_pass_the_chi_square_fail_the_gyro_test():
     assert velocity.valid[FAULT][5:-5].all()
     assert np.all(course_error[FAULT] > 2.9)
     assert np.all(np.radians(course_error[FAULT]) > 7.0 * velocity.course_sigma_rad[FAULT])
-    table = heading_from_gnss(t, rows, velocity, wheel, gyro, FRAME, HeadingPipelineConfig())
+    table = heading_from_gnss(
+        t, rows, velocity, VehicleSignals(wheel, gyro), FRAME, HeadingPipelineConfig()
+    )
     assert not table.conv_valid[FAULT].any()
     clean = np.ones(t.size, bool)
     clean[FAULT] = False
@@ -111,7 +114,7 @@ def test_reflections_that_pass_the_chi_square_fail_the_gyro_test():
     factor = table.sigma_conv[clean] / velocity.course_sigma_rad[clean]
     assert np.nanmedian(factor) == pytest.approx(1.0, abs=0.15)
     off = HeadingPipelineConfig(integrity=ConsistencyConfig(enabled=False))
-    unchecked = heading_from_gnss(t, rows, velocity, wheel, gyro, FRAME, off)
+    unchecked = heading_from_gnss(t, rows, velocity, VehicleSignals(wheel, gyro), FRAME, off)
     np.testing.assert_array_equal(unchecked.conv_valid, velocity.valid)
     np.testing.assert_array_equal(unchecked.yaw_tc, table.yaw_tc)  # tight heading untouched
 

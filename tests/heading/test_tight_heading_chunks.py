@@ -19,6 +19,7 @@ from vo_doppler.heading.tight_heading import (
     windows_per_chunk,
 )
 from vo_doppler.io.sequence import read_sequence
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.run import RunConfig
 from vo_doppler.sim.gnss_observations import GnssSimConfig
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
@@ -42,8 +43,7 @@ def heading_inputs(tmp_path_factory):
         obs.epoch_time,
         gnss.rows,
         gnss.velocity,
-        sequence.wheel_speed,
-        sequence.yaw_rate,
+        VehicleSignals(sequence.wheel_speed, sequence.yaw_rate),
         sequence.enu,
     ), sequence.antenna_lever_arm_m
 

@@ -1,5 +1,5 @@
 """A recording's sensors: whether it has GNSS and a camera, and the span both vehicle signals
-cover."""
+cover, and its vehicle signals as the heading stage takes them."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from vo_doppler.geo import EnuFrame
 from vo_doppler.model.camera import Camera
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 
 def _sequence(yaw_t, wheel_t, **fields) -> Sequence:
@@ -45,3 +46,15 @@ def test_gnss_needs_observations_and_navigation_and_a_camera_needs_images():
     assert not _sequence([0.0], [0.0], camera=camera).has_camera  # no image
     assert _sequence([0.0], [0.0], camera=camera, image_paths=[Path("0.png")]).has_camera
     assert not _sequence([0.0], [0.0], image_paths=[Path("0.png")]).has_camera  # no calibration
+
+
+def test_the_vehicle_signals_are_the_sequences_own_with_their_source():
+    accelerometer = SensorSeries(np.array([0.0, 1.0]), np.array([0.1, -0.2]))
+    source = VehicleSignalSource(sensor="CAN", yaw_rate="VEHICLE.YAW (vehicle.dbc)")
+    sequence = _sequence(
+        [0.0, 5.0], [2.0, 12.0], forward_acceleration=accelerometer, vehicle_source=source
+    )
+    signals = sequence.vehicle_signals
+    assert signals.wheel_speed is sequence.wheel_speed and signals.yaw_rate is sequence.yaw_rate
+    assert signals.forward_acceleration is accelerometer and signals.source is source
+    assert _sequence([0.0], [0.0]).vehicle_signals.forward_acceleration is None

@@ -42,6 +42,7 @@ from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv
 from vo_doppler.io.trajectory import read_trajectory
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.time_span import trim
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.model.vehicle_source import VehicleSignalSource
 from vo_doppler.report.heading_figure import heading_figure
 from vo_doppler.report.json_text import json_text
@@ -308,12 +309,10 @@ def run(args: argparse.Namespace) -> int:
         obs.epoch_time,
         rows,
         conventional,
-        speed,
-        yaw_rate,
+        VehicleSignals(speed, yaw_rate, source=_signal_source(args, yaw_rate_unit)),
         _local_frame(rows.receiver_ecef, obs),
         config,
         args.antenna_lever_arm,
-        source=_signal_source(args, yaw_rate_unit),
     )
     warnings = table.warnings
     if not table.tc_available.any() and not table.conv_valid.any():

@@ -25,8 +25,7 @@ from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.observations import Observations
-from vo_doppler.model.series import SensorSeries
-from vo_doppler.model.vehicle_source import VehicleSignalSource
+from vo_doppler.model.vehicle_signals import VehicleSignals
 
 log = logging.getLogger(__name__)
 
@@ -88,28 +87,25 @@ def heading_from_gnss(
     epoch_time: np.ndarray,
     rows: DopplerRows,
     velocity: VelocitySolution,
-    wheel_speed: SensorSeries,
-    yaw_rate: SensorSeries,
+    vehicle: VehicleSignals,
     enu: EnuFrame,
     config: HeadingPipelineConfig,
     antenna_lever_arm_m: Sequence[float] = (0.0, 0.0, 0.0),
-    forward_acceleration: SensorSeries | None = None,
-    source: VehicleSignalSource | None = None,
 ) -> HeadingTable:
     """The heading stage ([TK18] sec. 3.3–3.5) from the GNSS stage's Doppler rows and
     conventional velocities: what ``run``, ``heading`` and the benchmarks all call. The table
     carries the conventional solution's speed σ (scaled as the heading's, design (I1)) and
-    HDOP on its valid epochs.
-    ``forward_acceleration``: the road grade prior's accelerometer, if the recording has one
-    (:func:`~vo_doppler.heading.pipeline.heading_pipeline`).
+    HDOP on its valid epochs. ``vehicle``: the wheel speed, yaw rate and, where recorded, the
+    road grade prior's accelerometer (:func:`~vo_doppler.heading.pipeline.heading_pipeline`).
 
-    The vehicle signals are checked (:mod:`vo_doppler.checks`; ``source`` names them in the
-    messages): a yaw rate too large for a car (deg/s read as rad/s) before the work, and one
+    The vehicle signals are checked (:mod:`vo_doppler.checks`; their ``source`` names them in
+    the messages): a yaw rate too large for a car (deg/s read as rad/s) before the work, and one
     turning against the GNSS Doppler course after it, raise :class:`InputError`; the clock,
     the coverage of the GNSS epochs, the calibrated wheel scale and gyro bias give warnings,
     logged and kept in the table's ``warnings`` (the residual clock offset in
     ``clock_residual_offset_s``). Vehicle signals whose times miss the GNSS epochs raise
     before the work too (:func:`~vo_doppler.checks.check_vehicle_overlap`)."""
+    wheel_speed, yaw_rate, source = vehicle.wheel_speed, vehicle.yaw_rate, vehicle.source
     check_vehicle_overlap(wheel_speed, yaw_rate, epoch_time, source)
     check_yaw_rate_unit(yaw_rate, wheel_speed, source)
     table = heading_pipeline(
@@ -123,7 +119,7 @@ def heading_from_gnss(
         conventional_sigma_mps=velocity.sigma_mps,
         conventional_yaw_sigma=conventional_heading_sigma(velocity, enu),
         antenna_lever_arm_m=antenna_lever_arm_m,
-        forward_acceleration=forward_acceleration,
+        forward_acceleration=vehicle.forward_acceleration,
         conventional_speed_sigma_mps=velocity.speed_sigma_mps,
         conventional_untestable=velocity.untestable,
         conventional_vertical_sigma_mps=velocity.vertical_sigma_mps,

@@ -33,6 +33,7 @@ EXPORTS: dict[str, str] = {
     "SpanBound": "time_span",
     "TimeSpan": "time_span",
     "Trajectory": "trajectory",
+    "VehicleSignals": "vehicle_signals",
 }
 """Public dataclass → the module of this package that defines it."""
 
@@ -57,6 +58,7 @@ __all__ = [
     "SppSolution",
     "TimeSpan",
     "Trajectory",
+    "VehicleSignals",
     "VelocitySolution",
 ]
 """The names of ``EXPORTS`` (a literal list, for type checkers and linters)."""
@@ -78,6 +80,7 @@ if TYPE_CHECKING:
     from vo_doppler.model.series import SensorSeries
     from vo_doppler.model.time_span import SpanBound, TimeSpan
     from vo_doppler.model.trajectory import Trajectory
+    from vo_doppler.model.vehicle_signals import VehicleSignals
 
 
 def __getattr__(name: str) -> type:

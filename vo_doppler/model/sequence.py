@@ -15,6 +15,7 @@ from vo_doppler.model.observations import Observations
 from vo_doppler.model.precise_orbits import PreciseOrbits
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 
@@ -63,6 +64,14 @@ class Sequence:
     @property
     def has_camera(self) -> bool:
         return self.camera is not None and len(self.image_paths) > 0
+
+    @property
+    def vehicle_signals(self) -> VehicleSignals:
+        """The wheel speed, yaw rate and forward accelerometer with their source, as the
+        heading stage takes them."""
+        return VehicleSignals(
+            self.wheel_speed, self.yaw_rate, self.forward_acceleration, self.vehicle_source
+        )
 
     @property
     def vehicle_span(self) -> tuple[float, float] | None:
