@@ -9,6 +9,7 @@ import pytest
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.calibration import GateConfig, estimate_gyro_bias
+from vo_doppler.heading.conventional import ConventionalVelocity
 from vo_doppler.heading.grade import grade_prior
 from vo_doppler.heading.pipeline import (
     CalibrationMethod,
@@ -21,6 +22,7 @@ from vo_doppler.heading.pipeline import (
 )
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.sim.doppler_rows import gyro_from_heading, simulate_doppler
 
 AZIMUTH = [30.0, 110.0, 200.0, 280.0, 330.0, 160.0]
@@ -56,9 +58,9 @@ def test_pipeline_calibrates_and_keeps_heading_with_two_satellites():
         t, scenario.yaw, np.ones(len(t), bool), bias, np.radians(0.05), rate_hz=50.0
     )
     wheel = SensorSeries(t, scenario.speed / 1.03)
-    table = heading_pipeline(
-        t, scenario.rows, conv_velocity, open_sky, wheel, SensorSeries(t_gyro, rate)
-    )
+    conventional = ConventionalVelocity(conv_velocity, open_sky)
+    vehicle = VehicleSignals(wheel, SensorSeries(t_gyro, rate))
+    table = heading_pipeline(t, scenario.rows, conventional, vehicle)
     assert abs(np.degrees(table.gyro_bias[-1] - bias)) < 0.05
     assert abs(table.wheel_scale[-1] / 1.03 - 1.0) < 0.003
     assert not table.conv_valid[~open_sky].any() and table.conv_valid[open_sky].mean() > 0.99
@@ -69,13 +71,7 @@ def test_pipeline_calibrates_and_keeps_heading_with_two_satellites():
     assert table.tc_reliable[late].mean() > 0.9
     # Without calibration the same run is worse (3 % speed error, 0.5 deg/s bias).
     plain = heading_pipeline(
-        t,
-        scenario.rows,
-        conv_velocity,
-        open_sky,
-        wheel,
-        SensorSeries(t_gyro, rate),
-        HeadingPipelineConfig(calibration="none"),
+        t, scenario.rows, conventional, vehicle, HeadingPipelineConfig(calibration="none")
     )
     plain_error = np.degrees(np.abs(wrap_angle(plain.yaw_tc - scenario.yaw)))
     assert np.nanmedian(plain_error[late]) > 2 * np.nanmedian(error[late])
@@ -119,17 +115,10 @@ def _biased_drive():
 def test_pipeline_calibrates_the_gyro_from_tight_headings_without_conventional_velocity():
     t, scenario, velocity, wheel, gyro, bias = _biased_drive()
     none = np.zeros(len(t), dtype=bool)  # a street canyon from the start
-    table = heading_pipeline(t, scenario.rows, velocity, none, wheel, gyro)
+    args = (t, scenario.rows, ConventionalVelocity(velocity, none), VehicleSignals(wheel, gyro))
+    table = heading_pipeline(*args)
     assert np.all(np.abs(np.degrees(table.gyro_bias - bias)) < 0.01)
-    single = heading_pipeline(
-        t,
-        scenario.rows,
-        velocity,
-        none,
-        wheel,
-        gyro,
-        HeadingPipelineConfig(tight_calibration=False),
-    )
+    single = heading_pipeline(*args, HeadingPipelineConfig(tight_calibration=False))
     assert np.all(single.gyro_bias == 0.0)
     error = np.degrees(np.abs(wrap_angle(table.yaw_tc - scenario.yaw)))
     single_error = np.degrees(np.abs(wrap_angle(single.yaw_tc - scenario.yaw)))
@@ -142,10 +131,9 @@ def test_tight_calibration_leaves_the_conventionally_calibrated_epochs():
     t, scenario, velocity, wheel, gyro, bias = _biased_drive()
     conv = velocity + np.random.default_rng(5).normal(0.0, 0.03, velocity.shape)
     valid = np.ones(len(t), dtype=bool)
-    table = heading_pipeline(t, scenario.rows, conv, valid, wheel, gyro)
-    single = heading_pipeline(
-        t, scenario.rows, conv, valid, wheel, gyro, HeadingPipelineConfig(tight_calibration=False)
-    )
+    args = (t, scenario.rows, ConventionalVelocity(conv, valid), VehicleSignals(wheel, gyro))
+    table = heading_pipeline(*args)
+    single = heading_pipeline(*args, HeadingPipelineConfig(tight_calibration=False))
     raw_angle = integral_at(gyro.t, gyro.value, t)
     cal = causal_calibration(
         t,
@@ -200,18 +188,16 @@ def test_conventional_speeds_far_from_the_wheel_speed_do_not_calibrate():
     )
     wheel = SensorSeries(t, scenario.speed / 1.03)
     valid = np.ones(len(t), bool)
-    gated = heading_pipeline(
-        t, scenario.rows, conv_velocity, valid, wheel, SensorSeries(t_gyro, rate)
-    )
+    conventional = ConventionalVelocity(conv_velocity, valid)
+    vehicle = VehicleSignals(wheel, SensorSeries(t_gyro, rate))
+    gated = heading_pipeline(t, scenario.rows, conventional, vehicle)
     assert abs(gated.wheel_scale[-1] / 1.03 - 1.0) < 0.003
     for k, worse_than in ((np.inf, 0.02), (GateConfig().huber_k, None)):
         ungated = heading_pipeline(
             t,
             scenario.rows,
-            conv_velocity,
-            valid,
-            wheel,
-            SensorSeries(t_gyro, rate),
+            conventional,
+            vehicle,
             HeadingPipelineConfig(
                 calibration_max_speed_mismatch_mps=np.inf, gate=GateConfig(huber_k=k)
             ),
@@ -227,7 +213,10 @@ def _with_accelerometer(t, scenario, velocity, wheel, gyro, acceleration):
     """The pipeline with every conventional velocity valid and a forward accelerometer."""
     valid = np.ones(len(t), bool)
     return heading_pipeline(
-        t, scenario.rows, velocity, valid, wheel, gyro, forward_acceleration=acceleration
+        t,
+        scenario.rows,
+        ConventionalVelocity(velocity, valid),
+        VehicleSignals(wheel, gyro, forward_acceleration=acceleration),
     )
 
 
@@ -237,7 +226,8 @@ def test_the_table_records_where_the_grade_prior_came_from():
     wheel = SensorSeries(t, scenario.speed)
     gyro = SensorSeries(t, np.gradient(np.unwrap(scenario.yaw), t))
     config = HeadingPipelineConfig()
-    plain = heading_pipeline(t, scenario.rows, velocity, np.ones(len(t), bool), wheel, gyro)
+    conventional = ConventionalVelocity(velocity, np.ones(len(t), bool))
+    plain = heading_pipeline(t, scenario.rows, conventional, VehicleSignals(wheel, gyro))
     assert not plain.grade_from_accelerometer.any()
     np.testing.assert_array_equal(plain.grade_prior_sigma, config.tight.grade_sigma)
     # a level road: the accelerometer reads dv/dt plus an offset of 0.2 m/s²
@@ -380,10 +370,8 @@ def test_the_table_names_the_settings_auto_chose(step_s, method):
     table = heading_pipeline(
         t,
         scenario.rows,
-        velocity,
-        np.ones(len(t), bool),
-        SensorSeries(t, scenario.speed),
-        SensorSeries(t_gyro, rate),
+        ConventionalVelocity(velocity, np.ones(len(t), bool)),
+        VehicleSignals(SensorSeries(t, scenario.speed), SensorSeries(t_gyro, rate)),
         HeadingPipelineConfig.auto(),
     )
     assert table.method == method
@@ -426,10 +414,8 @@ def test_courses_beyond_a_cars_vertical_bound_calibrate_no_gyro_bias():
             heading_pipeline(
                 t,
                 scenario.rows,
-                conv_velocity,
-                np.ones(len(t), bool),
-                wheel,
-                SensorSeries(t_gyro, rate),
+                ConventionalVelocity(conv_velocity, np.ones(len(t), bool)),
+                VehicleSignals(wheel, SensorSeries(t_gyro, rate)),
             )
         )
     level, climbing = (np.degrees(table.gyro_bias[-1]) for table in tables)

@@ -14,11 +14,13 @@ import pytest
 from tests.heading.test_tight_heading import AZIMUTH, ELEVATION, T, sharp_turn, straight, turning
 from tests.heading.test_tight_heading import constant_speed as speed
 from vo_doppler.geo import wrap_angle
+from vo_doppler.heading.conventional import ConventionalVelocity
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.tight_heading import TightHeadingConfig, tight_heading_series
 from vo_doppler.io.heading_csv import read_heading_csv, write_heading_csv
 from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.sim.doppler_rows import simulate_doppler
 
 NO_REJECTION = TightHeadingConfig(outlier_passes=0)
@@ -183,10 +185,10 @@ def test_pipeline_reports_rejected_rows_in_the_heading_csv(tmp_path):
     table = heading_pipeline(
         t,
         with_bias(rows, bias),
-        velocity,
-        np.zeros(len(t), bool),
-        SensorSeries(t, scenario.speed),
-        SensorSeries(t, np.gradient(scenario.yaw, t)),
+        ConventionalVelocity(velocity, np.zeros(len(t), bool)),
+        VehicleSignals(
+            SensorSeries(t, scenario.speed), SensorSeries(t, np.gradient(scenario.yaw, t))
+        ),
         HeadingPipelineConfig(tight=SNOOPING),
     )
     assert table.rejected_rows.sum() > 0 and table.rejected_rows[t < 2.5].sum() == 0

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from vo_doppler.cli import main
 from vo_doppler.geo import wrap_angle
-from vo_doppler.heading.conventional import vehicle_heading_from_antenna
+from vo_doppler.heading.conventional import ConventionalVelocity, vehicle_heading_from_antenna
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.tight_heading import antenna_offset_velocity, tight_heading_series
 from vo_doppler.io.heading_csv import read_heading_csv
@@ -19,6 +19,7 @@ from vo_doppler.io.sequence import read_manifest
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import sample
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.sim.doppler_rows import simulate_doppler
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
@@ -71,9 +72,11 @@ def test_tight_heading_of_an_offset_antenna_is_exact_with_the_lever_arm():
 def test_pipeline_applies_the_lever_arm_to_both_headings():
     scenario, antenna_velocity = _offset_antenna(2)
     exact = HeadingPipelineConfig(fixed_gyro_bias_rad_s=0.0, fixed_wheel_scale=1.0)
-    sensors = (SensorSeries(T, scenario.speed), SensorSeries(T, np.full(len(T), OMEGA)))
+    vehicle = VehicleSignals(
+        SensorSeries(T, scenario.speed), SensorSeries(T, np.full(len(T), OMEGA))
+    )
     valid = np.ones(len(T), dtype=bool)
-    args = (T, scenario.rows, antenna_velocity, valid, *sensors, exact)
+    args = (T, scenario.rows, ConventionalVelocity(antenna_velocity, valid), vehicle, exact)
     applied = heading_pipeline(*args, antenna_lever_arm_m=LEVER)
     ignored = heading_pipeline(*args)
     assert _error(applied.yaw_conv, scenario.yaw, valid) < 1e-12

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from vo_doppler.heading.conventional import ConventionalVelocity
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.tight_heading import (
     MIN_SCALE_WINDOWS,
@@ -12,6 +13,7 @@ from vo_doppler.heading.tight_heading import (
     speed_scale_ratio,
 )
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.sim.doppler_rows import gyro_from_heading, simulate_doppler
 
 AZIMUTH = [30.0, 110.0, 200.0, 280.0, 330.0]
@@ -70,11 +72,13 @@ def test_a_canyon_from_the_start_calibrates_the_wheel_scale_from_the_rows():
     the prior."""
     scenario = _scenario(noise=0.03, seed=3)
     none = np.zeros(len(T), dtype=bool)
-    args = (T, scenario.rows, np.zeros((len(T), 3)), none)
     t_gyro, rate = gyro_from_heading(T, scenario.yaw, np.ones(len(T), bool), 0.0, 0.0, rate_hz=50.0)
-    sensors = (SensorSeries(T, scenario.speed / TRUE_SCALE), SensorSeries(t_gyro, rate))
-    table = heading_pipeline(*args, *sensors)
-    prior = heading_pipeline(*args, *sensors, HeadingPipelineConfig(tight_calibration=False))
+    vehicle = VehicleSignals(
+        SensorSeries(T, scenario.speed / TRUE_SCALE), SensorSeries(t_gyro, rate)
+    )
+    args = (T, scenario.rows, ConventionalVelocity(np.zeros((len(T), 3)), none), vehicle)
+    table = heading_pipeline(*args)
+    prior = heading_pipeline(*args, HeadingPipelineConfig(tight_calibration=False))
     assert np.all(prior.wheel_scale == 1.0)
     assert abs(table.wheel_scale[0] / TRUE_SCALE - 1.0) < 0.005
     error = np.abs(np.degrees(table.yaw_tc - scenario.yaw))[table.tc_reliable]

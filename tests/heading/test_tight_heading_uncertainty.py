@@ -15,9 +15,11 @@ import numpy as np
 
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.calibration import GateConfig, estimate_gyro_bias
+from vo_doppler.heading.conventional import ConventionalVelocity
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.tight_heading import TightHeadingConfig, tight_heading_series
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.sim.doppler_rows import simulate_doppler
 
 AZIMUTH = [30.0, 110.0, 200.0, 280.0]
@@ -112,10 +114,11 @@ def test_few_imprecise_samples_do_not_swing_the_gyro_bias():
     table = heading_pipeline(
         t,
         simulate_doppler(t, lambda t: 0.0 * t, _speed, AZIMUTH, ELEVATION, 2).rows,
-        speed[:, None] * np.array([[np.cos(v), np.sin(v), 0.0] for v in course_noise]),
-        np.ones(len(t), dtype=bool),
-        SensorSeries(t, speed),
-        SensorSeries(t, np.zeros(len(t))),
+        ConventionalVelocity(
+            speed[:, None] * np.array([[np.cos(v), np.sin(v), 0.0] for v in course_noise]),
+            np.ones(len(t), dtype=bool),
+        ),
+        VehicleSignals(SensorSeries(t, speed), SensorSeries(t, np.zeros(len(t)))),
     )
     assert np.all(np.abs(np.degrees(table.gyro_bias)) < 1.0)
 
@@ -125,14 +128,17 @@ def test_imprecise_conventional_velocities_do_not_calibrate():
     speed = np.full(len(t), 10.0)
     velocity = np.column_stack([1.1 * speed, np.zeros(len(t)), np.zeros(len(t))])  # 10 % off
     rows = simulate_doppler(t, lambda t: 0.0 * t, _speed, AZIMUTH, ELEVATION, 2).rows
-    args = (t, rows, velocity, np.ones(len(t), bool), SensorSeries(t, speed))
-    gyro = SensorSeries(t, np.zeros(len(t)))
-    precise = heading_pipeline(*args, gyro, conventional_sigma_mps=np.full(len(t), 0.5))
+    vehicle = VehicleSignals(SensorSeries(t, speed), SensorSeries(t, np.zeros(len(t))))
+
+    def conventional(sigma_mps):
+        return ConventionalVelocity(velocity, np.ones(len(t), bool), np.full(len(t), sigma_mps))
+
+    precise = heading_pipeline(t, rows, conventional(0.5), vehicle)
     assert abs(precise.wheel_scale[-1] - 1.1) < 1e-3
-    imprecise = heading_pipeline(*args, gyro, conventional_sigma_mps=np.full(len(t), 5.0))
+    imprecise = heading_pipeline(t, rows, conventional(5.0), vehicle)
     assert np.all(imprecise.wheel_scale == 1.0)
     # The gyro bias is the tight headings' (pipeline.tight_gyro_bias): the true zero.
     assert np.all(np.abs(imprecise.gyro_bias) < 1e-12)
     loose = HeadingPipelineConfig(calibration_max_velocity_sigma_mps=10.0)
-    calibrated = heading_pipeline(*args, gyro, loose, np.full(len(t), 5.0))
+    calibrated = heading_pipeline(t, rows, conventional(5.0), vehicle, loose)
     assert abs(calibrated.wheel_scale[-1] - 1.1) < 1e-3

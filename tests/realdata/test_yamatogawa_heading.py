@@ -26,7 +26,7 @@ from tests.conftest import require_shared
 from vo_doppler.cli import main
 from vo_doppler.geo import wrap_angle
 from vo_doppler.gnss.pipeline import gnss_velocity
-from vo_doppler.heading.conventional import heading_from_velocity
+from vo_doppler.heading.conventional import ConventionalVelocity, heading_from_velocity
 from vo_doppler.heading.from_gnss import emulated_canyon
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.heading.smoother import HeadingSmootherConfig
@@ -38,6 +38,7 @@ from vo_doppler.io.sensor_csv import write_sensor_csv
 from vo_doppler.io.trajectory import write_tum
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.sim.doppler_rows import gyro_from_heading
 
 pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
@@ -81,10 +82,8 @@ def _with_config(walk, config):
     return heading_pipeline(
         walk["t"],
         walk["rows"].in_enu(),
-        walk["conventional"].velocity_enu,
-        walk["conventional"].valid,
-        walk["speed"],
-        walk["yaw_rate"],
+        ConventionalVelocity(walk["conventional"].velocity_enu, walk["conventional"].valid),
+        VehicleSignals(walk["speed"], walk["yaw_rate"]),
         config,
     )
 

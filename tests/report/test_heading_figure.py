@@ -5,9 +5,11 @@ from __future__ import annotations
 import matplotlib
 import numpy as np
 
+from vo_doppler.heading.conventional import ConventionalVelocity
 from vo_doppler.heading.pipeline import heading_pipeline
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.report.heading_figure import build_heading_figure, heading_figure
 from vo_doppler.sim.doppler_rows import gyro_from_heading, simulate_doppler
 
@@ -57,7 +59,8 @@ def _table_at_10_mps(t, yaw_rate, n_sat, speed_t, gyro: SensorSeries) -> Heading
     )
     velocity = 10.0 * np.stack([np.cos(scenario.yaw), np.sin(scenario.yaw), 0 * t], axis=1)
     speed = SensorSeries(speed_t, np.full(len(speed_t), 10.0))
-    return heading_pipeline(t, scenario.rows, velocity, np.ones(len(t), bool), speed, gyro)
+    conventional = ConventionalVelocity(velocity, np.ones(len(t), bool))
+    return heading_pipeline(t, scenario.rows, conventional, VehicleSignals(speed, gyro))
 
 
 def test_satellites_are_counted_where_the_sensors_have_ended():

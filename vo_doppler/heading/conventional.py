@@ -1,11 +1,15 @@
 """Conventional heading ([TK18] sec. 3.2): the direction of a Doppler velocity solution, and its
-standard deviation from the velocity covariance."""
+standard deviation from the velocity covariance; and the conventional velocities as the heading
+stage takes them (:class:`ConventionalVelocity`)."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from vo_doppler.geo import wrap_angle
+from vo_doppler.geo import EnuFrame, wrap_angle
+from vo_doppler.model.gnss_solutions import VelocitySolution
 
 
 def heading_from_velocity(
@@ -60,3 +64,50 @@ def vehicle_heading_from_antenna(
     offset = np.asarray(offset_velocity, dtype=float)
     delta = np.arctan2(offset[:, 1], np.asarray(wheel_speed, dtype=float) + offset[:, 0])
     return wrap_angle(yaw - delta), speed * np.cos(delta) - offset[:, 0]
+
+
+@dataclass(frozen=True)
+class ConventionalVelocity:
+    """The GNSS stage's conventional velocities as the heading stage takes them, one per GNSS
+    epoch ([TK18] sec. 3.2; docs/design.md (2), (2a)); the σ are optional."""
+
+    velocity_enu: np.ndarray
+    """ENU velocity (m/s), (E, 3)."""
+    valid: np.ndarray
+    """The GNSS stage's verdict (``VelocitySolution.valid``)."""
+    sigma_mps: np.ndarray | None = None
+    """σ of each velocity (√trace of its covariance); where given, only velocities within
+    ``HeadingPipelineConfig.calibration_max_velocity_sigma_mps`` calibrate the sensors."""
+    yaw_sigma_rad: np.ndarray | None = None
+    """σ of each conventional heading (:func:`velocity_heading_sigma`), kept in the heading
+    table for the heading correction."""
+    speed_sigma_mps: np.ndarray | None = None
+    """σ of each horizontal speed. With ``yaw_sigma_rad`` it lets the heading stage test the
+    velocity against the calibrated gyro and wheel speed (docs/design.md (I1))."""
+    untestable: np.ndarray | None = None
+    """Epochs solved without redundancy (four satellites), whose fault the GNSS stage cannot
+    detect (``VelocitySolution.untestable``). They are not valid, but they calibrate the
+    sensors under the same gates as the valid ones: the calibration's robust fit over many
+    epochs is their test, as in [TK18] sec. 3.3, whose conventional headings need only four
+    satellites. In a street canyon they are most of the solved epochs (a simulated 120-s canyon
+    drive: 190 valid, 414 more untestable), and a calibration from the few valid ones converges
+    late."""
+    vertical_sigma_mps: np.ndarray | None = None
+    """σ of each up velocity, whose share the grade prior's σ leaves out
+    (:func:`~vo_doppler.heading.grade.grade_prior`)."""
+
+    @classmethod
+    def from_solution(cls, velocity: VelocitySolution, enu: EnuFrame) -> ConventionalVelocity:
+        """A velocity solution's velocities, verdicts and σ, its heading σ from its covariance
+        turned into the ENU frame ``enu`` (:func:`velocity_heading_sigma`)."""
+        return cls(
+            velocity_enu=velocity.velocity_enu,
+            valid=velocity.valid,
+            sigma_mps=velocity.sigma_mps,
+            yaw_sigma_rad=velocity_heading_sigma(
+                velocity.velocity_enu, velocity.covariance, enu.rotation
+            ),
+            speed_sigma_mps=velocity.speed_sigma_mps,
+            untestable=velocity.untestable,
+            vertical_sigma_mps=velocity.vertical_sigma_mps,
+        )

@@ -17,7 +17,7 @@ from vo_doppler.gnss.doppler_velocity import doppler_rows, solve_velocity
 from vo_doppler.gnss.moving_noise import moving_noise_weights
 from vo_doppler.gnss.satellite_source import StateSource
 from vo_doppler.gnss.spp import receiver_positions, solve_spp
-from vo_doppler.heading.conventional import velocity_heading_sigma
+from vo_doppler.heading.conventional import ConventionalVelocity
 from vo_doppler.heading.integrity import integrity_rate_warning
 from vo_doppler.heading.pipeline import HeadingPipelineConfig, heading_pipeline
 from vo_doppler.model.doppler import DopplerRows
@@ -76,13 +76,6 @@ def emulated_canyon(
     return rows, first if model.identity else solve_velocity(rows, obs.epoch_time)
 
 
-def conventional_heading_sigma(velocity: VelocitySolution, enu: EnuFrame) -> np.ndarray:
-    """Standard deviation (rad) of each epoch's conventional heading, from its Doppler velocity
-    covariance turned into the ENU frame ``enu``
-    (:func:`~vo_doppler.heading.conventional.velocity_heading_sigma`)."""
-    return velocity_heading_sigma(velocity.velocity_enu, velocity.covariance, enu.rotation)
-
-
 def heading_from_gnss(
     epoch_time: np.ndarray,
     rows: DopplerRows,
@@ -111,18 +104,10 @@ def heading_from_gnss(
     table = heading_pipeline(
         epoch_time,
         rows.in_enu(),
-        velocity.velocity_enu,
-        velocity.valid,
-        wheel_speed,
-        yaw_rate,
+        ConventionalVelocity.from_solution(velocity, enu),
+        vehicle,
         config,
-        conventional_sigma_mps=velocity.sigma_mps,
-        conventional_yaw_sigma=conventional_heading_sigma(velocity, enu),
-        antenna_lever_arm_m=antenna_lever_arm_m,
-        forward_acceleration=vehicle.forward_acceleration,
-        conventional_speed_sigma_mps=velocity.speed_sigma_mps,
-        conventional_untestable=velocity.untestable,
-        conventional_vertical_sigma_mps=velocity.vertical_sigma_mps,
+        antenna_lever_arm_m,
     )
     table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)
     estimate, warnings = heading_warnings(

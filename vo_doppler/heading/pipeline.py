@@ -41,7 +41,11 @@ from vo_doppler.heading.calibration import (
     WheelScaleKalman,
     estimate_gyro_bias,
 )
-from vo_doppler.heading.conventional import heading_from_velocity, vehicle_heading_from_antenna
+from vo_doppler.heading.conventional import (
+    ConventionalVelocity,
+    heading_from_velocity,
+    vehicle_heading_from_antenna,
+)
 from vo_doppler.heading.grade import GradePriorConfig, accelerometer_grade, grade_prior
 from vo_doppler.heading.integrity import (
     ConsistencyConfig,
@@ -69,6 +73,7 @@ from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.heading import CalibrationSummary, HeadingTable
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import integral_at, sample
+from vo_doppler.model.vehicle_signals import VehicleSignals
 from vo_doppler.robust import nmad
 
 
@@ -491,43 +496,260 @@ def _smoothed(
     return smooth_heading(windows, gyro, smoother, config.tight.max_sigma_rad)
 
 
+@dataclass(frozen=True)
+class _Epochs:
+    """The heading stage's inputs at the GNSS epochs, the same for every pass
+    (:func:`_epochs`): the conventional velocity as the antenna's and as the vehicle's heading
+    and speed, the raw vehicle signals there, and which epochs calibrate."""
+
+    t: np.ndarray
+    rows: DopplerRows
+    conventional: ConventionalVelocity
+    vehicle: VehicleSignals
+    lever_arm_m: Sequence[float]
+    """The GNSS antenna (x forward, y left[, z up], m) from the vehicle origin."""
+    velocity: np.ndarray
+    """The conventional ENU velocity (m/s), (E, 3)."""
+    valid: np.ndarray
+    """The GNSS stage's verdict."""
+    conv_ok: np.ndarray
+    """Valid, with a heading (moving at ``conventional_min_speed_mps`` or more)."""
+    antenna: tuple[np.ndarray, np.ndarray]
+    """Heading (rad) and horizontal speed (m/s) of the antenna's conventional velocity at the
+    valid and untestable epochs (NaN elsewhere)."""
+    conv_yaw: np.ndarray
+    """The vehicle's heading (rad): the antenna's less the angle of ω × r for the raw yaw
+    rate (:func:`~vo_doppler.heading.conventional.vehicle_heading_from_antenna`)."""
+    conv_speed: np.ndarray
+    """The vehicle's horizontal speed (m/s), likewise."""
+    wheel: np.ndarray
+    """The raw wheel speed (m/s)."""
+    raw_rate: np.ndarray
+    """The raw yaw rate (rad/s)."""
+    raw_angle: np.ndarray
+    """Its integral Φ (rad)."""
+    covered: np.ndarray
+    """Epochs that the wheel speed and the yaw rate both cover."""
+    car: np.ndarray
+    """Velocities within the car's vertical bound (docs/design.md (I1b))."""
+    calibrating: np.ndarray
+    """Epochs whose conventional velocity may calibrate the sensors (:func:`_calibrating`)."""
+
+    @property
+    def lever(self) -> bool:
+        """The antenna lies off the vehicle origin horizontally."""
+        return any(float(v) != 0.0 for v in tuple(self.lever_arm_m)[:2])
+
+
+def _epochs(
+    t_epoch: np.ndarray,
+    rows: DopplerRows,
+    conventional: ConventionalVelocity,
+    vehicle: VehicleSignals,
+    lever_arm_m: Sequence[float],
+    config: HeadingPipelineConfig,
+) -> _Epochs:
+    """The inputs of :func:`heading_pipeline` at its epochs ``t_epoch`` (:class:`_Epochs`)."""
+    velocity = np.asarray(conventional.velocity_enu, dtype=float).reshape(-1, 3)
+    valid = np.asarray(conventional.valid, dtype=bool)
+    candidates = valid.copy()
+    if conventional.untestable is not None:
+        candidates |= np.asarray(conventional.untestable, dtype=bool)
+    antenna_yaw, conv_seen = heading_from_velocity(
+        velocity, candidates, config.conventional_min_speed_mps
+    )
+    # Horizontal speed: the tightly coupled model's velocity is horizontal, and the vertical
+    # component of a canyon fix is noisy (large VDOP), which would bias |v| and the scale up.
+    antenna_speed = np.where(candidates, np.hypot(velocity[:, 0], velocity[:, 1]), np.nan)
+    speed, yaw_rate = vehicle.wheel_speed, vehicle.yaw_rate
+    wheel = sample(speed.t, speed.value, t_epoch)
+    raw_rate = sample(yaw_rate.t, yaw_rate.value, t_epoch)
+    conv_yaw, conv_speed = antenna_yaw, antenna_speed
+    if any(float(v) != 0.0 for v in tuple(lever_arm_m)[:2]):
+        offset = antenna_offset_velocity(raw_rate, lever_arm_m)
+        conv_yaw, conv_speed = vehicle_heading_from_antenna(
+            antenna_yaw, antenna_speed, wheel, offset
+        )
+    raw_angle = integral_at(yaw_rate.t, yaw_rate.value, t_epoch)
+    return _Epochs(
+        t=t_epoch,
+        rows=rows,
+        conventional=conventional,
+        vehicle=vehicle,
+        lever_arm_m=lever_arm_m,
+        velocity=velocity,
+        valid=valid,
+        conv_ok=conv_seen & valid,
+        antenna=(antenna_yaw, antenna_speed),
+        conv_yaw=conv_yaw,
+        conv_speed=conv_speed,
+        wheel=wheel,
+        raw_rate=raw_rate,
+        raw_angle=raw_angle,
+        covered=np.isfinite(wheel) & np.isfinite(raw_angle),
+        car=car_vertical_bound(velocity),
+        calibrating=_calibrating(candidates, conv_speed, wheel, conventional.sigma_mps, config),
+    )
+
+
+def _calibrating(
+    candidates: np.ndarray,
+    conv_speed: np.ndarray,
+    wheel: np.ndarray,
+    sigma_mps: np.ndarray | None,
+    config: HeadingPipelineConfig,
+) -> np.ndarray:
+    """The ``candidates`` (valid or untestable) whose velocity may calibrate the sensors: σ
+    within ``calibration_max_velocity_sigma_mps`` where known, and a speed near the raw wheel
+    speed (``calibration_max_speed_mismatch_mps`` / ``_ratio``)."""
+    calibrating = candidates.copy()
+    if sigma_mps is not None:
+        sigma = np.nan_to_num(np.asarray(sigma_mps, dtype=float), nan=np.inf)
+        calibrating &= sigma <= config.calibration_max_velocity_sigma_mps
+    tolerance = np.maximum(
+        config.calibration_max_speed_mismatch_mps,
+        config.calibration_max_speed_mismatch_ratio * np.abs(wheel),
+    )
+    calibrating &= np.abs(np.nan_to_num(conv_speed - wheel, nan=np.inf)) <= tolerance
+    return calibrating
+
+
+def _conventional_calibration(epochs: _Epochs, config: HeadingPipelineConfig) -> CalibrationSeries:
+    """The causal calibration from the conventional velocities (:func:`causal_calibration`)
+    with its first epochs backfilled (:func:`backfill_start`). A redundantly tested course
+    beyond the car's vertical bound calibrates no gyro bias (design (I1b)); its speed still
+    calibrates the wheels, the untestable epochs both."""
+    e = epochs
+    course = np.where(e.car | ~e.valid, e.conv_yaw, np.nan)
+    return backfill_start(
+        causal_calibration(e.t, e.conv_speed, course, e.calibrating, e.wheel, e.raw_angle, config),
+        config.backfill_bias_sigma_rad_s,
+        e.covered,
+    )
+
+
+def _solve(epochs: _Epochs, cal: CalibrationSeries, config: HeadingPipelineConfig) -> _Pass:
+    """The integrity test (I1), grade prior and tight heading (3)–(4) under calibration
+    ``cal``."""
+    e, conventional = epochs, epochs.conventional
+    # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
+    steps = cal.bias[:-1] * np.diff(e.t)
+    bias_integral = np.concatenate([[0.0], np.cumsum(steps)])[: len(e.t)]
+    yaw_angle = e.raw_angle - bias_integral
+    offset = antenna_offset_velocity(e.raw_rate - cal.bias, e.lever_arm_m)
+    conv_yaw = e.conv_yaw
+    if e.lever:
+        conv_yaw, _ = vehicle_heading_from_antenna(*e.antenna, cal.scale * e.wheel, offset)
+    integrity = conventional_integrity(
+        e.t,
+        e.conv_ok,
+        conv_yaw,
+        conventional.yaw_sigma_rad,
+        yaw_angle,
+        np.where(e.valid, e.conv_speed, np.nan),
+        conventional.speed_sigma_mps,
+        cal.scale * e.wheel,
+        cal.bias_sigma,
+        config.integrity,
+        vertical_bound=e.car,
+    )
+    speed = e.vehicle.wheel_speed
+    grade, grade_from_accelerometer = _grade_prior(
+        e.t,
+        e.velocity,
+        e.valid,
+        SensorSeries(speed.t, speed.value * cal.scale[-1]),
+        e.vehicle.forward_acceleration,
+        conventional.vertical_sigma_mps,
+        config,
+    )
+    inputs = {
+        "rows": e.rows,
+        "t_epoch": e.t,
+        "speed": cal.scale * e.wheel,
+        "yaw_angle": yaw_angle,
+        "config": config.tight,
+        "lever_velocity": np.nan_to_num(offset),
+        "grade_prior": grade,
+        "calibration": (cal.scale, cal.bias, bias_integral),
+    }
+    result = tight_heading_series(
+        **inputs,
+        speed_scale_sigma=cal.scale_sigma / cal.scale,
+        gyro_bias_sigma=cal.bias_sigma,
+    )
+    return _Pass(conv_yaw, integrity, grade, grade_from_accelerometer, result, inputs)
+
+
+def _tight_calibrated(
+    epochs: _Epochs, cal: CalibrationSeries, solved: _Pass, config: HeadingPipelineConfig
+) -> _Pass:
+    """``solved`` solved again where the conventional velocities left the gyro bias or the
+    wheel scale unestimated and the pass's tight headings give them: the bias
+    (:func:`tight_gyro_bias`), then the scale (:func:`tight_wheel_scale`); ``cal`` is updated
+    in place."""
+    if _tight_calibration_needed(cal, config):
+        result = solved.result
+        bias = tight_gyro_bias(
+            epochs.t,
+            result.yaw,
+            result.sigma,
+            result.reliable,
+            epochs.raw_angle,
+            epochs.wheel,
+            config,
+        )
+        if bias is not None:
+            cal.bias_sigma[~cal.bias_estimated] = bias[1]
+            cal.bias[~cal.bias_estimated] = bias[0]
+            solved = _solve(epochs, cal, config)
+    if _tight_scale_needed(cal, config):
+        scale = tight_wheel_scale(solved, float(cal.scale[-1]), config)
+        if scale is not None:
+            cal.scale[:], cal.scale_sigma[:] = scale
+            solved = _solve(epochs, cal, config)
+    return solved
+
+
+def _smoothed_heading(
+    epochs: _Epochs, solved: _Pass, cal: CalibrationSeries, config: HeadingPipelineConfig
+) -> tuple[SmoothedHeading | None, list[str]]:
+    """The pass's windows smoothed through the gyro ((S1)–(S2), :func:`_smoothed`) where the
+    smoother is on; None with a warning where the windows disagree with the gyro-propagated
+    heading by more than ``max_variance_factor`` times their σ."""
+    if not config.smoother.enabled:
+        return None, []
+    tight = _smoothed(solved, epochs.vehicle.yaw_rate, cal, epochs.covered, config)
+    if not tight.variance_factor > config.smoother.max_variance_factor:
+        return tight, []
+    return None, [
+        f"heading smoother: the windows disagree with the gyro-propagated heading by "
+        f"{tight.variance_factor:.1f} times their σ (above "
+        f"{config.smoother.max_variance_factor:g}): the gyro does not link them (course "
+        "and yaw apart?); the windows' own headings are kept"
+    ]
+
+
 def heading_pipeline(
     t_epoch: np.ndarray,
     rows: DopplerRows,
-    conventional_velocity_enu: np.ndarray,
-    conventional_valid: np.ndarray,
-    speed: SensorSeries,
-    yaw_rate: SensorSeries,
+    conventional: ConventionalVelocity,
+    vehicle: VehicleSignals,
     config: HeadingPipelineConfig = HeadingPipelineConfig(),
-    conventional_sigma_mps: np.ndarray | None = None,
-    conventional_yaw_sigma: np.ndarray | None = None,
     antenna_lever_arm_m: Sequence[float] = (0.0, 0.0),
-    forward_acceleration: SensorSeries | None = None,
-    conventional_speed_sigma_mps: np.ndarray | None = None,
-    conventional_untestable: np.ndarray | None = None,
-    conventional_vertical_sigma_mps: np.ndarray | None = None,
 ) -> HeadingTable:
-    """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise).
+    """Headings at every epoch (sensor series already on GPS time, yaw rate counter-clockwise):
+    the sensors calibrated by the conventional velocities ([TK18] sec. 3.3–3.4), those
+    velocities tested against the calibrated gyro and wheel speed (docs/design.md (I1)–(I1c)),
+    the tightly coupled heading (sec. 3.5, (3)–(4)), solved again where its own headings
+    calibrate the gyro bias or the wheel scale (:func:`_tight_calibrated`), and smoothed
+    through the gyro where configured ((S1)–(S2)).
 
-    ``conventional_sigma_mps``: standard deviation of each conventional velocity (√trace of
-    its covariance); when given, only velocities within ``calibration_max_velocity_sigma_mps``
-    calibrate the sensors. ``conventional_yaw_sigma`` (rad): standard deviation of each
-    conventional heading (:func:`~vo_doppler.heading.conventional.velocity_heading_sigma`),
-    kept in the table for the heading correction. ``conventional_speed_sigma_mps``: standard
-    deviation of each conventional horizontal speed.
-
-    Where these σ are given, the conventional velocity is tested against the calibrated gyro
-    and wheel speed (:mod:`vo_doppler.heading.integrity`, design (I1)): epochs that fail are
-    not valid in the table, and the table's conventional heading and speed σ are the given
-    ones times the factor by which the test's residuals exceed them.
-
-    ``conventional_untestable``: epochs solved without redundancy (four satellites), whose
-    fault the GNSS stage cannot detect (``VelocitySolution.untestable``). They are not valid,
-    but they calibrate the sensors under the same gates as the valid ones: the calibration's
-    robust fit over many epochs is their test, as in [TK18] sec. 3.3, whose conventional
-    headings need only four satellites. In a street canyon they are most of the solved epochs
-    (a simulated 120-s canyon drive: 190 valid, 414 more untestable), and a calibration from the
-    few valid ones converges late.
+    ``conventional``: the GNSS stage's velocities and what σ it gives
+    (:class:`~vo_doppler.heading.conventional.ConventionalVelocity` says what each does). Where
+    the heading and speed σ are given, epochs that fail the test (I1) are not valid in the
+    table, and the table's conventional heading and speed σ are the given ones times the factor
+    by which the test's residuals exceed them.
 
     ``antenna_lever_arm_m``: the GNSS antenna (x forward, y left[, z up], m) from the vehicle
     origin. In turns the antenna moves at ω × r relative to the vehicle, so the Doppler
@@ -536,148 +758,35 @@ def heading_pipeline(
     (:func:`~vo_doppler.heading.conventional.vehicle_heading_from_antenna`), with the raw yaw
     rate for the calibration (the bias is not known yet) and the calibrated one in the table.
 
-    ``forward_acceleration`` (m/s², specific force along the vehicle's forward axis): the road
-    grade prior of the tight heading comes from it and the wheel speed, its offset calibrated
-    on the conventional velocities (:mod:`vo_doppler.heading.grade`); without it, and before
-    that calibration, the prior is N(0, ``config.tight.grade_sigma``).
-    ``conventional_vertical_sigma_mps``: σ of each conventional up velocity, whose share the
-    grade prior's σ leaves out (:func:`~vo_doppler.heading.grade.grade_prior`).
+    ``vehicle.forward_acceleration`` (m/s², specific force along the vehicle's forward axis):
+    the road grade prior of the tight heading comes from it and the wheel speed, its offset
+    calibrated on the conventional velocities (:mod:`vo_doppler.heading.grade`); without it,
+    and before that calibration, the prior is N(0, ``config.tight.grade_sigma``).
     """
     t_epoch = np.asarray(t_epoch, dtype=float)
     config = config.for_rate(t_epoch)
-    velocity = np.asarray(conventional_velocity_enu, dtype=float).reshape(-1, 3)
-    valid = np.asarray(conventional_valid, dtype=bool)
-    candidates = valid.copy()
-    if conventional_untestable is not None:
-        candidates |= np.asarray(conventional_untestable, dtype=bool)
-    conv_yaw, conv_seen = heading_from_velocity(
-        velocity, candidates, config.conventional_min_speed_mps
-    )
-    conv_ok = conv_seen & valid
-    # Horizontal speed: the tightly coupled model's velocity is horizontal, and the vertical
-    # component of a canyon fix is noisy (large VDOP), which would bias |v| and the scale up.
-    conv_speed = np.where(candidates, np.hypot(velocity[:, 0], velocity[:, 1]), np.nan)
-    wheel = sample(speed.t, speed.value, t_epoch)
-    raw_rate = sample(yaw_rate.t, yaw_rate.value, t_epoch)
-    lever = any(float(v) != 0.0 for v in tuple(antenna_lever_arm_m)[:2])
-    antenna_yaw, antenna_speed = conv_yaw, conv_speed
-    if lever:
-        offset = antenna_offset_velocity(raw_rate, antenna_lever_arm_m)
-        conv_yaw, conv_speed = vehicle_heading_from_antenna(
-            antenna_yaw, antenna_speed, wheel, offset
-        )
-    calibrating = candidates.copy()
-    if conventional_sigma_mps is not None:
-        sigma = np.nan_to_num(np.asarray(conventional_sigma_mps, dtype=float), nan=np.inf)
-        calibrating &= sigma <= config.calibration_max_velocity_sigma_mps
-    tolerance = np.maximum(
-        config.calibration_max_speed_mismatch_mps,
-        config.calibration_max_speed_mismatch_ratio * np.abs(wheel),
-    )
-    calibrating &= np.abs(np.nan_to_num(conv_speed - wheel, nan=np.inf)) <= tolerance
-    raw_angle = integral_at(yaw_rate.t, yaw_rate.value, t_epoch)
-    covered = np.isfinite(wheel) & np.isfinite(raw_angle)
-    # A redundantly tested course beyond the car's vertical bound calibrates no gyro bias
-    # (design (I1b)); its speed still calibrates the wheels, the untestable epochs both.
-    car = car_vertical_bound(velocity)
-    cal = backfill_start(
-        causal_calibration(
-            t_epoch,
-            conv_speed,
-            np.where(car | ~valid, conv_yaw, np.nan),
-            calibrating,
-            wheel,
-            raw_angle,
-            config,
-        ),
-        config.backfill_bias_sigma_rad_s,
-        covered,
-    )
+    epochs = _epochs(t_epoch, rows, conventional, vehicle, antenna_lever_arm_m, config)
+    cal = _conventional_calibration(epochs, config)
+    solved = _tight_calibrated(epochs, cal, _solve(epochs, cal, config), config)
+    tight, warnings = _smoothed_heading(epochs, solved, cal, config)
+    return _heading_table(epochs, cal, solved, tight, warnings, config)
 
-    def solve(cal: CalibrationSeries) -> _Pass:
-        """The integrity test, grade prior and tight heading under calibration ``cal``."""
-        conv_yaw_cal = conv_yaw
-        # Φ_cal(t_k) = Φ_raw(t_k) − ∫ b̂ dt, with b̂ of epoch j held until epoch j + 1.
-        steps = cal.bias[:-1] * np.diff(t_epoch)
-        bias_integral = np.concatenate([[0.0], np.cumsum(steps)])[: len(t_epoch)]
-        yaw_angle = raw_angle - bias_integral
-        offset = antenna_offset_velocity(raw_rate - cal.bias, antenna_lever_arm_m)
-        if lever:
-            conv_yaw_cal, _ = vehicle_heading_from_antenna(
-                antenna_yaw, antenna_speed, cal.scale * wheel, offset
-            )
-        integrity = conventional_integrity(
-            t_epoch,
-            conv_ok,
-            conv_yaw_cal,
-            conventional_yaw_sigma,
-            yaw_angle,
-            np.where(valid, conv_speed, np.nan),
-            conventional_speed_sigma_mps,
-            cal.scale * wheel,
-            cal.bias_sigma,
-            config.integrity,
-            vertical_bound=car,
-        )
-        grade, grade_from_accelerometer = _grade_prior(
-            t_epoch,
-            velocity,
-            conventional_valid,
-            SensorSeries(speed.t, speed.value * cal.scale[-1]),
-            forward_acceleration,
-            conventional_vertical_sigma_mps,
-            config,
-        )
-        inputs = {
-            "rows": rows,
-            "t_epoch": t_epoch,
-            "speed": cal.scale * wheel,
-            "yaw_angle": yaw_angle,
-            "config": config.tight,
-            "lever_velocity": np.nan_to_num(offset),
-            "grade_prior": grade,
-            "calibration": (cal.scale, cal.bias, bias_integral),
-        }
-        result = tight_heading_series(
-            **inputs,
-            speed_scale_sigma=cal.scale_sigma / cal.scale,
-            gyro_bias_sigma=cal.bias_sigma,
-        )
-        return _Pass(conv_yaw_cal, integrity, grade, grade_from_accelerometer, result, inputs)
 
-    solved = solve(cal)
-    if _tight_calibration_needed(cal, config):
-        bias = tight_gyro_bias(
-            t_epoch,
-            solved.result.yaw,
-            solved.result.sigma,
-            solved.result.reliable,
-            raw_angle,
-            wheel,
-            config,
-        )
-        if bias is not None:
-            cal.bias_sigma[~cal.bias_estimated] = bias[1]
-            cal.bias[~cal.bias_estimated] = bias[0]
-            solved = solve(cal)
-    if _tight_scale_needed(cal, config):
-        scale = tight_wheel_scale(solved, float(cal.scale[-1]), config)
-        if scale is not None:
-            cal.scale[:], cal.scale_sigma[:] = scale
-            solved = solve(cal)
-    result, integrity = solved.result, solved.integrity
-    tight = _smoothed(solved, yaw_rate, cal, covered, config) if config.smoother.enabled else None
-    warnings = []
-    if tight is not None and tight.variance_factor > config.smoother.max_variance_factor:
-        warnings.append(
-            f"heading smoother: the windows disagree with the gyro-propagated heading by "
-            f"{tight.variance_factor:.1f} times their σ (above "
-            f"{config.smoother.max_variance_factor:g}): the gyro does not link them (course "
-            "and yaw apart?); the windows' own headings are kept"
-        )
-        tight = None
+def _heading_table(
+    epochs: _Epochs,
+    cal: CalibrationSeries,
+    solved: _Pass,
+    tight: SmoothedHeading | None,
+    warnings: list[str],
+    config: HeadingPipelineConfig,
+) -> HeadingTable:
+    """The table of the final pass ``solved`` under calibration ``cal``, its tight headings
+    the smoothed ``tight`` where given, else the windows' own."""
+    result, integrity, conventional = solved.result, solved.integrity, epochs.conventional
+    conv_ok = epochs.conv_ok
+    horizontal_speed = np.hypot(epochs.velocity[:, 0], epochs.velocity[:, 1])
     return HeadingTable(
-        t=t_epoch,
+        t=epochs.t,
         yaw_tc=result.yaw if tight is None else tight.yaw,
         sigma_tc=result.sigma if tight is None else tight.sigma,
         tc_reliable=result.reliable if tight is None else tight.reliable,
@@ -689,21 +798,21 @@ def heading_pipeline(
         wheel_scale=cal.scale,
         rejected_rows=result.n_rejected,
         tc_verifiable=result.verifiable,
-        sigma_conv=_scaled_sigma(conventional_yaw_sigma, integrity.course, integrity.valid),
+        sigma_conv=_scaled_sigma(conventional.yaw_sigma_rad, integrity.course, integrity.valid),
         speed_sigma_conv=_scaled_sigma(
-            conventional_speed_sigma_mps, integrity.speed, integrity.valid
+            conventional.speed_sigma_mps, integrity.speed, integrity.valid
         ),
         tc_window_s=config.tight.window_s
         if tight is None
         else 2.0 * config.smoother.consensus_span_s,
         conv_gnss_valid=conv_ok,
         conv_velocity_valid=velocity_integrity(
-            integrity, valid & car, np.hypot(velocity[:, 0], velocity[:, 1]), cal.scale * wheel
+            integrity, epochs.valid & epochs.car, horizontal_speed, cal.scale * epochs.wheel
         ).valid,
-        sigma_conv_gnss=_sigma_where(conventional_yaw_sigma, conv_ok),
+        sigma_conv_gnss=_sigma_where(conventional.yaw_sigma_rad, conv_ok),
         grade_prior_sigma=solved.grade[1],
         grade_from_accelerometer=solved.grade_from_accelerometer,
-        calibration=calibration_summary(cal, covered),
+        calibration=calibration_summary(cal, epochs.covered),
         method=config.method,
         warnings=warnings,
     )
