@@ -11,6 +11,7 @@ without the excluded rows.
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -148,31 +149,28 @@ def solve_spp(
     start = obs.header.approx_position
     if start is None or np.linalg.norm(start) < EARTH_SURFACE_M:
         start = np.zeros(3)
-    data = []
-    for k in range(obs.epoch_time.size):
-        r = np.arange(bounds[k], bounds[k + 1])
-        r = r[states.valid[r]]
-        data.append(
-            _EpochData(
-                obs.epoch_time[k],
-                states.position[r],
-                sel.value[r] + satellite_clock_m[r],
-                sel.system[r],
-                sel.prn[r],
-                frequency[r],
-                cn0[r],
-            )
-        )
+    healthy = states.valid
+    flat = _EpochData(
+        obs.epoch_time,
+        states.position[healthy],
+        (sel.value + satellite_clock_m)[healthy],
+        sel.system[healthy],
+        sel.prn[healthy],
+        frequency[healthy],
+        cn0[healthy],
+    )
+    data = _EpochRows(flat, np.concatenate(([0], np.cumsum(healthy)))[bounds])
     model = _Model(sorted(codes), elevation_mask_rad, source.klobuchar, {}, alpha)
     fits = _solve_all(data, model, start)
     noise_models = {}
     if fit_noise:
-        noise_models = fit_pseudorange_noise(*_residual_table(data, fits, codes))
+        starts, table = _first_pass(data, fits, codes)
+        noise_models = fit_pseudorange_noise(*table)
         model = replace(
             model,
             noise={s: noise_models[(s, c)] for s, c in codes.items() if (s, c) in noise_models},
         )
-        fits = _solve_all(data, model, start, [f.x if f is not None else None for f in fits])
+        fits = _solve_all(data, model, start, starts)
     return _solution(obs.epoch_time, fits, model.systems, n_no_ephemeris, noise_models, alpha)
 
 
@@ -233,6 +231,26 @@ class _EpochData:
     cn0: np.ndarray
 
 
+_ROW_FIELDS = ("sat_position", "corrected_range", "system", "prn", "frequency", "cn0")
+
+
+@dataclass(frozen=True)
+class _EpochRows:
+    """Every epoch's rows with a healthy ephemeris: ``flat`` holds them all (its ``t`` the
+    epochs' times), epoch ``k``'s from row ``bounds[k]`` to ``bounds[k + 1]``; each epoch's
+    :class:`_EpochData` is made when its turn comes. One set of small arrays per epoch held
+    for the whole drive cost about 1 kB each (36 MiB on a 30-min drive at 20 Hz)."""
+
+    flat: _EpochData
+    bounds: np.ndarray
+
+    def __iter__(self) -> Iterator[_EpochData]:
+        flat = self.flat
+        for k, t in enumerate(flat.t):
+            rows = slice(self.bounds[k], self.bounds[k + 1])
+            yield _EpochData(t, *(getattr(flat, name)[rows] for name in _ROW_FIELDS))
+
+
 @dataclass(frozen=True)
 class _Model:
     systems: list[str]
@@ -269,33 +287,46 @@ class _EpochFit:
     elevation: np.ndarray
 
 
-def _solve_all(data, model, start, starts=None) -> list[_EpochFit | None]:
-    """Every epoch, each started from ``starts[k]`` where given, else the last solution."""
-    fits = []
+def _solve_all(
+    data: _EpochRows,
+    model: _Model,
+    start: np.ndarray,
+    starts: tuple[np.ndarray, np.ndarray] | None = None,
+) -> Iterator[_EpochFit | None]:
+    """Every epoch in turn, each started from ``starts``' position where it marks the epoch
+    solved (positions, mask), else from the last solution. One fit alive at a time: held for
+    the whole drive, the fits (a dozen small arrays each) cost about 2.5 kB per epoch."""
     x = start
     for k, epoch in enumerate(data):
-        here = starts[k] if starts is not None and starts[k] is not None else x
+        here = starts[0][k] if starts is not None and starts[1][k] else x
         fit = _solve_epoch(epoch, model, here)
-        fits.append(fit)
+        yield fit
         if fit is not None:
             x = fit.x
-    return fits
 
 
-def _residual_table(data, fits, codes):
-    """(residual / spread, system, code, C/N0, elevation) of every row of the solved epochs:
-    the normalised residuals that fit the noise models."""
-    parts = [
-        (f.residual / f.spread, d.system[f.rows], d.cn0[f.rows], f.elevation)
-        for d, f in zip(data, fits, strict=True)
-        if f is not None
-    ]
-    if not parts:
-        empty = np.zeros(0)
-        return empty, empty.astype(str), empty.astype(str), empty, empty
-    residual, system, cn0, elevation = (np.concatenate(p) for p in zip(*parts, strict=True))
+def _first_pass(
+    data: _EpochRows, fits: Iterable[_EpochFit | None], codes: dict[str, str]
+) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, ...]]:
+    """The first solution's positions and which epochs it solved (the second pass's starts),
+    and the (residual / spread, system, code, C/N0, elevation) of every row of its solved
+    epochs, in epoch and row order: the normalised residuals that fit the noise models."""
+    starts = np.zeros((data.flat.t.size, 3))
+    solved = np.zeros(data.flat.t.size, dtype=bool)
+    normalised = np.full(data.flat.corrected_range.size, np.nan)
+    elevation = np.full(data.flat.corrected_range.size, np.nan)
+    used = np.zeros(data.flat.corrected_range.size, dtype=bool)
+    for k, fit in enumerate(fits):
+        if fit is None:
+            continue
+        starts[k], solved[k] = fit.x, True
+        rows = data.bounds[k] + fit.rows
+        normalised[rows] = fit.residual / fit.spread
+        elevation[rows] = fit.elevation
+        used[rows] = True
+    system = data.flat.system[used]
     code = np.array([codes[s] for s in system], dtype="U3")
-    return residual, system, code, cn0, elevation
+    return (starts, solved), (normalised[used], system, code, data.flat.cn0[used], elevation[used])
 
 
 def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray) -> _EpochFit | None:
