@@ -13,6 +13,8 @@ from vo_doppler.gnss.windowed_line import ConsistencyConfig, epochs_in_window
 from vo_doppler.heading.from_gnss import heading_from_gnss
 from vo_doppler.heading.integrity import (
     AT_REST_MAX_MPS,
+    CarReference,
+    ConventionalEpochs,
     car_checked_velocity,
     car_vertical_bound,
     conventional_integrity,
@@ -126,19 +128,13 @@ def test_a_speed_while_the_wheels_stand_fails_whatever_its_sigma():
     speed[10] = 0.75  # reflected satellites pulled the fix
     wheel = np.zeros(20)
     result = conventional_integrity(
-        t, valid, np.zeros(20), None, np.zeros(20), speed, np.full(20, 0.3), wheel, np.zeros(20)
+        ConventionalEpochs(t, valid, np.zeros(20), None, speed, np.full(20, 0.3)),
+        CarReference(np.zeros(20), wheel, np.zeros(20)),
     )
     assert not result.valid[10] and result.valid[[9, 11]].all()
     moving = conventional_integrity(
-        t,
-        valid,
-        np.zeros(20),
-        None,
-        np.zeros(20),
-        speed + 5,
-        np.full(20, 0.3),
-        wheel + 5,
-        np.zeros(20),
+        ConventionalEpochs(t, valid, np.zeros(20), None, speed + 5, np.full(20, 0.3)),
+        CarReference(np.zeros(20), wheel + 5, np.zeros(20)),
     )
     assert moving.valid[10]  # 0.75 m/s off at 5 m/s is within the speed test's 3σ here
 
@@ -162,19 +158,28 @@ def _courses(rate_hz: float, fault_deg: float = 0.0):
 
 
 def _judged(
-    t, course, angle, valid=None, wheel=8.0, speed=8.0, course_sigma=STATED_SIGMA, speed_sigma=0.3
+    t,
+    course,
+    angle,
+    valid=None,
+    wheel=8.0,
+    speed=8.0,
+    course_sigma=STATED_SIGMA,
+    speed_sigma=0.3,
+    vertical_bound=None,
 ):
     n = t.size
-    return conventional_integrity(
+    epochs = ConventionalEpochs(
         t,
         np.ones(n, bool) if valid is None else valid,
         course,
         np.full(n, course_sigma),
-        angle,
         np.broadcast_to(speed, n),
         np.full(n, speed_sigma),
-        np.broadcast_to(wheel, n),
-        np.full(n, 1e-4),
+        vertical_bound,
+    )
+    return conventional_integrity(
+        epochs, CarReference(angle, np.broadcast_to(wheel, n), np.full(n, 1e-4))
     )
 
 
@@ -253,18 +258,7 @@ def test_a_velocity_climbing_beyond_a_cars_road_is_not_valid_whatever_its_sigma(
     t, course, angle, _ = _courses(1.0)
     bound = np.ones(t.size, bool)
     bound[60] = False
-    result = conventional_integrity(
-        t,
-        np.ones(t.size, bool),
-        course,
-        np.full(t.size, STATED_SIGMA),
-        angle,
-        np.full(t.size, 8.0),
-        np.full(t.size, 0.3),
-        np.full(t.size, 8.0),
-        np.full(t.size, 1e-4),
-        vertical_bound=bound,
-    )
+    result = _judged(t, course, angle, vertical_bound=bound)
     assert not result.valid[60] and np.isnan(result.course.z[60])  # not tested: not usable
     assert result.valid[bound].all()
 

@@ -120,60 +120,77 @@ def course_protection(course: ConsistencyTest, quantile: float = PROTECTION_QUAN
     return np.abs(course.residual) + quantile * course.sigma_factor * course.line_sigma
 
 
+@dataclass(frozen=True)
+class ConventionalEpochs:
+    """The conventional velocity as test (I1) takes it, one value per GNSS epoch: ``valid`` so
+    far, the yaw (rad) and horizontal speed (m/s, NaN where not valid) with their σ (None: that
+    test is not made), and the car's vertical bound (:func:`car_vertical_bound`; None: none)."""
+
+    t: np.ndarray
+    valid: np.ndarray
+    yaw: np.ndarray
+    yaw_sigma: np.ndarray | None
+    speed: np.ndarray
+    speed_sigma: np.ndarray | None
+    vertical_bound: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class CarReference:
+    """What the car's own sensors say at the same epochs: the integrated calibrated yaw rate
+    (rad), the calibrated wheel speed (m/s; NaN where the signals do not cover the epoch) and
+    the σ of what is left of the gyro bias (rad/s)."""
+
+    yaw_angle: np.ndarray
+    wheel_speed: np.ndarray
+    gyro_bias_sigma: np.ndarray
+
+
 def conventional_integrity(
-    t: np.ndarray,
-    valid: np.ndarray,
-    yaw: np.ndarray,
-    yaw_sigma: np.ndarray | None,
-    yaw_angle: np.ndarray,
-    speed: np.ndarray,
-    speed_sigma: np.ndarray | None,
-    wheel_speed: np.ndarray,
-    gyro_bias_sigma: np.ndarray,
+    epochs: ConventionalEpochs,
+    car: CarReference,
     config: ConsistencyConfig = SENSOR_TEST,
     course_alert_limit: float = COURSE_ALERT_LIMIT,
-    vertical_bound: np.ndarray | None = None,
 ) -> ConventionalIntegrity:
-    """Test (I1) of the conventional yaw against the integrated calibrated yaw rate
-    ``yaw_angle`` and of its horizontal speed against the calibrated ``wheel_speed``, at the
-    epochs ``valid`` so far (rad, m/s; module docstring). The course line's slope is what is
-    left of the gyro bias: its prior is N(0, ``gyro_bias_sigma``²) (rad/s, per epoch). A course
-    whose error the gyro cannot bound within ``course_alert_limit`` (:func:`course_protection`)
-    is not valid, nor is an epoch the sensors cover that the tests could not judge. Where the
-    wheels stand (``WHEEL_AT_REST_MPS``) a speed above ``AT_REST_MAX_MPS`` fails outright.
-    ``vertical_bound`` (:func:`car_vertical_bound`, where given): epochs beyond it are neither
-    tested nor valid."""
-    valid = np.asarray(valid, dtype=bool)
-    if vertical_bound is not None and config.enabled:
-        valid = valid & np.asarray(vertical_bound, dtype=bool)
+    """Test (I1) of the conventional yaw against the integrated calibrated yaw rate and of its
+    horizontal speed against the calibrated wheel speed, at the epochs valid so far (module
+    docstring). The course line's slope is what is left of the gyro bias: its prior is
+    N(0, ``car.gyro_bias_sigma``²). A course whose error the gyro cannot bound within
+    ``course_alert_limit`` (:func:`course_protection`) is not valid, nor is an epoch the sensors
+    cover that the tests could not judge. Where the wheels stand (``WHEEL_AT_REST_MPS``) a
+    speed above ``AT_REST_MAX_MPS`` fails outright. Epochs beyond the vertical bound are
+    neither tested nor valid."""
+    t, wheel = epochs.t, np.asarray(car.wheel_speed, dtype=float)
+    valid = np.asarray(epochs.valid, dtype=bool)
+    if epochs.vertical_bound is not None and config.enabled:
+        valid = valid & np.asarray(epochs.vertical_bound, dtype=bool)
     none = np.zeros(valid.shape, dtype=bool)
     if not config.enabled:
         return ConventionalIntegrity(None, None, valid.copy(), none)
     course = speed_test = None
     failed = none.copy()
     unjudged = none.copy()
-    if yaw_sigma is not None:
+    if epochs.yaw_sigma is not None:
         course = consistency_test(
             t,
-            np.asarray(yaw) - np.asarray(yaw_angle),
-            yaw_sigma,
+            np.asarray(epochs.yaw) - np.asarray(car.yaw_angle),
+            epochs.yaw_sigma,
             valid,
             config,
             angular=True,
-            slope_sigma=gyro_bias_sigma,
+            slope_sigma=car.gyro_bias_sigma,
         )
         with np.errstate(invalid="ignore"):
             failed |= course.failed | (course_protection(course) > course_alert_limit)
         unjudged |= course.unjudged
-    if speed_sigma is not None:
-        speed_test = consistency_test(
-            t, np.asarray(speed) - np.asarray(wheel_speed), speed_sigma, valid, config
-        )
+    if epochs.speed_sigma is not None:
+        difference = np.asarray(epochs.speed) - wheel
+        speed_test = consistency_test(t, difference, epochs.speed_sigma, valid, config)
         failed |= speed_test.failed
         unjudged |= speed_test.unjudged
-    untested = valid & unjudged & np.isfinite(yaw_angle) & np.isfinite(wheel_speed)
-    at_rest = np.abs(np.nan_to_num(np.asarray(wheel_speed, dtype=float), nan=np.inf))
-    failed |= (at_rest < WHEEL_AT_REST_MPS) & (np.nan_to_num(speed, nan=0.0) > AT_REST_MAX_MPS)
+    untested = valid & unjudged & np.isfinite(car.yaw_angle) & np.isfinite(wheel)
+    at_rest = np.abs(np.nan_to_num(wheel, nan=np.inf)) < WHEEL_AT_REST_MPS
+    failed |= at_rest & (np.nan_to_num(epochs.speed, nan=0.0) > AT_REST_MAX_MPS)
     return ConventionalIntegrity(course, speed_test, valid & ~failed & ~untested, untested, valid)
 
 

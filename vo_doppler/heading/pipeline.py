@@ -48,7 +48,9 @@ from vo_doppler.heading.conventional import (
 )
 from vo_doppler.heading.grade import GradePriorConfig, accelerometer_grade, grade_prior
 from vo_doppler.heading.integrity import (
+    CarReference,
     ConsistencyConfig,
+    ConventionalEpochs,
     ConventionalIntegrity,
     car_vertical_bound,
     conventional_integrity,
@@ -640,19 +642,17 @@ def _solve(epochs: _Epochs, cal: CalibrationSeries, config: HeadingPipelineConfi
     conv_yaw = e.conv_yaw
     if e.lever:
         conv_yaw, _ = vehicle_heading_from_antenna(*e.antenna, cal.scale * e.wheel, offset)
-    integrity = conventional_integrity(
+    epochs = ConventionalEpochs(
         e.t,
         e.conv_ok,
         conv_yaw,
         conventional.yaw_sigma_rad,
-        yaw_angle,
         np.where(e.valid, e.conv_speed, np.nan),
         conventional.speed_sigma_mps,
-        cal.scale * e.wheel,
-        cal.bias_sigma,
-        config.integrity,
-        vertical_bound=e.car,
+        e.car,
     )
+    car = CarReference(yaw_angle, cal.scale * e.wheel, cal.bias_sigma)
+    integrity = conventional_integrity(epochs, car, config.integrity)
     speed = e.vehicle.wheel_speed
     grade, grade_from_accelerometer = _grade_prior(
         e.t,
