@@ -155,7 +155,6 @@ UNITLESS: dict[str, str] = {
     "reliability_n_sigma": "in σ",
     # names, letters and units in the name itself
     "systems": "RINEX system letters (choices.checked_letters)",
-    "method": "the name of the heading settings (HeadingPipelineConfig.method)",
     "channel": "a CAN interface name",
     "fps": "frames per second: the unit is the name",
     "origin": "geodetic latitude and longitude (deg) and height (m), as in sequence.yaml",

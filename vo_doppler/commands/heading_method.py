@@ -4,21 +4,9 @@
 from __future__ import annotations
 
 import argparse
-from enum import StrEnum
 
 from vo_doppler.choices import values
-from vo_doppler.heading.pipeline import HeadingPipelineConfig
-
-
-class HeadingMethod(StrEnum):
-    """``auto``: :meth:`HeadingPipelineConfig.auto`, robust below 10 Hz and snooping from 10 Hz;
-    ``snooping``: windows of 2 s, reflections detected and named by data snooping (tuned on
-    10–20 Hz recordings); ``robust``: :meth:`HeadingPipelineConfig.robust`, for any rate and
-    deep street canyons (1-Hz receivers)."""
-
-    AUTO = "auto"
-    SNOOPING = "snooping"
-    ROBUST = "robust"
+from vo_doppler.heading.pipeline import HeadingMethod, HeadingPipelineConfig
 
 
 def add_heading_method_option(parser: argparse.ArgumentParser) -> None:

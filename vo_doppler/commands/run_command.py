@@ -17,15 +17,12 @@ from rich.table import Table
 
 from vo_doppler.commands.arg_types import window_size
 from vo_doppler.commands.correction_options import add_correction_options, correction_config
-from vo_doppler.commands.heading_method import (
-    HeadingMethod,
-    add_heading_method_option,
-    heading_method_config,
-)
+from vo_doppler.commands.heading_method import add_heading_method_option, heading_method_config
 from vo_doppler.commands.satellite_options import add_selection_options
 from vo_doppler.commands.span_options import add_span_options, time_span
 from vo_doppler.errors import InputError, shown
 from vo_doppler.eval.pipelines import PIPELINE_LABELS
+from vo_doppler.heading.pipeline import HeadingMethod
 from vo_doppler.io.output_folder import RUN, check_output_folder, staged_output, untouched
 from vo_doppler.io.sequence import manifest_inputs
 from vo_doppler.job import require_tight_heading, run_recording

@@ -56,6 +56,7 @@ from vo_doppler.model.doppler import DopplerRows
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.observations import Observations, lookup, row_keys
+from vo_doppler.model.signals import DEFAULT_SYSTEMS
 
 log = logging.getLogger(__name__)
 
@@ -91,7 +92,7 @@ def doppler_rows(
     obs: Observations,
     source: StateSource,
     receiver_ecef: np.ndarray,
-    systems: str = "GREJC",
+    systems: str = DEFAULT_SYSTEMS,
     bands: str | None = None,
     elevation_mask_rad: float = np.deg2rad(10.0),
     reported_sigma: ReportedSigma | None = None,

@@ -25,6 +25,7 @@ from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.observations import Observations
+from vo_doppler.model.signals import DEFAULT_SYSTEMS
 from vo_doppler.model.vehicle_signals import VehicleSignals
 
 log = logging.getLogger(__name__)
@@ -52,7 +53,7 @@ def emulated_canyon(
     nav: StateSource,
     n_keep: int,
     after_t: float,
-    systems: str = "GREJC",
+    systems: str = DEFAULT_SYSTEMS,
     elevation_mask_rad: float = np.radians(10.0),
     reported_sigma: ReportedSigma | None = None,
 ) -> tuple[DopplerRows, VelocitySolution]:

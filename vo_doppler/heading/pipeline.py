@@ -92,6 +92,17 @@ AUTO_ROBUST_BELOW_RATE_HZ = 10.0
 """:meth:`HeadingPipelineConfig.auto`: GNSS rates below this take the robust settings."""
 
 
+class HeadingMethod(StrEnum):
+    """``--heading-method``: ``auto``: :meth:`HeadingPipelineConfig.auto`, robust below 10 Hz
+    and snooping from 10 Hz; ``snooping``: windows of 2 s, reflections detected and named by
+    data snooping (tuned on 10–20 Hz recordings); ``robust``: :meth:`HeadingPipelineConfig.
+    robust`, for any rate and deep street canyons (1-Hz receivers)."""
+
+    AUTO = "auto"
+    SNOOPING = "snooping"
+    ROBUST = "robust"
+
+
 @dataclass(frozen=True)
 class HeadingPipelineConfig:
     """``calibration``: least squares, Kalman or none; fixed values override the estimates."""
@@ -146,11 +157,11 @@ class HeadingPipelineConfig:
     robust_below_rate_hz: float | None = None
     """Recordings whose GNSS epochs come at a lower rate take the settings of :meth:`robust`
     (:meth:`for_rate`); None: these settings at any rate."""
-    method: str = "snooping"
+    method: HeadingMethod = HeadingMethod.SNOOPING
     """The name of these settings, kept in the heading table."""
 
     def __post_init__(self) -> None:
-        check_fields(self, calibration=CalibrationMethod)
+        check_fields(self, calibration=CalibrationMethod, method=HeadingMethod)
 
     @classmethod
     def robust(cls) -> HeadingPipelineConfig:
@@ -161,7 +172,7 @@ class HeadingPipelineConfig:
             tight=TightHeadingConfig.robust(),
             gate=GateConfig(window_s=600.0),
             smoother=HeadingSmootherConfig(enabled=True),
-            method="robust",
+            method=HeadingMethod.ROBUST,
         )
 
     @classmethod
