@@ -449,8 +449,11 @@ def test_correct_cli_kalman_weighs_conventional_headings_by_their_sigma(tmp_path
     write_tum(tmp_path / "vo.tum", _vo_output(gt))
     precise = (np.arange(len(t)) // 10) % 2 == 0
     table = _table(t, yaw, np.zeros(len(t), bool), np.ones(len(t), bool))
-    table.yaw_conv = np.where(precise, yaw, yaw + np.radians(3.0))
-    table.sigma_conv = np.radians(np.where(precise, 0.1, 10.0))
+    table = replace(
+        table,
+        yaw_conv=np.where(precise, yaw, yaw + np.radians(3.0)),
+        sigma_conv=np.radians(np.where(precise, 0.1, 10.0)),
+    )
     errors = {}
     for name, keep_sigma in (("with", True), ("without", False)):
         path = tmp_path / f"heading_{name}.csv"

@@ -3,6 +3,7 @@ without those columns read as NaN; the minimal heading CSV (your own heading) an
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -57,11 +58,15 @@ def test_files_without_the_columns_read_as_nan(tmp_path):
 
 
 def test_gnss_only_validity_and_sigma_round_trip_apart_from_the_checked_ones(tmp_path):
-    table = _table()
-    table.conv_gnss_valid = table.conv_valid
-    table.conv_valid = np.array([True, False, False, True])
-    table.sigma_conv = np.where(table.conv_valid, 0.006, np.nan)
-    table.sigma_conv_gnss = np.where(table.conv_gnss_valid, 0.002, np.nan)
+    checked = np.array([True, False, False, True])
+    gnss = _table().conv_valid
+    table = replace(
+        _table(),
+        conv_gnss_valid=gnss,
+        conv_valid=checked,
+        sigma_conv=np.where(checked, 0.006, np.nan),
+        sigma_conv_gnss=np.where(gnss, 0.002, np.nan),
+    )
     path = tmp_path / "heading.csv"
     write_heading_csv(path, table)
     back = read_heading_csv(path)
@@ -73,8 +78,7 @@ def test_gnss_only_validity_and_sigma_round_trip_apart_from_the_checked_ones(tmp
 
 def test_files_without_the_gnss_only_columns_take_the_checked_ones(tmp_path):
     path = tmp_path / "heading.csv"
-    table = _table()
-    table.conv_gnss_valid = np.ones(4, dtype=bool)
+    table = replace(_table(), conv_gnss_valid=np.ones(4, dtype=bool))
     write_heading_csv(path, table)
     rows = [line.split(",") for line in path.read_text().splitlines()]
     new = ("conv_gnss_valid", "heading_conv_gnss_sigma_deg")

@@ -110,7 +110,7 @@ def heading_from_gnss(
         config,
         antenna_lever_arm_m,
     )
-    table.hdop_conv = np.where(table.conv_valid, velocity.dop[:, 2], np.nan)
+    table = replace(table, hdop_conv=np.where(table.conv_valid, velocity.dop[:, 2], np.nan))
     estimate, warnings = heading_warnings(
         table,
         velocity,
@@ -123,6 +123,6 @@ def heading_from_gnss(
     warnings += [w for w in [integrity_rate_warning(epoch_time, config.integrity)] if w]
     for warning in table.warnings + warnings:
         log.warning("%s", warning)
-    table.warnings = table.warnings + warnings
-    table.clock_residual_offset_s = estimate.residual_s
-    return table
+    return replace(
+        table, warnings=table.warnings + warnings, clock_residual_offset_s=estimate.residual_s
+    )

@@ -46,7 +46,7 @@ class CalibrationSummary:
         }
 
 
-@dataclass
+@dataclass(frozen=True)
 class HeadingTable:
     """One row per GNSS epoch. Yaw in rad counter-clockwise from east (NaN when unavailable)."""
 
@@ -106,15 +106,18 @@ class HeadingTable:
 
     def __post_init__(self) -> None:
         n = len(self.t)
-        if self.rejected_rows is None:
-            self.rejected_rows = np.zeros(n, dtype=int)
-        if self.tc_verifiable is None:
-            self.tc_verifiable = np.zeros(n, dtype=bool)
-        if self.grade_from_accelerometer is None:
-            self.grade_from_accelerometer = np.zeros(n, dtype=bool)
-        for name in ("sigma_conv", "speed_sigma_conv", "hdop_conv", "grade_prior_sigma"):
+        defaults = {
+            "rejected_rows": np.zeros(n, dtype=int),
+            "tc_verifiable": np.zeros(n, dtype=bool),
+            "grade_from_accelerometer": np.zeros(n, dtype=bool),
+            **{
+                name: np.full(n, np.nan)
+                for name in ("sigma_conv", "speed_sigma_conv", "hdop_conv", "grade_prior_sigma")
+            },
+        }
+        for name, default in defaults.items():
             if getattr(self, name) is None:
-                setattr(self, name, np.full(n, np.nan))
+                object.__setattr__(self, name, default)
 
     def __len__(self) -> int:
         return len(self.t)
