@@ -148,6 +148,25 @@ GPS_ECCENTRICITY = SignalBounds(0.0, 0.05, "")
 reached 0.03)."""
 GPS_INCLINATION = SignalBounds(0.87, 1.05, "rad")
 """GPS orbital planes are inclined 55° ± a few degrees (50°–60°)."""
+GALILEO_SQRT_A = SignalBounds(5250.0, 5500.0, "√m")
+"""√a of a Galileo orbit: 29,600 km (√a = 5440.6 √m), the two satellites left in eccentric
+orbits 27,977 km (5289 √m)."""
+GALILEO_ECCENTRICITY = SignalBounds(0.0, 0.2, "")
+"""Galileo orbits are near circular, the two eccentric ones at e = 0.16."""
+GALILEO_INCLINATION = SignalBounds(0.82, 1.05, "rad")
+"""Galileo orbital planes are inclined 56°, the eccentric orbits 49.8°."""
+BEIDOU_SQRT_A = SignalBounds(5200.0, 6550.0, "√m")
+"""√a of a BeiDou orbit: MEO 27,906 km (5282.6 √m), IGSO and GEO 42,164 km (6493.4 √m)."""
+BEIDOU_ECCENTRICITY = SignalBounds(0.0, 0.05, "")
+"""BeiDou orbits are near circular."""
+BEIDOU_INCLINATION = SignalBounds(-0.2, 1.05, "rad")
+"""BeiDou MEO and IGSO planes are inclined 55°, GEO orbits a few degrees."""
+QZSS_SQRT_A = SignalBounds(6400.0, 6600.0, "√m")
+"""√a of a QZSS orbit: quasi-zenith and geostationary, 42,164 km (6493.4 √m)."""
+QZSS_ECCENTRICITY = SignalBounds(0.0, 0.1, "")
+"""QZSS quasi-zenith orbits have e ≈ 0.075, the geostationary one ≈ 0."""
+QZSS_INCLINATION = SignalBounds(-0.2, 0.9, "rad")
+"""QZSS quasi-zenith orbits are inclined about 41°, the geostationary one a few degrees."""
 MAX_SATELLITES = 256
 """More satellites than all GNSS systems together have (about 220 numbers)."""
 

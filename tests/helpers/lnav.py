@@ -177,14 +177,23 @@ def with_parity(words: tuple[int, ...]) -> tuple[int, ...]:
     return tuple(out)
 
 
-def sfrbx(prn: int, words: tuple[int, ...], flip: int | None = None) -> bytes:
-    """A UBX RXM-SFRBX frame carrying one GPS L1 C/A subframe (24-bit data words, each in bits
-    29…6 of its ``dwrd`` followed by its parity bits); ``flip``: one bit (0…299, bit 0 the
-    first word's most significant) inverted after the parity was computed."""
+def sfrbx(prn: int, words: tuple[int, ...], flip: int | None = None, gnss_id: int = 0) -> bytes:
+    """A UBX RXM-SFRBX frame carrying one GPS (``gnss_id`` 5: QZSS) L1 C/A subframe (24-bit data
+    words, each in bits 29…6 of its ``dwrd`` followed by its parity bits); ``flip``: one bit
+    (0…299, bit 0 the first word's most significant) inverted after the parity was computed."""
     full = list(with_parity(tuple(words)))
     if flip is not None:
         full[flip // 30] ^= 1 << (29 - flip % 30)
     dwrd = {f"dwrd_{k + 1:02d}": word for k, word in enumerate(full)}
     return UBXMessage(
-        "RXM", "RXM-SFRBX", 0, gnssId=0, svId=prn, sigId=0, numWords=10, chn=4, version=2, **dwrd
+        "RXM",
+        "RXM-SFRBX",
+        0,
+        gnssId=gnss_id,
+        svId=prn,
+        sigId=0,
+        numWords=10,
+        chn=4,
+        version=2,
+        **dwrd,
     ).serialize()

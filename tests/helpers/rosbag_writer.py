@@ -32,7 +32,7 @@ from rosbags.rosbag2 import Writer as Writer2
 from scipy.spatial.transform import Rotation
 
 from tests.helpers.glonass_strings import encode_strings, sfrbx_words
-from tests.helpers.lnav import encode_ephemeris
+from tests.helpers.lnav import encode_ephemeris, with_parity
 from vo_doppler.geo import ecef_to_geodetic
 from vo_doppler.io.gps_lnav import URA_METERS
 from vo_doppler.io.rosbag_gnss import carrier_hz, satellite_number
@@ -488,7 +488,7 @@ def _sfrbx(out: SmallBag, nav) -> None:
     for k in np.flatnonzero(kepler.system == "G"):
         t = float(kepler.toc[k])
         for n, words in enumerate(encode_ephemeris(lnav_dict(kepler, k), int(t % 604800) // 6)):
-            ublox_sfrbx(out, t + n, 0, int(kepler.prn[k]), 0, [(w << 6) | 0x15 for w in words])
+            ublox_sfrbx(out, t + n, 0, int(kepler.prn[k]), 0, with_parity(words))
     glonass = nav.glonass
     for k in range(len(glonass)):
         params = {name: float(values[k]) for name, values in glonass.params.items()}

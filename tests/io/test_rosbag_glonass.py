@@ -146,8 +146,8 @@ def test_glonass_ephemerides_come_back_from_the_navigation_file(tmp_path, flavou
 def test_glonass_strings_of_ublox_come_back_from_the_navigation_file(tmp_path, flavour):
     """RxmSFRBX GLONASS strings 1–4 of R05 (channel −3) and R12 (channel 4), encoded from the
     records above (tb on a quarter hour of UTC, the frame 15 min before): the navigation file
-    holds them at the values the strings carry, to its D19.12 digits; a Galileo page, which is
-    not decoded, is named in a warning with its count."""
+    holds them at the values the strings carry, to its D19.12 digits; a Galileo message that is
+    no I/NAV page is refused, counted and named by its message index in a warning."""
     toc = tb_quarter_hour(T0)
     channels = {5: CHANNEL, 12: 4}
     sent = {}
@@ -179,9 +179,7 @@ def test_glonass_strings_of_ublox_come_back_from_the_navigation_file(tmp_path, f
             assert glonass[name][k] == rounded_nav_value(sent[slot][name]), name
     assert glonass["frame_time"][0] == (toc - 18.0 - 900.0) % SECONDS_PER_WEEK
     assert (
-        "/ublox/rxmsfrb: navigation data of other systems not decoded (3 Galileo messages; "
-        "only GPS LNAV and GLONASS are): those satellites have no ephemeris in the sequence, so "
-        "their measurements are not used; add a RINEX navigation file of the day to gnss.nav "
-        "for them" in summary.warnings
+        "/ublox/rxmsfrb, message 0: 3 Galileo pages or ephemerides refused (the first: E11, page "
+        "parts not even then odd)" in summary.warnings
     )
     assert read_obs(tmp_path / "seq" / "gnss" / "rover.obs").header.glonass_channels == {5: CHANNEL}

@@ -13,11 +13,15 @@ non-information bits make zero); :func:`parity_error` finds the first word whose
 not match, as any one flipped bit makes it.
 
 An ephemeris is emitted when subframes 1, 2 and 3 of one satellite agree on their issue of data
-(IODE of 2 and 3 = the 8 LSBs of IODC, sec. 20.3.4.4) and describe a GPS orbit
-(:func:`off_gps_orbit`: semi-major axis, eccentricity and inclination of the constellation,
+(IODE of 2 and 3 = the 8 LSBs of IODC, sec. 20.3.4.4) and describe an orbit of the system
+(:func:`off_orbit`: semi-major axis, eccentricity and inclination of the constellation,
 :mod:`vo_doppler.bounds`); a repeated (PRN, IODC, toe) is emitted once. Not
 decoded: subframes 4 and 5 (almanac, ionosphere and UTC parameters, pages of sec. 20.3.3.5).
 The 10-bit week number is resolved with a full GPS week from the same recording.
+
+QZSS L1 C/A (IS-QZSS-PNT) sends the same subframes 1–3 with the same layout and scales on GPS
+time: an assembler made with ``system="J"`` decodes them (PRN 193–202 as J01–J10), checks QZSS
+orbits, and keeps the fit interval flag itself, as the RINEX 3.05 QZSS record holds it.
 """
 
 from __future__ import annotations
@@ -26,12 +30,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vo_doppler.bounds import GPS_ECCENTRICITY, GPS_INCLINATION, GPS_SQRT_A
+from vo_doppler.bounds import (
+    GPS_ECCENTRICITY,
+    GPS_INCLINATION,
+    GPS_SQRT_A,
+    QZSS_ECCENTRICITY,
+    QZSS_INCLINATION,
+    QZSS_SQRT_A,
+    SignalBounds,
+)
+from vo_doppler.io.nav_fields import ICD_PI
 from vo_doppler.io.rinex_nav import KEPLER_FIELDS
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK
 from vo_doppler.model.navigation import NavRecords
 
-GPS_PI = 3.1415926535898
+GPS_PI = ICD_PI
 PREAMBLE = 0x8B
 URA_METERS = (2.4, 3.4, 4.85, 6.85, 9.65, 13.65, 24.0, 48.0, 96.0, 192.0, 384.0, 768.0)
 URA_METERS += (1536.0, 3072.0, 6144.0, np.nan)
@@ -112,9 +125,15 @@ def parity_error(words30: tuple[int, ...]) -> int | None:
     return None
 
 
-def off_gps_orbit(fields: dict[str, float]) -> str | None:
-    """Why decoded subframe fields cannot be a GPS satellite's orbit, or None."""
-    for name, bounds in (("sqrt_a", GPS_SQRT_A), ("e", GPS_ECCENTRICITY), ("i0", GPS_INCLINATION)):
+GPS_ORBIT = (("sqrt_a", GPS_SQRT_A), ("e", GPS_ECCENTRICITY), ("i0", GPS_INCLINATION))
+QZSS_ORBIT = (("sqrt_a", QZSS_SQRT_A), ("e", QZSS_ECCENTRICITY), ("i0", QZSS_INCLINATION))
+ORBITS = {"G": GPS_ORBIT, "J": QZSS_ORBIT}
+
+
+def off_orbit(fields: dict[str, float], orbit: tuple[tuple[str, SignalBounds], ...]) -> str | None:
+    """Why decoded fields cannot be an orbit of the system whose bounds ``orbit`` lists (√a,
+    eccentricity, inclination), or None."""
+    for name, bounds in orbit:
         if name in fields and bounds.outside(np.array([fields[name]]))[0]:
             return f"{name} = {fields[name]:.6g} is outside {bounds}"
     return None
@@ -169,11 +188,13 @@ class LnavAssembler:
     pending: dict[int, dict[int, dict[str, float]]]
     emitted: set[tuple[int, int, float]]
     rejected: list[tuple[int, int, str]]
-    """(where, PRN, why) of each subframe set whose orbit is not a GPS orbit."""
+    """(where, PRN, why) of each subframe set whose orbit is not one of the system's."""
+    system: str = "G"
+    """'G' GPS, or 'J' QZSS (IS-QZSS-PNT: the same subframes 1–3, PRN 193–202 as J01–J10)."""
 
     @classmethod
-    def new(cls) -> LnavAssembler:
-        return cls([], {}, set(), [])
+    def new(cls, system: str = "G") -> LnavAssembler:
+        return cls([], {}, set(), [], system)
 
     def add(self, prn: int, words: tuple[int, ...], reference_week: int | None, where: int) -> None:
         """One subframe of satellite ``prn``; ``where`` (e.g. a byte offset) is kept per record."""
@@ -189,24 +210,32 @@ class LnavAssembler:
         key = (prn, int(one["iodc"]), two["toe_sow"])
         if key in self.emitted:
             return
-        why = off_gps_orbit(two | three)
+        why = off_orbit(two | three, ORBITS[self.system])
         if why is not None:
             self.rejected.append((where, prn, why))
             return
         self.emitted.add(key)
-        self.records.append(_record(prn, one, two, three, reference_week, where))
+        record = _record(prn, one, two, three, reference_week, where)
+        if self.system == "J":  # the RINEX 3.05 QZSS record holds the fit interval flag itself
+            record["fit_interval"] = two["fit_flag"]
+        self.records.append(record)
 
     def navrecords(self) -> NavRecords:
         """The emitted ephemerides with the parameter names of the RINEX navigation reader."""
-        rows = self.records
-        params = {name: np.array([r[name] for r in rows], dtype=float) for name in KEPLER_NAMES}
-        return NavRecords(
-            np.full(len(rows), "G", dtype="U1"),
-            np.array([r["prn"] for r in rows], dtype=np.int16),
-            np.array([r["toc"] for r in rows], dtype=float),
-            params,
-            np.array([r["where"] for r in rows], dtype=np.int64),
-        )
+        return kepler_records(self.system, self.records)
+
+
+def kepler_records(system: str, rows: list[dict[str, float]]) -> NavRecords:
+    """Records of one system from rows holding :data:`KEPLER_NAMES` (``toc`` and ``toe`` in GPS
+    seconds), ``prn`` and ``where`` (a byte offset or message index, kept as the record's line)."""
+    params = {name: np.array([r[name] for r in rows], dtype=float) for name in KEPLER_NAMES}
+    return NavRecords(
+        np.full(len(rows), system, dtype="U1"),
+        np.array([r["prn"] for r in rows], dtype=np.int16),
+        np.array([r["toc"] for r in rows], dtype=float),
+        params,
+        np.array([r["where"] for r in rows], dtype=np.int64),
+    )
 
 
 def _record(prn, one, two, three, reference_week, where) -> dict[str, float]:
@@ -216,8 +245,8 @@ def _record(prn, one, two, three, reference_week, where) -> dict[str, float]:
         week += 1024
     transmission_sow = one["tow"] - 6.0
     t_tx = week * SECONDS_PER_WEEK + transmission_sow
-    toc = _nearest(t_tx, one["toc_sow"])
-    toe = _nearest(toc, two["toe_sow"])
+    toc = time_of_week_near(t_tx, one["toc_sow"])
+    toe = time_of_week_near(toc, two["toe_sow"])
     return {
         **{k: v for k, v in (one | two | three).items() if k in KEPLER_NAMES},
         "iode": two["iode"],
@@ -232,8 +261,9 @@ def _record(prn, one, two, three, reference_week, where) -> dict[str, float]:
     }
 
 
-def _nearest(reference: float, seconds_of_week: float) -> float:
-    """The GPS time with the given second of week nearest to ``reference``."""
+def time_of_week_near(reference: float, seconds_of_week: float) -> float:
+    """The time with the given second of week nearest to ``reference`` (any system's time
+    counted in weeks from its own origin)."""
     delta = seconds_of_week - np.mod(reference, SECONDS_PER_WEEK)
     delta -= SECONDS_PER_WEEK * np.round(delta / SECONDS_PER_WEEK)
     return float(reference + delta)

@@ -1,7 +1,7 @@
 """One entry for GNSS observation files of any supported format, recognised by content.
 
 - u-blox UBX (binary, a ``B5 62`` sync in the first 4 KiB, not text) → :mod:`.ubx`, with the
-  GPS and GLONASS ephemerides decoded from its RXM-SFRBX subframes and strings;
+  ephemerides decoded from its RXM-SFRBX navigation data (GPS, QZSS, Galileo, BeiDou, GLONASS);
 - Android GnssLogger text (a ``# Raw,`` header line or ``Raw,`` rows) → :mod:`.android`;
 - GSDC ``device_gnss.csv`` (first line ``MessageType,…`` with the derived columns) →
   :mod:`.gsdc` (its satellite states are not returned here: use ``read_device_gnss``);

@@ -47,15 +47,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from vo_doppler.io.glonass_strings import GlonassAssembler, sfrbx_string
-from vo_doppler.io.gps_lnav import KEPLER_NAMES, LnavAssembler, subframe_id
-from vo_doppler.io.rinex_common import prn_in_range
+from vo_doppler.io.gps_lnav import KEPLER_NAMES
 from vo_doppler.io.rinex_nav import KEPLER_FIELDS
-from vo_doppler.io.rinex_write import GlonassRecord, KeplerRecord
+from vo_doppler.io.rinex_write import GLONASS_RECORD_FIELDS, GlonassRecord, KeplerRecord
 from vo_doppler.io.rosbag_bag import Bag
 from vo_doppler.io.rosbag_types import field as get
 from vo_doppler.io.rosbag_types import has_field
-from vo_doppler.io.ubx import SYSTEMS, VALUE_RANGES, _RawxRows
+from vo_doppler.io.sfrbx import SfrbxMessage, decode_sfrbx
+from vo_doppler.io.ubx import VALUE_RANGES, _RawxRows
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, SECONDS_PER_WEEK, gps_minus_utc
 from vo_doppler.model.observations import Observations
@@ -128,14 +127,6 @@ GLONASS_BANDS = {"1": (1602.0e6, 0.5625e6), "2": (1246.0e6, 0.4375e6)}
 DEFAULT_ATTRIBUTE = {"1": "C", "2": "C", "5": "Q", "6": "C", "7": "Q", "8": "Q", "9": "A"}
 DEFAULT_ATTRIBUTE_BDS = {"2": "I", "7": "I", "6": "I", "1": "P", "5": "P"}
 FREQUENCY_TOLERANCE_HZ = 1.0e5
-SYSTEM_NAMES = {
-    "S": "SBAS",
-    "E": "Galileo",
-    "C": "BeiDou",
-    "J": "QZSS",
-    "R": "GLONASS",
-    "I": "NavIC",
-}
 FIT_HOURS = {"G": 4.0, "J": 4.0}
 """The fit interval GnssEphemMsg does not carry: 4 h, the normal one (fit flag 0, IS-GPS-200
 sec. 20.3.3.4.3.1; IS-QZSS the same)."""
@@ -514,56 +505,27 @@ def read_ublox(bag: Bag, rawx_topic: str, sfrbx_topic: str | None) -> BagGnss:
 
 
 def _sfrbx_ephemerides(bag: Bag, topic: str, week: int | None, reference: float, problems):
-    """GPS LNAV and GLONASS ephemerides of the RxmSFRBX topic (module docstring)."""
-    assembler = LnavAssembler.new()
-    glonass = GlonassAssembler(reference)
-    n_other = n_slot = 0
-    foreign: dict[str, int] = {}
+    """The broadcast ephemerides of the RxmSFRBX topic (:mod:`vo_doppler.io.sfrbx`, as the UBX
+    reader decodes them), problems named by message index."""
+    messages = []
     for index, _, message in bag.messages(topic):
-        words = [int(w) for w in np.asarray(get(message, "dwrd", ()), dtype=np.int64).ravel()]
-        gnss = int(get(message, "gnssId", 0))
-        if gnss == 6 and len(words) >= 3:
-            slot, signal = int(get(message, "svId", 0)), int(get(message, "sigId", 0) or 0)
-            if prn_in_range("R", slot):
-                channel = int(get(message, "freqId", 0)) - 7
-                glonass.add(slot, channel, sfrbx_string(words), index, signal)
-            else:
-                n_slot += 1
-            continue
-        if gnss != 0:
-            system = SYSTEMS.get(gnss, f"gnssId {gnss}")
-            foreign[system] = foreign.get(system, 0) + 1
-            continue
-        if len(words) != 10 or int(get(message, "sigId", 0) or 0) != 0:
-            n_other += 1
-            continue
-        data = tuple((w >> 6) & 0xFFFFFF for w in words)
-        if subframe_id(data) in (1, 2, 3):
-            assembler.add(int(get(message, "svId", 0)), data, week, index)
-        else:
-            n_other += 1
-    if n_other:
-        problems.append(f"{topic}: {n_other} GPS subframes without ephemeris (4-5, L2C, L5)")
-    if n_slot:
-        problems.append(f"{topic}: {n_slot} GLONASS strings of an unknown slot skipped")
-    if glonass.rejected:
-        index, slot, why = glonass.rejected[0]
-        problems.append(
-            f"{topic}: {len(glonass.rejected)} GLONASS strings or ephemerides refused (the "
-            f"first: message {index}, R{slot:02d}, {why})"
-        )
-    if foreign:
-        counts = ", ".join(f"{n} {SYSTEM_NAMES.get(s, s)}" for s, n in sorted(foreign.items()))
-        problems.append(
-            f"{topic}: navigation data of other systems not decoded ({counts} messages; only "
-            "GPS LNAV and GLONASS are): those satellites have no ephemeris in the sequence, so "
-            "their measurements are not used; add a RINEX navigation file of the day to "
-            "gnss.nav for them"
-        )
-    records = assembler.navrecords()
+        words = tuple(int(w) for w in np.asarray(get(message, "dwrd", ()), dtype=np.int64).ravel())
+        number = [int(get(message, name, 0) or 0) for name in ("gnssId", "svId", "sigId", "freqId")]
+        messages.append(SfrbxMessage(index, *number, words))
+    decoded = decode_sfrbx(messages, week, reference)
+    for index, text in decoded.problems:
+        where = topic if index is None else f"{topic}, message {index}"
+        problems.append(f"{where}: {text}")
+    kepler = decoded.kepler
     out: list[KeplerRecord | GlonassRecord] = []
-    for k in range(len(records)):
-        params = {name: float(records[name][k]) for name in KEPLER_NAMES if name != "toe"}
-        out.append(KeplerRecord("G", int(records.prn[k]), float(records.toc[k]), params))
-    out.extend(GlonassRecord(slot, toc, params) for slot, toc, params, _ in glonass.records)
+    for k in range(len(kepler)):
+        params = {name: float(kepler[name][k]) for name in KEPLER_NAMES if name != "toe"}
+        system, toc = str(kepler.system[k]), float(kepler.toc[k])
+        if system == "C":
+            toc += BDT_MINUS_GPST_S  # RINEX writes BeiDou epochs on BDT
+        out.append(KeplerRecord(system, int(kepler.prn[k]), toc, params))
+    glonass = decoded.glonass
+    for k in range(len(glonass)):
+        params = {name: float(glonass[name][k]) for line in GLONASS_RECORD_FIELDS for name in line}
+        out.append(GlonassRecord(int(glonass.prn[k]), float(glonass.toc[k]), params))
     return out

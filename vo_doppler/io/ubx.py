@@ -1,5 +1,5 @@
-"""u-blox UBX binary logs (pyubx2): raw measurements, GPS and GLONASS ephemerides, the receiver's
-own fixes.
+"""u-blox UBX binary logs (pyubx2): raw measurements, GPS, QZSS, Galileo, BeiDou and GLONASS
+ephemerides, the receiver's own fixes.
 
 Framing (u-blox interface description, "UBX frame structure"): sync 0xB5 0x62, class, id,
 little-endian length, payload, 8-bit Fletcher checksum over class…payload. The stream is
@@ -21,15 +21,15 @@ Physical bounds come from :mod:`vo_doppler.bounds`.
   Reported σ (prStdev 0.01·2ⁿ m, cpStdev 0.004·n cycles, doStdev 0.002·2ⁿ Hz) are kept as a
   :class:`RowSigma`. GLONASS channel k = freqId − 7; rows
   with an unknown GLONASS slot (svId 255) are skipped.
-- RXM-SFRBX → GPS L1 C/A LNAV subframes 1–3 decoded into ephemerides
-  (:mod:`vo_doppler.io.gps_lnav`); the data bits of each word are bits 29…6 of ``dwrd``, its
-  parity bits 5…0: a subframe failing the LNAV parity check is skipped, and so is an ephemeris
-  off any GPS orbit (both named by byte offset in ``problems``); GLONASS strings 1–4
-  (the first three words of ``dwrd``, ``svId`` the slot, ``freqId`` − 7 the frequency number)
-  decoded into GLONASS records (:mod:`vo_doppler.io.glonass_strings`), their day from the first
-  RXM-RAWX epoch (or NAV-PVT fix); refused strings and records counted in one problem.
-  Not decoded: GPS subframes 4–5 (almanac, ionosphere, UTC), and every other system's
-  navigation data (Galileo I/NAV, BeiDou D1/D2, QZSS, SBAS); they are counted.
+- RXM-SFRBX → broadcast ephemerides (:mod:`vo_doppler.io.sfrbx`, shared with the ROS bag
+  reader): GPS and QZSS LNAV subframes 1–3 (parity-checked; their week from RXM-RAWX or NAV-PVT),
+  Galileo I/NAV words 1–5 (E1-B and E5b-I pages, CRC-checked), BeiDou D1 subframes 1–3 of the
+  MEO/IGSO satellites (BCH-checked), GLONASS strings 1–4 (their day from the first RXM-RAWX
+  epoch or NAV-PVT fix). A refused subframe, page or string, or an ephemeris off its system's
+  orbits, is named by byte offset in ``problems`` (GPS and QZSS one by one, the others counted
+  with the first named). Not decoded, counted: GPS/QZSS subframes 4–5 (almanac, ionosphere,
+  UTC), BeiDou GEO (D2) and almanac subframes, Galileo alert pages, and every other system's or
+  signal's navigation data (SBAS, NavIC, CNAV, F/NAV).
 - NAV-PVT → :class:`ReceiverSolution`; the time is the GPS time whose second of week is iTOW,
   nearest to the message's UTC date and time plus the leap seconds of that date; a message
   whose two times disagree by more than 2 s, or without a valid date, is skipped, and so is one
@@ -60,13 +60,12 @@ from vo_doppler.bounds import (
     VELOCITY_COMPONENT,
 )
 from vo_doppler.errors import InputError
-from vo_doppler.io.glonass_strings import GlonassAssembler, sfrbx_string
-from vo_doppler.io.gps_lnav import LnavAssembler, parity_error, subframe_id
 from vo_doppler.io.obs_rows import observations_from_rows
 from vo_doppler.io.rinex_common import prn_in_range
+from vo_doppler.io.sfrbx import SYSTEMS, SfrbxMessage, decode_sfrbx
 from vo_doppler.io.textfile import regular_file
 from vo_doppler.model.gpstime import SECONDS_PER_WEEK, calendar_to_gps_seconds, utc_to_gps_seconds
-from vo_doppler.model.navigation import Navigation, NavRecords
+from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.receiver_solution import ReceiverSolution
 from vo_doppler.model.row_sigma import RowSigma
@@ -77,7 +76,6 @@ SYNC = b"\xb5\x62"
 RAWX = (0x02, 0x15)
 SFRBX = (0x02, 0x13)
 PVT = (0x01, 0x07)
-SYSTEMS = {0: "G", 1: "S", 2: "E", 3: "C", 5: "J", 6: "R", 7: "I"}
 SIGNAL_CODES: dict[tuple[int, int], str] = {
     # (gnssId, sigId) → RINEX 3 band + attribute (u-blox F9 interface description, signal table)
     (0, 0): "1C",
@@ -136,7 +134,7 @@ _PARSE_ERRORS = (UBXParseError, UBXMessageError, UBXTypeError, ValueError, struc
 
 @dataclass(frozen=True)
 class UbxRecording:
-    """What a UBX log holds: observations (None without RXM-RAWX), GPS and GLONASS ephemerides, the
+    """What a UBX log holds: observations (None without RXM-RAWX), broadcast ephemerides, the
     receiver's fixes, the receiver-reported σ per observation row, and skipped-data messages."""
 
     observations: Observations | None
@@ -270,9 +268,7 @@ def _read_stream(stream: BinaryIO, path: Path) -> UbxRecording:
     problems: list[str] = []
     raw = _RawxRows()
     pvt: list[dict[str, float]] = []
-    subframes: list[tuple[int, int, tuple[int, ...]]] = []
-    strings: list[tuple[int, int, int, int, int]] = []
-    n_other_nav = 0
+    navigation_data: list[SfrbxMessage] = []
     for offset, cls, mid, frame in frames(stream, path, problems):
         if (cls, mid) not in (RAWX, SFRBX, PVT):
             continue
@@ -291,26 +287,18 @@ def _read_stream(stream: BinaryIO, path: Path) -> UbxRecording:
             fix = _pvt_fields(message, offset, path, problems)
             if fix is not None and _in_order(pvt, fix["t"], offset, path, problems):
                 pvt.append(fix)
-        elif message.gnssId == 0 and message.numWords == 10 and message.sigId == 0:
-            words30 = tuple(getattr(message, f"dwrd_{k:02d}") & 0x3FFFFFFF for k in range(1, 11))
-            word = parity_error(words30)
-            if word is not None or not prn_in_range("G", message.svId):
-                why = f"word {word} fails the LNAV parity check" if word else "no GPS satellite"
-                _problem(problems, path, offset, f"GPS subframe of SV {message.svId}: {why}")
-                continue
-            subframes.append((offset, message.svId, tuple(w >> 6 for w in words30)))
-        elif message.gnssId == 6 and message.numWords >= 3:
-            words = [getattr(message, f"dwrd_{k:02d}") for k in range(1, 4)]
-            string = sfrbx_string(words)
-            strings.append((offset, message.svId, message.freqId - 7, message.sigId, string))
         else:
-            n_other_nav += 1
-    if not (raw.time or pvt or subframes or strings):
+            words = tuple(getattr(message, f"dwrd_{k:02d}") for k in range(1, message.numWords + 1))
+            navigation_data.append(
+                SfrbxMessage(
+                    offset, message.gnssId, message.svId, message.sigId, message.freqId, words
+                )
+            )
+    if not (raw.time or pvt or navigation_data):
         raise InputError("no UBX RXM-RAWX, RXM-SFRBX or NAV-PVT message", path)
     week = raw.week if raw.week is not None else _week_of(pvt)
     reference = raw.time[0] if raw.time else (pvt[0]["t"] if pvt else None)
-    glonass = _glonass(strings, reference, path, problems)
-    navigation = _navigation(subframes, week, path, problems, n_other_nav, glonass)
+    navigation = _navigation(navigation_data, week, reference, path, problems)
     observations = raw.observations(path, problems) if raw.time else None
     return UbxRecording(
         observations, navigation, _solution(pvt), raw.sigma(), tuple(problems), path
@@ -513,56 +501,13 @@ def _solution(pvt: list[dict[str, float]]) -> ReceiverSolution:
     )
 
 
-def _glonass(strings, reference: float | None, path: Path, problems) -> NavRecords:
-    """GLONASS ephemerides from the strings (their day needs a GPS time from RAWX or NAV-PVT);
-    refused strings and records counted in one problem naming the first."""
-    assembler = GlonassAssembler(np.nan if reference is None else reference)
-    if strings and reference is None:
-        _problem(problems, path, strings[0][0], "GLONASS strings without a GPS time: not decoded")
-        strings = []
-    n_slot = 0
-    for offset, slot, channel, signal, string in strings:
-        if prn_in_range("R", slot):
-            assembler.add(slot, channel, string, offset, signal)
-        else:
-            n_slot += 1
-    if n_slot:
-        _problem(problems, path, 0, f"{n_slot} GLONASS strings of an unknown slot skipped")
-    if assembler.rejected:
-        offset, slot, why = assembler.rejected[0]
-        _problem(
-            problems,
-            path,
-            offset,
-            f"{len(assembler.rejected)} GLONASS strings or ephemerides refused (the first: "
-            f"R{slot:02d}, {why})",
-        )
-    return assembler.navrecords()
-
-
 def _navigation(
-    subframes, week: int | None, path: Path, problems, n_other: int, glonass: NavRecords
+    messages: list[SfrbxMessage], week: int | None, reference: float | None, path: Path, problems
 ) -> Navigation:
-    """GPS ephemerides from the LNAV subframes (needs a full week from RAWX or NAV-PVT) and the
-    GLONASS ones."""
-    assembler = LnavAssembler.new()
-    n_not_ephemeris = 0
-    if subframes and week is None:
-        _problem(problems, path, subframes[0][0], "GPS subframes without a week: not decoded")
-        subframes = []
-    for offset, prn, words in subframes:
-        if subframe_id(words) in (1, 2, 3):
-            assembler.add(prn, words, week, offset)
-        else:
-            n_not_ephemeris += 1
-    for offset, prn, why in assembler.rejected:
-        _problem(problems, path, offset, f"GPS ephemeris of G{prn:02d} off any GPS orbit: {why}")
-    if n_not_ephemeris or n_other:
-        _problem(
-            problems,
-            path,
-            0,
-            f"not decoded: {n_not_ephemeris} GPS subframes 4-5 or without preamble, "
-            f"{n_other} navigation messages of other systems or signals",
-        )
-    return Navigation(assembler.navrecords(), glonass, problems=tuple(problems))
+    """The ephemerides of the RXM-SFRBX messages (:mod:`vo_doppler.io.sfrbx`: GPS and QZSS need
+    a full week, GLONASS a GPS time, from RXM-RAWX or NAV-PVT), their problems named by byte
+    offset."""
+    decoded = decode_sfrbx(messages, week, reference)
+    for offset, text in decoded.problems:
+        _problem(problems, path, 0 if offset is None else offset, text)
+    return Navigation(decoded.kepler, decoded.glonass, problems=tuple(problems))
