@@ -9,7 +9,10 @@ from __future__ import annotations
 import subprocess
 import sys
 
+from tests.conftest import REPO_ROOT
 from vo_doppler.report.figure import new_figure
+
+SAMPLE = REPO_ROOT / "sample_sequences" / "urban_canyon_small"
 
 HEAVY = ("cv2", "pycolmap", "matplotlib", "scipy.stats", "filterpy")
 MAIN_JOB = (
@@ -33,6 +36,19 @@ def loaded_after_import(modules: tuple[str, ...]) -> list[str]:
 
 def test_the_main_job_imports_no_opencv_pycolmap_matplotlib_or_scipy_stats():
     assert loaded_after_import(MAIN_JOB) == []
+
+
+def test_reading_a_sequence_with_a_camera_loads_no_opencv():
+    """The image size is checked against the calibration from the first image's header
+    (``io.image_header``): OpenCV loads with the VO, not while the GNSS and heading stages run
+    (24 MiB less resident through them)."""
+    code = (
+        "import sys\nfrom vo_doppler.io.sequence import read_sequence\n"
+        f"sequence = read_sequence({str(SAMPLE)!r})\n"
+        "print(len(sequence.image_paths), sequence.camera.width, 'cv2' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.split() == ["570", "640", "False"]
 
 
 def test_the_check_sees_a_heavy_import():

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.image_header import image_size
 from vo_doppler.io.textfile import read_text
 from vo_doppler.model.camera import Camera
 
@@ -70,19 +71,31 @@ def decode_image(path: Path) -> tuple[np.ndarray | None, str]:
 def check_image_size(camera: Camera, images: list[Path], calibration: str | Path) -> None:
     """Raise an :class:`InputError` naming the ``calibration`` file, the first image and both
     sizes when the images are not of the size the calibration states
-    (:meth:`~vo_doppler.model.camera.Camera.size_mismatch`): checked on the first image that
-    decodes (of the first :data:`MAX_SIZE_PROBES`), before any work; the VO checks every frame
-    again."""
+    (:meth:`~vo_doppler.model.camera.Camera.size_mismatch`): checked on the first image whose
+    size is known (of the first :data:`MAX_SIZE_PROBES`), before any work; the VO checks every
+    frame again."""
     if not (camera.width and camera.height):
         return
     for path in images[:MAX_SIZE_PROBES]:
-        image, _ = decode_image(path)  # an unreadable one is the VO's to flag
-        if image is None:
+        size = probe_size(path)
+        if size is None:  # an unreadable one is the VO's to flag
             continue
-        mismatch = camera.size_mismatch(image.shape[1], image.shape[0])
+        mismatch = camera.size_mismatch(*size)
         if mismatch:
             raise InputError(f"{mismatch} (first image {path})", calibration)
         return
+
+
+def probe_size(path: Path) -> tuple[int, int] | None:
+    """(width, height) of the image ``path`` as the VO will decode it: from a PNG or JPEG
+    header (:func:`~vo_doppler.io.image_header.image_size`, so that OpenCV loads with the VO,
+    not with the reader), otherwise, or when that header is damaged, from decoding the image
+    (:func:`decode_image`); None when it does not decode."""
+    try:
+        return image_size(path)
+    except InputError:
+        image, _ = decode_image(path)
+        return None if image is None else (image.shape[1], image.shape[0])
 
 
 MAX_SIZE_PROBES = 5
