@@ -23,6 +23,7 @@ from tests.fuzz.gnss_families import register_gnss
 from tests.fuzz.import_families import register_imports
 from tests.fuzz.mutators import SHRINKING
 from tests.fuzz.rosbag_families import register_rosbag
+from tests.fuzz.sfrbx_families import register_sfrbx
 from tests.helpers.rinex_text import as_rinex4
 from tests.io.fuzz_families import register_all
 from vo_doppler.io.rinex_common import FIRST_YEAR, LAST_YEAR, PRN_RANGE
@@ -303,3 +304,4 @@ register_gnss(register, Family, Seed, check_observations, check_navigation)  # S
 register_imports(register, Family, Seed, check_observations, same_observations)  # smartLoc …
 register_rosbag(register, Family, Seed, check_observations)  # ROS 1 .bag, ROS 2 .mcap/.db3
 register_bounds(FAMILIES, register, Family, Seed, check_observations, check_navigation)
+register_sfrbx(register, Family, Seed, check_observations, check_navigation)  # Galileo, BeiDou

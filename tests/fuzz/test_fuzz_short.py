@@ -16,7 +16,7 @@ SHORT_CASES = 20
 
 @pytest.mark.slow
 def test_short_fuzz_of_every_reader_family():
-    """20 mutated files of every registered family (560 with the shared data, 380 without the
+    """20 mutated files of every registered family (600 with the shared data, 420 without the
     families seeded from it): each read plausibly or refused with the project's error naming
     the file, within 500 MB. The 5-s limit is ``make fuzz``'s (tests do not depend on timing: a
     loaded machine may be slow); a case killed at the runner's hard timeout still fails."""

@@ -128,6 +128,15 @@ def test_an_orbit_no_beidou_satellite_flies_is_refused(change):
     assert assembler.rejected[0][2].startswith(f"{next(iter(change))} = ")
 
 
+def test_a_week_past_the_years_rinex_holds_is_refused():
+    """BDT week 4905 (GPS week 6261, January 2100) and later: refused; week 4903 is read."""
+    assert len(_assemble(encode_subframes(EXAMPLE, 4903, SOW)).records) == 1
+    assembler = _assemble(encode_subframes(EXAMPLE, 4905, SOW))
+    assert assembler.records == [] and assembler.rejected == [
+        (202, 21, "BDT week 4905 is after 2099")
+    ]
+
+
 def test_geo_satellites_are_the_d2_ones():
     assert [p for p in range(1, 64) if is_geo(p)] == [1, 2, 3, 4, 5, 59, 60, 61, 62, 63]
 
@@ -149,7 +158,7 @@ EPHEMERIS = kepler_strategy(
 
 
 @settings(max_examples=150, deadline=None)
-@given(eph=EPHEMERIS, prn=st.integers(6, 58), wn=st.integers(0, 8191), sow=st.integers(0, 100_790))
+@given(eph=EPHEMERIS, prn=st.integers(6, 58), wn=st.integers(0, 4800), sow=st.integers(0, 100_790))
 def test_any_valid_ephemeris_comes_back_exactly(eph, prn, wn, sow):
     sow *= 6
     assembler = _assemble(encode_subframes(eph, wn, sow), prn=prn)

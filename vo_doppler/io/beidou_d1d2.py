@@ -22,7 +22,8 @@ significant bits of toe (toe in 2³ s), i0, C_ic, Ω-dot, C_is, IDOT, Ω0 and ω
 
 A record is made from subframes 1, 2 and 3 of one frame of a satellite (their SOW s, s + 6,
 s + 12: the ephemeris only changes between frames) whose orbit is a BeiDou orbit
-(:mod:`vo_doppler.bounds`); a repeated (PRN, AODE, toe) is made once. D1 is sent by PRN 6–58;
+(:mod:`vo_doppler.bounds`) and whose toe falls in the years RINEX holds (a 13-bit week reaches
+2163); a repeated (PRN, AODE, toe) is made once. D1 is sent by PRN 6–58;
 PRN 1–5 and 59–63 (GEO) send D2, whose ephemeris is spread over ten pages of subframe 1 at
 0.6 s: not decoded (counted by the caller).
 
@@ -48,7 +49,8 @@ from vo_doppler.io.gps_lnav import (
     time_of_week_near,
 )
 from vo_doppler.io.nav_fields import ICD_PI, Field, read_fields
-from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, SECONDS_PER_WEEK
+from vo_doppler.io.rinex_common import LAST_YEAR
+from vo_doppler.model.gpstime import BDT_MINUS_GPST_S, SECONDS_PER_WEEK, calendar_to_gps_seconds
 from vo_doppler.model.navigation import NavRecords
 
 PREAMBLE = 0b11100010010
@@ -57,6 +59,8 @@ BDT_WEEK_OFFSET = 1356
 BCH_GENERATOR = 0b10011
 INFO_BITS = 26 + 9 * 22
 SUBFRAME_S = 6.0
+LATEST_GPS_S = float(calendar_to_gps_seconds(LAST_YEAR + 1, 1, 1, 0, 0, 0))
+"""The end of the years a RINEX file holds: a 13-bit BDT week reaches 2163."""
 BEIDOU_ORBIT = (
     ("sqrt_a", BEIDOU_SQRT_A),
     ("e", BEIDOU_ECCENTRICITY),
@@ -219,6 +223,9 @@ class D1Assembler:
             return
         sent = one["wn"] * SECONDS_PER_WEEK + one["sow"]
         toe = time_of_week_near(sent, toe_sow)
+        if bdt_to_gps(toe) >= LATEST_GPS_S:
+            self.rejected.append((where, prn, f"BDT week {int(one['wn'])} is after {LAST_YEAR}"))
+            return
         merged = one | two | three
         self.records.append(
             {name: merged[name] for name in KEPLER_NAMES if name in merged}
