@@ -13,8 +13,8 @@ Topics (ROS times are the GPS times as Unix UTC times: GPS − 315964800 s − t
   the wheel speed);
 - raw GNSS, ``gnss_comm`` (``/gnss/meas`` GnssMeasMsg per epoch, ``/gnss/ephem`` GnssEphemMsg,
   ``/gnss/iono`` StampedFloat64Array) or ``ublox_msgs`` (``/ublox/rxmraw`` RxmRAWX per epoch,
-  ``/ublox/rxmsfrb`` RxmSFRBX: GPS LNAV subframes 1–3 of each GPS ephemeris, GLONASS strings
-  1–4 of each GLONASS one); a GNSS message's
+  ``/ublox/rxmsfrb`` RxmSFRBX: GPS LNAV subframes 1–3 of each GPS ephemeris, Galileo I/NAV
+  words 1–5 of each Galileo one, GLONASS strings 1–4 of each GLONASS one); a GNSS message's
   receive time is its epoch + ``GNSS_LATENCY_S``;
 - ``/fix`` (NavSatFix of the GNSS antenna on the ground truth, every 10th pose: its first is
   the simulator's RINEX approximate position) and ``/ground_truth`` (Odometry in the ENU frame
@@ -31,6 +31,8 @@ from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Writer2
 from scipy.spatial.transform import Rotation
 
+from tests.helpers.galileo_inav import encode_ephemeris as galileo_words
+from tests.helpers.galileo_inav import sfrbx_words as galileo_page
 from tests.helpers.glonass_strings import encode_strings, sfrbx_words
 from tests.helpers.lnav import encode_ephemeris, with_parity
 from vo_doppler.geo import ecef_to_geodetic
@@ -482,13 +484,20 @@ def lnav_dict(kepler, k: int) -> dict[str, float]:
 
 
 def _sfrbx(out: SmallBag, nav) -> None:
-    """GPS LNAV subframes 1–3 of each GPS record and GLONASS strings 1–4 of each GLONASS one,
-    sent from 30 s before its reference time, a subframe or string a second."""
+    """GPS LNAV subframes 1–3 of each GPS record, Galileo I/NAV words 1–5 of each Galileo one
+    (word 5's GST 10 min before toe) and GLONASS strings 1–4 of each GLONASS one, sent from 30 s
+    before its reference time, a subframe, page or string a second."""
     kepler = nav.kepler
     for k in np.flatnonzero(kepler.system == "G"):
         t = float(kepler.toc[k])
         for n, words in enumerate(encode_ephemeris(lnav_dict(kepler, k), int(t % 604800) // 6)):
             ublox_sfrbx(out, t + n, 0, int(kepler.prn[k]), 0, with_parity(words))
+    for k in np.flatnonzero(kepler.system == "E"):
+        t, svid = float(kepler.toc[k]), int(kepler.prn[k])
+        eph = {name: float(values[k]) for name, values in kepler.params.items()}
+        eph["toc_sow"] = t % SECONDS_PER_WEEK
+        for n, word in enumerate(galileo_words(svid, eph, t - 600.0)):
+            ublox_sfrbx(out, t - 30.0 + n, 2, svid, 0, galileo_page(word))
     glonass = nav.glonass
     for k in range(len(glonass)):
         params = {name: float(values[k]) for name, values in glonass.params.items()}

@@ -13,6 +13,7 @@ import pytest
 import yaml
 
 from tests.helpers.batch import tiny_drive
+from tests.helpers.galileo_inav import quantised as galileo_quantised
 from tests.helpers.lnav import quantised
 from tests.helpers.rosbag_writer import GNSS_LATENCY_S, lnav_dict, write_bag
 from vo_doppler.cli import main
@@ -160,8 +161,8 @@ def _rows(obs, code: str) -> dict[tuple[float, str], float]:
 
 @pytest.mark.slow
 def test_ublox_observations_at_message_precision(drive, imported):
-    """RxmRAWX carries the Doppler as float32 and C/N0 as whole dB-Hz; GPS ephemerides come
-    back as LNAV subframes carry them."""
+    """RxmRAWX carries the Doppler as float32 and C/N0 as whole dB-Hz; GPS and Galileo
+    ephemerides come back as LNAV subframes and I/NAV pages carry them."""
     original = read_obs(drive / "gnss/rover.obs")
     for name in ("ublox_ros1", "ublox_mcap"):
         back = read_obs(imported[name][0] / "gnss/rover.obs")
@@ -175,11 +176,17 @@ def test_ublox_observations_at_message_precision(drive, imported):
             assert _rows(back, code) == want, code
         nav = read_nav(drive / "gnss/brdc.nav").kepler
         nav_back = read_nav(imported[name][0] / "gnss/brdc.nav").kepler
-        gps = np.flatnonzero(nav.system == "G")
-        assert len(nav_back) == gps.size > 0 and set(nav_back.system) == {"G"}
-        for k, row in zip(gps, range(len(nav_back)), strict=True):
+        gps, galileo = np.flatnonzero(nav.system == "G"), np.flatnonzero(nav.system == "E")
+        assert len(nav_back) == gps.size + galileo.size and gps.size > 0 and galileo.size > 0
+        assert nav_back.system.tolist() == ["G"] * gps.size + ["E"] * galileo.size
+        for k, row in zip(gps, range(gps.size), strict=True):
             want = quantised(lnav_dict(nav, k))
             for key in ("sqrt_a", "e", "m0", "omega0", "af0", "toe_sow"):
+                assert nav_back[key][row] == pytest.approx(want[key], rel=1e-12, abs=1e-20)
+        for k, row in zip(galileo, range(gps.size, len(nav_back)), strict=True):
+            want = galileo_quantised({key: float(v[k]) for key, v in nav.params.items()})
+            assert (nav_back.prn[row], nav_back.toc[row]) == (nav.prn[k], nav.toc[k])
+            for key in ("sqrt_a", "e", "m0", "omega0", "af0", "toe_sow", "tgd", "iodc"):
                 assert nav_back[key][row] == pytest.approx(want[key], rel=1e-12, abs=1e-20)
         assert (imported[name][0] / "gnss/doppler_sigma.csv").is_file()
 
