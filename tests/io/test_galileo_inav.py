@@ -140,9 +140,12 @@ def test_words_of_different_iodnav_are_not_combined():
     assert record["iode"] == 161.0 and record["m0"] == quantised({"m0": 1.0})["m0"]
 
 
-def test_a_repeated_set_is_one_record():
+def test_a_repeated_set_is_one_record_and_no_set_is_kept_once_used():
+    """A long recording repeats each set every 30 s: the assembler keeps only the words of the
+    sets not yet complete."""
     words = encode_ephemeris(11, EXAMPLE, GST)
-    assert len(_assemble(words + words + words).records) == 1
+    assembler = _assemble(words + words + words)
+    assert len(assembler.records) == 1 and assembler.sets == {11: {}}
 
 
 def test_alert_pages_are_skipped_and_counted():

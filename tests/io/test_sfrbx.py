@@ -23,6 +23,7 @@ from vo_doppler.io.gps_lnav import KEPLER_NAMES
 from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.io.rosbag_bag import Bag
 from vo_doppler.io.rosbag_gnss import read_ublox
+from vo_doppler.io.sfrbx import SfrbxMessage, decode_sfrbx
 from vo_doppler.io.ubx import read_ubx
 from vo_doppler.model.navigation import Navigation, NavRecords
 
@@ -260,3 +261,32 @@ def test_real_broadcast_records_come_back_through_pages_and_subframes(tmp_path):
         error = np.linalg.norm(ours.position - theirs.position, axis=1)
         assert error.max() <= 1e-3, (system, prn, error)
         np.testing.assert_allclose(ours.clock_bias_s, theirs.clock_bias_s, rtol=0, atol=1e-12)
+
+
+def test_what_is_not_decoded_is_counted_by_kind():
+    """A GPS L2C message and a 9-word BeiDou one are another signal or length of a decoded
+    system; SBAS and NavIC have no decoder here and their satellites no ephemeris, which the
+    problem says; BeiDou subframes 4–5 are almanac."""
+    almanac = bds.almanac_subframe(4, BDT_SOW + 18)
+    messages = [
+        SfrbxMessage(10, 0, 5, 4, 0, tuple(range(10))),
+        SfrbxMessage(11, 3, 21, 0, 0, tuple(range(9))),
+        SfrbxMessage(12, 1, 131, 0, 0, tuple(range(8))),
+        SfrbxMessage(13, 7, 2, 0, 0, tuple(range(10))),
+        SfrbxMessage(14, 3, 21, 0, 0, tuple(almanac)),
+    ]
+    decoded = decode_sfrbx(messages, WEEK, T0)
+    assert len(decoded.kepler) == len(decoded.glonass) == 0
+    assert decoded.problems == (
+        (
+            None,
+            "not decoded: 1 BeiDou almanac subframes 4-5, 1 BeiDou messages of other signals or "
+            "lengths, 1 GPS messages of other signals or lengths",
+        ),
+        (
+            None,
+            "navigation data not decoded (1 NavIC messages, 1 SBAS messages): those satellites "
+            "have no ephemeris in the sequence, so their measurements are not used; add a RINEX "
+            "navigation file of the day for them",
+        ),
+    )

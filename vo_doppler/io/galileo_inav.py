@@ -211,8 +211,9 @@ class InavAssembler:
     rejected: list[tuple[int, int, str]] = field(default_factory=list)
     """(where, SVID, why) of each refused page or word set."""
     n_alert: int = 0
-    sets: dict[tuple[int, int], dict[int, dict[str, float]]] = field(default_factory=dict)
-    """Words 1–4 per (SVID, IODnav), each with the signals of its pages."""
+    sets: dict[int, dict[int, dict[int, dict[str, float]]]] = field(default_factory=dict)
+    """Words 1–4 per SVID and IODnav, each with the signals of its pages, until they make a
+    record (or are refused)."""
     status: dict[int, dict[str, float]] = field(default_factory=dict)
     """Per SVID: the latest word 5 and the latest GST (from word 5 or 0)."""
     emitted: set[tuple[int, int, float]] = field(default_factory=set)
@@ -239,13 +240,15 @@ class InavAssembler:
             status |= fields
         if number in (0, 5) and (number == 5 or fields["time"] == 2):
             status["gst"] = (fields["wn"] + GST_WEEK_OFFSET) * SECONDS_PER_WEEK + fields["tow"]
+        sets = self.sets.setdefault(svid, {})
         if number in (1, 2, 3, 4):
-            words_of = self.sets.setdefault((svid, int(fields["iodnav"])), {})
+            words_of = sets.setdefault(int(fields["iodnav"]), {})
             words_of.setdefault(number, fields)
             words_of[number]["sources"] = int(words_of[number].get("sources", 0)) | 1 << 2 * signal
-        for (sv, iodnav), words_of in list(self.sets.items()):
-            if sv == svid and len(words_of) == 4 and "bgd_e5b" in status and "gst" in status:
-                self._record(svid, iodnav, words_of, status, where)
+        if "bgd_e5b" not in status or "gst" not in status:
+            return
+        for iodnav in [k for k, words_of in sets.items() if len(words_of) == 4]:
+            self._record(svid, iodnav, sets.pop(iodnav), status, where)
 
     def navrecords(self) -> NavRecords:
         """The records with the parameter names of the RINEX navigation reader."""

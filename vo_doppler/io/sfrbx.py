@@ -104,6 +104,8 @@ class _Decoder:
                 self.d1.add(m.sv, list(m.words), m.where)
         elif system == "R" and len(m.words) >= 3:
             self.glonass_string(m)
+        elif system in ("G", "J", "E", "C", "R"):
+            self.count(self.not_decoded, f"{NAMES[system]} messages of other signals or lengths")
         else:
             self.count(self.no_ephemeris, f"{NAMES.get(system, f'gnssId {m.gnss}')} messages")
 
