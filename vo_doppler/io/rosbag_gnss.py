@@ -33,12 +33,12 @@ satellite's entry): it is not in the observations. ``RxmRAWX`` carries its time:
 ``ublox_msgs``: ``RxmRAWX`` → rows exactly as the UBX log reader decodes RXM-RAWX
 (:mod:`vo_doppler.io.ubx`: signal codes, LLI from the lock time and half-cycle flag, the value
 ranges; a ROS 1 definition without ``sigId`` is read as signal 0, the L1 C/A of an M8);
-``RxmSFRBX`` → GPS LNAV subframes 1–3 decoded into ephemerides (:mod:`vo_doppler.io.gps_lnav`),
-the week from the RAWX messages, and GLONASS strings 1–4 (``gnssId`` 6, ``svId`` the slot,
-``freqId`` − 7 the frequency number) into GLONASS records
-(:mod:`vo_doppler.io.glonass_strings`), their day from the first RAWX epoch; other systems'
-navigation data (Galileo, BeiDou, QZSS, SBAS) are counted, not decoded;
-``doStdev`` (0.002·2ⁿ Hz) × wavelength → the Doppler σ.
+``RxmSFRBX`` → ephemerides by the UBX reader's decoder (:mod:`vo_doppler.io.sfrbx`): GPS and
+QZSS LNAV subframes 1–3 (the week from the RAWX messages), Galileo I/NAV words 1–5, BeiDou D1
+subframes 1–3 of the MEO/IGSO satellites (BeiDou epochs written back on BDT), GLONASS strings
+1–4 (``gnssId`` 6, ``svId`` the slot, ``freqId`` − 7 the frequency number; their day from the
+first RAWX epoch); refused data named by message index, what is not decoded (BeiDou GEO, SBAS,
+NavIC …) counted; ``doStdev`` (0.002·2ⁿ Hz) × wavelength → the Doppler σ.
 """
 
 from __future__ import annotations
