@@ -141,23 +141,32 @@ def yaw_about(rotation: Rotation, up: np.ndarray) -> np.ndarray:
     return np.arctan2(sin, rotated @ reference)
 
 
+SEGMENT_CHUNK = 4096
+"""Start frames whose relative poses :func:`segment_errors` computes at once: each start's
+error depends on its two poses alone, so the chunks give the same figures as one pass, in
+about 4 MiB per chunk instead of 0.9 kB per pose (35 MiB for 40,000 poses)."""
+
+
 def segment_errors(estimate: Trajectory, truth: Trajectory, lengths) -> list[SegmentError]:
     """KITTI-devkit relative errors for each segment length (every start frame used)."""
     distance = truth.cumulative_distance()
-    est, gt = estimate.matrices, truth.matrices
     results = []
     for length in lengths:
-        starts = np.arange(len(distance))
         ends = np.searchsorted(distance, distance + length, side="left")
-        keep = ends < len(distance)
-        starts, ends = starts[keep], ends[keep]
+        starts = np.flatnonzero(ends < len(distance))
         if starts.size == 0:
             continue
-        delta_gt = np.linalg.inv(gt[starts]) @ gt[ends]
-        delta_est = np.linalg.inv(est[starts]) @ est[ends]
-        error = np.linalg.inv(delta_gt) @ delta_est
-        t_err = np.linalg.norm(error[:, :3, 3], axis=1) / length
-        r_err = Rotation.from_matrix(error[:, :3, :3]).magnitude() / length
+        t_err, r_err = np.empty(starts.size), np.empty(starts.size)
+        for k in range(0, starts.size, SEGMENT_CHUNK):
+            part = slice(k, k + SEGMENT_CHUNK)
+            first, last = starts[part], ends[starts[part]]
+            delta_gt = np.linalg.inv(truth.subset(first).matrices) @ truth.subset(last).matrices
+            delta_est = (
+                np.linalg.inv(estimate.subset(first).matrices) @ estimate.subset(last).matrices
+            )
+            error = np.linalg.inv(delta_gt) @ delta_est
+            t_err[part] = np.linalg.norm(error[:, :3, 3], axis=1) / length
+            r_err[part] = Rotation.from_matrix(error[:, :3, :3]).magnitude() / length
         results.append(
             SegmentError(
                 length_m=float(length),
