@@ -27,6 +27,7 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.report.provenance import config_rows
 from vo_doppler.report.trajectory_map import lon_lat
 from vo_doppler.run import RunConfig, run_sequence
+from vo_doppler.run_stages import sequence_gnss, sequence_heading
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
 
@@ -268,3 +269,22 @@ def test_the_library_run_refuses_a_yaw_rate_of_the_wrong_sign_or_in_deg_per_s(tu
 
 def _scaled(series: SensorSeries, factor: float) -> SensorSeries:
     return SensorSeries(series.t, series.value * factor, series.name, series.unit)
+
+
+@pytest.mark.slow
+def test_the_run_lets_the_doppler_rows_go_once_the_heading_is_made(turning_drive):
+    """Issue 30: the Doppler rows (28 MiB on a 30-min drive at 20 Hz) were held through the VO
+    and the outputs, which never read them; the result keeps the GNSS stage's figures and the
+    counts of rows not formed, and the heading made from every row."""
+    drive = replace(turning_drive, camera=None)
+    config = RunConfig().for_sequence(drive)
+    gnss = sequence_gnss(drive, config)
+    assert len(gnss.rows) > 1000
+    result = run_sequence(drive)
+    assert len(result.gnss.rows) == 0 and result.gnss.rows.frame == gnss.rows.frame
+    assert result.gnss.rows.n_no_ephemeris == gnss.rows.n_no_ephemeris
+    assert result.gnss.rows.missing == gnss.rows.missing
+    np.testing.assert_array_equal(result.gnss.velocity.velocity_enu, gnss.velocity.velocity_enu)
+    table = sequence_heading(drive, gnss.rows, gnss.velocity, config.heading)
+    np.testing.assert_array_equal(result.heading.yaw_tc, table.yaw_tc)
+    np.testing.assert_array_equal(result.heading.sigma_tc, table.sigma_tc)
