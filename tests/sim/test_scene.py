@@ -47,3 +47,18 @@ def test_asphalt_scales_the_ground_contrast():
     asphalt = city_scene(4, ground_contrast=0.35, **SMALL).textures[0].astype(float)
     assert asphalt.mean() == pytest.approx(plain.mean(), abs=0.5)
     assert asphalt.std() == pytest.approx(0.35 * plain.std(), rel=0.01)
+
+
+def test_an_untextured_city_has_the_textured_citys_geometry():
+    """A simulation without images skips painting the textures (85 % of its time) but draws
+    their random numbers: every plane (corners, texture index, offset, gain) and building is
+    that of the textured city, with window facades too."""
+    for options in ({}, {"window_facades": 2}):
+        textured = city_scene(7, **SMALL, **options)
+        bare = city_scene(7, textured=False, **SMALL, **options)
+        assert bare.textures == [] and textured.textures
+        assert bare.buildings == textured.buildings and bare.layout == textured.layout
+        assert len(bare.planes) == len(textured.planes)
+        for a, b in zip(textured.planes, bare.planes, strict=True):
+            np.testing.assert_array_equal(a.corners, b.corners)
+            assert (a.texture, a.offset, a.gain, a.bias) == (b.texture, b.offset, b.gain, b.bias)

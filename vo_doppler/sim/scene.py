@@ -114,12 +114,22 @@ class Scene:
 
 def _pink_noise(size: int, rng: np.random.Generator, f_low: float, f_high: float) -> np.ndarray:
     """Periodic noise with a 1/f amplitude spectrum between f_low and f_high cycles/texel."""
+    return _pink_filter(_white(size, rng), f_low, f_high)
+
+
+def _white(size: int, rng: np.random.Generator) -> np.ndarray:
+    """Square white noise (float32) of the standard normal law."""
+    return rng.standard_normal((size, size)).astype(np.float32)
+
+
+def _pink_filter(white: np.ndarray, f_low: float, f_high: float) -> np.ndarray:
+    """:func:`_pink_noise` of the square white noise ``white``."""
+    size = white.shape[0]
     fy = np.fft.fftfreq(size)[:, None]
     fx = np.fft.rfftfreq(size)[None, :]
     radius = np.hypot(fy, fx)
     band = (radius >= f_low) & (radius <= f_high)
     amplitude = np.where(band, 1.0 / np.maximum(radius, 1e-9), 0.0)
-    white = rng.standard_normal((size, size)).astype(np.float32)
     noise = np.fft.irfft2(np.fft.rfft2(white) * amplitude, s=(size, size))
     return ((noise - noise.mean()) / (noise.std() + 1e-12)).astype(np.float32)
 
@@ -135,6 +145,25 @@ def _draw_wrapped_rect(canvas: np.ndarray, x: int, y: int, w: int, h: int, value
             cv2.rectangle(canvas, corner, (corner[0] + w - 1, corner[1] + h - 1), value, -1)
 
 
+def texture_draws(
+    size: int, rng: np.random.Generator, rect_coverage: float = 0.12, max_rect: float = 1 / 8
+) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray, np.ndarray]], np.ndarray]:
+    """The random numbers of one :func:`procedural_texture`, in the order it draws them: the
+    white noise of its blobs, each octave's rectangles (corners, sizes, grey levels) and the
+    white noise of its fine texture. An untextured city draws them without painting, so that
+    its buildings are those of the textured city of the same seed."""
+    blobs = _white(size, rng)
+    octaves = []
+    side = 4.0
+    while side <= max_rect * size:
+        count = int(rect_coverage * size * size / side**2)
+        xy = rng.integers(0, size, size=(count, 2))
+        wh = np.maximum((side * rng.uniform(0.5, 1.5, size=(count, 2))).astype(int), 2)
+        octaves.append((xy, wh, rng.uniform(0.0, 1.0, size=count)))
+        side *= 2.0
+    return blobs, octaves, _white(size, rng)
+
+
 def procedural_texture(
     size: int, rng: np.random.Generator, rect_coverage: float = 0.12, max_rect: float = 1 / 8
 ) -> np.ndarray:
@@ -146,19 +175,14 @@ def procedural_texture(
     level) add straight-edged corners; a little fine noise adds texture inside flat areas.
     Levels are stretched to 12..243.
     """
-    noise = _pink_noise(size, rng, 2.0 / size, 1.0 / 12.0)
+    blobs, octaves, fine = texture_draws(size, rng, rect_coverage, max_rect)
+    noise = _pink_filter(blobs, 2.0 / size, 1.0 / 12.0)
     levels = np.quantile(noise, [0.2, 0.4, 0.6, 0.8])
     tile = (np.digitize(noise, levels).astype(np.float32) / 4.0) * 0.8 + 0.1
-    side = 4.0
-    while side <= max_rect * size:
-        count = int(rect_coverage * size * size / side**2)
-        xy = rng.integers(0, size, size=(count, 2))
-        wh = np.maximum((side * rng.uniform(0.5, 1.5, size=(count, 2))).astype(int), 2)
-        values = rng.uniform(0.0, 1.0, size=count)
+    for xy, wh, values in octaves:
         for (x, y), (w, h), value in zip(xy.tolist(), wh.tolist(), values.tolist(), strict=True):
             _draw_wrapped_rect(tile, x, y, w, h, value)
-        side *= 2.0
-    tile += 0.05 * _pink_noise(size, rng, 0.1, 0.5)
+    tile += 0.05 * _pink_filter(fine, 0.1, 0.5)
     lo, hi = np.quantile(tile, [0.01, 0.99])
     return np.clip(12.0 + 231.0 * (tile - lo) / (hi - lo), 0, 255).round().astype(np.uint8)
 
@@ -286,6 +310,7 @@ def city_scene(
     ground_margin_m: float = 2000.0,
     window_facades: int = 0,
     ground_contrast: float = 1.0,
+    textured: bool = True,
 ) -> Scene:
     """A city of ``blocks_x × blocks_y`` building blocks on a street grid (deterministic per seed).
 
@@ -298,18 +323,27 @@ def city_scene(
     among all of them, roofs among the former (0, the default, gives the scene of earlier versions).
     ``ground_contrast`` scales the ground texture's grey levels about their mean (1: as drawn;
     worn asphalt is a low-contrast surface, about a third of the facades' contrast).
+    ``textured`` False leaves ``Scene.textures`` empty: the geometry alone (the same planes and
+    buildings), for a simulation that renders no image.
     """
     rng = np.random.default_rng(seed)
     ground_tile = 2 * tile_size
-    textures = [procedural_texture(ground_tile, rng, rect_coverage=0.1, max_rect=1 / 32)]
-    if ground_contrast != 1.0:
-        mean = float(textures[0].mean())
-        textures[0] = np.clip(mean + ground_contrast * (textures[0] - mean), 0, 255).round()
-        textures[0] = textures[0].astype(np.uint8)
-    textures += [procedural_texture(tile_size, rng) for _ in range(n_facade_textures)]
+    textures = []
+    if textured:
+        textures = [procedural_texture(ground_tile, rng, rect_coverage=0.1, max_rect=1 / 32)]
+        if ground_contrast != 1.0:
+            mean = float(textures[0].mean())
+            textures[0] = np.clip(mean + ground_contrast * (textures[0] - mean), 0, 255).round()
+            textures[0] = textures[0].astype(np.uint8)
+        textures += [procedural_texture(tile_size, rng) for _ in range(n_facade_textures)]
+    else:  # the same draws unpainted (85 % of a simulation without images): the same buildings
+        texture_draws(ground_tile, rng, rect_coverage=0.1, max_rect=1 / 32)
+        for _ in range(n_facade_textures):
+            texture_draws(tile_size, rng)
     # Window facades draw from their own stream, so the city is the same with or without them.
     window_rng = np.random.default_rng([seed, WINDOW_STREAM])
-    textures += [window_facade_texture(tile_size, window_rng) for _ in range(window_facades)]
+    windows = [window_facade_texture(tile_size, window_rng) for _ in range(window_facades)]
+    textures += windows if textured else []
     layout = CityLayout(blocks_x, blocks_y, block_size, street_width)
     px, py = layout.pitch
     extent = np.array([blocks_x * px, blocks_y * py])

@@ -292,7 +292,8 @@ class VehicleDrive:
 
 
 def build_city(config: UrbanCanyonConfig):
-    """The city scene of a configuration (``vo_doppler.sim.scene.city_scene``)."""
+    """The city scene of a configuration (``vo_doppler.sim.scene.city_scene``), untextured when
+    it renders no image."""
     city = config.city
     return city_scene(
         config.seed,
@@ -304,6 +305,7 @@ def build_city(config: UrbanCanyonConfig):
         buildings_per_side=city.buildings_per_side,
         window_facades=city.window_facades,
         ground_contrast=city.ground_contrast,
+        textured=config.render,
     )
 
 
