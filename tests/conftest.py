@@ -1,14 +1,26 @@
-"""Shared test fixtures: the real recordings folder, skipped cleanly when absent."""
+"""Shared test fixtures: the real recordings folder, skipped cleanly when absent, and the
+recordings and runs that several test files use, each built once per test process.
+
+With pytest-xdist every worker builds its own copy of a session fixture: the tests sharing one
+carry the same ``xdist_group`` mark (``--dist loadgroup`` in pyproject.toml's ``addopts``), so
+that one worker builds it once for all of them."""
 
 from __future__ import annotations
 
 import os
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
+if TYPE_CHECKING:
+    from vo_doppler.model.sequence import Sequence
+    from vo_doppler.run import RunResult
+
 REPO_ROOT = Path(__file__).resolve().parents[1]
+SAMPLE = REPO_ROOT / "sample_sequences" / "urban_canyon_small"
+"""The bundled sample: 38 s at 20 Hz with 570 images."""
 
 
 def shared_data_dir() -> Path:
@@ -38,6 +50,43 @@ def turning_drive_folder(tmp_path_factory) -> Path:
         duration_s=20.0, seed=1, render=False, gnss=replace(defaults.gnss, nlos=True)
     )
     folder = tmp_path_factory.mktemp("turning") / "s1"
+    simulate_urban_canyon(folder, config)
+    return folder
+
+
+@dataclass(frozen=True)
+class SampleRun:
+    """The bundled sample as read and its run with the default configuration."""
+
+    sequence: Sequence
+    result: RunResult
+
+
+@pytest.fixture(scope="session")
+def sample_run() -> SampleRun:
+    """``run_sequence(read_sequence(SAMPLE), RunConfig())``, every stage with the VO (about
+    30 s on a quiet core), once per test process: the README's first snippet makes this very
+    call and the time-origin test compares it with the shifted sample's run (group
+    ``time_origin``). Read-only."""
+    from vo_doppler.io.sequence import read_sequence
+    from vo_doppler.run import RunConfig, run_sequence
+
+    sequence = read_sequence(SAMPLE)
+    return SampleRun(sequence, run_sequence(sequence, RunConfig()))
+
+
+@pytest.fixture(scope="session")
+def drive_1hz_folder(tmp_path_factory) -> Path:
+    """The 90-s simulated canyon drive without images and with a 1-Hz receiver (seed 3), built
+    once per test process for the time-origin tests of the library and of the commands (group
+    ``time_origin``). Read-only: a test that changes the recording works on a copy."""
+    from vo_doppler.sim.gnss_observations import GnssSimConfig
+    from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+
+    folder = tmp_path_factory.mktemp("drive_1hz") / "drive"
+    config = UrbanCanyonConfig(
+        duration_s=90.0, seed=3, render=False, gnss=GnssSimConfig(rate_hz=1.0)
+    )
     simulate_urban_canyon(folder, config)
     return folder
 

@@ -20,7 +20,6 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tests.conftest import REPO_ROOT
 from tests.helpers.comma2k19 import imported_comma2k19
 from tests.helpers.time_shift import WEEKS_NEAR_1E9_S, shifted_sequence
 from vo_doppler.eval.pipelines import evaluate_pipelines
@@ -28,10 +27,8 @@ from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.run import RunConfig, RunResult, run_sequence
-from vo_doppler.sim.gnss_observations import GnssSimConfig
-from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("time_origin")]
 
 SHIFT = WEEKS_NEAR_1E9_S
 TOLERANCE = 1e-5
@@ -70,11 +67,14 @@ def errors_per_100m(result: RunResult, sequence: Sequence) -> dict[str, float]:
     return {name: e.error_per_100m_m for name, e in errors.items()}
 
 
-def assert_origin_free(sequence: Sequence, config: RunConfig | None = None) -> dict[str, float]:
-    """The run on ``sequence`` and on it shifted by :data:`SHIFT` agree; the errors per 100 m
-    of the first."""
+def assert_origin_free(
+    sequence: Sequence, config: RunConfig | None = None, first: RunResult | None = None
+) -> dict[str, float]:
+    """The run on ``sequence`` (``first``, when already made) and on it shifted by
+    :data:`SHIFT` agree; the errors per 100 m of the first."""
     shifted = shifted_sequence(sequence, SHIFT)
-    first, second = run_sequence(sequence, config), run_sequence(shifted, config)
+    first = first or run_sequence(sequence, config)
+    second = run_sequence(shifted, config)
     assert_same_arrays("velocity", first.gnss.velocity, second.gnss.velocity)
     assert_same_arrays("heading", first.heading, second.heading)
     np.testing.assert_array_equal(first.tc_usable, second.tc_usable)
@@ -91,9 +91,8 @@ def assert_origin_free(sequence: Sequence, config: RunConfig | None = None) -> d
     return errors
 
 
-def test_the_sample_runs_the_same_at_another_time_origin():
-    sequence = read_sequence(REPO_ROOT / "sample_sequences" / "urban_canyon_small")
-    errors = assert_origin_free(sequence)
+def test_the_sample_runs_the_same_at_another_time_origin(sample_run):
+    errors = assert_origin_free(sample_run.sequence, first=sample_run.result)
     assert {"vo", "vo_gps_tc", "dr_gps_tc"} <= errors.keys()
 
 
@@ -103,12 +102,8 @@ def test_the_comma2k19_minute_runs_the_same_at_another_time_origin(tmp_path_fact
 
 
 @pytest.mark.parametrize("method", ["snooping", "robust"])
-def test_a_1hz_drive_runs_the_same_at_another_time_origin(method, tmp_path):
-    config = UrbanCanyonConfig(
-        duration_s=90.0, seed=3, render=False, gnss=GnssSimConfig(rate_hz=1.0)
-    )
-    simulate_urban_canyon(tmp_path / "drive", config)
-    sequence = read_sequence(tmp_path / "drive")
+def test_a_1hz_drive_runs_the_same_at_another_time_origin(method, drive_1hz_folder):
+    sequence = read_sequence(drive_1hz_folder)
     heading = HeadingPipelineConfig.robust() if method == "robust" else HeadingPipelineConfig()
     errors = assert_origin_free(sequence, RunConfig(heading=heading))
     assert {"dr", "dr_gps_conv", "dr_gps_tc"} <= errors.keys()

@@ -35,24 +35,17 @@ from vo_doppler.model.gnss_solutions import SppSolution
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.run import run_sequence
-from vo_doppler.sim.gnss_observations import GnssSimConfig
 from vo_doppler.sim.two_gyro import TwoGyroSpec, generate_two_gyro, write_two_gyro
-from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("time_origin")]
 
 SHIFT = WEEKS_NEAR_1E9_S
 ORIGINS = {"own": 0.0, "shifted": SHIFT}
 
 
 @pytest.fixture(scope="module")
-def drive_1hz(tmp_path_factory) -> Sequence:
-    folder = tmp_path_factory.mktemp("drive_1hz") / "drive"
-    config = UrbanCanyonConfig(
-        duration_s=90.0, seed=3, render=False, gnss=GnssSimConfig(rate_hz=1.0)
-    )
-    simulate_urban_canyon(folder, config)
-    return read_sequence(folder)
+def drive_1hz(drive_1hz_folder) -> Sequence:
+    return read_sequence(drive_1hz_folder)
 
 
 def _recording(name: str, drive_1hz: Sequence, tmp_path_factory) -> Sequence:
