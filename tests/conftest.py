@@ -91,6 +91,30 @@ def drive_1hz_folder(tmp_path_factory) -> Path:
     return folder
 
 
+@pytest.fixture(scope="session")
+def short_drive_folder(tmp_path_factory) -> Path:
+    """A 10-s simulated canyon drive with 320×180 images (seed 4), built once per test process
+    for the tests that damage a copy of a recording or need one to read (group
+    ``short_drive``). Read-only: a test that changes the recording works on a copy."""
+    from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+
+    folder = tmp_path_factory.mktemp("short_drive") / "clean"
+    config = UrbanCanyonConfig(duration_s=10.0, seed=4, image_size_px=(320, 180))
+    simulate_urban_canyon(folder, config)
+    return folder
+
+
+@pytest.fixture(scope="session")
+def short_drive_run(short_drive_folder, tmp_path_factory) -> Path:
+    """The folder ``vo-doppler run`` writes for :func:`short_drive_folder` (report.html,
+    summary.json, …), once per test process (group ``short_drive``). Read-only."""
+    from vo_doppler.cli import main
+
+    out = tmp_path_factory.mktemp("short_drive_run")
+    assert main(["run", str(short_drive_folder), "-o", str(out)]) == 0
+    return out
+
+
 def require_shared(relative: str) -> Path:
     """Path of one recording inside the shared data folder, or skip the test."""
     path = shared_data_dir() / relative

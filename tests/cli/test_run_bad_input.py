@@ -24,25 +24,20 @@ from vo_doppler.errors import EXIT_FAILURE, EXIT_OK
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.output_folder import RUN, begin_staging, mark_output
 from vo_doppler.io.trajectory import read_tum
-from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
+
+pytestmark = pytest.mark.xdist_group("short_drive")
 
 OUTPUTS = ("trajectory_vo.tum", "trajectory_corrected.tum", "heading.csv", "summary.json")
 
 
 @pytest.fixture(scope="module")
-def clean(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("bad_input") / "clean"
-    simulate_urban_canyon(
-        folder, UrbanCanyonConfig(duration_s=10.0, seed=4, image_size_px=(320, 180))
-    )
-    return folder
+def clean(short_drive_folder) -> Path:
+    return short_drive_folder
 
 
 @pytest.fixture(scope="module")
-def clean_run(clean, tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("clean_run")
-    assert main(["run", str(clean), "-o", str(out)]) == 0
-    return out
+def clean_run(short_drive_run) -> Path:
+    return short_drive_run
 
 
 def damaged_copy(clean: Path, tmp_path: Path) -> Path:

@@ -11,16 +11,14 @@ import pytest
 from vo_doppler import job
 from vo_doppler.cli import main
 from vo_doppler.errors import EXIT_INTERNAL
-from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("short_drive")]
 
 
-def test_the_collector_is_frozen_during_the_stages_and_unfrozen_after(tmp_path, monkeypatch):
-    drive = tmp_path / "drive"
-    simulate_urban_canyon(
-        drive, UrbanCanyonConfig(duration_s=10.0, seed=4, image_size_px=(320, 180))
-    )
+def test_the_collector_is_frozen_during_the_stages_and_unfrozen_after(
+    short_drive_folder, tmp_path, monkeypatch
+):
+    drive = short_drive_folder
     frozen_during = []
 
     def failing_stages(*args, **kwargs):
