@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -18,6 +19,7 @@ import pytest
 from tests.helpers.batch import (
     BLOCK_DIR_ENV,
     die_or_fail,
+    imageless_drive,
     opencv_thread_count,
     tiny_drive,
     wait_while_blocked,
@@ -43,7 +45,6 @@ from vo_doppler.io.output_folder import MARKER as OUTPUT_MARKER
 from vo_doppler.io.output_folder import RUN, mark_output, open_output_folder, written_by
 from vo_doppler.model.time_span import SpanBound, TimeSpan
 from vo_doppler.run import RunConfig
-from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 from vo_doppler.vo.config import VoConfig
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
@@ -213,14 +214,16 @@ def test_a_batch_never_replaces_a_recording_or_a_folder_it_did_not_write(tmp_pat
 
 
 @pytest.mark.slow
-def test_a_rerun_that_fails_before_its_outputs_keeps_the_earlier_results(tmp_path):
+def test_a_rerun_that_fails_before_its_outputs_keeps_the_earlier_results(
+    tmp_path_factory, tmp_path
+):
     """A recording that succeeded, then fails (its RINEX cut short): the failure is listed, the
     earlier results stay as they were with the failed run's log beside them, and no staging
     folder is left. With the RINEX restored as it was (the first run's fingerprint again),
     ``resume`` runs the recording again instead of listing as skipped the results beside the
     failed run's log, and the log goes."""
     drive = tmp_path / "drive"
-    simulate_urban_canyon(drive, UrbanCanyonConfig(duration_s=8.0, seed=1, render=False))
+    shutil.copytree(imageless_drive(tmp_path_factory, 1), drive)
     out = tmp_path / "out"
     assert run_batch([drive], out, workers=1).outcomes[0].status is Status.DONE
     earlier = _mtimes(out / "drive")
@@ -293,7 +296,7 @@ def test_killed_batch_resumes_without_recomputing_finished_recordings(
 ):
     """Kill the whole batch (SIGKILL to its process group: parent and workers) while the
     second of three recordings is running; resuming recomputes the second and third only."""
-    drives = [tiny_drive(tmp_path_factory, seed) for seed in (1, 2, 3)]
+    drives = [imageless_drive(tmp_path_factory, seed) for seed in (1, 2, 3)]
     out, block_dir = tmp_path / "out", tmp_path / "block"
     block_dir.mkdir()
     for drive in drives[1:]:
@@ -349,10 +352,13 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("tiny_drives")
 def test_ray_executor_gives_the_local_aggregate(tmp_path_factory, tmp_path):
+    """One worker each (a local Ray instance of 1 CPU: its start costs the same whatever the
+    work): the second recording waits for the first's task to end, as a larger batch would."""
     drives = [tiny_drive(tmp_path_factory, seed) for seed in (1, 2)]
-    local = run_batch(drives, tmp_path / "local", workers=2)
-    remote = run_batch(drives, tmp_path / "ray", executor="ray", workers=2)
+    local = run_batch(drives, tmp_path / "local", workers=1)
+    remote = run_batch(drives, tmp_path / "ray", executor="ray", workers=1)
     assert [o.status for o in remote.outcomes] == [Status.DONE, Status.DONE]
     drop = {"seconds"}
     assert [{k: v for k, v in row.items() if k not in drop} for row in remote.rows] == [

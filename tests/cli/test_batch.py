@@ -18,6 +18,8 @@ from vo_doppler.batch import MARKER, RecordingOutcome, Status
 from vo_doppler.cli import main
 from vo_doppler.commands.batch_command import outcome_table
 
+pytestmark = pytest.mark.xdist_group("tiny_drives")
+
 
 @pytest.fixture(scope="module")
 def batch_run(tmp_path_factory):

@@ -15,6 +15,8 @@ from tests.conftest import require_shared
 from vo_doppler.cli import main
 from vo_doppler.io.trajectory import read_tum
 
+pytestmark = pytest.mark.xdist_group("span_drive")
+
 CORRECTED = ("vo_gps_conv", "vo_gps_tc", "dr_gps_conv", "dr_gps_tc")
 
 

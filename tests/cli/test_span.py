@@ -13,6 +13,8 @@ import pytest
 from tests.cli.conftest import SPAN_END_S, SPAN_START_S
 from vo_doppler.cli import main
 
+pytestmark = pytest.mark.xdist_group("span_drive")
+
 TRAJECTORIES = (
     "trajectory_vo.tum",
     "trajectory_vo_gps_conv.tum",

@@ -15,7 +15,7 @@ from tests.conftest import require_shared
 from tests.helpers.rinex_text import field, rinex2_epoch, rinex2_header
 from vo_doppler.io.rinex_obs import read_obs
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("georinex")]
 
 FILES = ("septentrio_static/rover.obs", "yamatogawa_ublox_walk/yamatogawa_rover.obs")
 

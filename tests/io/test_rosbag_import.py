@@ -35,6 +35,8 @@ from vo_doppler.io.sequence import read_manifest, read_sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.run import run_sequence
 
+pytestmark = pytest.mark.xdist_group("tiny_drives")
+
 BAGS = {  # name → (flavour, GNSS interface, compressed images)
     "ros1": ("ros1", "gnss_comm", False),
     "sqlite3": ("sqlite3", "gnss_comm", True),
