@@ -3,7 +3,8 @@ recordings and runs that several test files use, each built once per test proces
 
 With pytest-xdist every worker builds its own copy of a session fixture: the tests sharing one
 carry the same ``xdist_group`` mark (``--dist loadgroup`` in pyproject.toml's ``addopts``), so
-that one worker builds it once for all of them."""
+that one worker builds it once for all of them (ignored by pytest-xdist 3.8 under pytest 9.2:
+see the note in pyproject.toml)."""
 
 from __future__ import annotations
 
