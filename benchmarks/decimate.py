@@ -2,12 +2,12 @@
 recorded it (e.g. the 10 Hz comma2k19 minute at 1 Hz).
 
 An epoch is kept when it is the recorded epoch nearest a tick of the new rate (multiples of
-1/rate in GPS seconds: whole seconds at 1 Hz) and lies within half a recorded interval of it; a
-receiver whose clock runs a few milliseconds off GPS time (epochs at x.997 s) keeps the epoch
-nearest each whole second, and a tick with no recorded epoch near it stays empty, as a
-receiver's skipped epoch would. The kept epochs' observation rows and the receiver's reported
-Doppler σ of those epochs go with them; images, vehicle signals, navigation and ground truth
-are unchanged.
+1/rate in GPS seconds: whole seconds at 1 Hz, or x.3 s with a phase of 0.3 s) and lies within
+half a recorded interval of it; a receiver whose clock runs a few milliseconds off GPS time
+(epochs at x.997 s) keeps the epoch nearest each whole second, and a tick with no recorded
+epoch near it stays empty, as a receiver's skipped epoch would. The kept epochs' observation
+rows and the receiver's reported Doppler σ of those epochs go with them; images, vehicle
+signals, navigation and ground truth are unchanged.
 """
 
 from __future__ import annotations
@@ -27,9 +27,10 @@ def recorded_interval(epoch_time: np.ndarray) -> float:
     return float(np.median(steps)) if steps.size else float("nan")
 
 
-def decimated_epochs(epoch_time: np.ndarray, rate_hz: float) -> np.ndarray:
-    """Mask of the epochs kept at ``rate_hz`` (module docstring). At or above the recorded
-    rate every epoch is kept."""
+def decimated_epochs(epoch_time: np.ndarray, rate_hz: float, phase_s: float = 0.0) -> np.ndarray:
+    """Mask of the epochs kept at ``rate_hz`` (module docstring), the ticks shifted by
+    ``phase_s`` (a receiver logging at x.3 s: 0.3). At or above the recorded rate every epoch
+    is kept."""
     if not rate_hz > 0:
         raise ValueError(f"rate {rate_hz} Hz: give a positive rate")
     t = np.asarray(epoch_time, dtype=float)
@@ -40,8 +41,8 @@ def decimated_epochs(epoch_time: np.ndarray, rate_hz: float) -> np.ndarray:
     if not np.isfinite(interval) or 1.0 / rate_hz <= interval * (1.0 + 1e-6):
         keep[:] = True
         return keep
-    tick = np.round(t * rate_hz)
-    offset = np.abs(t - tick / rate_hz)
+    tick = np.round((t - phase_s) * rate_hz)
+    offset = np.abs(t - phase_s - tick / rate_hz)
     # nearest epoch per tick: sort by (tick, offset) and take the first of each tick
     order = np.lexsort((offset, tick))
     first = np.ones(order.size, dtype=bool)
@@ -71,13 +72,14 @@ def decimate_observations(observations: Observations, keep: np.ndarray) -> Obser
     )
 
 
-def decimate(sequence: Sequence, rate_hz: float) -> Sequence:
-    """``sequence`` with its GNSS observations (and reported Doppler σ) at ``rate_hz``; a
-    sequence without GNSS, or recorded at or below that rate, comes back unchanged."""
+def decimate(sequence: Sequence, rate_hz: float, phase_s: float = 0.0) -> Sequence:
+    """``sequence`` with its GNSS observations (and reported Doppler σ) at ``rate_hz``, the
+    ticks shifted by ``phase_s``; a sequence without GNSS, or recorded at or below that rate,
+    comes back unchanged."""
     obs = sequence.observations
     if obs is None:
         return sequence
-    keep = decimated_epochs(obs.epoch_time, rate_hz)
+    keep = decimated_epochs(obs.epoch_time, rate_hz, phase_s)
     if keep.all():
         return sequence
     sigma = sequence.doppler_sigma

@@ -151,6 +151,7 @@ UNITLESS: dict[str, str] = {
     "huber_k": "in σ of the residuals",
     "cauchy_c": "in σ of the residuals",
     "student_dof": "degrees of freedom",
+    "noise_model_dof": "degrees of freedom",
     "ambiguity_chi2": "a χ² value",
     "reliability_n_sigma": "in σ",
     # names, letters and units in the name itself

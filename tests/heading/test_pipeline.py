@@ -347,20 +347,25 @@ def test_auto_takes_the_robust_settings_below_10_hz(rate_hz, method):
     assert HeadingPipelineConfig().for_rate(t) == HeadingPipelineConfig()
 
 
-@pytest.mark.parametrize(("step_s", "method"), [(1.0, "robust"), (0.1, "snooping")])
-def test_the_table_names_the_settings_auto_chose(step_s, method):
-    t = np.arange(0.0, 60.0, step_s)
-    scenario = simulate_doppler(
+def _two_satellites(t, yaw, seed):
+    """Two satellites' Doppler rows (σ 0.05 m/s) of a drive at 10 m/s with heading ``yaw(t)``."""
+    return simulate_doppler(
         t,
-        lambda t: 1.0 + 0.5 * np.sin(0.05 * t),
+        yaw,
         lambda t: 10.0 + 0.0 * t,
         AZIMUTH,
         ELEVATION,
-        sats_per_epoch=2,
+        2,
         rotate=False,
         noise_mps=0.05,
-        seed=2,
+        seed=seed,
     )
+
+
+@pytest.mark.parametrize(("step_s", "method"), [(1.0, "robust"), (0.1, "snooping")])
+def test_the_table_names_the_settings_auto_chose(step_s, method):
+    t = np.arange(0.0, 60.0, step_s)
+    scenario = _two_satellites(t, lambda t: 1.0 + 0.5 * np.sin(0.05 * t), seed=2)
     velocity = scenario.speed[:, None] * np.stack(
         [np.cos(scenario.yaw), np.sin(scenario.yaw), np.zeros_like(t)], axis=1
     )
@@ -424,3 +429,29 @@ def test_courses_beyond_a_cars_vertical_bound_calibrate_no_gyro_bias():
     assert tables[0].wheel_scale[-1] == tables[1].wheel_scale[-1]
     assert tables[1].wheel_scale[-1] == pytest.approx(1.03, rel=0.003)
     assert not tables[1].conv_valid[faulty].any()
+
+
+@pytest.mark.parametrize("step_s", [1.0, 0.1])
+def test_two_headings_that_fit_alike_give_no_tight_heading_and_a_warning(step_s):
+    # Two satellites on a straight road from the first epoch, no conventional velocity: each
+    # window fits the heading and its mirror alike and nothing earlier chooses between them.
+    t = np.arange(0.0, 60.0, step_s)
+    scenario = _two_satellites(t, lambda t: 0.7 + 0.0 * t, seed=4)
+    vehicle = VehicleSignals(SensorSeries(t, scenario.speed), SensorSeries(t, 0.0 * t))
+    conventional = ConventionalVelocity(np.zeros((len(t), 3)), np.zeros(len(t), bool))
+    table = heading_pipeline(t, scenario.rows, conventional, vehicle)
+    assert not table.tc_available.any()
+    warning = [w for w in table.warnings if w.startswith("tight heading:")]
+    assert len(warning) == 1
+    unresolved = int(warning[0].split()[2])
+    assert unresolved >= 0.9 * len(t) and f"of {len(t)} moving epochs" in warning[0]
+
+
+def test_a_drive_whose_windows_decide_has_no_ambiguity_warning():
+    t, scenario, velocity = _drive()
+    t_gyro, rate = gyro_from_heading(t, scenario.yaw, np.ones(len(t), bool), 0.0, 0.0)
+    vehicle = VehicleSignals(SensorSeries(t, scenario.speed), SensorSeries(t_gyro, rate))
+    conventional = ConventionalVelocity(velocity, np.ones(len(t), bool))
+    table = heading_pipeline(t, scenario.rows, conventional, vehicle)
+    assert table.tc_available[t > 5.0].mean() > 0.95
+    assert not [w for w in table.warnings if w.startswith("tight heading:")]

@@ -107,6 +107,28 @@ def test_ambiguity_resolved_by_the_gyro_propagated_prior():
     assert _max_error(scenario, result) < 1e-6
 
 
+@pytest.mark.parametrize(
+    ("rate_hz", "curve_rad_s", "ambiguous"),
+    [(20.0, 0.001, True), (20.0, 0.003, False), (1.0, 0.003, True), (1.0, 0.02, False)],
+)
+def test_roots_apart_by_less_than_the_noise_stay_ambiguous(rate_hz, curve_rad_s, ambiguous):
+    # Two satellites on a gentle curve, noise-free: the true root fits exactly (s² at its
+    # floor), the mirror root by a gap that only a sharper curve makes larger than the noise.
+    # Judged by the window's own s² alone, any gap at all looked decisive.
+    def curve(t):
+        return 0.7 + curve_rad_s * t
+
+    t = np.arange(0.0, 12.0, 1.0 / rate_hz)
+    scenario, result = _solve(curve, 2, t=t)
+    late = scenario.t_epoch >= 2.0
+    if ambiguous:
+        assert result.ambiguous[late].all()
+        assert not result.available.any()
+    else:
+        assert result.available[late].all() and not result.ambiguous[late].any()
+        assert _max_error(scenario, result) < 1e-6
+
+
 def test_noisy_heading_sigma_and_reliability():
     scenario = simulate_doppler(
         np.arange(0.0, 40.0, 0.05),

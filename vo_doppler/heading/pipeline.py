@@ -90,6 +90,9 @@ class CalibrationMethod(StrEnum):
 
 AUTO_ROBUST_BELOW_RATE_HZ = 10.0
 """:meth:`HeadingPipelineConfig.auto`: GNSS rates below this take the robust settings."""
+AMBIGUOUS_WARNING_SHARE = 0.1
+"""Share of the moving epochs left without a tight heading by ambiguous windows from which
+:func:`heading_pipeline` warns."""
 
 
 class HeadingMethod(StrEnum):
@@ -780,7 +783,24 @@ def heading_pipeline(
     cal = _conventional_calibration(epochs, config)
     solved = _tight_calibrated(epochs, cal, _solve(epochs, cal, config), config)
     tight, warnings = _smoothed_heading(epochs, solved, cal, config)
+    moving = epochs.wheel >= config.tight.min_speed_mps
+    warnings = _ambiguity_warning(solved.result, moving) + warnings
     return _heading_table(epochs, cal, solved, tight, warnings, config)
+
+
+def _ambiguity_warning(result: TightHeadingResult, moving: np.ndarray) -> list[str]:
+    """A warning when ambiguous windows (two headings fitting alike, docs/design.md,
+    "Ambiguity") leave at least ``AMBIGUOUS_WARNING_SHARE`` of the ``moving`` epochs without
+    a tight heading."""
+    unresolved = int(np.count_nonzero(result.ambiguous & ~result.available))
+    n_moving = int(np.count_nonzero(moving))
+    if unresolved == 0 or unresolved < AMBIGUOUS_WARNING_SHARE * n_moving:
+        return []
+    return [
+        f"tight heading: {unresolved} of {n_moving} moving epochs without one: two headings "
+        "fit their window's Doppler rows within the noise (few satellites on a straight "
+        "road) and no earlier heading propagated by the gyro chose between them"
+    ]
 
 
 def _heading_table(

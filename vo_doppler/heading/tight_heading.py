@@ -130,6 +130,11 @@ class TightHeadingConfig:
     sigma_floor_mps: float = 0.01
     observability_ratio: float = 1e-6
     ambiguity_chi2: float = 9.0
+    """Two minima more than ``ambiguity_min_separation_rad`` apart whose costs differ by less
+    than this many variance factors (:func:`_ambiguity_variance`) make the window ambiguous."""
+    noise_model_dof: float = 10.0
+    """Degrees of freedom credited to the a-priori noise model when the ambiguity test pools
+    it with a window's own variance factor (:func:`_ambiguity_variance`)."""
     ambiguity_min_separation_rad: float = np.radians(5.0)
     max_sigma_rad: float = np.radians(20.0)
     prior_max_age_s: float = 10.0
@@ -248,6 +253,8 @@ class _WindowSolution:
     info: np.ndarray
     info_raw: np.ndarray
     variance_factor: np.ndarray
+    variance_dof: np.ndarray
+    """Degrees of freedom of ``variance_factor`` (redundant rows of the window's fit)."""
     rho0: np.ndarray
     alpha: np.ndarray
     grade: np.ndarray
@@ -500,9 +507,7 @@ def solve_windows(
     lost &= n_used < n_obs
     inconsistent = snooped.inconsistent | lost
     fallback = inconsistent & snooped.blunder & ~lost
-    variance_factor = _variance_factor(
-        (X, T, prior), np.where(accepted, w, 0.0), fit, fallback, config
-    )
+    variance = _variance_factor((X, T, prior), np.where(accepted, w, 0.0), fit, fallback, config)
     Q = fit["Q"]
     return _WindowSolution(
         theta=theta,
@@ -511,8 +516,8 @@ def solve_windows(
         cost_second=fit["cost2"],
         info=quadratic(Q, dz, dz),
         info_raw=quadratic(fit["XtWX"], dz, dz),
-        variance_factor=variance_factor,
-        profile_sigma=_profile_sigma(Q, theta, cost, variance_factor, config),
+        **variance,
+        profile_sigma=_profile_sigma(Q, theta, cost, variance["variance_factor"], config),
         rho0=params[:, 0],
         alpha=params[:, 1] if clock_epoch is None else np.full(K, np.nan),
         grade=params[:, -1] if prior is not None else np.zeros(K),
@@ -530,12 +535,13 @@ def solve_windows(
     )
 
 
-def _variance_factor(model, used_w, fit, fallback, config) -> np.ndarray:
+def _variance_factor(model, used_w, fit, fallback, config) -> dict[str, np.ndarray]:
     """The a-posteriori variance factor s² of each window's robust fit (``model`` = X, T and
     the grade prior; ``used_w`` the a-priori weights of the rows used), at least the floor
-    ``sigma_floor_mps``². Fallback windows: the Huber weights hide the fault that could not be
-    named, so the scatter is judged with the a-priori weights (the least-squares variance
-    factor at the robust θ₀) where that is larger."""
+    ``sigma_floor_mps``², and its degrees of freedom, as the :class:`_WindowSolution` fields
+    ``variance_factor`` and ``variance_dof``. Fallback windows: the Huber weights hide the
+    fault that could not be named, so the scatter is judged with the a-priori weights (the
+    least-squares variance factor at the robust θ₀) where that is larger."""
     X, T, prior = model
     cost, z = fit["cost"], z_of(fit["theta"])
     n_used = np.count_nonzero(used_w > 0, axis=1)
@@ -550,7 +556,23 @@ def _variance_factor(model, used_w, fit, fallback, config) -> np.ndarray:
     )[0]
     unweighted = quadratic(Q_prior, z[robust], z[robust]) / dof[robust]
     posterior[robust] = np.maximum(posterior[robust], unweighted)
-    return np.maximum(posterior, floor)
+    return {
+        "variance_factor": np.maximum(posterior, floor),
+        "variance_dof": np.maximum(dof, 0).astype(float),
+    }
+
+
+def _ambiguity_variance(sol: _WindowSolution, config: TightHeadingConfig) -> np.ndarray:
+    """The variance factor that judges whether a window's two minima fit alike: its own s²
+    (ν degrees of freedom) pooled with the a-priori noise model (s² = 1) counted as
+    ν₀ = ``noise_model_dof``, (ν·s² + ν₀) / (ν + ν₀), the posterior mean of a scaled
+    inverse-χ² prior on the variance factor (docs/design.md, "Ambiguity"). A window with a
+    handful of redundant rows can fit far below the noise by chance (s² 0.04–0.15 with three
+    degrees of freedom on the comma2k19 minute at 1 Hz): dividing the two roots' cost gap by
+    that s² made a gap of about one noise variance look like 14–27 χ², and the wrong root a
+    confident heading. With many redundant rows s² speaks for itself."""
+    nu, nu0 = sol.variance_dof, config.noise_model_dof
+    return (nu * sol.variance_factor + nu0) / (nu + nu0)
 
 
 def _fallback_variance(suspects, theta, bias_variance):
@@ -1177,7 +1199,7 @@ def _decide(
         noise_variance = np.maximum(sol.variance_factor / sol.info, sol.profile_sigma**2)
         sigma = np.sqrt(noise_variance + model_variance)
         observable = (sol.info > 0) & (sol.info >= config.observability_ratio * sol.info_raw)
-        chi2_gap = (sol.cost_second - sol.cost) / sol.variance_factor
+        chi2_gap = (sol.cost_second - sol.cost) / _ambiguity_variance(sol, config)
     separated = (
         np.abs(wrap_angle(sol.theta_second - sol.theta)) > config.ambiguity_min_separation_rad
     )
