@@ -331,7 +331,11 @@ def canyon_inputs(sequence: Sequence, config: RunConfig, after_s: float = CANYON
 def dead_reckoning_figures(sequence: Sequence, table: HeadingTable, config: RunConfig) -> dict:
     """Error per 100 m (m) of the wheel + gyro dead reckoning alone, corrected by the
     conventional and by the tightly coupled heading of ``table`` (``run``'s pipelines), over
-    the time the ground truth covers."""
+    the time the ground truth covers. Without any absolute heading (no valid conventional
+    heading, no reliable tight one) nothing places the trajectories, which ``run`` starts
+    facing east with a warning: no figure (None) rather than that arbitrary start's."""
+    if not (table.conv_valid.any() or (table.tc_available & table.tc_reliable).any()):
+        return {str(name): None for name in DEAD_RECKONING}
     speed = table.calibrated_speed(sequence.wheel_speed)
     origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)))  # the figures align the starts
     trajectories, usable = sequence_trajectories(sequence, table, None, speed, origin, config)

@@ -11,7 +11,12 @@ import numpy as np
 import pytest
 
 from benchmarks.decimate import decimate, decimated_epochs
-from benchmarks.real_heading import CANYON_AFTER_S, canyon_inputs, tight_figures
+from benchmarks.real_heading import (
+    CANYON_AFTER_S,
+    canyon_inputs,
+    dead_reckoning_figures,
+    tight_figures,
+)
 from tests.helpers.comma2k19 import imported_comma2k19
 from vo_doppler.geo import EnuFrame
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
@@ -176,3 +181,5 @@ def test_two_satellites_from_the_start_give_no_wrong_heading(minute):
         assert figures["tc_available"] == 0.0, phase
         warning = [w for w in table.warnings if w.startswith("tight heading:")]
         assert len(warning) == 1 and "two headings fit" in warning[0], phase
+    # nothing places the dead reckoning: the benchmark gives no figure for it
+    assert set(dead_reckoning_figures(minute, table, RunConfig()).values()) == {None}
