@@ -1,4 +1,4 @@
-"""Carrier wavelengths per signal and GPS time conversions."""
+"""Carrier wavelengths and BeiDou signals per code, and GPS time conversions."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ from vo_doppler.model.gpstime import (
     time_of_week,
     utc_to_gps_seconds,
 )
+from vo_doppler.model.signals import beidou_signal
 
 
 def test_glonass_fdma_wavelengths_use_the_channel():
@@ -38,6 +39,30 @@ def test_beidou_b1i_band_number_depends_on_version():
     assert carrier_frequency("G", "D9X") is None
     assert strength_code("D5Q") == "S5Q"
     assert strength_code("D1") == "S1"
+
+
+@pytest.mark.parametrize(
+    ("code", "version", "signal"),
+    [
+        ("C1I", 3.02, "B1I"),
+        ("D1X", 3.02, "B1I"),
+        ("C2I", 3.01, "B1I"),
+        ("C2I", 3.03, "B1I"),
+        ("C2X", 3.04, "B1I"),
+        ("C1P", 3.04, "B1C"),
+        ("C1X", 3.04, "B1C"),
+        ("C1Z", 3.05, "B1A"),
+        ("C5P", 3.04, "B2a"),
+        ("C7I", 3.02, "B2I"),
+        ("C7Z", 3.04, "B2b"),
+        ("C8X", 3.04, "B2a+b"),
+        ("C6I", 3.02, "B3I"),
+        ("C6D", 3.05, "B3A"),
+        ("C9X", 3.04, None),
+    ],
+)
+def test_beidou_signal_of_a_code_in_its_rinex_version(code, version, signal):
+    assert beidou_signal(code, version) == signal
 
 
 def test_gps_time_epochs_and_leap_seconds():
