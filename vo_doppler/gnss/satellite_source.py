@@ -9,6 +9,7 @@ source once with :func:`satellite_source`.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 from typing import Protocol
@@ -20,6 +21,9 @@ from vo_doppler.gnss.ephemeris import SatelliteStates, rotate_earth, satellite_s
 from vo_doppler.gnss.precise_orbits import LAGRANGE_POINTS, precise_states
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.precise_orbits import PreciseOrbits
+from vo_doppler.model.signals import beidou_signal
+
+log = logging.getLogger(__name__)
 
 STATES_CHUNK = 8192
 """Rows of satellite states computed at once. Each row gathers its ephemeris' parameters and
@@ -27,7 +31,18 @@ their intermediate results (about 100 numbers), so the states of a whole drive i
 grew with its duration (a 30-min drive's 200,000 Doppler rows: about 130 MB at once); in
 chunks the GNSS stage's peak memory stays flat in the duration, with the same results."""
 
-_GROUP_DELAY_FIELD = {("G", "1"): "tgd", ("J", "1"): "tgd", ("E", "1"): "iodc", ("C", "2"): "tgd"}
+_GROUP_DELAY_FIELD = {("G", "1"): "tgd", ("J", "1"): "tgd", ("E", "1"): "iodc"}
+"""Navigation record column of the group delay per (system, band) of the pseudorange: the GPS
+and QZSS L1 T_GD (IS-GPS-200 sec. 20.3.3.3.3.2), Galileo's BGD(E1, E5b) (RINEX's IODC slot)."""
+BEIDOU_GROUP_DELAY_FIELD: dict[str, str | None] = {"B1I": "tgd", "B2I": "iodc", "B3I": None}
+"""BeiDou D1/D2 record column of the group delay per signal (``model.signals.beidou_signal``).
+The broadcast clock is B3I's: Δt_sv(B1I) = Δt_sv − T_GD1, Δt_sv(B2I) = Δt_sv − T_GD2, B3I none
+(BDS-SIS-ICD-B1I-3.0 sec. 5.2.4.9–5.2.4.10, the D1 clock correction and equipment group delay
+differential; T_GD2 and B2I in BDS-SIS-ICD-2.0, the B1I + B2I edition). A RINEX 3 BeiDou record
+holds T_GD1 where GPS has T_GD (``tgd``) and T_GD2 where GPS has IODC (``iodc``; BROADCAST
+ORBIT-6, "TGD1 B1/B3", "TGD2 B2/B3"). The other signals' group delays (B1C's ISC_B1Cd and
+T_GD,B1Cp: BDS-SIS-ICD-B1C-1.0 sec. 7.6; B2a's likewise) come in the B-CNAV messages, which a
+D1/D2 record does not carry."""
 
 
 class SatelliteSource(Protocol):
@@ -41,10 +56,15 @@ class SatelliteSource(Protocol):
         """Satellite states at GPS times ``t`` (s), arrays broadcast (``ephemeris`` docstring)."""
 
     def group_delay_s(
-        self, system: np.ndarray, states: SatelliteStates, codes: dict[str, str]
+        self,
+        system: np.ndarray,
+        states: SatelliteStates,
+        codes: dict[str, str],
+        rinex_version: float,
     ) -> np.ndarray:
         """Group delay (s) to subtract from the satellite clock for the pseudorange ``codes``
-        chosen per system (IS-GPS-200 sec. 20.3.3.3.3.2)."""
+        chosen per system, written in an observation file of ``rinex_version`` (BeiDou's band
+        digits depend on it; IS-GPS-200 sec. 20.3.3.3.3.2)."""
 
     def glonass_channels(self) -> dict[int, int]:
         """GLONASS frequency channel per slot, as far as the source knows them."""
@@ -64,12 +84,36 @@ class BroadcastSource:
         return states_in_chunks(lambda *rows: satellite_states(self.nav, *rows), system, prn, t)
 
     def group_delay_s(
-        self, system: np.ndarray, states: SatelliteStates, codes: dict[str, str]
+        self,
+        system: np.ndarray,
+        states: SatelliteStates,
+        codes: dict[str, str],
+        rinex_version: float,
     ) -> np.ndarray:
+        """The broadcast T_GD/BGD of each row's pseudorange (:data:`BEIDOU_GROUP_DELAY_FIELD`,
+        ``_GROUP_DELAY_FIELD``), 0 where the record has none; a BeiDou code whose correction
+        no D1/D2 record carries gets none, and one warning."""
         delay = np.zeros(system.size)
-        for (letter, band), name in _GROUP_DELAY_FIELD.items():
+        for letter, code in codes.items():
             hit = (system == letter) & states.valid
-            if codes.get(letter, "")[1:2] == band and hit.any():
+            if not hit.any():
+                continue
+            if letter == "C":
+                signal = beidou_signal(code, rinex_version)
+                if signal not in BEIDOU_GROUP_DELAY_FIELD:
+                    log.warning(
+                        "BeiDou %s pseudoranges (%s in RINEX %.2f): no broadcast group delay "
+                        "for them in a D1/D2 ephemeris, their satellite clocks are left "
+                        "uncorrected (metres of bias)",
+                        signal or "unknown-signal",
+                        code,
+                        rinex_version,
+                    )
+                    continue
+                name = BEIDOU_GROUP_DELAY_FIELD[signal]
+            else:
+                name = _GROUP_DELAY_FIELD.get((letter, code[1:2]))
+            if name is not None:
                 delay[hit] = self.nav.kepler[name][states.record[hit]]
         return delay
 
@@ -97,7 +141,11 @@ class PreciseSource:
         )
 
     def group_delay_s(
-        self, system: np.ndarray, states: SatelliteStates, codes: dict[str, str]
+        self,
+        system: np.ndarray,
+        states: SatelliteStates,
+        codes: dict[str, str],
+        rinex_version: float,
     ) -> np.ndarray:
         return np.zeros(system.size)
 

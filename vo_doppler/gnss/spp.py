@@ -133,7 +133,7 @@ def solve_spp(
     first = source.states(sel.system, sel.prn, sel.time - travel)
     t_tx = sel.time - travel - np.nan_to_num(first.clock_bias_s)
     states = source.states(sel.system, sel.prn, t_tx)
-    group_delay = source.group_delay_s(sel.system, states, codes)
+    group_delay = source.group_delay_s(sel.system, states, codes, obs.header.version)
     satellite_clock_m = SPEED_OF_LIGHT * (states.clock_bias_s - np.nan_to_num(group_delay))
     n_no_ephemeris = int((~states.valid).sum())
     channels = {**source.glonass_channels(), **obs.header.glonass_channels}
