@@ -3,21 +3,34 @@ recordings and runs that several test files use, each built once per test proces
 
 With pytest-xdist every worker builds its own copy of a session fixture: the tests sharing one
 carry the same ``xdist_group`` mark (``--dist loadgroup`` in pyproject.toml's ``addopts``), so
-that one worker builds it once for all of them (ignored by pytest-xdist 3.8 under pytest 9.2:
-see the note in pyproject.toml)."""
+that one worker builds it once for all of them. The grouping is this file's
+:class:`MarkGroupScheduling`: pytest-xdist 3.8's own loadgroup passes the group to the
+controller in ``item._nodeid``, which pytest 9.2 no longer reads (pytest-xdist issue 1386), so
+its groups were ignored."""
 
 from __future__ import annotations
 
+import collections.abc
+import json
 import os
+import shutil
+import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import pytest
+from xdist.scheduler import LoadScopeScheduling
 
 if TYPE_CHECKING:
+    from xdist.remote import Producer
+    from xdist.workermanage import WorkerController
+
     from vo_doppler.model.sequence import Sequence
     from vo_doppler.run import RunResult
+
+pytest_plugins = ["pytester"]
+"""Its ``pytester`` fixture runs small suites of their own (tests/test_xdist_groups.py)."""
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = REPO_ROOT / "sample_sequences" / "urban_canyon_small"
@@ -135,3 +148,85 @@ def pytest_runtest_makereport(item, call):
         (title, text.encode("utf-8", "backslashreplace").decode("utf-8"))
         for title, text in report.sections
     ]
+
+
+GROUPS_DIR_KEY = "vo_doppler_xdist_groups_dir"
+"""The ``workerinput`` entry naming the folder where each worker writes its tests' groups."""
+
+_groups_dir = pytest.StashKey[Path]()
+
+
+def xdist_group_of(item: pytest.Item) -> str | None:
+    """The item's ``xdist_group`` as pytest-xdist's loadgroup names it (the names of all its
+    marks, sorted and joined by ``_``; ``default`` for a mark without one), None when unmarked."""
+    names = {
+        str(mark.args[0] if mark.args else mark.kwargs.get("name", "default"))
+        for mark in item.iter_markers("xdist_group")
+    }
+    return "_".join(sorted(names)) if names else None
+
+
+class MarkGroupScheduling(LoadScopeScheduling):
+    """``--dist loadgroup``: the tests of one ``xdist_group`` form one work unit, so one worker
+    runs them all; every other test is a unit of its own, spread as ``--dist load`` would.
+
+    The controller collects no tests, so it cannot read the marks: each worker writes its
+    collection's groups (node id → group) to ``<groups_dir>/<worker id>.json`` before it reports
+    the collection (:func:`pytest_collection_modifyitems`), and the scheduler reads that file
+    with the collection."""
+
+    def __init__(self, config: pytest.Config, log: Producer | None, groups_dir: Path) -> None:
+        super().__init__(config, log)
+        self.groups_dir = groups_dir
+        self.groups: dict[str, str] = {}
+
+    def add_node_collection(
+        self, node: WorkerController, collection: collections.abc.Sequence[str]
+    ) -> None:
+        """Register the worker's collection and the groups it wrote for it."""
+        groups_file = self.groups_dir / f"{node.gateway.id}.json"
+        self.groups.update(json.loads(groups_file.read_text(encoding="utf-8")))
+        super().add_node_collection(node, collection)
+
+    def _split_scope(self, nodeid: str) -> str:
+        """The test's work unit: its group's name, or its own node id when it has none."""
+        return self.groups.get(nodeid, nodeid)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node: WorkerController) -> None:
+    """Under ``--dist loadgroup``, tell each worker the folder for its groups (one temporary
+    folder per run, made with the first worker, removed by :func:`pytest_unconfigure`)."""
+    config = node.config
+    if config.getvalue("dist") != "loadgroup":
+        return
+    if _groups_dir not in config.stash:
+        config.stash[_groups_dir] = Path(tempfile.mkdtemp(prefix="xdist-groups-"))
+    node.workerinput[GROUPS_DIR_KEY] = str(config.stash[_groups_dir])
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """On a worker under ``--dist loadgroup``: write the grouped tests' node ids and groups for
+    :class:`MarkGroupScheduling`, once the items and their ids are final (``trylast``)."""
+    workerinput: dict[str, object] | None = getattr(config, "workerinput", None)
+    if workerinput is None or GROUPS_DIR_KEY not in workerinput:
+        return
+    groups = {item.nodeid: group for item in items if (group := xdist_group_of(item))}
+    groups_file = Path(str(workerinput[GROUPS_DIR_KEY])) / f"{workerinput['workerid']}.json"
+    groups_file.write_text(json.dumps(groups), encoding="utf-8")
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log: Producer) -> MarkGroupScheduling | None:
+    """The scheduler for ``--dist loadgroup`` (pytest-xdist's own for every other mode)."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    return MarkGroupScheduling(config, log, config.stash[_groups_dir])
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """Remove the run's folder of worker groups, if it made one."""
+    groups_dir = config.stash.get(_groups_dir, None)
+    if groups_dir is not None:
+        shutil.rmtree(groups_dir, ignore_errors=True)
