@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -73,3 +77,19 @@ def test_noisy_window_residual_matches_injected_noise():
     n_params = 6 * (len(truth.poses_cw) - 2) + 3 * len(truth.points)
     expected_rms = sigma * np.sqrt(2.0 * (1.0 - n_params / (2.0 * n_obs)))
     assert result.final_rms_px == pytest.approx(expected_rms, rel=0.05)
+
+
+def test_importing_the_bundle_adjustment_leaves_sigterm_to_python():
+    """pycolmap's glog handler on SIGTERM deadlocks a process terminated inside malloc: after the
+    import the default action (end the process, status -SIGTERM) is back."""
+    code = (
+        "import os, signal\n"
+        "import vo_doppler.vo.window_ba\n"
+        "status = open('/proc/self/status').read().split('SigCgt:')[1]\n"
+        "caught = int(status.split()[0], 16)\n"
+        "print(bool(caught & (1 << (signal.SIGTERM - 1))))\n"
+        "os.kill(os.getpid(), signal.SIGTERM)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.stdout.split() == ["False"]
+    assert done.returncode == -signal.SIGTERM

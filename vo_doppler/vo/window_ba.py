@@ -7,12 +7,28 @@ fixes the gauge (one pose) and the scale (two poses).
 
 from __future__ import annotations
 
+import signal
+import threading
 from dataclasses import dataclass
 
 import numpy as np
 import pycolmap
 
 from vo_doppler.vo.geometry import project
+
+
+def _give_sigterm_back_to_python() -> None:
+    """Importing pycolmap installs glog's failure-signal handler, SIGTERM included. That handler
+    is not async-signal-safe (it formats a backtrace, which allocates), so a process terminated
+    while inside malloc, e.g. a batch worker ended by its pool, deadlocks instead of ending.
+    Python's own table still holds the handler it had before the import; it is installed again.
+    Only the main thread may set handlers, and the VO runs there."""
+    handler = signal.getsignal(signal.SIGTERM)
+    if handler is not None and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, handler)
+
+
+_give_sigterm_back_to_python()
 
 
 @dataclass
