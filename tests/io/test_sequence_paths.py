@@ -55,3 +55,15 @@ def test_relative_path_inside_is_fine(sequence):
     os.rename(sequence / "times.txt", sequence / "image_0" / "times.txt")
     set_times(sequence, "image_0/../image_0/times.txt")
     assert len(read_sequence(sequence).image_times) == 570
+
+
+def test_an_image_folder_without_images_names_the_manifest_and_its_key(sequence):
+    path = sequence / "sequence.yaml"
+    manifest = yaml.safe_load(path.read_text())
+    (sequence / "empty").mkdir()
+    manifest["camera"]["images"] = "empty"
+    path.write_text(yaml.safe_dump(manifest))
+    with pytest.raises(ManifestError, match=r"camera\.images: .*no PNG/JPG images") as info:
+        read_sequence(sequence)
+    assert info.value.key == "camera.images"
+    assert info.value.path == path

@@ -232,6 +232,14 @@ class Manifest:
             raise self.error(f"{section}.{key}", f"{path} is not a folder")
         return path
 
+    def images(self, section: str, key: str) -> list[Path]:
+        """The image files of the folder the key names (an empty folder names the key)."""
+        folder = self.folder(section, key)
+        try:
+            return list_images(folder)
+        except InputError as exc:
+            raise self.error(f"{section}.{key}", str(exc)) from exc
+
 
 def read_sequence(folder: str | Path, allow_outside: bool = False) -> Sequence:
     """All inputs of a sequence folder, on GPS time; ground truth when the folder has one."""
@@ -247,7 +255,7 @@ def read_sequence_with_report(
     report = InputReport()
     images, times, camera, camera_offset = [], np.zeros(0), None, 0.0
     if "camera" in m.data:  # a recording without video has no camera section
-        images = list_images(m.folder("camera", "images"))
+        images = m.images("camera", "images")
         camera_offset = m.time_offset("camera")
         times = read_times(m.file("camera", "times"), len(images))
         if np.any(np.diff(times + camera_offset) <= 0):
