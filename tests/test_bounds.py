@@ -51,3 +51,24 @@ def test_the_gnss_bounds_follow_from_each_other():
     assert SIGNAL_TRAVEL_TIME.low * SPEED_OF_LIGHT <= PSEUDORANGE.low
     assert SIGNAL_TRAVEL_TIME.high * SPEED_OF_LIGHT >= PSEUDORANGE.high
     assert TIME_OFFSET.high == GPS_TIME.high
+
+
+def test_the_receiver_radius_is_written_only_in_the_bounds_module():
+    """ "A position on Earth" is one bound: no other module writes its radii as numbers."""
+    import re
+    from pathlib import Path
+
+    import vo_doppler
+    from vo_doppler.bounds import RECEIVER_RADIUS
+
+    package = Path(vo_doppler.__file__).parent
+    radius = re.compile(r"(?<![\w.])[67](?:\.0)?e6(?![\w.])")
+    found = [
+        f"{path.relative_to(package)}:{number}"
+        for path in sorted(package.rglob("*.py"))
+        if path.name != "bounds.py"
+        for number, line in enumerate(path.read_text().splitlines(), 1)
+        if radius.search(line)
+    ]
+    assert found == []
+    assert (RECEIVER_RADIUS.low, RECEIVER_RADIUS.high) == (6.0e6, 7.0e6)

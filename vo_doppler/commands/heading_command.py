@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.bounds import RECEIVER_RADIUS
 from vo_doppler.choices import values
 from vo_doppler.commands.arg_types import (
     add_yaw_rate_sign,
@@ -262,7 +263,7 @@ def _local_frame(receiver_ecef: np.ndarray, obs) -> EnuFrame:
     if finite.size:
         return EnuFrame.from_ecef(receiver_ecef[finite[0]])
     approx = obs.header.approx_position
-    if approx is not None and np.all(np.isfinite(approx)) and np.linalg.norm(approx) > 6.0e6:
+    if approx is not None and not RECEIVER_RADIUS.outside(np.linalg.norm(approx)):
         return EnuFrame.from_ecef(approx)
     raise InputError("no receiver position (no SPP fix, no approximate position)", obs.header.path)
 

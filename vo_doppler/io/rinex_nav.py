@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.bounds import SATELLITE_SPEED
 from vo_doppler.io.rinex_common import (
     add_problem,
     label,
@@ -377,7 +378,7 @@ PLAUSIBLE = {
 """Ranges of broadcast Keplerian parameters (IS-GPS-200 Table 20-I bit ranges: e < 0.5,
 √a 2530–8192 √m; Galileo, BeiDou and QZSS fall inside), seconds of week, inclination (rad)."""
 GLONASS_RADIUS_KM = (19_000.0, 32_000.0)
-GLONASS_MAX_SPEED_KM_S = 5.0
+GLONASS_MAX_SPEED_KM_S = SATELLITE_SPEED.high / 1000.0
 
 
 def _implausible(params: dict[str, float]) -> str:

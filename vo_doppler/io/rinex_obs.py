@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.bounds import RECEIVER_RADIUS
 from vo_doppler.errors import InputError
 from vo_doppler.io.rinex_common import (
     add_problem,
@@ -257,7 +258,7 @@ def _approx_position(path, values, problems) -> np.ndarray | None:
     radius = float(np.linalg.norm(position))
     if radius == 0.0:
         return None
-    if not (np.isfinite(position).all() and 6.0e6 < radius < 7.0e6):
+    if not (np.isfinite(position).all() and not RECEIVER_RADIUS.outside(radius)):
         add_problem(problems, path, number, f"APPROX POSITION XYZ {text.strip()!r} ignored")
         return None
     return position
