@@ -60,6 +60,7 @@ FIGURES = ("trajectories.png", "heading.png", "error_per_100m.png", "heading_err
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("run_output")
 def test_run_writes_every_output(sequence, run_output):
     recording = read_sequence(sequence)
     written = sorted(p.name for p in run_output.iterdir() if not p.name.startswith("."))
@@ -146,6 +147,7 @@ def test_run_writes_every_output(sequence, run_output):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("run_output")
 def test_run_recovers_calibration_and_heading(sequence, run_output):
     summary = json.loads((run_output / "summary.json").read_text())
     assert summary["tight_heading_availability"] >= summary["conventional_heading_availability"]
@@ -166,6 +168,7 @@ def test_run_recovers_calibration_and_heading(sequence, run_output):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("run_output")
 def test_every_trajectory_starts_where_the_vehicle_was(sequence, run_output):
     """The canyon's first valid fixes come 21 s into the drive: carried back along each
     trajectory they put its first pose 0.3-0.7 m from the truth's horizontally and 1.2-1.9 m
@@ -197,6 +200,7 @@ def test_the_samples_trajectories_are_placed_at_the_truths_height():
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("run_output")
 def test_corrected_trajectory_is_finite_and_covers_every_image(sequence, run_output):
     corrected = read_tum(run_output / "trajectory_corrected.tum")
     images = list((sequence / "image_0").iterdir())
