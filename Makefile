@@ -32,15 +32,17 @@ browser:
 	           || echo "chromium could not be installed: the browser tests will skip"; \
 	       else echo "no chromium and no root apt-get: the browser tests will skip"; fi; }
 
-# The suite runs on two workers (pytest-xdist): 10:03 and 11:05 on an idle 2-core machine
-# (a5a78bb, bc0367e: 1,159 and 1,260 CPU-s), over the 10-min budget; cuts are still due.
+# The suite runs on two workers (pytest-xdist), each with one thread for OpenBLAS and OpenCV:
+# their default pools would put four threads on two cores (about 10 % more CPU time measured
+# on tests/heading, fusion, vo and gnss: 270 against 245 CPU-s).
+ONE_THREAD = OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 OPENCV_FOR_THREADS_NUM=1
 test: $(TEST_STAMP) browser
-	$(BIN)/python -m pytest -q -n 2
+	$(ONE_THREAD) $(BIN)/python -m pytest -q -n 2
 
 # The suite without the tests marked slow (generated drives, whole runs, real recordings):
 # under 2 min on 2 cores, for the edit-test loop; `make test` still runs everything.
 test-fast: $(TEST_STAMP) browser
-	$(BIN)/python -m pytest -q -n 2 -m "not slow"
+	$(ONE_THREAD) $(BIN)/python -m pytest -q -n 2 -m "not slow"
 
 lint: $(TEST_STAMP)
 	$(BIN)/ruff check . && $(BIN)/ruff format --check .
