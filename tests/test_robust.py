@@ -1,5 +1,6 @@
-"""vo_doppler.robust: exact answers of the scale (R1), the weights (R2)–(R4), the Huber
-covariance (R5) and the IRLS loop, and properties over generated data."""
+"""vo_doppler.robust: exact answers of the scale (R1), the weights (R2)–(R4), Huber's ψ (R2′)
+and inflated variance (R2″), the Huber covariance (R5) and the IRLS loop, and properties over
+generated data."""
 
 from __future__ import annotations
 
@@ -11,6 +12,8 @@ from hypothesis import strategies as st
 from vo_doppler.robust import (
     MAD_TO_SIGMA,
     cauchy_weight,
+    huber_inflated_variance,
+    huber_psi,
     huber_variance,
     huber_weight,
     irls,
@@ -86,6 +89,43 @@ def test_weights_of_known_residuals():
         student_weight(np.array([0.0, 1.0, -np.sqrt(6.0)]), 4.0), [1.25, 1.0, 0.5]
     )
     assert student_weight(1.0, 4.0, prior=2.0) == 2.0
+
+
+def test_huber_psi_of_known_residuals():
+    np.testing.assert_array_equal(
+        huber_psi(np.array([0.0, 1.0, -1.5, 2.69, -5.38]), 1.345),
+        [0.0, 1.0, -1.345, 1.345, -1.345],
+    )
+    u = np.array([-1e300, -2.5, 0.0, 7.0, 1e300])
+    np.testing.assert_array_equal(huber_psi(u, np.inf), u)  # k = ∞: least squares
+    assert huber_psi(-0.5, 0.5) == -0.5  # the bound itself is inside
+    assert np.isnan(huber_psi(np.nan, 1.0))
+
+
+def test_huber_inflated_variance_of_known_residuals():
+    np.testing.assert_array_equal(
+        huber_inflated_variance(2.0, np.array([0.0, 3.0, -6.0, -1.5, 7.5]), 3.0),
+        [2.0, 2.0, 4.0, 2.0, 5.0],
+    )
+    np.testing.assert_array_equal(  # variances and residuals side by side
+        huber_inflated_variance(np.array([1.0, 4.0, 0.5]), np.array([8.0, -2.0, -16.0]), 2.0),
+        [4.0, 4.0, 4.0],
+    )
+    np.testing.assert_array_equal(
+        huber_inflated_variance(np.array([1.0, 2.0]), np.array([1e300, -1e300]), np.inf),
+        [1.0, 2.0],
+    )
+    assert huber_inflated_variance(3.0, np.nan, 1.0) == 3.0  # a NaN residual keeps it
+
+
+def test_the_inflated_variance_bounds_a_kalman_update_by_k_standard_deviations():
+    """Gain P⁻/(S/w) with u = ν/√S: a gross innovation moves the state by k·P⁻/√S exactly as
+    far as an innovation of k standard deviations, and by no more."""
+    P_pred, r, k = 0.75, 0.25, 3.0
+    S = P_pred + r
+    nu = np.array([0.5, 3.0, 30.0, -300.0])
+    moved = P_pred / huber_inflated_variance(S, nu / np.sqrt(S), k) * nu
+    np.testing.assert_allclose(moved, [0.375, 2.25, 2.25, -2.25], rtol=1e-15)
 
 
 def test_huber_variance_is_least_squares_with_infinite_k_and_counts_the_clipped():
@@ -187,6 +227,24 @@ def test_nmad_is_shift_invariant_and_scale_equivariant(values, factor, negative,
     assert nmad(a * values + shift) == pytest.approx(expected, abs=tolerance * 10)
     assert nmad(a * values, centre=False) == pytest.approx(
         abs(a) * nmad(values, centre=False), rel=1e-12
+    )
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(finite, min_size=1, max_size=20),
+    st.floats(1e-3, 1e3),
+    st.floats(1e-6, 1e6),
+)
+def test_huber_psi_and_inflated_variance_are_the_weight(u, k, variance):
+    """ψ(u) = u·w(u) (R2′), |ψ| ≤ k, and S/(S/w(u)) = w(u) (R2″), to rounding."""
+    u = np.asarray(u)
+    weight = huber_weight(u, k, floor=1e-300)
+    psi = huber_psi(u, k)
+    np.testing.assert_allclose(psi, u * weight, rtol=1e-15, atol=0)
+    assert np.all(np.abs(psi) <= k)
+    np.testing.assert_allclose(
+        variance / huber_inflated_variance(variance, u, k), weight, rtol=1e-15, atol=0
     )
 
 

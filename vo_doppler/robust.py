@@ -21,13 +21,24 @@ reweighted least-squares", Commun. Statist. A6, 1977):
     Cauchy:     w(u) = 1/(1 + (u/c)²)                                                   (R3)
     Student-t:  w(u) = (ν + 1)/(ν + u²)                                                 (R4)
 
+Huber's ψ, the influence of a residual, is the residual clipped at k scales,
+
+    ψ(u) = clip(u, −k, k) = u·w(u)                                                      (R2′)
+
+and a Kalman filter gives an innovation ν of variance S and normalised size u (e.g. ν/√S) its
+weight (R2) through that variance: the gain P⁻·w(u)/S is P⁻ over the inflated variance
+
+    S/w(u) = S·max(1, |u|/k)                                                            (R2″)
+
+so that with u = ν/√S a gross innovation moves the state by at most k·P⁻/√S.
+
 Huber's weight levels off (a gross fault keeps the influence k·s); the Cauchy and Student-t
 weights redescend, so a fault far from the fit gets almost no weight, at the price of a cost
 that is not convex (start them from a Huber fit). k = 1.345 and c = 2.385 give 95 % of least
 squares' efficiency for Gaussian errors (Holland & Welsch 1977). Every weight here multiplies an
 a-priori weight (1/σ² of each observation) given as ``prior``.
 
-**Covariance of a Huber estimate** (Huber 1981, sec. 7.6): with u_i = r_i/s, ψ(u) = clip(u, ±k),
+**Covariance of a Huber estimate** (Huber 1981, sec. 7.6): with u_i = r_i/s, ψ of (R2′),
 m the fraction of |u_i| ≤ k and p parameters,
 
     cov β = K²·s²·Σψ(u_i)²/(n − p)/m² · (XᵀX)⁻¹,   K = 1 + p(1 − m)/(n·m)              (R5)
@@ -99,6 +110,20 @@ def huber_weight(residual, k: float, scale=1.0, floor: float = 0.0, prior=1.0) -
     return prior * np.minimum(1.0, k * scale / np.maximum(np.abs(residual), floor))
 
 
+def huber_psi(u, k: float) -> np.ndarray:
+    """Huber's ψ (R2′) of residuals ``u`` in units of their scale: u clipped to [−k, k], which
+    is u times the weight :func:`huber_weight` (k = ∞: u itself)."""
+    return np.clip(u, -k, k)
+
+
+def huber_inflated_variance(variance, u, k: float) -> np.ndarray:
+    """The variance (R2″) that gives an observation of ``variance`` and normalised residual
+    ``u`` its Huber weight (R2) in a least-squares or Kalman update: variance·|u|/k where
+    |u| > k, else ``variance`` (k = ∞: ``variance``); NaN residuals keep ``variance``."""
+    size = np.abs(u)
+    return np.where(size > k, variance * size / k, variance)
+
+
 def cauchy_weight(u, c: float, prior=1.0) -> np.ndarray:
     """The Cauchy weight (R3) of residuals ``u`` in units of their scale, times ``prior``."""
     return prior / (1.0 + (u / c) ** 2)
@@ -121,7 +146,7 @@ def huber_variance(residual: np.ndarray, scale: float, k: float, params: int) ->
     if inside == 0:
         return float("nan")
     factor = 1.0 + params * (1.0 - inside) / (n * inside)
-    psi = np.clip(u, -k, k)
+    psi = huber_psi(u, k)
     return factor**2 * scale**2 * float(psi @ psi) / (n - params) / inside**2
 
 
