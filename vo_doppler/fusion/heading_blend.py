@@ -42,9 +42,9 @@ State: the offset δ = (true course − VO course), a scalar in rad, held unwrap
   innovation of one measurement: κ_j of (B2) accounts for the information that correlated
   measurements share, not for the error of each, which is (s·σ_j)² whatever its neighbours
   (judged against S_j, a 20σ error of a tight heading with κ = 40 would pass as a 3σ one).
-  With w_j = min(1, k/|u_j|) the innovation variance is taken as S_j/w_j (r_j inflated to
-  S_j/w_j − P⁻_j), so an innovation beyond k standard deviations moves δ by at most
-  k·√S'_j·K_j. k = ∞ gives (B3).
+  With w_j = min(1, k/|u_j|) the innovation variance is taken as S_j/w_j (``robust`` (R2″);
+  r_j inflated to S_j/w_j − P⁻_j), so an innovation beyond k standard deviations moves δ by
+  at most k·√S'_j·K_j. k = ∞ gives (B3).
 
 * Likelihood of the fit (B3″): a contaminated normal density of each innovation,
   (1 − ε)·N(ν_j; 0, S'_j) + ε/(2π), a share ε of headings being anything at all (Huber's
@@ -114,6 +114,7 @@ from vo_doppler.fusion.result import CorrectionResult
 from vo_doppler.geo import wrap_angle, yaw_of
 from vo_doppler.model.timeseries import TIME_TOLERANCE_S, relative_times
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.robust import huber_inflated_variance, huber_psi
 
 SIGMA_GRID = np.logspace(-4.0, -1.0, 16)
 """Candidate σ_d (rad/√m) and σ_ψ (rad/√rad) for the maximum-likelihood fit, steps of 1.6×:
@@ -312,8 +313,7 @@ def forward_filter(
         S_single = S if single_is_inflated else P_pred[j] + r_single[j]
         innovation = wrap_angle(z[j] - x[j - 1])
         size = np.abs(innovation) / np.sqrt(S_single)
-        beyond = size > huber_k
-        gain = P_pred[j] / np.where(beyond, S * size / huber_k, S)
+        gain = P_pred[j] / huber_inflated_variance(S, size, huber_k)
         x[j] = x[j - 1] + gain * innovation
         P[j] = (1.0 - gain) * P_pred[j]
         log_likelihood += density(size, S_single)
@@ -439,7 +439,7 @@ def innovation_whiteness(
     q = np.diff(accumulated, prepend=accumulated[:1])
     forward = forward_filter(z, r, q, config.huber_k, start=start)
     innovation = wrap_angle(z[1:] - forward.x[:-1]) / np.sqrt(forward.P_pred[1:] + r[1:])
-    u = np.clip(innovation, -config.huber_k, config.huber_k)
+    u = huber_psi(innovation, config.huber_k)
     u = u - u.mean()
     denominator = float(np.sum(u**2))
     rho = float(np.sum(u[1:] * u[:-1]) / denominator) if denominator > 0 else float("nan")
