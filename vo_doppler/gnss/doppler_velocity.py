@@ -407,10 +407,10 @@ def vertical_velocity_plausible(velocity_enu: np.ndarray, covariance_enu: np.nda
     """Whether the vertical velocity v_u is one a land vehicle can have:
     |v_u| ≤ 3·√(P_uu + σ_g²), σ_g = √((g·s)² + f²) with s the horizontal speed, g
     ``GRADE_SIGMA`` and f ``VERTICAL_FLOOR_MPS``; P_uu the solution's own vertical variance.
-    (Capping P_uu's share at 0.3 m/s was tried for issue 29: on the Hong Kong canyon drive no
-    valid course was then beyond 15° (one at 20° without), but the calibration lost good epochs
-    elsewhere: comma2k19's dead reckoning alone 0.36 → 0.54 m per 100 m, the sample's VO + GPS
-    (tightly coupled) 0.05 → 0.10 m.)"""
+    (Capping P_uu's share was tried for issue 29 and not kept: it removed the worst valid
+    courses of the Hong Kong canyon drive, but the calibration lost good epochs elsewhere and
+    the dead reckoning and the tightly coupled VO drifted more
+    (docs/benchmarks.md, "The GNSS velocity's settings").)"""
     speed = np.hypot(velocity_enu[0], velocity_enu[1])
     prior = (GRADE_SIGMA * speed) ** 2 + VERTICAL_FLOOR_MPS**2
     return bool(abs(velocity_enu[2]) <= VERTICAL_GATE * np.sqrt(covariance_enu[2, 2] + prior))
@@ -464,11 +464,11 @@ def solve_with_fitted_noise(
     of each signal to the residuals (``noise_model.fit_noise_models``), scale it per satellite
     by the robust scale of that satellite's residuals in units of the model
     (``doppler_noise.fitted_sigma``), solve again. Every row gets a fitted σ, the receiver's
-    reported one included: on the comma2k19 u-blox those are powers of two, 0.097 m/s for
-    every row from 38 to 50 dB-Hz, where the residuals scatter by 0.18 to 0.03 m/s. Passes,
-    because the first residuals still carry the pull of the noisy rows weighted by the prior
-    (measured on comma2k19, GPS L1: the model's σ at 45 dB-Hz 0.065 m/s after one pass, 0.050
-    after three)."""
+    reported one included: on the comma2k19 u-blox those are powers of two, one value over a
+    wide band of C/N0 across which the residuals' scatter changes several times over. Passes,
+    because the first residuals still carry the pull of the noisy rows weighted by the prior:
+    on comma2k19 the fitted σ still falls after the first pass
+    (docs/benchmarks.md, "The GNSS velocity's settings")."""
     prior = rows.sigma()
     solution = solve_velocity(rows, epoch_time)
     models: dict[tuple[str, str], NoiseModel] = {}

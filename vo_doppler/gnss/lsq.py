@@ -9,9 +9,9 @@ every row's |w| is the same: the residuals span one direction), and the first of
 order is excluded: the choice is the data's order, not the rounding of the numbers (issue 30:
 on the sample, which of five satellites was dropped changed when every time was shifted by
 10⁹ s, and the four left gave velocities 10–56 m/s apart). Leaving such an epoch failed
-instead, or excluding the tied row of largest σ, was measured and not kept: the sample's wheel
-scale moved 0.1 % off and its dead reckoning + tight heading went 0.058 -> 0.18 and 0.16 m per
-100 m.
+instead, or excluding the tied row of largest σ, was tried and not kept: the sample's wheel
+scale moved off and its dead reckoning with the tight heading drifted about three times as
+much (docs/benchmarks.md, "The GNSS velocity's settings").
 
 What the test cannot see (external reliability, :func:`minimal_detectable_shift`): the shift of
 the solution that the smallest bias on one satellite the test still detects with probability

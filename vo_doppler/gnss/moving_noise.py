@@ -46,8 +46,8 @@ MIN_MOVING_ROWS = 100
 """Fewer moving rows fit no speed share: the moving rows then keep their a-priori σ (22 rows
 of a walker's first steps gave k 0.64 at 35 dB-Hz, three times a car's in a street canyon)."""
 DEFAULT_SLOPE = -1.0
-"""κ₁ where only one C/N0 bin has data: k falls tenfold per 10 dB, as measured on the Hong Kong
-drive (−1.0 between 25 and 40 dB-Hz)."""
+"""κ₁ where only one C/N0 bin has data: k falls tenfold per 10 dB, the slope fitted on the Hong Kong
+drive (docs/benchmarks.md, "The GNSS velocity's settings")."""
 SLOPE_RANGE = (-2.0, 0.0)
 FACTOR_RANGE = (0.1, 10.0)
 MAX_K = 1.0
