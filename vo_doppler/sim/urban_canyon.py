@@ -166,11 +166,10 @@ def _round_up(value: float, digits: int = 5) -> str:
 
 
 MAX_DURATION_S = 3600.0
-"""Longest drive simulated (s). The whole drive is held in memory until written: measured
-without images (``/usr/bin/time -v``), the peak is 0.37 GB at 60 and at 300 s and 0.80 GB at
-1800 s, about 0.25 MB per second once the satellite states are computed in chunks (it was
-1 MB per second: 1.9 GB at 1800 s), so an hour needs about 1.3 GB; a longer one would still
-grow without bound before writing anything."""
+"""Longest drive simulated (s). The whole drive is held in memory until written, and its peak
+grows with the duration, so that an hour already needs over a gigabyte (docs/benchmarks.md,
+"Memory", the simulator's peaks); a longer one would still grow without bound before writing
+anything."""
 
 
 @dataclass(frozen=True)
