@@ -62,10 +62,10 @@ class GateConfig:
     """The gyro bias is a slope, so it needs samples spanning at least this long (s). Reflections
     come in episodes of about half a second (docs/design.md (I1)); over a span not much longer,
     one episode tilts the whole slope while the residuals' scatter, from a dozen samples, does
-    not show it: on a simulated drive (clean1) the first estimate, from 0.75 s of samples, was
-    −3.6 ± 1.0 °/s for a true 0.30 °/s and turned the dead reckoning by 5.8° over the 5 s until
-    the next valid sample. Least squares tilts the slope by 6·δ·e·(T − e)/T³ for courses δ off
-    over the first e of T seconds: half a second weighs a fifth as much over 3 s as over 1 s."""
+    not show it (a simulated drive's first estimate, from a braking corner's samples:
+    docs/benchmarks.md, "The gyro bias needs samples over 3 s"). Least squares tilts the slope
+    by 6·δ·e·(T − e)/T³ for courses δ off over the first e of T seconds: half a second weighs a
+    fifth as much over 3 s as over 1 s."""
     huber_k: float = 1.345
     """k of the Huber fits (:func:`huber_line`), in robust standard deviations of the
     residuals (1.345: 95 % efficiency on Gaussian noise; inf: least squares)."""

@@ -21,15 +21,13 @@ the run is post-processing), and the prior's σ is the robust scatter of those d
 (:func:`grade_prior`), plus the median's own σ (1.25·scatter/√n), at least ``min_sigma``.
 With fewer than ``min_samples`` differences there is no prior (NaN).
 
-A running (causal) median left a drive's first seconds, before 20 valid velocities, at the
-zero-mean prior's 5 %: on the simulated level drives of ``benchmarks/heading_nlos.py`` the
-tight heading's σ there was 2.3–5° and the used share 72.2 / 90.6 / 81.3 % against
-72.7 / 91.1 / 83.8 % now (with the calibrated wheel speed in dv/dt; the level roads' grade
-prior then errs by 0.24 % at p95 instead of 0.77 %).
-
-On the comma2k19 minute (device pitched about 4° down: f₀/g₀ = −7 %) the grade so found,
-offset fitted over the first 20 s (the canyon emulation's open sky), is within 0.4 % (median)
-/ 1.3 % (p95) of the ground truth's, whose own spread is 3.3 %.
+A running (causal) median left a drive's first seconds, before ``min_samples`` valid
+velocities, at the zero-mean prior's σ, with wider tight headings and fewer of them used on the
+simulated level drives of ``benchmarks/heading_nlos.py``; the calibrated wheel speed in dv/dt
+likewise narrows the level roads' grade error. On the comma2k19 minute (device pitched down,
+so f₀ is far from zero) the grade so found, offset fitted over the canyon emulation's open-sky
+start, follows the ground truth's within the truth's own spread. Both in docs/benchmarks.md,
+"A street canyon from the start" and "The heading stage's settings".
 """
 
 from __future__ import annotations
@@ -96,8 +94,9 @@ def grade_prior(
         σ_a² = max(s² − median(σ_u² / |v_h|²), 0),    σ = max(σ_a + 1.25·s/√n, σ_min)
 
     with s the robust scatter of d and n its count; the second term is the offset's own σ. In
-    a street canyon the Doppler's vertical noise (VDOP) is most of s: simulated level drives
-    with a longitudinal accelerometer gave s ≈ 4–5 % and σ 0.5–0.6 %."""
+    a street canyon the Doppler's vertical noise (VDOP) is most of s, which the split leaves
+    out (simulated level drives with a longitudinal accelerometer: docs/benchmarks.md, "A
+    street canyon from the start")."""
     velocity = np.asarray(velocity_enu, dtype=float).reshape(-1, 3)
     horizontal = np.hypot(velocity[:, 0], velocity[:, 1])
     calibrating = np.asarray(valid, dtype=bool) & (horizontal >= config.min_speed_mps)

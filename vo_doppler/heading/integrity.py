@@ -53,8 +53,9 @@ while fixes a few reflected satellites pulled reached 0.75 m/s and passed the sp
 COURSE_ALERT_LIMIT = np.radians(5.0)
 """A conventional course is valid only where the gyro bounds its error within this at
 ``PROTECTION_QUANTILE``: the accuracy asked of a heading from the Doppler velocity (issue 29:
-p95 within 5°). Hong Kong canyon drive at 1 Hz, moving epochs valid / p95: 37 % / 3.8° at 5°,
-53 % / 5.0° at 8°, 65 % / 6.9° at 15° (docs/design.md (I1a))."""
+p95 within 5°). A wider limit validates more of a street canyon's epochs but lets their p95
+beyond that accuracy (docs/design.md (I1a); the Hong Kong canyon drive at three limits in
+docs/benchmarks.md, "The heading stage's settings")."""
 PROTECTION_QUANTILE = 1.96
 """The bound holds the course error at 95 % (two-sided) where the reference's σ is honest."""
 REST_FALSE_ALARM = 0.01

@@ -210,8 +210,9 @@ class HeadingPipelineConfig:
 def _grade_prior(t_epoch, velocity, valid, speed, forward_acceleration, vertical_sigma, config):
     """(μ, σ) of the tight heading's grade per epoch: the accelerometer's where calibrated,
     else N(0, ``config.tight.grade_sigma``); and where it is the accelerometer's. ``speed``:
-    the wheel speed times the recording's final wheel scale (dv/dt of a wheel speed 2 % off
-    moved the grade of the simulator's level drives by 0.77 % at p95, 0.24 % calibrated)."""
+    the wheel speed times the recording's final wheel scale (dv/dt of an uncalibrated wheel
+    speed moves the grade by the scale error times the acceleration: docs/benchmarks.md, "Real
+    recording: comma2k19")."""
     m = len(t_epoch)
     level = np.zeros(m), np.full(m, config.tight.grade_sigma)
     if forward_acceleration is None or not len(forward_acceleration.t):
@@ -330,9 +331,9 @@ def backfill_start(
     random walk); but nothing measured the sensor in those first seconds, when a gyro may
     still be warming up, so their σ stays the spread of an uncalibrated sensor. (With the last
     estimate's σ the tight heading's consistency tests rejected most rows of the sample's
-    first 3 s and lost 7 % of its headings.) Not causal there; causal from the first estimate
-    on (from the first precise one for the bias). On the simulator's drives the first estimate
-    comes 1.7–11.2 s after the start (comma2k19: 0.9 s).
+    first seconds and lost headings.) Not causal there; causal from the first estimate on (from
+    the first precise one for the bias). On the simulator's drives the first estimate comes
+    seconds after the start (docs/benchmarks.md, "The calibration's first seconds").
 
     Why the bias's imprecise first estimates go too: a bias error b_e held for T seconds turns
     the dead reckoning by b_e·T for the rest of the drive, which no later estimate undoes. A
@@ -440,16 +441,15 @@ def tight_wheel_scale(
     σ ≤ ``config.tight_calibration_max_sigma_rad`` and no rejected row.
 
     The headings of a pass carry its scale's error (a two-satellite heading turns by about the
-    relative speed error, in radians), which pulls the fit towards that scale: from the prior's
-    1, for a true 0.9804, the simulator's canyon drives give 0.9810 / 0.9829 / 0.9808 at σ
-    0.18–0.20 %. Fitting again from there comes closer (0.9796 on the sample, σ 0.10 %), but
-    the sample's canyon from the start then keeps a third fewer reliable headings (51.5 →
-    33.5 %; the same with the true scale given as fixed). The lost ones are right (0.09° median
-    error); the reliability test shuts them out: the drive's first windows (0.3–0.6 s of rows,
-    two satellites, one reflected) give a heading 64° off at σ 0.2° that counts as verifiable,
-    hence reliable, and the smaller gyro-bias σ of that calibration keeps it an informative
-    reference for the 3.9–10.6 s that follow (``TightHeadingConfig.prior_max_age_s``). One fit
-    it is, until such a first window is caught."""
+    relative speed error, in radians), which pulls the fit towards that scale, from the
+    prior's 1 part of the way to the true one. Fitting again from there comes closer, but the
+    sample's canyon from the start then keeps a third fewer reliable headings (the same with
+    the true scale given as fixed). The lost ones are right; the reliability test shuts them
+    out: the drive's first windows (a fraction of a second of rows, two satellites, one
+    reflected) give a heading far off at a small σ that counts as verifiable, hence reliable,
+    and the smaller gyro-bias σ of that calibration keeps it an informative reference for the
+    seconds that follow (``TightHeadingConfig.prior_max_age_s``). One fit it is, until such a
+    first window is caught (docs/benchmarks.md, "The heading stage's settings")."""
     result = solved.result
     informative = (
         result.reliable
