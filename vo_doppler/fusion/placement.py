@@ -133,9 +133,9 @@ PLACEMENT_SPAN_S = 60.0
 """Seconds of antenna positions, from the first inside a trajectory, that place it. A street
 canyon's fixes are off by tens of metres for seconds at a time (reflections), while a
 trajectory carries a fix back with its own drift, a few metres per minute even for the VO
-alone. First DR pose against the truth, 5 s → 60 s: the sample 48.7 → 4.1 m (its first
-five seconds of fixes lie 49 m off, the rest 4–5 m), the 60-s NLOS drive 20.3 → 16.0 m,
-comma2k19 0.7 → 0.6 m, the clean 120-s drives 3.2 → 4.0 and 0.9 → 0.9 m."""
+alone: a minute of fixes outvotes a canyon's biased first seconds at little cost in drift
+(the first dead-reckoning pose against the truth with a span of 5 s and of 60 s in
+docs/benchmarks.md, "Error per 100 m on the simulator's drives", "The placement span")."""
 PLACEMENT_MIN_FIXES = 5
 """At least this many antenna positions place a trajectory (if it has them), however long."""
 

@@ -7,8 +7,8 @@ an error δr in the position turns e by δr/ρ (ρ ≈ 20,000 km) and moves the 
 0.02 m/s per 100 m. In a street canyon single-point fixes are off by tens to hundreds of metres
 (reflected pseudoranges, four-satellite geometry), the nearest fix in time can be a whole block
 behind, and that bias, constant over a heading window and different per satellite, looks like
-a reflection to the tight heading (simulated canyons: fixes 27–86 m off at the median, 150–290 m
-at p95; the tight heading's p95 0.61° → 0.28° with the true positions).
+a reflection to the tight heading (simulated canyons: the fixes' errors and the tight
+heading's p95 with the true positions in docs/benchmarks.md, "The GNSS velocity's settings").
 
 The track is the least-squares fit, per ENU axis, of positions p_k to the fixes s_k and to the
 displacements the Doppler velocities give between consecutive epochs:
@@ -24,15 +24,15 @@ their formal σ (the horizontal σ of the SPP covariance per horizontal axis, ``
 times it for up), scaled per axis by the robust scatter of the normalised residuals. Reflected
 fixes are biased for seconds at a time; iteratively re-weighted passes give them Huber weights
 w_k (k = ``huber_k``) for the first half of the passes, then Cauchy weights (c = ``cauchy_c``),
-which leave a fix a block off almost no weight once the track is near the others. Simulated
-canyons: the rows' positions 6–19 m off at the median, 15–52 m at p95 (from 27–86 m and
-150–290 m with the nearest valid fix). (T1) is solved only on the epochs a chain of finite
-steps links to a fix; the others have no solution of their own.
+which leave a fix a block off almost no weight once the track is near the others; on the
+simulated canyons the rows' positions come several times closer than the nearest valid fix
+(docs/benchmarks.md, "The GNSS velocity's settings"). (T1) is solved only on the epochs a
+chain of finite steps links to a fix; the others have no solution of their own.
 
 A canyon lasts: with two satellites for minutes there is neither a fix nor a velocity, and (T1)
-alone carries the last velocity on in a straight line (a simulated 1 Hz drive circling at
-8 m/s, two satellites after 60 s: 0.6 km off after 2 min, 9 km after 20 min, lines of sight
-off by 1.8 m/s). So every epoch gets the σ of its track position, per axis
+alone carries the last velocity on in a straight line, kilometres off within minutes on a
+simulated drive that circles (docs/benchmarks.md, "The GNSS velocity's settings"). So every
+epoch gets the σ of its track position, per axis
 
     P_k = (1/P⁻_f,k + w_k/σ_k² + 1/P⁻_b,k)⁻¹,                                         (T2)
     P⁻_f,k = (1/P⁻_f,k−1 + w_k−1/σ_k−1²)⁻¹ + τ_k−1²   (P⁻_b,k likewise from the end)
@@ -51,10 +51,10 @@ position is held at the trusted neighbour in time, before or after, whose held �
     σ_held,k = σ_j + |L_k − L_j|,   L_k = Σ_{i<k} min(|d_i| + |δ_i|, v_max Δt_i)          (T4)
 
 the distance the receiver can have covered since epoch j (``max_speed_mps`` bounds a step whose
-velocity is unknown). The same drive: held 13 s into the canyon, the track stays within 0.33 km
-of the truth for 20 min (the circle's diameter and the 35 m it drifted before the hold), lines
-of sight within 0.065 m/s. Without a single velocity (no Doppler row, no solved epoch) every
-step is unlinked: the fixes as they are, held in between (it was a singular system).
+velocity is unknown). The same drive, held: the track stays within the circle's diameter of
+the truth, and its lines of sight close enough for the rows (same section). Without a single
+velocity (no Doppler row, no solved epoch) every step is unlinked: the fixes as they are, held
+in between (it was a singular system).
 """
 
 from __future__ import annotations
