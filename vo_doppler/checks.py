@@ -81,29 +81,27 @@ MAX_MEDIAN_LATERAL_ACCELERATION = 1.5
 CLOCK_TOLERANCE_S = 0.2
 CLOCK_TOLERANCE_M = 1.0
 """Largest residual clock offset times the median moving speed (m) without a warning: on
-comma2k19 (17.7 m/s) the vehicle signals shifted by 0.025 / 0.05 / 0.1 / 0.126 / 0.2 s (0.1 /
-0.4 / 1.6 / 1.7 / 3.3 m by the estimates) gave DR + GPS 0.14 / 0.15 / 0.27 / 0.34 / 0.54 m per
-100 m against 0.15 m unshifted; the estimate's own error there is about 0.02 s (0.6 m at
-30 m/s)."""
+comma2k19 the dead reckoning's error per 100 m grows once the vehicle signals are shifted by
+more than this along the track, while the estimate's own error stays well below it
+(docs/benchmarks.md, "Plausibility checks")."""
 CLOCK_SEARCH_S = 5.0
 CLOCK_RATE_HZ = 10.0
 MAX_CLOCK_MATCH_RATIO = 0.5
 """Largest best-to-median ratio of the speed difference over the lags for a lag to count as
-found: a true lag leaves the speeds' noise (a tenth of the median on comma2k19), a chance
-alignment of unrelated stretches of the drive or a featureless speed barely beats the rest."""
+found: a true lag leaves the speeds' noise, a small fraction of the median, a chance alignment
+of unrelated stretches of the drive or a featureless speed barely beats the rest
+(docs/benchmarks.md, "Plausibility checks")."""
 MIN_CLOCK_EPOCHS = 20
 """Fewest valid GNSS epochs inside the wheel speed's span (less the searched lag) to search,
 and fewest of them where the wheel speed changes, at every searched lag."""
 MAX_CHANGE_MATCH_RATIO = 0.25
 """``MAX_CLOCK_MATCH_RATIO`` of the search over the epochs where the speed changes: there a
-true lag leaves a twentieth to an eighth of the median (comma2k19: 0.07-0.12), a chance
-match of a few changes a quarter or more."""
+true lag leaves a small fraction of the median, a chance match of a few changes a
+quarter or more (docs/benchmarks.md, "Plausibility checks")."""
 MAX_CLOCK_NOISE_MULTIPLE = 2.0
 """Largest best median difference for a lag, in units of the GNSS speed's sample noise σ: at
-the true shift the two speeds differ by their noise (median 0.67 σ; 0.56-0.82 σ over all
-epochs of comma2k19 and four simulated drives); a chance match differs by more (over the speed
-changes 4-10 σ on 120-s cruises shifted by 6-60 s; over all epochs 1.5-33 σ on those drives
-shifted by 8-40 s)."""
+the true shift the two speeds differ by their noise, below one σ; a chance match differs by
+more (docs/benchmarks.md, "Plausibility checks")."""
 MIN_CLOCK_NOISE_MPS = 0.02
 """Least GNSS speed noise assumed (m/s): a noise-free speed still differs from the wheel
 speed by interpolation and the sampling of the shifts."""
