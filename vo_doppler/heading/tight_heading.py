@@ -1035,20 +1035,18 @@ def window_lengths(
 
     The gyro: a bias error of σ_b (``gyro_bias_sigma`` per epoch, rad/s) turns the rows of a
     window of length W by up to σ_b·W, which moves θ₀ by about σ_b·W/2, so W stays within
-    2·target/σ_b: before the bias is calibrated that is the minimum (on the comma2k19 minute in
-    a two-satellite canyon from its start, 8-s windows with the prior's bias settled on the
-    mirror root, 15° median error; the sample's canyon gave a first pass whose bias was
-    −1.2 °/s for a true 0.3 with the bias traded against noise instead). The road: the model
-    holds one grade per window, and a road's grade changes over a few tens of metres (at 10 Hz
-    with 8-s windows, 160 m at 20 m/s, the minute went to the mirror root with the bias
-    calibrated).
+    2·target/σ_b: before the bias is calibrated that is the minimum (longer windows with the
+    prior's bias settled on the mirror root, and trading the bias against noise instead
+    calibrated a wrong bias: docs/benchmarks.md, "The heading stage's settings"). The road: the
+    model holds one grade per window, and a road's grade changes over a few tens of metres
+    (longer windows went to the mirror root with the bias calibrated, same section).
 
     ``equations``: per epoch the rows left by its own clock drift, and how many unknowns the
     window's clock has besides. Whatever the limits above, up to ``config.max_window_s``, a
     window holds ``config.min_window_equations`` of them: two satellites of a 1-Hz receiver
     with one clock drift per epoch give one equation per epoch, and a 2-s window of them cannot
-    tell θ₀ from its mirror (the comma2k19 minute decimated to 1 Hz in a two-satellite canyon
-    from its start had no heading at all; 83 % with this rule)."""
+    tell θ₀ from its mirror (a 1-Hz two-satellite canyon from the start had no heading at all
+    without this rule, same section)."""
     t_epoch = np.asarray(t_epoch, dtype=float)
     m = len(t_epoch)
     if m == 0:
