@@ -73,10 +73,10 @@ RECENT_FRAMES = 5
 
 class _FinishedFrames:
     """The frames that left the window, whose poses no longer change, in arrays grown by
-    doubling: time, world→camera pose, measured and keyframe flags (0.15 kB a frame), the
-    flags of the frames that have some, and the last :data:`RECENT_FRAMES` frames whole.
-    Holding every frame object instead took 0.8 kB a frame, 22 MiB over a 30-min drive at
-    15 frames per second (issue 30: the run's memory flat in the drive's duration)."""
+    doubling: time, world→camera pose, measured and keyframe flags, the flags of the frames
+    that have some, and the last :data:`RECENT_FRAMES` frames whole. Holding every frame object
+    instead grew the run's memory with the drive's duration several times faster (issue 30; the
+    sizes per frame in docs/benchmarks.md, "Memory")."""
 
     def __init__(self) -> None:
         self.count = 0
