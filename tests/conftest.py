@@ -3,7 +3,8 @@ recordings and runs that several test files use, each built once per test proces
 
 With pytest-xdist every worker builds its own copy of a session fixture: the tests sharing one
 carry the same ``xdist_group`` mark (``--dist loadgroup`` in pyproject.toml's ``addopts``), so
-that one worker builds it once for all of them. The grouping is this file's
+that one worker builds it once for all of them; the tests of one module go to one worker too,
+so that a module-scoped fixture is built once. The grouping is this file's
 :class:`MarkGroupScheduling`: pytest-xdist 3.8's own loadgroup passes the group to the
 controller in ``item._nodeid``, which pytest 9.2 no longer reads (pytest-xdist issue 1386), so
 its groups were ignored."""
@@ -168,29 +169,46 @@ def xdist_group_of(item: pytest.Item) -> str | None:
 
 class MarkGroupScheduling(LoadScopeScheduling):
     """``--dist loadgroup``: the tests of one ``xdist_group`` form one work unit, so one worker
-    runs them all; every other test is a unit of its own, spread as ``--dist load`` would.
+    runs them all; every other test is in its module's unit (as ``--dist loadfile``), so that a
+    module-scoped fixture is built once (tests/vo/test_odometry.py's rendered drive was built on
+    both workers: 9 s each). After the first units, the units with the most tests marked
+    ``slow`` go first and the fast ones last, so that the workers end together.
 
     The controller collects no tests, so it cannot read the marks: each worker writes its
-    collection's groups (node id → group) to ``<groups_dir>/<worker id>.json`` before it reports
-    the collection (:func:`pytest_collection_modifyitems`), and the scheduler reads that file
-    with the collection."""
+    collection's groups (node id → group) and slow tests to ``<groups_dir>/<worker id>.json``
+    before it reports the collection (:func:`pytest_collection_modifyitems`), and the scheduler
+    reads that file with the collection."""
 
     def __init__(self, config: pytest.Config, log: Producer | None, groups_dir: Path) -> None:
         super().__init__(config, log)
         self.groups_dir = groups_dir
         self.groups: dict[str, str] = {}
+        self.slow: set[str] = set()
 
     def add_node_collection(
         self, node: WorkerController, collection: collections.abc.Sequence[str]
     ) -> None:
-        """Register the worker's collection and the groups it wrote for it."""
+        """Register the worker's collection and the groups and slow tests it wrote for it."""
         groups_file = self.groups_dir / f"{node.gateway.id}.json"
-        self.groups.update(json.loads(groups_file.read_text(encoding="utf-8")))
+        written = json.loads(groups_file.read_text(encoding="utf-8"))
+        self.groups.update(written["groups"])
+        self.slow.update(written["slow"])
         super().add_node_collection(node, collection)
 
     def _split_scope(self, nodeid: str) -> str:
-        """The test's work unit: its group's name, or its own node id when it has none."""
-        return self.groups.get(nodeid, nodeid)
+        """The test's work unit: its group's name, or its module's path when it has none."""
+        return self.groups.get(nodeid, nodeid.split("::", 1)[0])
+
+    def schedule(self) -> None:
+        """Distribute the first units (the largest, as pytest-xdist does), then queue the rest
+        by their number of slow tests, then of tests, both decreasing."""
+        super().schedule()
+        queued = sorted(
+            self.workqueue.items(),
+            key=lambda unit: (-sum(nodeid in self.slow for nodeid in unit[1]), -len(unit[1])),
+        )
+        self.workqueue.clear()
+        self.workqueue.update(queued)
 
 
 @pytest.hookimpl(optionalhook=True)
@@ -207,14 +225,16 @@ def pytest_configure_node(node: WorkerController) -> None:
 
 @pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """On a worker under ``--dist loadgroup``: write the grouped tests' node ids and groups for
-    :class:`MarkGroupScheduling`, once the items and their ids are final (``trylast``)."""
+    """On a worker under ``--dist loadgroup``: write the grouped tests' node ids and groups and
+    the node ids of the tests marked ``slow`` for :class:`MarkGroupScheduling`, once the items
+    and their ids are final (``trylast``)."""
     workerinput: dict[str, object] | None = getattr(config, "workerinput", None)
     if workerinput is None or GROUPS_DIR_KEY not in workerinput:
         return
     groups = {item.nodeid: group for item in items if (group := xdist_group_of(item))}
+    slow = [item.nodeid for item in items if item.get_closest_marker("slow")]
     groups_file = Path(str(workerinput[GROUPS_DIR_KEY])) / f"{workerinput['workerid']}.json"
-    groups_file.write_text(json.dumps(groups), encoding="utf-8")
+    groups_file.write_text(json.dumps({"groups": groups, "slow": slow}), encoding="utf-8")
 
 
 @pytest.hookimpl(optionalhook=True)

@@ -1,8 +1,8 @@
 """The ``xdist_group`` marks keep a group's tests on one pytest-xdist worker under
 ``--dist loadgroup`` (tests/conftest.py's :class:`MarkGroupScheduling`): the groups as the
-marks name them, one work unit per group and one per unmarked test, and a real run of a small
-suite on two workers. pytest-xdist 3.8's own loadgroup stopped grouping under pytest 9.2
-without any test failing."""
+marks name them, one work unit per group and one per module's unmarked tests, the units with
+slow tests queued first, and a real run of a small suite on two workers. pytest-xdist 3.8's
+own loadgroup stopped grouping under pytest 9.2 without any test failing."""
 
 from __future__ import annotations
 
@@ -85,12 +85,43 @@ class Worker:
         self.shutting_down = True
 
 
-def collect(pytester: pytest.Pytester) -> list[pytest.Item]:
-    """The small suite's items, collected in this process. Without Hypothesis's plugin, which
-    would import Hypothesis anew for each collection when this process has not (3 s)."""
-    pytester.makepyfile(test_marked=MARKED, test_mixed=MIXED)
+SLOW = """
+import pytest
+
+
+@pytest.mark.slow
+def test_slow():
+    pass
+"""
+
+
+def collect(pytester: pytest.Pytester, **files: str) -> list[pytest.Item]:
+    """The small suite's items (and those of ``files``), collected in this process. Without
+    Hypothesis's plugin, which would import Hypothesis anew for each collection when this
+    process has not (3 s)."""
+    pytester.makepyfile(test_marked=MARKED, test_mixed=MIXED, **files)
+    pytester.makeini("[pytest]\nmarkers =\n    slow: a slow test\n")
     items, _ = pytester.inline_genitems("-p", "no:hypothesispytest")
     return items
+
+
+def schedule(pytester, tmp_path, items, workers: int) -> tuple[MarkGroupScheduling, list[Worker]]:
+    """A scheduler fed as the controller feeds it by ``workers`` workers that collected
+    ``items`` and wrote their groups, after its first distribution."""
+    nodeids = [item.nodeid for item in items]
+    nodes = [Worker(SimpleNamespace(id=f"gw{n}")) for n in range(workers)]
+    scheduler = MarkGroupScheduling(
+        pytester.parseconfig("--tx", f"{workers}*popen"), None, tmp_path
+    )
+    for node in nodes:
+        config = SimpleNamespace(
+            workerinput={GROUPS_DIR_KEY: str(tmp_path), "workerid": node.gateway.id}
+        )
+        pytest_collection_modifyitems(config, items)
+        scheduler.add_node(node)
+        scheduler.add_node_collection(node, nodeids)
+    scheduler.schedule()
+    return scheduler, nodes
 
 
 def test_the_marks_name_the_groups(pytester):
@@ -100,28 +131,30 @@ def test_the_marks_name_the_groups(pytester):
 
 def test_a_group_is_one_work_unit_on_one_worker(pytester, tmp_path):
     """Each worker writes its collection's groups, the scheduler reads them: the tests of group
-    ``drive`` from both files share one scope and go to one worker, every unmarked test is a
-    scope of its own."""
+    ``drive`` from both files share one scope and go to one worker, the unmarked tests of a
+    module share their module's scope."""
     items = collect(pytester)
     nodeids = [item.nodeid for item in items]
-    workers = [Worker(SimpleNamespace(id=f"gw{n}")) for n in range(2)]
-    scheduler = MarkGroupScheduling(pytester.parseconfig("--tx", "2*popen"), None, tmp_path)
-    for worker in workers:
-        config = SimpleNamespace(
-            workerinput={GROUPS_DIR_KEY: str(tmp_path), "workerid": worker.gateway.id}
-        )
-        pytest_collection_modifyitems(config, items)
-        scheduler.add_node(worker)
-        scheduler.add_node_collection(worker, nodeids)
-    scheduler.schedule()
+    scheduler, workers = schedule(pytester, tmp_path, items, 2)
 
     scopes = {nodeid: scheduler._split_scope(nodeid) for nodeid in nodeids}
     drive = [nodeid for nodeid, group in GROUPS.items() if group == "drive"]
     free = [nodeid for nodeid, group in GROUPS.items() if group is None]
     assert {scopes[nodeid] for nodeid in drive} == {"drive"}
-    assert [scopes[nodeid] for nodeid in free] == free
+    assert [scopes[nodeid] for nodeid in free] == ["test_mixed.py"] * 3
     sent = [{nodeids[index] for index in worker.sent} for worker in workers]
     assert [set(drive) <= tests for tests in sent].count(True) == 1
+    assert [set(free) <= tests for tests in sent].count(True) == 1
+
+
+def test_units_with_slow_tests_are_queued_first(pytester, tmp_path):
+    """The worker takes the largest unit (``drive``: 4 tests); of the units left, test_slow.py
+    with its slow test is queued before test_mixed.py (3 tests) and ``drive_sample`` (1 test,
+    first in the collection), as pytest-xdist would not."""
+    items = collect(pytester, test_slow=SLOW)
+    scheduler, (worker,) = schedule(pytester, tmp_path, items, 1)
+    assert list(scheduler.assigned_work[worker]) == ["drive"]
+    assert list(scheduler.workqueue) == ["test_slow.py", "test_mixed.py", "drive_sample"]
 
 
 @pytest.mark.slow
