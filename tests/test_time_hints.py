@@ -13,6 +13,7 @@ from vo_doppler.time_hints import (
     UNIX_OFFSET_S,
     TimeBase,
     coverage,
+    epochs_offset_fix,
     looks_like_frame_numbers,
     offset_hint,
     overlap_error,
@@ -114,3 +115,23 @@ def test_times_the_epochs_cover_mostly_pass_and_disjoint_ones_are_an_error():
     disjoint = time_base_check(t + 1e9, np.arange(0.0, 60.0, 0.2), "t", "e", "--o")
     assert disjoint.coverage == 0.0 and "do not overlap" in disjoint.error
     assert "pass --o" in disjoint.error
+
+
+def test_epochs_on_another_clock_name_the_offset_to_add_to_them():
+    """``run --heading FILE``: the file is on the wrong clock, not the recording; the fix given
+    instead of an option's adds the recording's start to the file's times."""
+    recording = np.array([1425953404.1, 1425953412.0])
+    epochs = np.arange(0.0, 8.0, 0.1)
+    fix = epochs_offset_fix(recording, epochs)
+    assert fix.endswith(
+        "add the GPS time of its first row to each (about 1425953404 s if it "
+        "starts with the recording)"
+    )
+    verdict = time_base_check(
+        recording, epochs, "recording", "heading epochs", "--o", offset_fix=fix
+    )
+    assert verdict.error.endswith(f"do not overlap; {fix}") and "--o" not in verdict.error
+    part = time_base_check(
+        recording, epochs + recording[0] - 5.0, "recording", "e", "--o", offset_fix=fix
+    )
+    assert part.warning.endswith(f"if the two clocks differ, {fix}")

@@ -25,6 +25,7 @@ from vo_doppler.model.time_span import TimeSpan, trim_sequence
 from vo_doppler.report.run_outputs import input_warnings, result_checks, write_run_outputs
 from vo_doppler.run import RunResult, run_sequence
 from vo_doppler.run_stages import RunConfig
+from vo_doppler.time_hints import epochs_offset_fix, time_base_check
 
 log = logging.getLogger(__name__)
 
@@ -67,9 +68,10 @@ def run_recording(
     if span is not None and not span.whole:
         sequence, interval = trim_sequence(sequence, span)
     given = None
+    warnings = input_warnings(sequence, report)
     if heading_file is not None:
         given = GivenHeading(read_heading_csv(heading_file), str(heading_file))
-    warnings = input_warnings(sequence, report)
+        warnings += _heading_time_base(sequence, given, heading_file)
     for text in warnings:
         log.warning("%s", text)
     try:
@@ -91,6 +93,29 @@ def run_recording(
     finally:
         gc.unfreeze()
     return JobOutput(sequence, result, summary)
+
+
+def _heading_time_base(sequence: Sequence, given: GivenHeading, path: Path) -> list[str]:
+    """``correct``'s check of a heading file's clock (:func:`time_base_check`) for ``run
+    --heading FILE``: its epochs against the vehicle signals' span, where the tightly coupled
+    heading it replaces would be (none when the signals do not overlap: a check of its own
+    refuses that). Raises the check's error naming the file; returns its warning, naming the
+    file, if any."""
+    if sequence.vehicle_span is None:
+        return []
+    recording = np.array(sequence.vehicle_span)
+    epochs = given.table.t
+    verdict = time_base_check(
+        recording,
+        epochs,
+        "recording",
+        "heading epochs",
+        "--heading",
+        offset_fix=epochs_offset_fix(recording, epochs),
+    )
+    if verdict.error:
+        raise InputError(verdict.error, path)
+    return [f"{path}: {verdict.warning}"] if verdict.warning else []
 
 
 def _nothing(_: Sequence) -> AbstractContextManager[None]:

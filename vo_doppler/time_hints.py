@@ -42,6 +42,16 @@ def offset_hint(sensor_t0: float, gnss_t0: float, option: str) -> str:
     )
 
 
+def epochs_offset_fix(t: np.ndarray, epochs: np.ndarray) -> str:
+    """What fixes a file of epochs (``run --heading FILE``) not on the GPS time of the times
+    ``t`` it is joined with: the offset to add to its times, from the first of each."""
+    gap = float(t[0]) - float(epochs[0]) if len(t) and len(epochs) else 0.0
+    return (
+        "the file's times must be GPS seconds, as the recording's are: add the GPS time of its "
+        f"first row to each (about {gap:.0f} s if it starts with the recording)"
+    )
+
+
 FRAME_NUMBER_FIX = (
     "pass --times with the images' times.txt (a KITTI poses file has no times; then "
     "--time-offset to GPS time)"
@@ -100,6 +110,7 @@ def time_base_check(
     epochs_what: str,
     offset_option: str,
     frame_fix: str = FRAME_NUMBER_FIX,
+    offset_fix: str | None = None,
 ) -> TimeBase:
     """Check a join of two clocks: ``t`` (``what``'s times, after any offset) with ``epochs``
     (``epochs_what``'s, GPS time), each increasing.
@@ -110,7 +121,9 @@ def time_base_check(
     warning when the epochs cover less than :data:`LOW_COVERAGE`, or when frame numbers are
     covered (plausible only with epochs on a frame clock too). Each message gives both spans,
     the cause guessed and the option that fixes it: ``frame_fix`` for frame numbers, else
-    ``offset_option`` with the likely offset (:func:`offset_hint`)."""
+    ``offset_fix`` when given (the epochs are on the wrong clock, e.g.
+    :func:`epochs_offset_fix`), else ``offset_option`` with the likely offset
+    (:func:`offset_hint`)."""
     t = np.asarray(t, dtype=float)
     epochs = np.asarray(epochs, dtype=float)
     share = coverage(t, epochs)
@@ -120,7 +133,7 @@ def time_base_check(
     if frames and share < FRAME_NUMBER_COVERAGE:
         meet = f"meet over {share:.0%} of the {what}" if share > 0 else "do not overlap"
         return TimeBase(share, error=f"{spans} {meet}: {frame_cause}; {frame_fix}")
-    offset = (
+    offset = offset_fix or (
         offset_hint(float(t[0]), float(epochs[0]), offset_option) if len(t) and len(epochs) else ""
     )
     if share <= 0:

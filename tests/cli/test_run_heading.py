@@ -5,6 +5,7 @@ heading CSV runs the corrected pipelines on a recording without GNSS."""
 from __future__ import annotations
 
 import json
+import re
 import shutil
 
 import numpy as np
@@ -107,17 +108,55 @@ def test_run_with_a_minimal_heading_corrects_a_recording_without_gnss(no_gnss, t
     assert set(_summary(without)["evaluation"]) == {"vo", "dr"}
 
 
+def _shifted(heading, path, start_s: float, keep: float = 1.0):
+    """The minimal heading CSV ``heading`` with its times moved to start at ``start_s`` and
+    only the first ``keep`` share of its span kept, written to ``path``."""
+    table = np.loadtxt(heading, delimiter=",", skiprows=1)
+    t = table[:, 0]
+    table = table[t <= t[0] + keep * (t[-1] - t[0])]
+    table[:, 0] += start_s - t[0]
+    np.savetxt(path, table, fmt="%.3f", delimiter=",", header="gps_time_s,course_deg,sigma_deg")
+    path.write_text(path.read_text().removeprefix("# "))
+    return path
+
+
 @pytest.mark.slow
-def test_a_heading_of_another_time_is_refused(no_gnss, tmp_path, capsys):
-    folder, _ = no_gnss
-    other = tmp_path / "other.csv"
-    other.write_text("gps_time_s,heading_deg,sigma_deg\n1000.0,90,1\n1001.0,91,1\n")
+def test_a_heading_on_another_clock_is_refused_naming_the_file_and_the_fix(
+    no_gnss, tmp_path, capsys
+):
+    """Issue 30: the heading file checked against the recording's times as ``correct`` checks
+    it against the trajectory's: times in seconds from the start are an error naming the file
+    and the offset to add (they were refused only by the heading stage, for no valid row)."""
+    folder, heading = no_gnss
+    other = _shifted(heading, tmp_path / "from_start.csv", 0.0)
     out = tmp_path / "out"
     assert main(["run", str(folder), "-o", str(out), "--heading", str(other)]) == 1
-    err = capsys.readouterr().err
-    assert "other.csv: no valid heading within the recording's times" in err
-    assert "the file's rows run 1000.000 to 1001.000 s, 2 of them valid" in err
+    err = " ".join(capsys.readouterr().err.split())
+    said = re.search(
+        r"from_start\.csv: the recording times \((\d+\.\d{3})\.\.\d+\.\d{3} s\) and the "
+        r"heading epochs \(0\.000\.\.7\.900 s, GPS time\) do not overlap; the file's times must "
+        r"be GPS seconds, as the recording's are: add the GPS time of its first row to each "
+        r"\(about (\d+) s if it starts with the recording\)",
+        err,
+    )
+    assert said, err
+    assert abs(float(said[2]) - float(said[1])) <= 0.5
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_a_heading_of_part_of_the_recording_is_warned(no_gnss, tmp_path, caplog):
+    """A heading file covering a third of the recording: the run goes on, warned as
+    ``correct`` warns, in the log and in the summary."""
+    folder, heading = no_gnss
+    first = read_tum(folder / "ground_truth.tum").t[0]
+    part = _shifted(heading, tmp_path / "part.csv", first, keep=0.35)
+    out = tmp_path / "out"
+    assert main(["run", str(folder), "-o", str(out), "--heading", str(part)]) == 0
+    warned = [w for w in _summary(out)["warnings"] if w.startswith(f"{part}: the recording times")]
+    assert len(warned) == 1
+    assert re.search(r"meet over 3\d% of the recording only: the rest is joined", warned[0])
+    assert warned[0] in [r.getMessage() for r in caplog.records]
 
 
 def test_a_heading_method_with_a_given_heading_is_a_usage_error(tmp_path, capsys):
