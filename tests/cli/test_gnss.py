@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,11 @@ from tests.conftest import REPO_ROOT, require_shared
 from tests.helpers.precise_text import clock_text, sp3_text
 from tests.helpers.rinex_text import field, rinex3_epoch, rinex3_header
 from vo_doppler.cli import main
+from vo_doppler.commands import gnss_command
+from vo_doppler.commands.gnss_command import _glonass_dropped
 from vo_doppler.io.gnss_csv import SPP_COLUMNS, VELOCITY_COLUMNS
+from vo_doppler.io.receiver_file import read_observation_file
+from vo_doppler.io.rinex_nav import read_nav
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 
 
@@ -215,15 +220,50 @@ def test_precise_orbits_or_clocks_of_another_time_are_named(tmp_path, capsys, ca
 
 
 @pytest.mark.slow
-def test_glonass_rows_without_a_frequency_channel_are_said_once(tmp_path, caplog):
-    """GLONASS Doppler without a channel (no GLONASS SLOT / FRQ # entry, no GLONASS record in
-    the navigation file): one warning with the count and the satellites (they were dropped
-    without a word)."""
+def _glonass_without_channels(tmp_path):
+    """The canyon's rover.obs with its Galileo satellites renamed GLONASS: GLONASS Doppler with
+    no GLONASS SLOT / FRQ # entry, and brdc.nav has no GLONASS record."""
     text = (SAMPLE_GNSS / "rover.obs").read_text()
     obs = tmp_path / "glonass.obs"
     obs.write_text(re.sub(r"(?m)^E(\d\d)", r"R\1", text.replace("E    3 C1C", "R    3 C1C")))
-    out = tmp_path / "vel.csv"
-    main(["gnss", "velocity", str(obs), "--nav", str(SAMPLE_GNSS / "brdc.nav"), "-o", str(out)])
+    return obs
+
+
+@pytest.mark.parametrize("action", ["velocity", "spp"])
+def test_glonass_rows_without_a_frequency_channel_are_said_once_and_left_out_of_the_title(
+    action, tmp_path, caplog, monkeypatch
+):
+    """GLONASS Doppler without a channel (no GLONASS SLOT / FRQ # entry, no GLONASS record in
+    the navigation file): one warning with the count and the satellites (they were dropped
+    without a word), and the figure's title names the systems used, not R (issue 30: it read
+    "GREJC", the systems asked for)."""
+    obs = _glonass_without_channels(tmp_path)
+    titles = []
+
+    def drawn(path, solution, title=""):
+        titles.append(title)
+        Path(path).write_bytes(b"")
+
+    monkeypatch.setattr(gnss_command, f"{action}_figure", drawn)
+    out = tmp_path / "out.csv"
+    main(["gnss", action, str(obs), "--nav", str(SAMPLE_GNSS / "brdc.nav"), "-o", str(out)])
     said = [r.getMessage() for r in caplog.records if r.getMessage().startswith("GLONASS:")]
     assert len(said) == 1
     assert said[0].startswith("GLONASS: 1606 Doppler rows of R02, R03, R04, R10, R19, R21 dropped")
+    assert titles == ["glonass.obs (G)"]
+
+
+def test_glonass_with_a_channel_for_some_satellites_stays_in_the_title(tmp_path, caplog):
+    """Only the satellites without a channel are dropped: GLONASS keeps its place among the
+    systems used."""
+    obs, _ = read_observation_file(_glonass_without_channels(tmp_path))
+    nav = read_nav(SAMPLE_GNSS / "brdc.nav")
+    assert _glonass_dropped(obs, nav, "GREJC", None) == "G"
+    some = replace(obs, header=replace(obs.header, glonass_channels={2: 1, 3: -4}))
+    assert _glonass_dropped(some, nav, "GREJC", None) == "GR"
+    assert _glonass_dropped(some, nav, "R", None) == "R"
+    said = [r.getMessage() for r in caplog.records if r.getMessage().startswith("GLONASS:")]
+    assert (
+        said[-1].startswith("GLONASS: ")
+        and " Doppler rows of R04, R10, R19, R21 dropped" in said[-1]
+    )
