@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import pytest
@@ -10,8 +9,9 @@ import pytest
 import vo_doppler.io.sequence
 import vo_doppler.run
 from tests.conftest import REPO_ROOT, SAMPLE
+from tests.helpers.doc_snippets import python_snippets, run_snippet
 
-SNIPPETS = re.findall(r"```python\n(.*?)```", (REPO_ROOT / "README.md").read_text(), re.S)
+SNIPPETS = python_snippets(REPO_ROOT / "README.md")
 
 
 def test_the_readme_has_library_snippets():
@@ -50,5 +50,5 @@ def test_snippet_runs_as_written(code, monkeypatch, capsys, request):
     monkeypatch.chdir(REPO_ROOT)
     if "run_sequence(" in code:
         answer_the_sample_run_from(request.getfixturevalue("sample_run"), monkeypatch)
-    exec(compile(code, "README.md", "exec"), {})
+    run_snippet(code, "README.md")
     assert capsys.readouterr().out.strip()
