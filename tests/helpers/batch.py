@@ -14,11 +14,11 @@ BLOCK_DIR_ENV = "VO_DOPPLER_TEST_BLOCK_DIR"
 
 
 def tiny_drive(tmp_path_factory, seed: int) -> Path:
-    """An 8 s urban-canyon drive with 320×180 images, generated once per test process (its
+    """An 8 s urban-canyon drive with 320×180 images at 10 Hz, generated once per test process (its
     users carry the ``xdist_group`` mark ``tiny_drives``)."""
     folder = tmp_path_factory.getbasetemp() / "tiny_drives" / f"drive{seed}"
     if not (folder / "sequence.yaml").exists():
-        config = UrbanCanyonConfig(duration_s=8.0, seed=seed, image_size_px=(320, 180))
+        config = UrbanCanyonConfig(duration_s=8.0, seed=seed, fps=10.0, image_size_px=(320, 180))
         simulate_urban_canyon(folder, config)
     return folder
 
