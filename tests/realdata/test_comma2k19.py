@@ -15,29 +15,19 @@ from benchmarks.real_heading import (
     truth_velocity,
 )
 from tests.conftest import require_shared
-from tests.helpers.comma2k19 import COMMA, checked_conventional_figures, imported_comma2k19
+from tests.helpers.comma2k19 import COMMA, checked_conventional_figures
 from vo_doppler.fusion.antenna_track import antenna_track
 from vo_doppler.geo import ecef_to_enu_rotation
-from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.io.comma2k19 import read_vehicle_poses
 from vo_doppler.model.timeseries import sample
 from vo_doppler.run_stages import RunConfig, sequence_heading, sequence_trajectories
 
-pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
+pytestmark = [pytest.mark.shared_data, pytest.mark.slow, pytest.mark.xdist_group("comma2k19")]
 
 
 @pytest.fixture(scope="module")
-def comma(tmp_path_factory):
-    sequence = imported_comma2k19(tmp_path_factory)
-    config = RunConfig()
-    gnss = gnss_velocity(
-        sequence.observations,
-        sequence.navigation,
-        config.systems,
-        config.elevation_mask_rad,
-        reported_sigma=sequence.doppler_sigma,
-    )
-    return sequence, gnss, config
+def comma(comma2k19_sequence, comma2k19_gnss):
+    return comma2k19_sequence, comma2k19_gnss, RunConfig()
 
 
 def test_imported_sequence(comma):

@@ -9,17 +9,16 @@ import numpy as np
 import pytest
 
 from benchmarks.real_heading import truth_velocity
-from tests.helpers.comma2k19 import checked_conventional_figures, imported_comma2k19
+from tests.helpers.comma2k19 import checked_conventional_figures
 from vo_doppler.report.run_outputs import doppler_noise_summary
 from vo_doppler.run_stages import RunConfig, sequence_gnss, sequence_heading
 
-pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
+pytestmark = [pytest.mark.shared_data, pytest.mark.slow, pytest.mark.xdist_group("comma2k19")]
 
 
 @pytest.fixture(scope="module")
-def comma(tmp_path_factory):
-    sequence = imported_comma2k19(tmp_path_factory)
-    return sequence, sequence_gnss(sequence, RunConfig(), fit_noise=True)
+def comma(comma2k19_sequence):
+    return comma2k19_sequence, sequence_gnss(comma2k19_sequence, RunConfig(), fit_noise=True)
 
 
 def test_doppler_and_truth_share_one_clock(comma):

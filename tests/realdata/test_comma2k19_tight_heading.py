@@ -10,24 +10,17 @@ import pytest
 
 from benchmarks.heading_real_noise import row_cases
 from benchmarks.real_heading import MOVING_MPS, calibration_truth, tight_figures, truth_velocity
-from tests.conftest import require_shared
-from tests.helpers.comma2k19 import COMMA, SP3
 from vo_doppler.heading.tight_heading import tight_heading_series
-from vo_doppler.io.comma2k19_import import import_comma2k19
-from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.timeseries import integral_at, sample
-from vo_doppler.run_stages import RunConfig, sequence_gnss, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_heading
 
-pytestmark = [pytest.mark.shared_data, pytest.mark.slow]
+pytestmark = [pytest.mark.shared_data, pytest.mark.slow, pytest.mark.xdist_group("comma2k19")]
 
 
 @pytest.fixture(scope="module")
-def comma(tmp_path_factory):
+def comma(comma2k19_sequence, comma2k19_gnss):
     """The minute imported with its SP3 file and its GNSS stage as ``run`` does it."""
-    folder = tmp_path_factory.mktemp("comma") / "sequence"
-    import_comma2k19(require_shared(COMMA), folder, require_shared(SP3))
-    sequence, config = read_sequence(folder), RunConfig()
-    return sequence, sequence_gnss(sequence, config), config
+    return comma2k19_sequence, comma2k19_gnss, RunConfig()
 
 
 def test_open_sky_tight_heading(comma):

@@ -4,44 +4,26 @@ method's figures (issue 29's acceptance) and a negated yaw rate caught at 1 Hz."
 
 from __future__ import annotations
 
-import logging
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from benchmarks.real_sequences import HK_TST_CANYON, write_sequence
-from tests.conftest import require_shared
 from vo_doppler.errors import InputError
 from vo_doppler.eval.gnss_scores import score_heading, score_velocity
 from vo_doppler.geo import wrap_angle
 from vo_doppler.heading.integrity import car_checked_velocity
 from vo_doppler.heading.pipeline import HeadingPipelineConfig
-from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.ground_truth import GroundTruth
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.timeseries import sample
-from vo_doppler.run_stages import RunConfig, sequence_gnss, sequence_heading
+from vo_doppler.run_stages import sequence_heading
 
-pytestmark = pytest.mark.slow
-
-
-@pytest.fixture(scope="module")
-def canyon(tmp_path_factory):
-    require_shared(HK_TST_CANYON.folder)
-    shared = require_shared(".")
-    folder = write_sequence(HK_TST_CANYON, shared, tmp_path_factory.mktemp("hk"))
-    sequence = read_sequence(folder)
-    logging.disable(logging.WARNING)
-    try:
-        gnss = sequence_gnss(sequence, RunConfig())
-    finally:
-        logging.disable(logging.NOTSET)
-    return sequence, gnss
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("hk_canyon")]
 
 
-def test_robust_heading_holds_in_the_real_canyon_at_1_hz(canyon):
-    sequence, gnss = canyon
+def test_robust_heading_holds_in_the_real_canyon_at_1_hz(hk_canyon):
+    sequence, gnss = hk_canyon
     table = sequence_heading(sequence, gnss.rows, gnss.velocity, HeadingPipelineConfig.robust())
     truth = sequence.truth
     velocity = np.gradient(truth.positions, truth.t, axis=0)
@@ -64,11 +46,11 @@ def test_robust_heading_holds_in_the_real_canyon_at_1_hz(canyon):
     assert noise.n_bins >= 3 and noise.k_slope < 0 and 0.15 < noise.rest_factor < 0.5
 
 
-def test_conventional_headings_and_velocities_the_car_checked_hold_in_the_canyon(canyon):
+def test_conventional_headings_and_velocities_the_car_checked_hold_in_the_canyon(hk_canyon):
     """Issue 29: the conventional course valid after the car's tests within 5° at p95 and none
     beyond 15°, and the conventional velocity (``vel.csv`` of ``run``) at standstill within
     0.1 m/s at p95; the GNSS stage's own verdict (``gnss velocity``) does not meet either."""
-    sequence, gnss = canyon
+    sequence, gnss = hk_canyon
     table = sequence_heading(sequence, gnss.rows, gnss.velocity, HeadingPipelineConfig.robust())
     truth = GroundTruth(sequence.truth.t, sequence.truth.positions, sequence.enu, None, "TUM")
     headings = score_heading(table, truth).conventional
@@ -85,8 +67,8 @@ def test_conventional_headings_and_velocities_the_car_checked_hold_in_the_canyon
     assert alone.course_error_deg.p95 > 5.0 and alone.standstill_speed_mps.p95 > 0.1
 
 
-def test_a_negated_yaw_rate_at_1_hz_is_an_error_naming_it(canyon):
-    sequence, gnss = canyon
+def test_a_negated_yaw_rate_at_1_hz_is_an_error_naming_it(hk_canyon):
+    sequence, gnss = hk_canyon
     negated = SensorSeries(sequence.yaw_rate.t, -sequence.yaw_rate.value)
     with pytest.raises(InputError, match="wrong sign"):
         sequence_heading(
