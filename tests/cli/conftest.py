@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from tests.helpers.cut_recording import csv_sequence, cut_copy
+from vo_doppler.cli import main
 from vo_doppler.io.rinex_obs import read_obs
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
@@ -47,3 +48,12 @@ def span_drive(tmp_path_factory) -> SpanDrive:
     first = float(read_obs(full / "gnss" / "rover.obs").epoch_time[0])
     cut = cut_copy(full, root / "cut", first + SPAN_START_S, first + SPAN_END_S)
     return SpanDrive(full, cut, first)
+
+
+@pytest.fixture(scope="session")
+def span_cut_run(span_drive, tmp_path_factory) -> Path:
+    """The folder ``vo-doppler -q run`` writes for the cut drive (heading.csv, summary.json,
+    the trajectories), once per test process (group ``span_drive``). Read-only."""
+    out = tmp_path_factory.mktemp("span_cut_run") / "out"
+    assert main(["-q", "run", str(span_drive.cut), "-o", str(out)]) == 0
+    return out

@@ -21,30 +21,22 @@ pytestmark = pytest.mark.xdist_group("span_drive")
 CORRECTED = ("vo_gps_conv", "vo_gps_tc", "dr_gps_conv", "dr_gps_tc")
 
 
-@pytest.fixture(scope="module")
-def first_run(span_drive, tmp_path_factory):
-    """``run`` on the 8-s cut drive: its outputs, heading.csv among them."""
-    out = tmp_path_factory.mktemp("first") / "out"
-    assert main(["-q", "run", str(span_drive.cut), "-o", str(out)]) == 0
-    return out
-
-
 def _summary(folder) -> dict:
     return json.loads((folder / "summary.json").read_text())
 
 
 @pytest.mark.slow
 def test_run_with_an_earlier_runs_heading_csv_reproduces_its_corrected_figures(
-    span_drive, first_run, tmp_path, capsys
+    span_drive, span_cut_run, tmp_path, capsys
 ):
     heading = tmp_path / "heading.csv"
-    shutil.copy(first_run / "heading.csv", heading)
+    shutil.copy(span_cut_run / "heading.csv", heading)
     out = tmp_path / "again"
     argv = ["run", str(span_drive.cut), "-o", str(out), "--heading", str(heading)]
     assert main(argv) == 0
     printed = capsys.readouterr().out
     assert f"absolute heading given: {heading}, not computed from GNSS" in printed.replace("\n", "")
-    before, after = _summary(first_run), _summary(out)
+    before, after = _summary(span_cut_run), _summary(out)
     assert after["heading_source"].startswith(f"given: {heading}, not computed from GNSS")
     assert "heading_source" not in before
     assert set(after["evaluation"]) == set(before["evaluation"])
@@ -168,14 +160,15 @@ def test_a_heading_method_with_a_given_heading_is_a_usage_error(tmp_path, capsys
 
 
 @pytest.mark.slow
-def test_the_heading_file_is_not_overwritten_by_the_run(span_drive, first_run, capsys):
+def test_the_heading_file_is_not_overwritten_by_the_run(span_drive, span_cut_run, capsys):
     """An earlier run's heading.csv given back to a run into the same folder is an input the
-    output would replace: refused before anything is written."""
-    heading = first_run / "heading.csv"
-    before = heading.read_bytes()
-    argv = ["run", str(span_drive.cut), "-o", str(first_run), "--heading", str(heading)]
+    output would replace: refused before anything is written (the folder is another test's
+    too: every file of it stays as it was)."""
+    heading = span_cut_run / "heading.csv"
+    before = {p: p.read_bytes() for p in sorted(span_cut_run.rglob("*")) if p.is_file()}
+    argv = ["run", str(span_drive.cut), "-o", str(span_cut_run), "--heading", str(heading)]
     assert main(argv) == 1
-    assert heading.read_bytes() == before
+    assert {p: p.read_bytes() for p in sorted(span_cut_run.rglob("*")) if p.is_file()} == before
     assert "heading.csv" in capsys.readouterr().err
 
 
