@@ -187,6 +187,43 @@ def procedural_texture(
     return np.clip(12.0 + 231.0 * (tile - lo) / (hi - lo), 0, 255).round().astype(np.uint8)
 
 
+@dataclass(frozen=True)
+class WindowFacadeDraws:
+    """The random numbers of one :func:`window_facade_texture`, drawn in its order: wall,
+    glass and frame levels, window size, each window's blind (the fraction drawn and its grey
+    level, or None) in column-major order, and the white noise of the plaster."""
+
+    wall: float
+    glass: float
+    frame_step: float
+    width_fraction: float
+    height_fraction: float
+    blinds: list[tuple[float, float] | None]
+    plaster: np.ndarray
+    fine: np.ndarray
+
+
+def window_facade_draws(
+    size: int, rng: np.random.Generator, columns: int = 16, storeys: int = 12
+) -> WindowFacadeDraws:
+    """The draws of :func:`window_facade_texture`; an untextured city makes them without
+    painting, so that its walls are those of the textured city of the same seed."""
+    wall = float(rng.uniform(0.45, 0.8))
+    plaster = _white(size, rng)
+    glass, frame_step = float(rng.uniform(0.08, 0.3)), float(rng.uniform(0.08, 0.2))
+    width_fraction, height_fraction = float(rng.uniform(0.45, 0.65)), float(rng.uniform(0.4, 0.6))
+    blinds = [
+        (float(rng.uniform(0.2, 0.9)), float(rng.uniform(0.5, 0.9)))
+        if rng.uniform() < 0.2
+        else None
+        for _ in range(columns * storeys)
+    ]
+    fine = _white(size, rng)
+    return WindowFacadeDraws(
+        wall, glass, frame_step, width_fraction, height_fraction, blinds, plaster, fine
+    )
+
+
 def window_facade_texture(
     size: int, rng: np.random.Generator, columns: int = 16, storeys: int = 12
 ) -> np.ndarray:
@@ -198,14 +235,14 @@ def window_facade_texture(
     few windows have a blind drawn to a random height, as on real buildings. The repetition is
     what makes real facades hard for feature tracking: a patch matches its neighbours a bay away.
     """
-    wall = rng.uniform(0.45, 0.8)
-    tile = wall + 0.04 * _pink_noise(size, rng, 4.0 / size, 0.25)
-    glass = rng.uniform(0.08, 0.3)
-    frame = min(wall + rng.uniform(0.08, 0.2), 1.0)
+    draws = window_facade_draws(size, rng, columns, storeys)
+    tile = draws.wall + 0.04 * _pink_filter(draws.plaster, 4.0 / size, 0.25)
+    frame = min(draws.wall + draws.frame_step, 1.0)
     bay_w, bay_h = size / columns, size / storeys
-    win_w = int(bay_w * rng.uniform(0.45, 0.65))
-    win_h = int(bay_h * rng.uniform(0.4, 0.6))
+    win_w = int(bay_w * draws.width_fraction)
+    win_h = int(bay_h * draws.height_fraction)
     border = max(2, int(0.08 * win_w))
+    blinds = iter(draws.blinds)
     for i in range(columns):
         for j in range(storeys):
             x = round(i * bay_w + (bay_w - win_w) / 2)
@@ -217,11 +254,12 @@ def window_facade_texture(
                 frame,
                 -1,
             )
-            cv2.rectangle(tile, (x, y), (x + win_w, y + win_h), glass, -1)
-            if rng.uniform() < 0.2:
-                drawn = int(win_h * rng.uniform(0.2, 0.9))
-                cv2.rectangle(tile, (x, y), (x + win_w, y + drawn), rng.uniform(0.5, 0.9), -1)
-    tile += 0.02 * _pink_noise(size, rng, 0.1, 0.5)
+            cv2.rectangle(tile, (x, y), (x + win_w, y + win_h), draws.glass, -1)
+            blind = next(blinds)
+            if blind is not None:
+                drawn = int(win_h * blind[0])
+                cv2.rectangle(tile, (x, y), (x + win_w, y + drawn), blind[1], -1)
+    tile += 0.02 * _pink_filter(draws.fine, 0.1, 0.5)
     return np.clip(12.0 + 231.0 * tile, 0, 255).round().astype(np.uint8)
 
 
@@ -342,8 +380,11 @@ def city_scene(
             texture_draws(tile_size, rng)
     # Window facades draw from their own stream, so the city is the same with or without them.
     window_rng = np.random.default_rng([seed, WINDOW_STREAM])
-    windows = [window_facade_texture(tile_size, window_rng) for _ in range(window_facades)]
-    textures += windows if textured else []
+    for _ in range(window_facades):
+        if textured:
+            textures.append(window_facade_texture(tile_size, window_rng))
+        else:
+            window_facade_draws(tile_size, window_rng)
     layout = CityLayout(blocks_x, blocks_y, block_size, street_width)
     px, py = layout.pitch
     extent = np.array([blocks_x * px, blocks_y * py])
