@@ -171,6 +171,11 @@ def _clip_polygon(polygon: np.ndarray, normal: np.ndarray, offset: float) -> np.
     if len(polygon) == 0:
         return polygon
     side = polygon @ normal - offset
+    inside = side >= 0
+    if inside.all():
+        return polygon
+    if not inside.any():
+        return polygon[:0]
     out = []
     for k in range(len(polygon)):
         j = (k + 1) % len(polygon)
