@@ -43,18 +43,17 @@ def ecef_to_geodetic(ecef: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarr
     u = np.sqrt(0.5 * (r**2 - e**2) + 0.5 * np.hypot(r**2 - e**2, 2 * e * z))
     hxy = np.hypot(x, y)
     hue = np.hypot(u, e)
-    beta = np.empty_like(r)
     bad = (np.abs(u) <= 1e-8) | (np.abs(hxy) <= 1e-8)
-    good = ~bad
-    beta[good] = np.arctan(hue[good] / u[good] * z[good] / hxy[good])
-    beta[good] += ((b * u[good] - a * hue[good] + e**2) * np.sin(beta[good])) / (
-        a * hue[good] * 1 / np.cos(beta[good]) - e**2 * np.cos(beta[good])
-    )
+    # Element-wise selections rather than masked assignments: one point (the SPP's every
+    # iteration) costs a third of the time; the kept elements are the same operations.
+    with np.errstate(divide="ignore", invalid="ignore"):
+        beta = np.arctan(hue / u * z / hxy)
+        beta = beta + ((b * u - a * hue + e**2) * np.sin(beta)) / (
+            a * hue * 1 / np.cos(beta) - e**2 * np.cos(beta)
+        )
     on_axis = bad & (np.abs(z) <= 1e-8)
-    north = bad & ~on_axis & (z > 0)
-    beta[on_axis] = 0
-    beta[north] = np.pi / 2
-    beta[bad & ~on_axis & ~north] = -np.pi / 2
+    pole = np.where(z > 0, np.pi / 2, -np.pi / 2)
+    beta = np.where(bad, np.where(on_axis, 0.0, pole), beta)
     lat = np.arctan(a / b * np.tan(beta))
     limit = np.pi / 2 - np.finfo(beta.dtype).eps
     lat = np.where(beta >= limit, np.pi / 2, lat)
