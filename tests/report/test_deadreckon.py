@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from matplotlib.image import imread
 
+from tests.helpers.images import distinct_colours
 from vo_doppler.geo import WGS84_A, WGS84_F, EnuFrame
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.lowcost.drift import VARIANTS
@@ -129,4 +130,4 @@ def test_the_figures_are_pictures(written):
     for name in ("map", "allan"):
         pixels = imread(paths[name])
         assert pixels.shape[0] > 200 and pixels.shape[1] > 200, name
-        assert len(np.unique(pixels.reshape(-1, pixels.shape[2]), axis=0)) > 10, name
+        assert distinct_colours(pixels) > 10, name

@@ -8,8 +8,10 @@ from __future__ import annotations
 import io
 
 import numpy as np
+import pytest
 from matplotlib.image import imread
 
+from tests.helpers.images import distinct_colours
 from vo_doppler.report.figure import integer_ticks, new_figure, tight_layout
 
 
@@ -66,7 +68,7 @@ def test_tight_layout_gives_the_layout_and_pixels_of_matplotlibs():
     assert png == _png(theirs)
     pixels = imread(io.BytesIO(png), format="png")
     assert pixels.shape == (300, 600, 4)  # 6 x 3 in at 100 dpi, RGBA
-    assert len(np.unique(pixels.reshape(-1, 4), axis=0)) > 10  # drawn, not blank
+    assert distinct_colours(pixels) > 10  # drawn, not blank
 
 
 def test_the_layout_and_the_png_share_the_canvas_renderer():
@@ -89,3 +91,16 @@ def test_integer_ticks_are_whole_numbers():
     np.testing.assert_array_equal(ticks, np.round(ticks))
     # without it, the same axis gets fractional ticks
     assert np.any(ax.xaxis.get_ticklocs() != np.round(ax.xaxis.get_ticklocs()))
+
+
+@pytest.mark.parametrize("channels", [3, 4])
+def test_distinct_colours_counts_the_distinct_pixels(channels):
+    """The packed count of tests/helpers/images.py equals the count of distinct rows, for 8-bit
+    images and for the float images matplotlib decodes (levels / 255)."""
+    rng = np.random.default_rng(channels)
+    levels = rng.integers(0, 4, size=(40, 50, channels)).astype(np.uint8) * 85
+    expected = len(np.unique(levels.reshape(-1, channels), axis=0))
+    assert 2 < expected <= 4**channels
+    assert distinct_colours(levels) == expected
+    assert distinct_colours(levels.astype(np.float32) / 255.0) == expected
+    assert distinct_colours(np.zeros((5, 5, channels), np.uint8)) == 1
