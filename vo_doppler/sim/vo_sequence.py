@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -208,12 +209,14 @@ def drive(
     limit[1:] = np.minimum(limit[1:], limit[:-1].copy())
     limit[:-1] = np.minimum(limit[:-1], limit[1:].copy())
     limit[stop_index] = 0.0
-    v = np.empty_like(s)
-    v[0] = min(initial_speed, limit[0])
-    for i in range(1, len(s)):
-        v[i] = min(limit[i], np.sqrt(v[i - 1] ** 2 + 2 * max_accel * step_m))
-    for i in range(len(s) - 2, -1, -1):
-        v[i] = min(v[i], np.sqrt(v[i + 1] ** 2 + 2 * max_decel * step_m))
+    # The two passes are recurrences, run on Python floats (the same IEEE operations as on
+    # NumPy scalars, ten times faster).
+    speeds = [min(initial_speed, float(limit[0]))]
+    for bound in limit[1:].tolist():
+        speeds.append(min(bound, math.sqrt(speeds[-1] ** 2 + 2 * max_accel * step_m)))
+    for i in range(len(speeds) - 2, -1, -1):
+        speeds[i] = min(speeds[i], math.sqrt(speeds[i + 1] ** 2 + 2 * max_decel * step_m))
+    v = np.array(speeds)
     dt = 2 * step_m / np.maximum(v[:-1] + v[1:], 1e-9)
     knot_t = np.concatenate([[0.0], np.cumsum(dt)])
     knot_s, knot_v = s, v
