@@ -334,10 +334,11 @@ def _solve_epoch(data: _EpochData, model: _Model, start: np.ndarray) -> _EpochFi
     keep = np.ones(data.corrected_range.size, dtype=bool)
     x = np.asarray(start, dtype=float).copy()
     clocks = np.zeros(len(model.systems))
+    rows = _SystemRows.of(data, model)
     for _ in range(2):
         for _ in range(12):
             H, residual, sigma, keep_now, present, elevation = _linearise(
-                data, model, x, clocks, keep
+                data, model, rows, x, clocks, keep
             )
             if keep_now.sum() < 3 + present.sum():
                 return None
@@ -415,21 +416,43 @@ def _quality(fit: _EpochFit, alpha: float) -> tuple[float, float, float, float, 
     )
 
 
+def signal_in_space_sigma(system: np.ndarray) -> np.ndarray:
+    """σ (m) of the broadcast orbit and clock of each row's system (``SIGNAL_IN_SPACE_SIGMA_M``,
+    2 m for a system it does not list)."""
+    return np.array([SIGNAL_IN_SPACE_SIGMA_M.get(str(s), 2.0) for s in system])
+
+
 def model_error_sigma(
-    system: np.ndarray, elevation: np.ndarray, ionosphere_m: np.ndarray
+    orbit_clock: np.ndarray, elevation: np.ndarray, ionosphere_m: np.ndarray
 ) -> np.ndarray:
     """σ (m) of the errors of the models behind a pseudorange that its epoch's residuals do not
     show (common to the satellites, slowly varying), added to the fitted noise in quadrature:
-    the broadcast orbit and clock (``SIGNAL_IN_SPACE_SIGMA_M`` per system), half of the
+    the broadcast orbit and clock (``orbit_clock``, :func:`signal_in_space_sigma`), half of the
     broadcast ionospheric delay (the Klobuchar model corrects about half of it, IS-GPS-200
     sec. 20.3.3.5.2.5) and the troposphere's residual 0.3 m / (sin el + 0.1) (the budget of
     RTKLIB's ``pntpos``, T. Takasu, RTKLIB 2.4.2 manual, appendix E.6)."""
-    orbit_clock = np.array([SIGNAL_IN_SPACE_SIGMA_M.get(str(s), 2.0) for s in system])
     troposphere = TROPOSPHERE_SIGMA_M / (np.sin(elevation) + 0.1)
     return np.sqrt(orbit_clock**2 + (IONOSPHERE_FRACTION * ionosphere_m) ** 2 + troposphere**2)
 
 
-def _linearise(data: _EpochData, model: _Model, x, clocks, keep):
+@dataclass(frozen=True)
+class _SystemRows:
+    """An epoch's rows by system, the same at every iteration: the clock columns (rows ×
+    systems, one-hot), the rows of each system with a noise model and the σ of each row's
+    broadcast orbit and clock."""
+
+    one_hot: np.ndarray
+    noise_rows: dict[str, np.ndarray]
+    orbit_clock: np.ndarray
+
+    @classmethod
+    def of(cls, data: _EpochData, model: _Model) -> _SystemRows:
+        one_hot = np.stack([data.system == s for s in model.systems], axis=1).astype(float)
+        noise_rows = {system: data.system == system for system in model.noise}
+        return cls(one_hot, noise_rows, signal_in_space_sigma(data.system))
+
+
+def _linearise(data: _EpochData, model: _Model, rows: _SystemRows, x, clocks, keep):
     travel = np.linalg.norm(data.sat_position - x, axis=1) / SPEED_OF_LIGHT
     vector = rotate_earth(data.sat_position, travel) - x
     rho = np.linalg.norm(vector, axis=1)
@@ -444,7 +467,7 @@ def _linearise(data: _EpochData, model: _Model, x, clocks, keep):
         keep_now &= elevation >= model.mask
         sigma = prior_sigma(elevation)
         for system, noise in model.noise.items():
-            hit = data.system == system
+            hit = rows.noise_rows[system]
             sigma[hit] = noise.sigma(data.cn0[hit], elevation[hit])
         troposphere = troposphere_delay(lat, height, elevation)
         ionosphere = np.zeros(rho.size)
@@ -454,8 +477,8 @@ def _linearise(data: _EpochData, model: _Model, x, clocks, keep):
             )
         atmosphere = troposphere + ionosphere
         if model.noise:
-            sigma = np.hypot(sigma, model_error_sigma(data.system, elevation, ionosphere))
-    one_hot = np.stack([data.system == s for s in model.systems], axis=1).astype(float)
+            sigma = np.hypot(sigma, model_error_sigma(rows.orbit_clock, elevation, ionosphere))
+    one_hot = rows.one_hot
     present = one_hot[keep_now].any(axis=0)
     predicted = rho + one_hot @ clocks + atmosphere
     H = np.hstack([-los, one_hot])
