@@ -112,18 +112,14 @@ class Scene:
     layout: CityLayout | None = None
 
 
-def _pink_noise(size: int, rng: np.random.Generator, f_low: float, f_high: float) -> np.ndarray:
-    """Periodic noise with a 1/f amplitude spectrum between f_low and f_high cycles/texel."""
-    return _pink_filter(_white(size, rng), f_low, f_high)
-
-
 def _white(size: int, rng: np.random.Generator) -> np.ndarray:
     """Square white noise (float32) of the standard normal law."""
     return rng.standard_normal((size, size)).astype(np.float32)
 
 
 def _pink_filter(white: np.ndarray, f_low: float, f_high: float) -> np.ndarray:
-    """:func:`_pink_noise` of the square white noise ``white``."""
+    """Periodic noise with a 1/f amplitude spectrum between f_low and f_high cycles/texel,
+    normalised, from the square white noise ``white``."""
     size = white.shape[0]
     fy = np.fft.fftfreq(size)[:, None]
     fx = np.fft.rfftfreq(size)[None, :]
@@ -191,7 +187,8 @@ def procedural_texture(
 class WindowFacadeDraws:
     """The random numbers of one :func:`window_facade_texture`, drawn in its order: wall,
     glass and frame levels, window size, each window's blind (the fraction drawn and its grey
-    level, or None) in column-major order, and the white noise of the plaster."""
+    level, or None) in column-major order, and the white noises of the plaster's pink noise and
+    of its fine texture."""
 
     wall: float
     glass: float
