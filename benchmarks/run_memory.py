@@ -8,7 +8,9 @@ of :func:`vo_doppler.run.run_sequence` (GNSS, heading, VO, correction: each stag
 (report and figures). Before each step the kernel's peak-RSS mark is reset
 (``/proc/self/clear_refs``, value 5, Linux ≥ 4.0) and read back after it (``VmHWM``), so every
 row is that step's own peak; the whole process's peak is the largest of them (the reset clears
-``ru_maxrss`` too). Prints a table and writes JSON.
+``ru_maxrss`` too). Prints a table and writes JSON. By default the VO runs in this process, so
+its row is the VO's own peak; ``--vo-in-child`` runs it in a forked child as ``vo-doppler run``
+does (the rows are then this process's alone; ``tree_memory.py`` counts the child too).
 """
 
 from __future__ import annotations
@@ -74,6 +76,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("sequence", type=Path)
     parser.add_argument("--json", type=Path, default=Path("out/bench/run_memory.json"))
+    parser.add_argument(
+        "--vo-in-child",
+        action="store_true",
+        help="run the VO in a forked child process, as vo-doppler run does; the VO row is then "
+        "this process's own memory while it waits (the child's: benchmarks/tree_memory.py)",
+    )
     args = parser.parse_args(argv)
     meter = StageMeter()
     start_mib = _status_kib("VmRSS") / 1024.0
@@ -86,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
         meter.wrap(run_module if name in vars(run_module) else vo_doppler.run_stages, name)
     sequence, report = meter.measure("read", read_sequence_with_report, args.sequence)
     config = run_module.RunConfig()
-    result = run_module.run_sequence(sequence, config)
+    result = run_module.run_sequence(sequence, config, vo_in_child=args.vo_in_child)
     warnings = input_warnings(sequence, report)
     checks = result_checks(sequence, report, result, warnings)
     with tempfile.TemporaryDirectory(prefix="run_memory_") as out:

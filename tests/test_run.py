@@ -7,6 +7,8 @@ import html
 import io
 import json
 import re
+import subprocess
+import sys
 from dataclasses import replace
 
 import numpy as np
@@ -293,3 +295,43 @@ def test_the_run_lets_the_doppler_rows_go_once_the_heading_is_made(turning_drive
     table = sequence_heading(drive, gnss.rows, gnss.velocity, config.heading)
     np.testing.assert_array_equal(result.heading.yaw_tc, table.yaw_tc)
     np.testing.assert_array_equal(result.heading.sigma_tc, table.sigma_tc)
+
+
+CHILD_RUN = """
+import sys
+import numpy as np
+from vo_doppler.io.sequence import read_sequence
+from vo_doppler.run import run_sequence
+
+frames = []
+result = run_sequence(read_sequence(sys.argv[1]), on_frame=frames.append, vo_in_child=True)
+arrays = {name.value: np.column_stack([track.t, track.positions, track.orientations.as_quat()])
+          for name, track in result.trajectories.items()}
+np.savez(sys.argv[2], frames=np.array(frames), **arrays)
+print(" ".join(m for m in ("cv2", "pycolmap") if m in sys.modules) or "none")
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("short_drive")
+def test_the_vo_in_a_child_process_gives_the_same_run_and_leaves_no_opencv_here(
+    short_drive_folder, tmp_path
+):
+    """``vo_in_child`` (what ``run`` and ``batch`` use, issue 30): OpenCV and pycolmap load only
+    in the child, which ends with the VO, so a fresh interpreter never has them; every frame's
+    progress comes back, and every trajectory is the in-process run's, bit for bit."""
+    saved = tmp_path / "child_run.npz"
+    done = subprocess.run(
+        [sys.executable, "-c", CHILD_RUN, str(short_drive_folder), str(saved)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert done.stdout.split() == ["none"]
+    child = np.load(saved)
+    here = run_sequence(read_sequence(short_drive_folder))
+    np.testing.assert_array_equal(child["frames"], np.arange(len(here.vo.trajectory.t)))
+    assert sorted(child.files) == sorted(["frames", *(name.value for name in here.trajectories)])
+    for name, track in here.trajectories.items():
+        poses = np.column_stack([track.t, track.positions, track.orientations.as_quat()])
+        np.testing.assert_array_equal(child[name.value], poses)

@@ -54,7 +54,7 @@ from vo_doppler.run_stages import (
 )
 
 if TYPE_CHECKING:
-    from vo_doppler.vo.batch import VoOutput
+    from vo_doppler.model.visual_odometry import VoOutput
 
 log = logging.getLogger(__name__)
 
@@ -90,11 +90,15 @@ def run_sequence(
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
     given: GivenHeading | None = None,
+    vo_in_child: bool = False,
 ) -> RunResult:
     """Run every stage on a recording. ``images`` replaces reading ``sequence.image_paths``
     (e.g. frames already in memory); ``on_frame`` is called after each VO frame; ``given``,
     an absolute heading from elsewhere, replaces the heading stage
-    (:func:`run_with_given_heading`).
+    (:func:`run_with_given_heading`). With ``vo_in_child`` the VO runs in a forked child
+    process, with the same result: OpenCV and pycolmap (about 70 MiB) then leave with it
+    instead of staying loaded through the correction and the outputs, where the job peaks
+    (``vo-doppler run`` and ``batch`` do so; :mod:`vo_doppler.child_process`).
 
     The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`, in the
     heading stage: :func:`~vo_doppler.heading.from_gnss.heading_from_gnss`): vehicle signals
@@ -104,9 +108,9 @@ def run_sequence(
     ``RunResult.warnings``."""
     config = (config or RunConfig()).for_sequence(sequence)
     if given is not None:
-        return run_with_given_heading(sequence, given, config, on_frame, images)
+        return run_with_given_heading(sequence, given, config, on_frame, images, vo_in_child)
     if not sequence.has_gnss:
-        return run_without_gnss(sequence, config, on_frame, images)
+        return run_without_gnss(sequence, config, on_frame, images, vo_in_child)
     obs = sequence.observations
     origin = origin_warning(sequence.enu, obs.header.approx_position)
     if origin:
@@ -117,7 +121,7 @@ def run_sequence(
     gnss = without_rows(gnss)
     release_free_heap()
     speed = table.calibrated_speed(sequence.wheel_speed)
-    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images)
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, vo_in_child)
     if vo is None:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
     antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
@@ -149,6 +153,7 @@ def run_without_gnss(
     config: RunConfig,
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
+    vo_in_child: bool = False,
 ) -> RunResult:
     """:func:`run_sequence` on a recording without GNSS: the VO (scaled by the wheel speed as
     recorded) and the wheel + gyro dead reckoning, each started at the ENU origin facing east
@@ -158,7 +163,7 @@ def run_without_gnss(
     note = NO_GNSS.format(name=sequence.name)
     log.warning("%s", note)
     speed, yaw_rate = sequence.wheel_speed, sequence.yaw_rate
-    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images)
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, vo_in_child)
     origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)), None, "the sequence origin (no GNSS)")
     tracks = {
         Pipeline.VO: vo_vehicle,
@@ -184,6 +189,7 @@ def run_with_given_heading(
     config: RunConfig,
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
+    vo_in_child: bool = False,
 ) -> RunResult:
     """:func:`run_sequence` with the absolute heading ``given`` instead of the heading stage.
 
@@ -229,7 +235,7 @@ def run_with_given_heading(
     speed, yaw_rate = sequence.wheel_speed, sequence.yaw_rate
     if given.has_calibration:
         speed, yaw_rate = table.calibrated_speed(speed), table.calibrated_yaw_rate(yaw_rate)
-    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images)
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, vo_in_child)
     trajectories, usable = sequence_trajectories(
         sequence, table, vo_vehicle, speed, antenna, config, yaw_rate, tight_source
     )

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from vo_doppler.child_process import call_in_child
 from vo_doppler.choices import checked_letters
 from vo_doppler.errors import InputError
 from vo_doppler.fusion.antenna_track import AntennaTrack
@@ -31,7 +32,7 @@ from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.frames import vehicle_trajectory
 
 if TYPE_CHECKING:
-    from vo_doppler.vo.batch import VoOutput
+    from vo_doppler.model.visual_odometry import VoOutput
 
 
 @dataclass
@@ -127,12 +128,20 @@ def vehicle_vo(
     speed: SensorSeries,
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
+    in_child: bool = False,
 ) -> tuple[VoOutput | None, Trajectory | None]:
     """:func:`sequence_vo` and its camera poses as vehicle poses, (None, None) for a recording
-    without a camera."""
+    without a camera. With ``in_child`` the VO runs in a forked child process
+    (:func:`~vo_doppler.child_process.call_in_child`: the same result, and OpenCV and pycolmap
+    leave with the child instead of staying loaded through the correction and the outputs)."""
     if not sequence.has_camera:
         return None, None
-    vo = sequence_vo(sequence, config, speed, on_frame, images)
+    if in_child:
+        vo = call_in_child(
+            lambda report: sequence_vo(sequence, config, speed, report, images), on_frame
+        )
+    else:
+        vo = sequence_vo(sequence, config, speed, on_frame, images)
     vo_vehicle = vehicle_trajectory(vo.trajectory, sequence.camera.T_vehicle_camera)
     release_free_heap()
     return vo, vo_vehicle

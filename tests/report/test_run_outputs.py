@@ -19,6 +19,7 @@ from vo_doppler.geo import ecef_to_geodetic, geodetic_to_ecef
 from vo_doppler.io.sequence import InputReport, read_sequence
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.model.visual_odometry import VoStats
 from vo_doppler.report.run_outputs import (
     FACT_FORMATS,
     NOT_FACTS,
@@ -30,7 +31,6 @@ from vo_doppler.report.run_outputs import (
 )
 from vo_doppler.run import RunConfig, run_sequence
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
-from vo_doppler.vo.odometry import VoStats
 
 
 @pytest.fixture(scope="module")

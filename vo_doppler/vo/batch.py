@@ -3,28 +3,18 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
 
 import numpy as np
 
 from vo_doppler.model.camera import Camera
 from vo_doppler.model.trajectory import Trajectory
+from vo_doppler.model.visual_odometry import VoOutput
 from vo_doppler.vo.config import VoConfig
-from vo_doppler.vo.odometry import VisualOdometry, VoStats
+from vo_doppler.vo.odometry import VisualOdometry
 from vo_doppler.vo.scale import metric_positions
 
 MIN_VO_FRAMES = 2
 """Fewest decoded images a VO trajectory needs: a motion takes two views."""
-
-
-@dataclass
-class VoOutput:
-    """Camera poses (camera→first-camera frame, OpenCV axes), one per image, and statistics."""
-
-    trajectory: Trajectory
-    stats: VoStats
-    metric: bool
-    """True when step lengths come from a speed signal; otherwise the unit is arbitrary."""
 
 
 def run_visual_odometry(

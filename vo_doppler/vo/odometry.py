@@ -20,6 +20,7 @@ import numpy as np
 
 from vo_doppler.errors import InputError
 from vo_doppler.model.camera import Camera
+from vo_doppler.model.visual_odometry import VoStats
 from vo_doppler.vo.config import VoConfig
 from vo_doppler.vo.geometry import (
     camera_center,
@@ -108,37 +109,6 @@ class _FinishedFrames:
             self.flags[k] = frame.flags
         self.recent.append(frame)
         self.count += 1
-
-
-@dataclass
-class VoStats:
-    frames: int = 0
-    keyframes: int = 0
-    wall_seconds: float = 0.0
-    mean_tracks: float = 0.0
-    ba_runs: int = 0
-    ba_iterations: int = 0
-    reprojection_rms_px: float = float("nan")
-    initialisations: int = 0
-    flagged_frames: list[dict] = field(default_factory=list)
-
-    @property
-    def fps(self) -> float:
-        return self.frames / self.wall_seconds if self.wall_seconds > 0 else float("nan")
-
-    def to_dict(self) -> dict:
-        return {
-            "frames": self.frames,
-            "keyframes": self.keyframes,
-            "fps": self.fps,
-            "wall_seconds": self.wall_seconds,
-            "mean_tracks": self.mean_tracks,
-            "ba_runs": self.ba_runs,
-            "ba_iterations": self.ba_iterations,
-            "reprojection_rms_px": self.reprojection_rms_px,
-            "initialisations": self.initialisations,
-            "flagged_frames": self.flagged_frames,
-        }
 
 
 @dataclass

@@ -1,0 +1,148 @@
+"""A step in a forked child process: its result, progress and log records come back; its
+imports and changes stay in the child; its errors are raised here with the child's traceback;
+a child that dies is reported, one that is no longer listened to is ended."""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+from vo_doppler import child_process
+from vo_doppler.child_process import call_in_child
+from vo_doppler.errors import InputError, ManifestError
+
+STATE = {"touched": False}
+
+
+def test_the_result_and_every_progress_call_come_back_in_order():
+    seen = []
+
+    def task(progress):
+        for index in range(5):
+            progress(index)
+        return np.arange(6.0) / 7.0, os.getpid()
+
+    values, pid = call_in_child(task, seen.append)
+    assert seen == [0, 1, 2, 3, 4]
+    np.testing.assert_array_equal(values, np.arange(6.0) / 7.0)
+    assert pid != os.getpid()
+
+
+def test_without_a_progress_callback_the_task_gets_none():
+    assert call_in_child(lambda progress: progress is None) is True
+
+
+def test_what_the_child_imports_or_changes_stays_in_the_child(tmp_path, monkeypatch):
+    (tmp_path / "only_in_the_child_xq7.py").write_text("VALUE = 41\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+
+    def task(_):
+        import only_in_the_child_xq7
+
+        STATE["touched"] = True
+        return only_in_the_child_xq7.VALUE + 1
+
+    assert call_in_child(task) == 42
+    assert "only_in_the_child_xq7" not in sys.modules
+    assert STATE["touched"] is False
+
+
+def _raise(error: BaseException):
+    def task(_):
+        raise error
+
+    return task
+
+
+def test_an_error_in_the_child_is_raised_here_with_its_traceback():
+    with pytest.raises(InputError) as raised:
+        call_in_child(_raise(InputError("bad row", "seq/x.csv", 3)))
+    assert str(raised.value) == "seq/x.csv:3: bad row"
+    assert any(
+        "in the child process" in note and "bad row" in note for note in raised.value.__notes__
+    )
+    with pytest.raises(ValueError) as raised:
+        call_in_child(_raise(ValueError("not a number")))
+    assert str(raised.value) == "not a number"
+
+
+def test_an_error_that_cannot_be_pickled_keeps_its_kind_and_text():
+    """ManifestError's constructor takes two arguments, so pickle cannot rebuild it: it arrives
+    as an InputError (the same exit code) with the same message."""
+    error = ManifestError("camera.fps", "not a number", "seq/sequence.yaml")
+    with pytest.raises(InputError) as raised:
+        call_in_child(_raise(error))
+    assert str(raised.value) == str(error)
+
+
+def test_a_child_that_dies_is_an_error_naming_the_signal():
+    def task(_):
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    with pytest.raises(
+        RuntimeError, match=r"ended without a result \(killed by signal 9 \(SIGKILL\)\)"
+    ):
+        call_in_child(task)
+
+
+class StopListeningError(Exception):
+    pass
+
+
+def test_a_child_no_longer_listened_to_is_ended_and_reaped():
+    children = []
+
+    def remember_and_stop(pid):
+        children.append(pid)
+        raise StopListeningError
+
+    def task(progress):
+        while True:
+            progress(os.getpid())
+
+    with pytest.raises(StopListeningError):
+        call_in_child(task, remember_and_stop)
+    with pytest.raises(ChildProcessError):
+        os.waitpid(children[0], os.WNOHANG)
+
+
+def test_log_records_and_warnings_of_the_child_are_handled_here_once(caplog):
+    middle = logging.getLogger("vo_doppler.child_test")
+    collected: list[logging.LogRecord] = []
+    extra = logging.Handler()
+    extra.emit = collected.append
+    middle.addHandler(extra)
+    try:
+
+        def task(_):
+            logging.getLogger("vo_doppler.child_test.stage").warning("%d frames %s", 3, "unread")
+            warnings.warn("a warning of the child", UserWarning, stacklevel=1)
+            return None
+
+        with caplog.at_level(logging.INFO):
+            call_in_child(task)
+    finally:
+        middle.removeHandler(extra)
+    frames = [r for r in caplog.records if r.name == "vo_doppler.child_test.stage"]
+    assert [r.getMessage() for r in frames] == ["3 frames unread"]
+    assert frames[0].levelno == logging.WARNING
+    assert [r.getMessage() for r in collected] == ["3 frames unread"]
+    assert any("a warning of the child" in r.getMessage() for r in caplog.records)
+
+
+def test_without_fork_the_task_runs_here(monkeypatch):
+    monkeypatch.setattr(child_process, "can_fork", lambda: False)
+    seen = []
+
+    def task(progress):
+        progress(7)
+        return os.getpid()
+
+    assert call_in_child(task, seen.append) == os.getpid()
+    assert seen == [7]
