@@ -1,15 +1,20 @@
 """The memory a command needs from the machine, counted over every process it starts.
 
-    python benchmarks/tree_memory.py [--interval S] [--json F] -- COMMAND [ARG ...]
+    python benchmarks/tree_memory.py [--interval S] [--json F] [--timeline F] -- COMMAND [ARG ...]
 
 ``/usr/bin/time -v`` reports the largest resident set of a single process. A job that hands
 part of its work to a child process can look smaller that way while the machine needs more, so
-this samples the command's whole process tree every ``--interval`` seconds and reports the peak
-of the **summed proportional set size** (``Pss`` of ``/proc/PID/smaps_rollup``: a page shared by
-n processes counts 1/n in each, so the sum is what the tree occupies), next to the peak of the
-summed resident sets (shared pages counted in every process) and the largest single process's
-peak (``ru_maxrss`` of the children, what ``time -v`` prints). Sampling can miss a peak shorter
-than the interval; the single-process figure cannot. Prints a table and writes JSON.
+this samples the command's whole process tree every ``--interval`` seconds
+(``/proc/PID/smaps_rollup``) and reports the peak of its **footprint**: the command's own
+resident set plus the pages private to each of its descendants (``Private_Clean`` +
+``Private_Dirty``). A forked child shares the command's pages until it writes one, and those
+are counted once, in the command; what the child writes or loads is its own. For a command
+without children the footprint is its resident set, what ``time -v`` reports, so the two
+arrangements compare on one scale, and it does not depend on what else runs on the machine
+(the summed proportional set size, ``Pss``, also reported, splits a shared library's pages with
+every other process using it). Also reported: the largest single process's peak
+(``ru_maxrss`` of the children, what ``time -v`` prints; never missed between samples). Prints
+a table and writes JSON.
 """
 
 from __future__ import annotations
@@ -21,7 +26,20 @@ import resource
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
+
+MIB = 1024.0
+"""KiB per MiB."""
+
+
+@dataclass(frozen=True)
+class Rollup:
+    """One process's memory in KiB (all zero once it has gone)."""
+
+    rss: int = 0
+    pss: int = 0
+    private: int = 0
 
 
 def _children(pid: int) -> list[int]:
@@ -40,33 +58,39 @@ def _children(pid: int) -> list[int]:
 
 
 def _tree(root: int) -> list[int]:
+    """``root`` first, then every descendant."""
     pids, todo = [], [root]
     while todo:
-        pid = todo.pop()
+        pid = todo.pop(0)
         pids.append(pid)
         todo += _children(pid)
     return pids
 
 
-def _rollup_kib(pid: int) -> tuple[int, int]:
-    """(Rss, Pss) of one process in KiB; (0, 0) once it has gone."""
-    rss = pss = 0
+def _rollup(pid: int) -> Rollup:
+    fields = {}
     try:
         with open(f"/proc/{pid}/smaps_rollup") as rollup:
             for line in rollup:
-                if line.startswith("Rss:"):
-                    rss = int(line.split()[1])
-                elif line.startswith("Pss:"):
-                    pss = int(line.split()[1])
+                name, _, rest = line.partition(":")
+                if name in ("Rss", "Pss", "Private_Clean", "Private_Dirty"):
+                    fields[name] = int(rest.split()[0])
     except OSError:
-        return 0, 0
-    return rss, pss
+        return Rollup()
+    private = fields.get("Private_Clean", 0) + fields.get("Private_Dirty", 0)
+    return Rollup(fields.get("Rss", 0), fields.get("Pss", 0), private)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--interval", type=float, default=0.1)
     parser.add_argument("--json", type=Path, default=Path("out/bench/tree_memory.json"))
+    parser.add_argument(
+        "--timeline",
+        type=Path,
+        help="also write every sample (CSV): seconds, processes, the footprint, the command's "
+        "own resident set and the summed PSS [MiB]",
+    )
     parser.add_argument("command", nargs=argparse.REMAINDER)
     args = parser.parse_args(argv)
     command = args.command[1:] if args.command[:1] == ["--"] else args.command
@@ -74,36 +98,54 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("no command given")
     start = time.monotonic()
     process = subprocess.Popen(command)
-    peak_pss = peak_rss = 0
-    most_processes = 1
+    samples = []
     while process.poll() is None:
-        pids = _tree(process.pid)
-        sizes = [_rollup_kib(pid) for pid in pids]
-        peak_rss = max(peak_rss, sum(rss for rss, _ in sizes))
-        peak_pss = max(peak_pss, sum(pss for _, pss in sizes))
-        most_processes = max(most_processes, sum(1 for rss, _ in sizes if rss))
+        rollups = [_rollup(pid) for pid in _tree(process.pid)]
+        own = rollups[0]
+        footprint = own.rss + sum(child.private for child in rollups[1:])
+        pss = sum(rollup.pss for rollup in rollups)
+        alive = sum(1 for rollup in rollups if rollup.rss)
+        samples.append((time.monotonic() - start, alive, footprint, own.rss, pss))
         time.sleep(args.interval)
     wall = time.monotonic() - start
     largest = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    peak = max(samples, key=lambda sample: sample[2], default=(0.0, 0, 0, 0, 0))
     record = {
         "command": command,
         "exit_code": process.returncode,
         "wall_s": wall,
         "interval_s": args.interval,
-        "peak_tree_pss_mib": peak_pss / 1024.0,
-        "peak_tree_rss_mib": peak_rss / 1024.0,
-        "largest_process_peak_rss_mib": largest / 1024.0,
-        "most_processes": most_processes,
+        "peak_footprint_mib": peak[2] / MIB,
+        "peak_footprint_at_s": peak[0],
+        "processes_at_peak": peak[1],
+        "peak_tree_pss_mib": max((s[4] for s in samples), default=0) / MIB,
+        "largest_process_peak_rss_mib": largest / MIB,
+        "most_processes": max((s[1] for s in samples), default=0),
     }
-    print(f"{'command':<22}{' '.join(command)}")
-    print(f"{'exit code':<22}{process.returncode}")
-    print(f"{'wall time [s]':<22}{wall:.1f}")
-    print(f"{'processes (at most)':<22}{most_processes}")
-    print(f"{'tree PSS peak':<22}{peak_pss / 1024.0:.1f} MiB ({peak_pss * 1.024e-3:.1f} MB)")
-    print(f"{'tree RSS peak':<22}{peak_rss / 1024.0:.1f} MiB")
-    print(f"{'largest process':<22}{largest / 1024.0:.1f} MiB (time -v's maximum resident set)")
+    rows = [
+        ("command", " ".join(command)),
+        ("exit code", str(process.returncode)),
+        ("wall time [s]", f"{wall:.1f}"),
+        ("processes (at most)", str(record["most_processes"])),
+        (
+            "footprint peak",
+            f"{peak[2] / MIB:.1f} MiB ({peak[2] * 1.024e-3:.1f} MB) at {peak[0]:.0f} s, "
+            f"{peak[1]} process(es)",
+        ),
+        ("summed PSS peak", f"{record['peak_tree_pss_mib']:.1f} MiB"),
+        ("largest process", f"{largest / MIB:.1f} MiB (time -v's maximum resident set)"),
+    ]
+    for name, value in rows:
+        print(f"{name:<22}{value}")
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(record, indent=2))
+    if args.timeline is not None:
+        lines = ["seconds,processes,footprint_mib,command_rss_mib,tree_pss_mib"]
+        lines += [
+            f"{t:.2f},{count},{foot / MIB:.1f},{own / MIB:.1f},{pss / MIB:.1f}"
+            for t, count, foot, own, pss in samples
+        ]
+        args.timeline.write_text("\n".join(lines) + "\n")
     print(f"wrote {args.json}")
     return process.returncode
 
