@@ -146,3 +146,11 @@ def test_without_fork_the_task_runs_here(monkeypatch):
 
     assert call_in_child(task, seen.append) == os.getpid()
     assert seen == [7]
+
+
+@pytest.mark.parametrize(
+    ("platform", "forks"), [("linux", True), ("darwin", False), ("win32", False)]
+)
+def test_only_linux_forks(monkeypatch, platform, forks):
+    monkeypatch.setattr(sys, "platform", platform)
+    assert child_process.can_fork() is (forks and hasattr(os, "fork"))

@@ -19,6 +19,7 @@ import logging
 import os
 import pickle
 import signal
+import sys
 import traceback
 from collections.abc import Callable
 from multiprocessing.connection import Connection, Pipe
@@ -33,8 +34,10 @@ _PROGRESS, _LOG, _RESULT, _ERROR = "progress", "log", "result", "error"
 
 
 def can_fork() -> bool:
-    """Whether this platform forks (POSIX); elsewhere :func:`call_in_child` runs in-process."""
-    return hasattr(os, "fork")
+    """Whether :func:`call_in_child` forks here: on Linux only. Windows has no ``fork``, and on
+    macOS system libraries may start threads, so a forked child can crash (Python's own
+    ``multiprocessing`` spawns there since 3.8); elsewhere the task runs in-process."""
+    return hasattr(os, "fork") and sys.platform.startswith("linux")
 
 
 def call_in_child(task: Callable[[Progress | None], T], on_progress: Progress | None = None) -> T:
@@ -42,7 +45,8 @@ def call_in_child(task: Callable[[Progress | None], T], on_progress: Progress | 
 
     ``progress`` is None when ``on_progress`` is None, else a callable that forwards each call
     to ``on_progress`` in this process. Log records of the child go to this process's loggers
-    of the same names. Where the platform does not fork, ``task(on_progress)`` runs here."""
+    of the same names. Where it does not fork (:func:`can_fork`), ``task(on_progress)`` runs
+    here."""
     if not can_fork():
         return task(on_progress)
     receiver, sender = Pipe(duplex=False)
