@@ -72,13 +72,22 @@ def test_an_error_in_the_child_is_raised_here_with_its_traceback():
     assert str(raised.value) == "not a number"
 
 
-def test_an_error_that_cannot_be_pickled_keeps_its_kind_and_text():
-    """ManifestError's constructor takes two arguments, so pickle cannot rebuild it: it arrives
-    as an InputError (the same exit code) with the same message."""
+def test_a_project_error_comes_back_as_itself_and_a_foreign_unpicklable_one_as_its_text():
+    """ManifestError's constructor takes two arguments, which plain exception pickling cannot
+    give back: the project's errors pickle as themselves (class, so exit code, and key). An
+    error of another library that will not pickle arrives as a RuntimeError with its text."""
     error = ManifestError("camera.fps", "not a number", "seq/sequence.yaml")
-    with pytest.raises(InputError) as raised:
+    with pytest.raises(ManifestError) as raised:
         call_in_child(_raise(error))
-    assert str(raised.value) == str(error)
+    assert str(raised.value) == str(error) and raised.value.key == "camera.fps"
+
+    class TwoArgumentError(Exception):
+        def __init__(self, first, second):
+            super().__init__(f"{first}/{second}")
+
+    with pytest.raises(RuntimeError) as foreign:
+        call_in_child(_raise(TwoArgumentError("a", "b")))
+    assert str(foreign.value) == "TwoArgumentError: a/b"
 
 
 def test_a_child_that_dies_is_an_error_naming_the_signal():

@@ -1,9 +1,10 @@
-"""The toolkit's errors name where the problem is; exit codes; storage refusals; names that are
-not UTF-8 shown as escapes."""
+"""The toolkit's errors name where the problem is and pickle as themselves; exit codes; storage
+refusals; names that are not UTF-8 shown as escapes."""
 
 from __future__ import annotations
 
 import errno
+import pickle
 from pathlib import Path
 
 from vo_doppler.errors import (
@@ -13,6 +14,8 @@ from vo_doppler.errors import (
     EXIT_USAGE,
     InputError,
     ManifestError,
+    OutputError,
+    UsageError,
     VoDopplerError,
     shown,
     storage_refused,
@@ -49,3 +52,23 @@ def test_names_that_are_not_utf8_are_shown_as_escapes():
     assert shown(Path("plain/é.csv")) == "plain/é.csv"
     assert shown("bad\udcffname") == "bad\\xffname"  # the byte 0xFF of a non-UTF-8 name
     assert shown("lone\ud800") == "lone\\ud800"
+
+
+def test_every_error_pickles_as_itself_with_its_attributes_and_notes():
+    """What a child process raises reaches the parent whole (vo_doppler.child_process): the
+    class (so the exit code), the message, the file, line, byte or key, the notes."""
+    errors = [
+        InputError("bad row", "seq/a.csv", line=3),
+        InputError("bad frame", "seq/b.ubx", byte=17),
+        ManifestError("camera.fps", "not a number", "seq/sequence.yaml"),
+        UsageError("--start after the end"),
+        OutputError("out is a file"),
+    ]
+    errors[0].add_note("while reading the wheel speed")
+    for error in errors:
+        copy = pickle.loads(pickle.dumps(error))
+        assert type(copy) is type(error)
+        assert str(copy) == str(error) and copy.args == error.args
+        assert vars(copy) == vars(error)
+    assert errors[0].__notes__ == ["while reading the wheel speed"]
+    assert pickle.loads(pickle.dumps(errors[0])).__notes__ == errors[0].__notes__

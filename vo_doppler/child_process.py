@@ -25,8 +25,6 @@ from collections.abc import Callable
 from multiprocessing.connection import Connection, Pipe
 from typing import TypeVar
 
-from vo_doppler.errors import InputError, VoDopplerError
-
 T = TypeVar("T")
 Progress = Callable[[int], None]
 
@@ -82,8 +80,7 @@ def _log_to(sender: Connection) -> None:
     """Every logger that has handlers, the root's included, sends its records to the parent
     instead (once per record: the parent's loggers propagate it again); so do warnings."""
     handler = _PipeHandler(sender)
-    loggers = [logging.getLogger(), *logging.Logger.manager.loggerDict.values()]
-    for logger in loggers:
+    for logger in logging.Logger.manager.loggerDict.values():
         if isinstance(logger, logging.Logger) and logger.handlers:
             logger.handlers = [handler]
     logging.getLogger().handlers = [handler]
@@ -91,12 +88,12 @@ def _log_to(sender: Connection) -> None:
 
 
 def _portable(error: BaseException) -> BaseException:
-    """``error`` if it survives pickling, else an error of the same kind (exit code) and text."""
+    """``error`` if it survives pickling (the project's errors do, as they are), else a
+    ``RuntimeError`` naming its class and giving its text."""
     try:
         pickle.loads(pickle.dumps(error))
     except Exception:
-        text = f"{type(error).__name__}: {error}"
-        return InputError(str(error)) if isinstance(error, VoDopplerError) else RuntimeError(text)
+        return RuntimeError(f"{type(error).__name__}: {error}")
     return error
 
 

@@ -23,7 +23,23 @@ EXIT_INTERNAL = 3
 
 
 class VoDopplerError(Exception):
-    """Base class of every error the toolkit raises on purpose."""
+    """Base class of every error the toolkit raises on purpose.
+
+    It pickles as what it is, its attributes (file, line, key) and notes included, whatever
+    its constructor takes: an error raised in a child process (:mod:`vo_doppler.child_process`)
+    keeps its class, and so its exit code, in the parent."""
+
+    def __reduce__(self):
+        return _restored, (type(self), self.args, self.__dict__)
+
+
+def _restored(cls: type[VoDopplerError], args: tuple, state: dict) -> VoDopplerError:
+    """An error of class ``cls`` with ``args`` and attributes ``state``, without calling its
+    constructor (pickle's rebuilding of a :class:`VoDopplerError`)."""
+    error = cls.__new__(cls)
+    error.args = args
+    error.__dict__.update(state)
+    return error
 
 
 class InputError(VoDopplerError):
