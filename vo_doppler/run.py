@@ -116,9 +116,10 @@ def run_sequence(
     if origin:
         log.warning("%s", origin)
     gnss = sequence_gnss(sequence, config)
+    rows, gnss = gnss.rows.in_enu(), without_rows(gnss)
     release_free_heap()
-    table = sequence_heading(sequence, gnss.rows, gnss.velocity, config.heading)
-    gnss = without_rows(gnss)
+    table = sequence_heading(sequence, rows, gnss.velocity, config.heading)
+    del rows
     release_free_heap()
     speed = table.calibrated_speed(sequence.wheel_speed)
     vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, vo_in_child)
@@ -136,7 +137,8 @@ def run_sequence(
 def without_rows(gnss: GnssVelocityResult) -> GnssVelocityResult:
     """``gnss`` with no Doppler row (their counts of rows not formed kept): nothing after the
     heading stage reads them, and the rows of a 30-min drive at 20 Hz are 28 MiB held through
-    the VO and the outputs."""
+    the VO and the outputs. :func:`run_sequence` lets them go as soon as it has them in the
+    ENU frame the heading stage takes, which share every array but the vectors with them."""
     return replace(gnss, rows=gnss.rows.select(np.zeros(0, dtype=int)))
 
 

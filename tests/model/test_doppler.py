@@ -1,5 +1,6 @@
-"""DopplerRows owns its per-row arrays: sorted on construction, they stay sorted whatever the
-caller does to its arrays; their frame is a member of VectorFrame."""
+"""DopplerRows owns its per-row arrays: sorted on construction and read-only, they stay sorted
+whatever the caller does to its arrays; rows made from other rows share what did not change;
+their frame is a member of VectorFrame."""
 
 from __future__ import annotations
 
@@ -33,9 +34,46 @@ def test_rows_sorted_on_construction_are_copies_in_time_order():
     np.testing.assert_array_equal(rows.sat_clock_drift, [0.5, 0.5])
     assert list(rows.sat_id) == ["G02", "G01"]
     for name in ROW_ARRAYS:
-        getattr(rows, name)[0] = getattr(rows, name)[1]  # each its own writeable array
-    rows.weight[1] = 9.0
-    assert rows.sat_clock_drift[1] == 0.5 and rows.weight[0] == 1.0
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(rows, name)[0] = getattr(rows, name)[1]
+
+
+def test_rows_made_from_rows_share_the_arrays_that_did_not_change():
+    rows = rows_of(np.array([1.0, 2.0]), np.array([4.0, -3.0]), np.array([2.0, 1.0]))
+    weight = np.array([5.0, 6.0])
+    reweighted = dataclasses.replace(rows, weight=weight)
+    for name in set(ROW_ARRAYS) - {"weight"}:
+        assert getattr(reweighted, name) is getattr(rows, name)
+    assert not np.shares_memory(reweighted.weight, weight)
+    weight[0] = -1.0
+    np.testing.assert_array_equal(reweighted.weight, [5.0, 6.0])
+    np.testing.assert_array_equal(rows.weight, [2.0, 1.0])
+
+
+def test_rows_made_from_rows_in_another_order_are_sorted_copies():
+    rows = rows_of(np.array([1.0, 2.0]), np.array([4.0, -3.0]), np.array([2.0, 1.0]))
+    later = dataclasses.replace(rows, t=np.array([3.0, 0.0]))
+    np.testing.assert_array_equal(later.t, [0.0, 3.0])
+    np.testing.assert_array_equal(later.range_rate, [-3.0, 4.0])
+    assert list(later.sat_id) == ["G02", "G01"]
+    np.testing.assert_array_equal(rows.range_rate, [4.0, -3.0])
+    assert not np.shares_memory(later.range_rate, rows.range_rate)
+
+
+def test_rows_turned_into_enu_share_everything_but_the_vectors():
+    lat, lon = np.radians(35.0), np.radians(139.0)
+    ecef = np.array([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)]) * 6.4e6
+    rows = dataclasses.replace(
+        rows_of(np.array([1.0, 2.0]), np.array([4.0, -3.0]), np.array([2.0, 1.0])),
+        frame="ecef",
+        receiver_ecef=np.tile(ecef, (2, 1)),
+    )
+    enu = rows.in_enu()
+    for name in set(ROW_ARRAYS) - {"los", "sat_velocity"}:
+        assert getattr(enu, name) is getattr(rows, name)
+    assert enu.receiver_ecef is rows.receiver_ecef
+    np.testing.assert_allclose(np.linalg.norm(enu.los, axis=1), 1.0, atol=1e-12)
+    assert not np.shares_memory(enu.los, rows.los)
 
 
 def test_the_frame_is_a_member_and_an_unknown_one_is_refused():
