@@ -10,7 +10,11 @@ runs of rows); and where the line breaks (a non-finite value), the last finite r
 the first non-finite row of each break and the first finite row after it. Runs of rows that
 each span less than a pixel then draw the same pixels as every row: within a run the line
 moves less than a pixel, its extent in each coordinate is kept, and its ends join the
-neighbouring runs as before; the axes' limits are unchanged (every extreme is kept)."""
+neighbouring runs as before; the axes' limits are unchanged (every extreme is kept).
+
+Dots and ticks (the heading figure's per-epoch markers) are not a line: :func:`drawn_points`
+keeps one point of each cell of a grid finer than the figure's pixels (``DOT_CELLS``), so the
+markers cover the same pixels."""
 
 from __future__ import annotations
 
@@ -50,3 +54,46 @@ def drawn_rows(values: np.ndarray, runs: int = FIGURE_RUNS) -> np.ndarray:
     change = np.flatnonzero(whole[1:] != whole[:-1])
     keep += [change, change + 1]
     return np.unique(np.concatenate(keep))
+
+
+def drawn_line(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The points of a line over ``x`` (increasing) that a figure draws (:func:`drawn_rows` of
+    ``y``, N or N×D)."""
+    rows = drawn_rows(y)
+    return x[rows], y[rows]
+
+
+DOT_CELLS = (2000, 1000)
+"""Columns and rows of the grid over a dot plot's extent of which :func:`drawn_points` keeps
+one point per cell: at most half a pixel wide and high in the report's figures (at most 1,100
+pixels wide, a panel at most 500 high), well below a marker's size."""
+
+
+def drawn_points(x: np.ndarray, y: np.ndarray, cells: tuple[int, int] = DOT_CELLS) -> np.ndarray:
+    """Sorted indices of the points (``x``, ``y``) that a dot or tick plot draws: all of them
+    when there are at most ``cells[0]``, else the first finite point in each occupied cell of a
+    grid of ``cells`` (columns, rows) over the finite points' extent, and the points of least
+    and greatest x and y (the axes' limits unchanged). A point with a non-finite coordinate
+    draws nothing and is left out."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    columns, levels = cells
+    if min(columns, levels) < 1:
+        raise ValueError(f"cells must be at least 1 × 1, got {cells}")
+    if len(x) <= columns:
+        return np.arange(len(x))
+    finite = np.flatnonzero(np.isfinite(x) & np.isfinite(y))
+    if finite.size == 0:
+        return finite
+    fx, fy = x[finite], y[finite]
+    _, first = np.unique(_cell(fx, columns) * levels + _cell(fy, levels), return_index=True)
+    extremes = [np.argmin(fx), np.argmax(fx), np.argmin(fy), np.argmax(fy)]
+    return np.unique(np.concatenate([finite[first], finite[extremes]]))
+
+
+def _cell(values: np.ndarray, count: int) -> np.ndarray:
+    """Index (0 … count − 1) of each finite value's cell among ``count`` equal cells over their
+    extent."""
+    low, span = values.min(), values.max() - values.min()
+    if not span > 0:
+        return np.zeros(values.size, dtype=np.int64)
+    return np.minimum(((values - low) * (count / span)).astype(np.int64), count - 1)

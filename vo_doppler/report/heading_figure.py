@@ -12,6 +12,7 @@ import numpy as np
 
 from vo_doppler.geo import wrap_angle, yaw_to_course
 from vo_doppler.model.heading import HeadingTable
+from vo_doppler.report.decimation import drawn_line, drawn_points, drawn_rows
 from vo_doppler.report.figure import new_figure, tight_layout
 
 if TYPE_CHECKING:
@@ -45,9 +46,11 @@ def continuous_course_deg(course: np.ndarray, reference: np.ndarray) -> np.ndarr
 
 
 def _strip(ax, t: np.ndarray, rows: list[tuple[str, np.ndarray, str]]) -> None:
-    """One row of ticks per flag: a tick at every epoch where it holds."""
+    """One row of ticks per flag: a tick at every epoch where it holds (those a figure can
+    tell apart, :func:`~vo_doppler.report.decimation.drawn_points`)."""
     for k, (_, flag, colour) in enumerate(rows):
-        ax.scatter(t[flag], np.full(int(flag.sum()), k), marker="|", s=60, c=colour, lw=1)
+        ticks = t[flag][drawn_points(t[flag], np.zeros(int(flag.sum())))]
+        ax.scatter(ticks, np.full(len(ticks), k), marker="|", s=60, c=colour, lw=1)
     ax.set_yticks(range(len(rows)), [label for label, _, _ in rows], fontsize=8)
     ax.set_ylim(-0.6, len(rows) - 0.4)
     ax.invert_yaxis()
@@ -61,7 +64,8 @@ def build_heading_figure(
     used: np.ndarray | None = None,
 ) -> Figure:
     """The figure of :func:`heading_figure`. The satellite curve is ``table.n_sat_epoch``, one
-    step per epoch centred on it."""
+    step per epoch centred on it. A long drive's lines, bands and dots are drawn from the
+    epochs the figure can tell apart (:mod:`vo_doppler.report.decimation`)."""
     t = table.t - (table.t[0] if len(table) else 0.0)
     panels = 4 if truth_yaw is not None else 3
     fig = new_figure(figsize=(10, 1.6 + 2.3 * panels))
@@ -69,7 +73,7 @@ def build_heading_figure(
         panels, 1, sharex=True, height_ratios=[1.0, 0.7, 1.6] + [1.6] * (panels - 3)
     )
     ax = axes[0]
-    ax.step(t, table.n_sat_epoch, where="mid", color="0.3", label="satellites")
+    ax.step(*drawn_line(t, table.n_sat_epoch), where="mid", color="0.3", label="satellites")
     ax.set_ylabel("satellites\nper epoch")
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
@@ -88,24 +92,23 @@ def build_heading_figure(
     course_tc = continuous_course_deg(table.course_tc, reference)
     course_conv = continuous_course_deg(table.course_conv, reference)
     if truth_yaw is not None:
-        ax.plot(t, continuous_course_deg(reference, reference), c="k", lw=1, label="ground truth")
+        truth_course = continuous_course_deg(reference, reference)
+        ax.plot(*drawn_line(t, truth_course), c="k", lw=1, label="ground truth")
     band = BAND_SIGMAS * np.degrees(sigma)
-    ax.fill_between(t, course_tc - band, course_tc + band, color=TIGHT, alpha=0.2, lw=0)
-    ax.plot(t, course_conv, ".", ms=3, c=CONVENTIONAL, label="conventional")
-    ax.plot(t, course_tc, ".", ms=3, c=TIGHT, label=f"tightly coupled (band ±{BAND_SIGMAS:g}σ)")
+    _band(ax, t, course_tc - band, course_tc + band)
+    _dots(ax, t, course_conv, CONVENTIONAL, "conventional")
+    _dots(ax, t, course_tc, TIGHT, f"tightly coupled (band ±{BAND_SIGMAS:g}σ)")
     ax.set_ylabel("course [deg from north,\nclockwise, unwrapped]")
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     if truth_yaw is not None:
         ax = axes[3]
-        ax.fill_between(
-            t, -band, band, color=TIGHT, alpha=0.2, lw=0, label=f"±{BAND_SIGMAS:g}σ (tight)"
-        )
+        _band(ax, t, -band, band, f"±{BAND_SIGMAS:g}σ (tight)")
         for yaw, colour, label in (
             (table.yaw_conv, CONVENTIONAL, "conventional"),
             (table.yaw_tc, TIGHT, "tightly coupled"),
         ):
-            ax.plot(t, np.degrees(wrap_angle(yaw - truth_yaw)), ".", ms=3, c=colour, label=label)
+            _dots(ax, t, np.degrees(wrap_angle(yaw - truth_yaw)), colour, label)
         ax.axhline(0.0, c="k", lw=0.8)
         ax.set_ylabel("heading error\n(estimate − truth) [deg]")
         ax.grid(alpha=0.3)
@@ -114,3 +117,15 @@ def build_heading_figure(
     fig.suptitle(title)
     tight_layout(fig)
     return fig
+
+
+def _band(ax, t: np.ndarray, low: np.ndarray, high: np.ndarray, label: str | None = None) -> None:
+    """The tight heading's band between ``low`` and ``high`` (breaks where either is NaN)."""
+    rows = drawn_rows(np.column_stack([low, high]))
+    ax.fill_between(t[rows], low[rows], high[rows], color=TIGHT, alpha=0.2, lw=0, label=label)
+
+
+def _dots(ax, t: np.ndarray, values: np.ndarray, colour: str, label: str) -> None:
+    """A dot per epoch (those the figure can tell apart)."""
+    rows = drawn_points(t, values)
+    ax.plot(t[rows], values[rows], ".", ms=3, c=colour, label=label)

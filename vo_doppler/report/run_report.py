@@ -30,7 +30,7 @@ from vo_doppler.geo import EnuFrame, wrap_angle
 from vo_doppler.gnss.doppler_velocity import MIN_SATELLITES
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.trajectory import Trajectory
-from vo_doppler.report.decimation import drawn_rows
+from vo_doppler.report.decimation import drawn_line, drawn_rows
 from vo_doppler.report.figure import new_figure, tight_layout
 from vo_doppler.report.provenance import DataDescription
 from vo_doppler.report.trajectory_map import COLOURS, TRUTH, map_html
@@ -216,12 +216,6 @@ def _drawn_plane(trajectory: Trajectory) -> np.ndarray:
     return plane[drawn_rows(plane)].T
 
 
-def _drawn_line(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The rows of a line over ``x`` (increasing) that a figure draws (:func:`drawn_rows`)."""
-    rows = drawn_rows(y)
-    return x[rows], y[rows]
-
-
 def _mean_text(mean_m: float | None) -> str:
     return "path too short: not available" if mean_m is None else f"mean {mean_m:.2f} m"
 
@@ -232,7 +226,7 @@ def build_error_per_100m_figure(per_100m: dict[str, ErrorPerDistance], title: st
     ax = fig.subplots()
     for name, result in per_100m.items():
         ax.plot(
-            *_drawn_line(result.start_distance_m, result.errors_m),
+            *drawn_line(result.start_distance_m, result.errors_m),
             lw=1.4,
             c=COLOURS.get(name),
             label=f"{label(name)} ({_mean_text(result.mean_m_per_100m)})",
@@ -272,7 +266,7 @@ def build_heading_error_figure(
     for name, trajectory in trajectories.items():
         error = np.degrees(heading_error_over_time(trajectory, truth))
         ax.plot(
-            *_drawn_line(trajectory.t - t0, error), lw=1.2, c=COLOURS.get(name), label=label(name)
+            *drawn_line(trajectory.t - t0, error), lw=1.2, c=COLOURS.get(name), label=label(name)
         )
         if np.isfinite(error).any():
             spread.append(np.nanpercentile(np.abs(error), 99))
