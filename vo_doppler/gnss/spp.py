@@ -34,7 +34,7 @@ from vo_doppler.gnss.pseudorange_noise import (
     fit_pseudorange_noise,
     prior_sigma,
 )
-from vo_doppler.gnss.satellite_source import StateSource, satellite_source
+from vo_doppler.gnss.satellite_source import SatelliteSource, StateSource, satellite_source
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.model.gnss_solutions import SppSolution
 from vo_doppler.model.observations import Observations, lookup, row_keys
@@ -125,41 +125,10 @@ def solve_spp(
     if not codes:
         raise InputError(no_system_message(obs, systems), obs.header.path)
     source = satellite_source(source)
-    rows = np.zeros(len(obs), dtype=bool)
-    for system, code in codes.items():
-        rows |= obs.mask(system, code)
-    sel = obs.subset(rows & np.isfinite(obs.value) & (obs.value > 1e6))
-    travel = sel.value / SPEED_OF_LIGHT
-    first = source.states(sel.system, sel.prn, sel.time - travel)
-    t_tx = sel.time - travel - np.nan_to_num(first.clock_bias_s)
-    states = source.states(sel.system, sel.prn, t_tx)
-    group_delay = source.group_delay_s(sel.system, states, codes, obs.header.version)
-    satellite_clock_m = SPEED_OF_LIGHT * (states.clock_bias_s - np.nan_to_num(group_delay))
-    n_no_ephemeris = int((~states.valid).sum())
-    channels = {**source.glonass_channels(), **obs.header.glonass_channels}
-    frequency = np.full(len(sel), L1_HZ)
-    cn0 = np.full(len(sel), np.nan)
-    for system, code in codes.items():
-        hit = sel.system == system
-        lam = wavelengths(sel.system[hit], sel.prn[hit], code, channels, obs.header.version)
-        frequency[hit] = np.nan_to_num(SPEED_OF_LIGHT / lam, nan=L1_HZ)
-        cn0[hit] = _signal_strength(obs, sel.subset(hit), strength_code(code))
-    epoch = np.searchsorted(obs.epoch_time, sel.time)
-    bounds = np.searchsorted(epoch, np.arange(obs.epoch_time.size + 1))
+    data, n_no_ephemeris = _epoch_rows(obs, source, codes)
     start = obs.header.approx_position
     if start is None or np.linalg.norm(start) < EARTH_SURFACE_M:
         start = np.zeros(3)
-    healthy = states.valid
-    flat = _EpochData(
-        obs.epoch_time,
-        states.position[healthy],
-        (sel.value + satellite_clock_m)[healthy],
-        sel.system[healthy],
-        sel.prn[healthy],
-        frequency[healthy],
-        cn0[healthy],
-    )
-    data = _EpochRows(flat, np.concatenate(([0], np.cumsum(healthy)))[bounds])
     model = _Model(sorted(codes), elevation_mask_rad, source.klobuchar, {}, alpha)
     fits = _solve_all(data, model, start)
     noise_models = {}
@@ -172,6 +141,48 @@ def solve_spp(
         )
         fits = _solve_all(data, model, start, starts)
     return _solution(obs.epoch_time, fits, model.systems, n_no_ephemeris, noise_models, alpha)
+
+
+def _epoch_rows(
+    obs: Observations, source: SatelliteSource, codes: dict[str, str]
+) -> tuple[_EpochRows, int]:
+    """The pseudoranges of ``codes`` (system → code) with a healthy satellite state, by epoch,
+    corrected for the satellite clock, with their carrier frequency and C/N0; and the count of
+    those without a state. The satellite states at the receive time less the travel time give
+    the satellite clock, and so the transmission time, at which the states are taken again.
+    The arrays of the whole drive made on the way (the satellite states, twice) are let go
+    before the epochs are solved, and the first states as soon as their clock is read."""
+    rows = np.zeros(len(obs), dtype=bool)
+    for system, code in codes.items():
+        rows |= obs.mask(system, code)
+    sel = obs.subset(rows & np.isfinite(obs.value) & (obs.value > 1e6))
+    travel = sel.value / SPEED_OF_LIGHT
+    clock_first = source.states(sel.system, sel.prn, sel.time - travel).clock_bias_s
+    states = source.states(sel.system, sel.prn, sel.time - travel - np.nan_to_num(clock_first))
+    group_delay = source.group_delay_s(sel.system, states, codes, obs.header.version)
+    satellite_clock_m = SPEED_OF_LIGHT * (states.clock_bias_s - np.nan_to_num(group_delay))
+    channels = {**source.glonass_channels(), **obs.header.glonass_channels}
+    frequency = np.full(len(sel), L1_HZ)
+    cn0 = np.full(len(sel), np.nan)
+    for system, code in codes.items():
+        hit = sel.system == system
+        lam = wavelengths(sel.system[hit], sel.prn[hit], code, channels, obs.header.version)
+        frequency[hit] = np.nan_to_num(SPEED_OF_LIGHT / lam, nan=L1_HZ)
+        cn0[hit] = _signal_strength(obs, sel.subset(hit), strength_code(code))
+    epoch = np.searchsorted(obs.epoch_time, sel.time)
+    bounds = np.searchsorted(epoch, np.arange(obs.epoch_time.size + 1))
+    healthy = states.valid
+    flat = _EpochData(
+        obs.epoch_time,
+        states.position[healthy],
+        (sel.value + satellite_clock_m)[healthy],
+        sel.system[healthy],
+        sel.prn[healthy],
+        frequency[healthy],
+        cn0[healthy],
+    )
+    starts = np.concatenate(([0], np.cumsum(healthy)))[bounds]
+    return _EpochRows(flat, starts), int((~healthy).sum())
 
 
 def _solution(t, fits, systems, n_no_ephemeris, noise_models, alpha) -> SppSolution:
