@@ -6,6 +6,8 @@ from __future__ import annotations
 import os
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from vo_doppler.errors import InputError
 from vo_doppler.io.textfile import (
@@ -16,6 +18,7 @@ from vo_doppler.io.textfile import (
     read_bytes,
     read_text,
     regular_file,
+    text_lines,
 )
 
 
@@ -82,3 +85,15 @@ def test_the_first_line_too_long_is_named_with_its_length():
     check_line_lengths(b"0123456789\n0123456789", "f", "the log", max_line=10)  # at the bound
     with pytest.raises(InputError, match=r"^f:1: the log line has 11 bytes"):
         decode_text(b"0123456789A\n" * 3, "f", "the log", max_line=10)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(
+        st.sampled_from(["1.5 2", "", " ", "#c", "\n", "\r", "\r\n", "\x0b", "\x85", "\u2028"]),
+        max_size=40,
+    ).map("".join),
+    st.integers(min_value=0, max_value=9),
+)
+def test_lines_split_in_pieces_are_those_of_splitlines(text, piece_chars):
+    assert list(text_lines(text, piece_chars)) == text.splitlines()

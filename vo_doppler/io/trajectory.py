@@ -16,7 +16,7 @@ from scipy.spatial.transform import Rotation
 
 from vo_doppler.choices import checked
 from vo_doppler.errors import InputError
-from vo_doppler.io.textfile import read_text
+from vo_doppler.io.textfile import read_text, text_lines
 from vo_doppler.model.trajectory import Trajectory
 
 
@@ -28,7 +28,7 @@ def _read_numeric_rows(path: Path, n_columns: int, what: str) -> tuple[np.ndarra
     values_out = array("d")
     numbers = array("q")
     text = read_text(path, f"{what} file")
-    for number, line in enumerate(text.splitlines(), start=1):
+    for number, line in enumerate(text_lines(text), start=1):
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
             continue
