@@ -12,9 +12,10 @@ each span less than a pixel then draw the same pixels as every row: within a run
 moves less than a pixel, its extent in each coordinate is kept, and its ends join the
 neighbouring runs as before; the axes' limits are unchanged (every extreme is kept).
 
-Dots and ticks (the heading figure's per-epoch markers) are not a line: :func:`drawn_points`
-keeps one point of each cell of a grid finer than the figure's pixels (``DOT_CELLS``), so the
-markers cover the same pixels."""
+Dots (the heading figure's per-epoch markers) are not a line: :func:`drawn_points` keeps one
+point of each cell of a grid finer than the figure's pixels (``DOT_CELLS``), so the markers
+cover the same pixels. Thin ticks are not decimated: dozens of them overlapping in a pixel make
+its colour, which fewer would lighten."""
 
 from __future__ import annotations
 

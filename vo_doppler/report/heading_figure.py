@@ -46,11 +46,10 @@ def continuous_course_deg(course: np.ndarray, reference: np.ndarray) -> np.ndarr
 
 
 def _strip(ax, t: np.ndarray, rows: list[tuple[str, np.ndarray, str]]) -> None:
-    """One row of ticks per flag: a tick at every epoch where it holds (those a figure can
-    tell apart, :func:`~vo_doppler.report.decimation.drawn_points`)."""
+    """One row of ticks per flag: a tick at every epoch where it holds (all of them: dozens
+    of thin ticks per pixel make the strip's solid colour, which fewer would lighten)."""
     for k, (_, flag, colour) in enumerate(rows):
-        ticks = t[flag][drawn_points(t[flag], np.zeros(int(flag.sum())))]
-        ax.scatter(ticks, np.full(len(ticks), k), marker="|", s=60, c=colour, lw=1)
+        ax.scatter(t[flag], np.full(int(flag.sum()), k), marker="|", s=60, c=colour, lw=1)
     ax.set_yticks(range(len(rows)), [label for label, _, _ in rows], fontsize=8)
     ax.set_ylim(-0.6, len(rows) - 0.4)
     ax.invert_yaxis()
