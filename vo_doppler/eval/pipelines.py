@@ -64,8 +64,9 @@ def truth_at(truth: Trajectory, t: np.ndarray) -> tuple[Trajectory, np.ndarray]:
 
 SLERP_BLOCK = 8192
 """Times interpolated by one :class:`~scipy.spatial.transform.Slerp`, built on the truth rows
-around them only: built on a 30-min ground truth at 100 Hz (180,000 rows) it took about
-20 MiB, once per pipeline evaluated."""
+around them only: one built on the whole truth holds a rotation vector and copies of the times
+for each of its rows (a 30-min ground truth at 100 Hz has 180,000), once per pipeline
+evaluated."""
 
 
 def _slerp_in_blocks(truth: Trajectory, tq: np.ndarray) -> Rotation:
