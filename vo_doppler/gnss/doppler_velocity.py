@@ -52,7 +52,7 @@ from vo_doppler.gnss.satellite_source import (
 )
 from vo_doppler.gnss.signals import strength_code, wavelengths
 from vo_doppler.gnss.spp import elevation_azimuth
-from vo_doppler.model.doppler import DopplerRows
+from vo_doppler.model.doppler import DopplerRows, read_only
 from vo_doppler.model.doppler_sigma import ReportedSigma
 from vo_doppler.model.gnss_solutions import VelocitySolution
 from vo_doppler.model.observations import Observations, lookup, row_keys
@@ -153,10 +153,8 @@ def doppler_rows(
         "azimuth": _joined(blocks, "azimuth", float),
     }
     rows["receiver_ecef"] = receiver[rows["epoch"]]
-    for array in rows.values():
-        array.flags.writeable = False  # new arrays: the rows take them without a copy
     return DopplerRows(
-        **rows,
+        **{name: read_only(array) for name, array in rows.items()},
         frame="ecef",
         n_no_ephemeris=int(no_eph.sum()),
         n_no_wavelength=int((~np.isfinite(wavelength)).sum()),

@@ -37,8 +37,9 @@ def _is_shareable(given: object, checked: np.ndarray) -> bool:
     )
 
 
-def _read_only(array: np.ndarray) -> np.ndarray:
-    """``array`` made read-only: the rows take a new array of theirs without copying it."""
+def read_only(array: np.ndarray) -> np.ndarray:
+    """``array`` made read-only: :class:`DopplerRows` take a new array of their own (one no one
+    else writes) without copying it."""
     array.flags.writeable = False
     return array
 
@@ -110,7 +111,7 @@ class DopplerRows:
             if order is None and _is_shareable(given[name], value):
                 setattr(self, name, given[name])
                 continue
-            setattr(self, name, _read_only(np.array(value if order is None else value[order])))
+            setattr(self, name, read_only(np.array(value if order is None else value[order])))
 
     def __len__(self) -> int:
         return len(self.t)
@@ -127,7 +128,7 @@ class DopplerRows:
     def select(self, keep: np.ndarray) -> DopplerRows:
         """The rows where ``keep`` (mask or indices) selects (counts unchanged)."""
         return replace(
-            self, **{name: _read_only(value[keep]) for name, value in self._row_arrays().items()}
+            self, **{name: read_only(value[keep]) for name, value in self._row_arrays().items()}
         )
 
     def reduced(self) -> np.ndarray:
