@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import itertools
 import logging
+import os
 from collections import deque
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -17,6 +18,7 @@ from vo_doppler.errors import InputError
 from vo_doppler.io.image_header import image_size
 from vo_doppler.io.textfile import read_text
 from vo_doppler.model.camera import Camera
+from vo_doppler.model.image_files import ImageFiles
 
 log = logging.getLogger(__name__)
 
@@ -26,17 +28,17 @@ frame, not read."""
 IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm"}
 
 
-def list_images(folder: str | Path) -> list[Path]:
+def list_images(folder: str | Path) -> ImageFiles:
     """Image files of a folder (or its ``image_0`` subfolder), sorted by name."""
     folder = Path(folder)
     if not folder.is_dir():
         raise InputError("image folder does not exist", folder)
-    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
-    if not files and (folder / "image_0").is_dir():
+    names = sorted(n for n in os.listdir(folder) if Path(n).suffix.lower() in IMAGE_SUFFIXES)
+    if not names and (folder / "image_0").is_dir():
         return list_images(folder / "image_0")
-    if not files:
+    if not names:
         raise InputError("no PNG/JPG images in folder", folder)
-    return files
+    return ImageFiles.in_folder(folder, names)
 
 
 def read_image(path: Path) -> np.ndarray | None:

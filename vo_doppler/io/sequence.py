@@ -39,6 +39,7 @@ from vo_doppler.io.time_order import TimeOrderReport
 from vo_doppler.io.trajectory import read_tum
 from vo_doppler.io.yaml_file import load_yaml
 from vo_doppler.memory import release_free_heap
+from vo_doppler.model.image_files import ImageFiles
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.vehicle_source import VehicleSignalSource
@@ -232,7 +233,7 @@ class Manifest:
             raise self.error(f"{section}.{key}", f"{path} is not a folder")
         return path
 
-    def images(self, section: str, key: str) -> list[Path]:
+    def images(self, section: str, key: str) -> ImageFiles:
         """The image files of the folder the key names (an empty folder names the key)."""
         folder = self.folder(section, key)
         try:

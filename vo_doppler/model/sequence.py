@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from vo_doppler.geo import EnuFrame
 from vo_doppler.model.camera import Camera
 from vo_doppler.model.doppler_sigma import ReportedSigma
+from vo_doppler.model.image_files import ImageFiles
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.precise_orbits import PreciseOrbits
@@ -30,7 +30,8 @@ class Sequence:
     """
 
     name: str
-    image_paths: list[Path]
+    image_paths: ImageFiles
+    """The images in order; any paths given (a list, say) are held as :class:`ImageFiles`."""
     image_times: np.ndarray
     camera: Camera | None
     observations: Observations | None
@@ -56,6 +57,9 @@ class Sequence:
     the tight heading's road grade prior."""
     vehicle_source: VehicleSignalSource = field(default_factory=VehicleSignalSource)
     """Where the yaw rate and wheel speed came from, for the checks' messages."""
+
+    def __post_init__(self) -> None:
+        self.image_paths = ImageFiles.of(self.image_paths)
 
     @property
     def has_gnss(self) -> bool:

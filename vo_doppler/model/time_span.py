@@ -225,7 +225,7 @@ def trim_sequence(sequence: Sequence, span: TimeSpan) -> tuple[Sequence, GpsInte
     timed = ("observations", "doppler_sigma", "yaw_rate", "wheel_speed", "forward_acceleration")
     cut = replace(
         sequence,
-        image_paths=[p for p, keep in zip(sequence.image_paths, images, strict=True) if keep],
+        image_paths=sequence.image_paths.select(images),
         image_times=sequence.image_times[images],
         truth=trim(sequence.truth, interval),
         **{name: trim(getattr(sequence, name), interval) for name in timed},
