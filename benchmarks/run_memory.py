@@ -9,8 +9,9 @@ of :func:`vo_doppler.run.run_sequence` (GNSS, heading, VO, correction: each stag
 (``/proc/self/clear_refs``, value 5, Linux ≥ 4.0) and read back after it (``VmHWM``), so every
 row is that step's own peak; the whole process's peak is the largest of them (the reset clears
 ``ru_maxrss`` too). Prints a table and writes JSON. By default the VO runs in this process, so
-its row is the VO's own peak; ``--vo-in-child`` runs it in a forked child as ``vo-doppler run``
-does (the rows are then this process's alone; ``tree_memory.py`` counts the child too).
+its row is the VO's own peak; ``--in-child`` runs the GNSS and heading stages and the VO in
+forked children as ``vo-doppler run`` does (the rows are then this process's alone, and the
+stages run in a child have none; ``tree_memory.py`` counts the children too).
 """
 
 from __future__ import annotations
@@ -77,10 +78,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("sequence", type=Path)
     parser.add_argument("--json", type=Path, default=Path("out/bench/run_memory.json"))
     parser.add_argument(
-        "--vo-in-child",
+        "--in-child",
         action="store_true",
-        help="run the VO in a forked child process, as vo-doppler run does; the VO row is then "
-        "this process's own memory while it waits (the child's: benchmarks/tree_memory.py)",
+        help="run the GNSS and heading stages and the VO in forked child processes, as "
+        "vo-doppler run does; the VO row is then this process's own memory while it waits, "
+        "and the GNSS and heading stages have no row (the children's: "
+        "benchmarks/tree_memory.py)",
     )
     args = parser.parse_args(argv)
     meter = StageMeter()
@@ -90,11 +93,13 @@ def main(argv: list[str] | None = None) -> int:
     from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
     from vo_doppler.report.run_outputs import input_warnings, result_checks, write_run_outputs
 
-    for name in STAGES:  # wrapped where it is called: run_sequence, or vehicle_vo (the VO)
-        meter.wrap(run_module if name in vars(run_module) else vo_doppler.run_stages, name)
+    for name in STAGES:  # wrapped where it is called: in run.py, in run_stages.py, or both
+        for module in (run_module, vo_doppler.run_stages):
+            if callable(vars(module).get(name)):
+                meter.wrap(module, name)
     sequence, report = meter.measure("read", read_sequence_with_report, args.sequence)
     config = run_module.RunConfig()
-    result = run_module.run_sequence(sequence, config, vo_in_child=args.vo_in_child)
+    result = run_module.run_sequence(sequence, config, in_child=args.in_child)
     warnings = input_warnings(sequence, report)
     checks = result_checks(sequence, report, result, warnings)
     with tempfile.TemporaryDirectory(prefix="run_memory_") as out:

@@ -304,10 +304,12 @@ from vo_doppler.io.sequence import read_sequence
 from vo_doppler.run import run_sequence
 
 frames = []
-result = run_sequence(read_sequence(sys.argv[1]), on_frame=frames.append, vo_in_child=True)
+result = run_sequence(read_sequence(sys.argv[1]), on_frame=frames.append, in_child=True)
 arrays = {name.value: np.column_stack([track.t, track.positions, track.orientations.as_quat()])
           for name, track in result.trajectories.items()}
-np.savez(sys.argv[2], frames=np.array(frames), **arrays)
+np.savez(sys.argv[2], frames=np.array(frames), yaw_tc=result.heading.yaw_tc,
+         sigma_tc=result.heading.sigma_tc, velocity=result.gnss.velocity.velocity_enu,
+         spp=result.gnss.spp.position_ecef, warnings=np.array(result.warnings), **arrays)
 print(" ".join(m for m in ("cv2", "pycolmap") if m in sys.modules) or "none")
 """
 
@@ -317,7 +319,7 @@ print(" ".join(m for m in ("cv2", "pycolmap") if m in sys.modules) or "none")
 def test_the_vo_in_a_child_process_gives_the_same_run_and_leaves_no_opencv_here(
     short_drive_folder, tmp_path
 ):
-    """``vo_in_child`` (what ``run`` and ``batch`` use, issue 30): OpenCV and pycolmap load only
+    """``in_child`` (what ``run`` and ``batch`` use, issue 30): OpenCV and pycolmap load only
     in the child, which ends with the VO, so a fresh interpreter never has them; every frame's
     progress comes back, and every trajectory is the in-process run's, bit for bit."""
     saved = tmp_path / "child_run.npz"
@@ -331,7 +333,14 @@ def test_the_vo_in_a_child_process_gives_the_same_run_and_leaves_no_opencv_here(
     child = np.load(saved)
     here = run_sequence(read_sequence(short_drive_folder))
     np.testing.assert_array_equal(child["frames"], np.arange(len(here.vo.trajectory.t)))
-    assert sorted(child.files) == sorted(["frames", *(name.value for name in here.trajectories)])
+    stages = ["yaw_tc", "sigma_tc", "velocity", "spp", "warnings"]
+    names = [name.value for name in here.trajectories]
+    assert sorted(child.files) == sorted(["frames", *stages, *names])
+    np.testing.assert_array_equal(child["yaw_tc"], here.heading.yaw_tc)
+    np.testing.assert_array_equal(child["sigma_tc"], here.heading.sigma_tc)
+    np.testing.assert_array_equal(child["velocity"], here.gnss.velocity.velocity_enu)
+    np.testing.assert_array_equal(child["spp"], here.gnss.spp.position_ecef)
+    assert list(child["warnings"]) == here.warnings
     for name, track in here.trajectories.items():
         poses = np.column_stack([track.t, track.positions, track.orientations.as_quat()])
         np.testing.assert_array_equal(child[name.value], poses)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -47,10 +47,11 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.run_stages import (
     RunConfig,
+    gnss_and_heading,
     sequence_gnss,
-    sequence_heading,
     sequence_trajectories,
     vehicle_vo,
+    without_rows,
 )
 
 if TYPE_CHECKING:
@@ -90,15 +91,17 @@ def run_sequence(
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
     given: GivenHeading | None = None,
-    vo_in_child: bool = False,
+    in_child: bool = False,
 ) -> RunResult:
     """Run every stage on a recording. ``images`` replaces reading ``sequence.image_paths``
     (e.g. frames already in memory); ``on_frame`` is called after each VO frame; ``given``,
     an absolute heading from elsewhere, replaces the heading stage
-    (:func:`run_with_given_heading`). With ``vo_in_child`` the VO runs in a forked child
-    process, with the same result: OpenCV and pycolmap (about 70 MiB) then leave with it
-    instead of staying loaded through the correction and the outputs, where the job peaks
-    (``vo-doppler run`` and ``batch`` do so; :mod:`vo_doppler.child_process`).
+    (:func:`run_with_given_heading`). With ``in_child`` the GNSS and heading stages run in
+    one forked child process and the VO in another, with the same result: OpenCV and pycolmap
+    (about 70 MiB) leave with the VO's child instead of staying loaded through the correction
+    and the outputs, where the job peaks, and the heap the GNSS and heading stages fragment
+    leaves with theirs (``vo-doppler run`` and ``batch`` do so;
+    :mod:`vo_doppler.child_process`).
 
     The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`, in the
     heading stage: :func:`~vo_doppler.heading.from_gnss.heading_from_gnss`): vehicle signals
@@ -108,21 +111,16 @@ def run_sequence(
     ``RunResult.warnings``."""
     config = (config or RunConfig()).for_sequence(sequence)
     if given is not None:
-        return run_with_given_heading(sequence, given, config, on_frame, images, vo_in_child)
+        return run_with_given_heading(sequence, given, config, on_frame, images, in_child)
     if not sequence.has_gnss:
-        return run_without_gnss(sequence, config, on_frame, images, vo_in_child)
+        return run_without_gnss(sequence, config, on_frame, images, in_child)
     obs = sequence.observations
     origin = origin_warning(sequence.enu, obs.header.approx_position)
     if origin:
         log.warning("%s", origin)
-    gnss = sequence_gnss(sequence, config)
-    rows, gnss = gnss.rows.in_enu(), without_rows(gnss)
-    release_free_heap()
-    table = sequence_heading(sequence, rows, gnss.velocity, config.heading)
-    del rows
-    release_free_heap()
+    gnss, table = gnss_and_heading(sequence, config, in_child)
     speed = table.calibrated_speed(sequence.wheel_speed)
-    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, vo_in_child)
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
     if vo is None:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
     antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
@@ -132,14 +130,6 @@ def run_sequence(
     release_free_heap()
     warnings = ([origin] if origin else []) + table.warnings
     return RunResult(gnss, table, vo, speed, trajectories, antenna, usable, warnings)
-
-
-def without_rows(gnss: GnssVelocityResult) -> GnssVelocityResult:
-    """``gnss`` with no Doppler row (their counts of rows not formed kept): nothing after the
-    heading stage reads them, and the rows of a 30-min drive at 20 Hz are 28 MiB held through
-    the VO and the outputs. :func:`run_sequence` lets them go as soon as it has them in the
-    ENU frame the heading stage takes, which share every array but the vectors with them."""
-    return replace(gnss, rows=gnss.rows.select(np.zeros(0, dtype=int)))
 
 
 NO_GNSS = (
@@ -155,7 +145,7 @@ def run_without_gnss(
     config: RunConfig,
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
-    vo_in_child: bool = False,
+    in_child: bool = False,
 ) -> RunResult:
     """:func:`run_sequence` on a recording without GNSS: the VO (scaled by the wheel speed as
     recorded) and the wheel + gyro dead reckoning, each started at the ENU origin facing east
@@ -165,7 +155,7 @@ def run_without_gnss(
     note = NO_GNSS.format(name=sequence.name)
     log.warning("%s", note)
     speed, yaw_rate = sequence.wheel_speed, sequence.yaw_rate
-    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, vo_in_child)
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
     origin = AntennaTrack(np.zeros(0), np.zeros((1, 3)), None, "the sequence origin (no GNSS)")
     tracks = {
         Pipeline.VO: vo_vehicle,
@@ -191,7 +181,7 @@ def run_with_given_heading(
     config: RunConfig,
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
-    vo_in_child: bool = False,
+    in_child: bool = False,
 ) -> RunResult:
     """:func:`run_sequence` with the absolute heading ``given`` instead of the heading stage.
 
@@ -237,7 +227,7 @@ def run_with_given_heading(
     speed, yaw_rate = sequence.wheel_speed, sequence.yaw_rate
     if given.has_calibration:
         speed, yaw_rate = table.calibrated_speed(speed), table.calibrated_yaw_rate(yaw_rate)
-    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, vo_in_child)
+    vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
     trajectories, usable = sequence_trajectories(
         sequence, table, vo_vehicle, speed, antenna, config, yaw_rate, tight_source
     )

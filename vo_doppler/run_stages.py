@@ -168,3 +168,31 @@ def sequence_trajectories(
     dr = dead_reckoning(speed, yaw_rate, config.dead_reckoning_rate_hz, vo_vehicle)
     lever = sequence.antenna_lever_arm_m
     return correct_all(table, vo_vehicle, dr, antenna, config.correction, lever, tight_source)
+
+
+def gnss_and_heading(
+    sequence: Sequence, config: RunConfig, in_child: bool = False
+) -> tuple[GnssVelocityResult, HeadingTable]:
+    """The GNSS stage (:func:`without_rows`: its result without the Doppler rows) and the
+    heading stage on its rows. With ``in_child`` both run in a forked child process
+    (:func:`~vo_doppler.child_process.call_in_child`) and only their results come back: the
+    heap the two stages leave fragmented (their transients grow with the drive) leaves with
+    the child instead of staying under the VO, the correction and the outputs."""
+
+    def stages(_: object) -> tuple[GnssVelocityResult, HeadingTable]:
+        gnss = sequence_gnss(sequence, config)
+        rows, gnss = gnss.rows.in_enu(), without_rows(gnss)
+        release_free_heap()
+        return gnss, sequence_heading(sequence, rows, gnss.velocity, config.heading)
+
+    gnss, table = call_in_child(stages) if in_child else stages(None)
+    release_free_heap()
+    return gnss, table
+
+
+def without_rows(gnss: GnssVelocityResult) -> GnssVelocityResult:
+    """``gnss`` with no Doppler row (their counts of rows not formed kept): nothing after the
+    heading stage reads them, and the rows of a 30-min drive at 20 Hz are 28 MiB held through
+    the VO and the outputs. :func:`gnss_and_heading` lets them go as soon as it has them in the
+    ENU frame the heading stage takes, which share every array but the vectors with them."""
+    return replace(gnss, rows=gnss.rows.select(np.zeros(0, dtype=int)))
