@@ -15,7 +15,7 @@ from vo_doppler.heading.pipeline import HeadingPipelineConfig
 from vo_doppler.heading.smoother import HeadingSmootherConfig
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.timeseries import sample
-from vo_doppler.run import RunConfig, sequence_gnss, sequence_heading
+from vo_doppler.run_stages import RunConfig, sequence_gnss, sequence_heading
 from vo_doppler.sim.canyon_realism import real_canyon_config
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
