@@ -100,8 +100,8 @@ def run_sequence(
     one forked child process and the VO in another, with the same result: OpenCV and pycolmap
     (about 70 MiB) leave with the VO's child instead of staying loaded through the correction
     and the outputs, where the job peaks, and the heap the GNSS and heading stages fragment
-    leaves with theirs (``vo-doppler run`` and ``batch`` do so;
-    :mod:`vo_doppler.child_process`).
+    leaves with theirs (with ``given``, only the VO runs in a child; ``vo-doppler run`` and
+    ``batch`` pass ``in_child``; :mod:`vo_doppler.child_process`).
 
     The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`, in the
     heading stage: :func:`~vo_doppler.heading.from_gnss.heading_from_gnss`): vehicle signals
