@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 
-from vo_doppler.child_process import call_in_child
 from vo_doppler.errors import InputError
 from vo_doppler.io.heading_csv import read_heading_csv
 from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
@@ -61,17 +60,10 @@ def run_recording(
     into the folder ``write_into()`` gives (``staged_output`` for ``run``; ``batch`` its
     staging folder).
 
-    The sequence is read in a forked child process
-    (:func:`~vo_doppler.child_process.call_in_child`, on Linux): only what it read comes back,
-    and the heap the readers fragment leaves with the child. The stages run in children too
-    (:func:`~vo_doppler.run.run_sequence` with ``in_child``).
-
     What is alive before the run (the imported modules, the inputs) and after it (its results)
     is frozen until the job ends: the cycle collector's full passes (automatic, and after
     each figure) skip it."""
-    sequence, report = call_in_child(
-        lambda _: read_sequence_with_report(folder, allow_outside_paths)
-    )
+    sequence, report = read_sequence_with_report(folder, allow_outside_paths)
     interval = None
     if span is not None and not span.whole:
         sequence, interval = trim_sequence(sequence, span)
