@@ -8,10 +8,13 @@ import logging
 import os
 import signal
 import sys
+import threading
 import warnings
+from multiprocessing.connection import Pipe
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from vo_doppler import child_process
 from vo_doppler.child_process import call_in_child
@@ -32,6 +35,46 @@ def test_the_result_and_every_progress_call_come_back_in_order():
     assert seen == [0, 1, 2, 3, 4]
     np.testing.assert_array_equal(values, np.arange(6.0) / 7.0)
     assert pid != os.getpid()
+
+
+def test_arrays_come_back_equal_writable_and_in_their_layout():
+    rng = np.random.default_rng(7)
+    big = rng.normal(size=(300_000, 4))
+    fortran = np.asfortranarray(rng.normal(size=(50, 3)))
+    records = np.array([(1, 2.5), (3, -1.0)], dtype=[("a", "i4"), ("b", "f8")])
+    sent = {
+        "big": big,
+        "strided": big[::7, 1],
+        "fortran": fortran,
+        "records": records,
+        "empty": np.zeros((0, 3)),
+        "objects": np.array([{"x": 1}, None], dtype=object),
+        "rotation": Rotation.from_quat(big[:1000] / np.linalg.norm(big[:1000], axis=1)[:, None]),
+    }
+    got = call_in_child(lambda _: sent)
+    for name in ("big", "strided", "fortran", "records", "empty", "objects"):
+        np.testing.assert_array_equal(got[name], sent[name], err_msg=name)
+        assert got[name].dtype == sent[name].dtype
+        assert got[name].flags.writeable, name
+    assert got["fortran"].flags.f_contiguous
+    np.testing.assert_array_equal(got["rotation"].as_quat(), sent["rotation"].as_quat())
+    got["big"][0, 0] = 42.0
+    assert big[0, 0] != 42.0
+
+
+def test_a_results_arrays_travel_beside_its_pickle_not_in_it():
+    receiver, sender = Pipe(duplex=False)
+    poses = np.arange(4 * 4 * 20_000, dtype=float).reshape(-1, 4, 4)
+    thread = threading.Thread(target=child_process._send_result, args=(sender, (poses, "VO")))
+    thread.start()
+    kind, header, sizes = receiver.recv()
+    assert kind == "result"
+    assert sizes == [poses.nbytes]
+    assert len(header) < 1024
+    got, label = child_process._receive_result(receiver, header, sizes)
+    thread.join()
+    np.testing.assert_array_equal(got, poses)
+    assert label == "VO"
 
 
 def test_without_a_progress_callback_the_task_gets_none():
