@@ -304,7 +304,10 @@ from vo_doppler.io.sequence import read_sequence
 from vo_doppler.run import run_sequence
 
 frames = []
-result = run_sequence(read_sequence(sys.argv[1]), on_frame=frames.append, in_child=True)
+sequence = read_sequence(sys.argv[1])
+epochs = sequence.observations.epoch_time
+result = run_sequence(sequence, on_frame=frames.append, in_child=True, keep_rows=False)
+assert len(sequence.observations) == 0 and sequence.observations.epoch_time is epochs
 arrays = {name.value: np.column_stack([track.t, track.positions, track.orientations.as_quat()])
           for name, track in result.trajectories.items()}
 np.savez(sys.argv[2], frames=np.array(frames), yaw_tc=result.heading.yaw_tc,
@@ -321,7 +324,8 @@ def test_the_vo_in_a_child_process_gives_the_same_run_and_leaves_no_opencv_here(
 ):
     """``in_child`` (what ``run`` and ``batch`` use, issue 30): OpenCV and pycolmap load only
     in the child, which ends with the VO, so a fresh interpreter never has them; every frame's
-    progress comes back, and every trajectory is the in-process run's, bit for bit."""
+    progress comes back, and every trajectory is the in-process run's, bit for bit. With
+    ``keep_rows=False`` too, the sequence is left with its observations' epochs alone."""
     saved = tmp_path / "child_run.npz"
     done = subprocess.run(
         [sys.executable, "-c", CHILD_RUN, str(short_drive_folder), str(saved)],

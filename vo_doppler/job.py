@@ -77,7 +77,9 @@ def run_recording(
     try:
         gc.freeze()
         with (running or _nothing)(sequence) as on_frame:
-            result = run_sequence(sequence, config, on_frame, given=given, in_child=True)
+            result = run_sequence(
+                sequence, config, on_frame, given=given, in_child=True, keep_rows=False
+            )
         gc.freeze()
         checks = result_checks(sequence, report, result, warnings)
         with write_into() as out:

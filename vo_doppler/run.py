@@ -92,6 +92,7 @@ def run_sequence(
     images: Iterable[np.ndarray] | None = None,
     given: GivenHeading | None = None,
     in_child: bool = False,
+    keep_rows: bool = True,
 ) -> RunResult:
     """Run every stage on a recording. ``images`` replaces reading ``sequence.image_paths``
     (e.g. frames already in memory); ``on_frame`` is called after each VO frame; ``given``,
@@ -101,7 +102,10 @@ def run_sequence(
     (about 70 MiB) leave with the VO's child instead of staying loaded through the correction
     and the outputs, where the job peaks, and the heap the GNSS and heading stages fragment
     leaves with theirs (with ``given``, only the VO runs in a child; ``vo-doppler run`` and
-    ``batch`` pass ``in_child``; :mod:`vo_doppler.child_process`).
+    ``batch`` pass ``in_child``; :mod:`vo_doppler.child_process`). With ``keep_rows`` False,
+    ``sequence.observations`` is replaced by its
+    :meth:`~vo_doppler.model.observations.Observations.epochs_only` once the GNSS stage has
+    used its rows, so that they are not held through the VO (``run`` and ``batch`` pass it).
 
     The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`, in the
     heading stage: :func:`~vo_doppler.heading.from_gnss.heading_from_gnss`): vehicle signals
@@ -111,7 +115,9 @@ def run_sequence(
     ``RunResult.warnings``."""
     config = (config or RunConfig()).for_sequence(sequence)
     if given is not None:
-        return run_with_given_heading(sequence, given, config, on_frame, images, in_child)
+        return run_with_given_heading(
+            sequence, given, config, on_frame, images, in_child, keep_rows
+        )
     if not sequence.has_gnss:
         return run_without_gnss(sequence, config, on_frame, images, in_child)
     obs = sequence.observations
@@ -119,6 +125,8 @@ def run_sequence(
     if origin:
         log.warning("%s", origin)
     gnss, table = gnss_and_heading(sequence, config, in_child)
+    if not keep_rows:
+        sequence.observations = obs = obs.epochs_only()
     speed = table.calibrated_speed(sequence.wheel_speed)
     vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
     if vo is None:
@@ -182,6 +190,7 @@ def run_with_given_heading(
     on_frame: Callable[[int], None] | None = None,
     images: Iterable[np.ndarray] | None = None,
     in_child: bool = False,
+    keep_rows: bool = True,
 ) -> RunResult:
     """:func:`run_sequence` with the absolute heading ``given`` instead of the heading stage.
 
@@ -218,6 +227,8 @@ def run_with_given_heading(
         origin = origin_warning(sequence.enu, obs.header.approx_position)
         warnings += [origin] if origin else []
         gnss = without_rows(sequence_gnss(sequence, config))
+        if not keep_rows:
+            sequence.observations = obs = obs.epochs_only()
         antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
         release_free_heap()
     else:

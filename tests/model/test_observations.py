@@ -31,6 +31,27 @@ def test_satellite_names_and_codes():
     assert OBS.codes_of("C") == []
 
 
+def test_epochs_only_keeps_header_codes_epochs_and_problems_and_no_row():
+    noted = observations_from_rows(
+        Path("x.obs"),
+        "r",
+        time=[1.0, 2.0],
+        system=["G", "G"],
+        prn=[5, 5],
+        code=["D1C", "D1C"],
+        value=[-100.0, -90.0],
+        problems=("line 7: skipped",),
+        row_fields={"flag": np.arange(2)},
+    )
+    bare = noted.epochs_only()
+    assert len(bare) == 0 and bare.satellites().size == 0
+    assert bare.header is noted.header and bare.codes == noted.codes
+    assert bare.problems == ("line 7: skipped",)
+    np.testing.assert_array_equal(bare.epoch_time, [1.0, 2.0])
+    assert bare.row_fields["flag"].size == 0
+    assert len(noted) == 2
+
+
 def test_masks_and_subsets_keep_the_header_epochs_and_row_fields():
     # rows by time, system, satellite, code: E11, G05 C1C, G05 D1C, G07, R03, G05 at 3 s
     np.testing.assert_array_equal(OBS.mask("G", "D1C"), [False, False, True, True, False, True])
