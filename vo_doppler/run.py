@@ -127,6 +127,7 @@ def run_sequence(
     gnss, table = gnss_and_heading(sequence, config, in_child)
     if not keep_rows:
         sequence.observations = obs = obs.epochs_only()
+        release_free_heap()
     speed = table.calibrated_speed(sequence.wheel_speed)
     vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
     if vo is None:
