@@ -102,10 +102,9 @@ def run_sequence(
     (about 70 MiB) leave with the VO's child instead of staying loaded through the correction
     and the outputs, where the job peaks, and the heap the GNSS and heading stages fragment
     leaves with theirs (with ``given``, only the VO runs in a child; ``vo-doppler run`` and
-    ``batch`` pass ``in_child``; :mod:`vo_doppler.child_process`). With ``keep_rows`` False,
-    ``sequence.observations`` is replaced by its
-    :meth:`~vo_doppler.model.observations.Observations.epochs_only` once the GNSS stage has
-    used its rows, so that they are not held through the VO (``run`` and ``batch`` pass it).
+    ``batch`` pass ``in_child``; :mod:`vo_doppler.child_process`). With ``keep_rows`` False
+    (``run`` and ``batch``), ``sequence.observations`` becomes its ``epochs_only()`` once the
+    GNSS stage has used its rows, so that they are not held through the VO.
 
     The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`, in the
     heading stage: :func:`~vo_doppler.heading.from_gnss.heading_from_gnss`): vehicle signals
