@@ -23,7 +23,6 @@ in both frames).
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import KroghInterpolator
 
 from vo_doppler.geo import SPEED_OF_LIGHT
 from vo_doppler.gnss.ephemeris import OMEGA_E, SatelliteStates, rotate_earth
@@ -80,6 +79,10 @@ def _columns(sat_ids: np.ndarray, system: np.ndarray, prn: np.ndarray) -> np.nda
 def _interpolate_positions(orbits: PreciseOrbits, column, t, n_points):
     """Quasi-inertial position, velocity and acceleration (NaN where invalid), each satellite
     over the window of its own tabulated (non-missing) epochs."""
+    # scipy.interpolate brings scipy.optimize (about 24 MiB resident): loaded by the GNSS stage
+    # that needs it, not by every process that imports the GNSS package (vo_doppler.memory).
+    from scipy.interpolate import KroghInterpolator
+
     out = np.full((3, t.size, 3), np.nan)
     if orbits.t.size < 2:
         return out

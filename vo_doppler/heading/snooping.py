@@ -71,7 +71,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
 from scipy.special import chdtri, gammaincinv
 
 from vo_doppler.heading.profile import (
@@ -557,6 +556,10 @@ def receiver_noise(samples: list[NoiseSample]) -> ReceiverNoise:
 
     if not parts["seen"].size or excess(0.0) <= 0.0:
         return ReceiverNoise(scale, 0.0)
+    # scipy.optimize (about 22 MiB resident) loads here, in the heading stage, not with the
+    # module: the processes that import it and never fit the noise stay without it.
+    from scipy.optimize import brentq
+
     upper = 1.0
     while excess(upper) > 0.0 and upper < 1e12:
         upper *= 10.0
