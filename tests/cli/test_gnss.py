@@ -219,7 +219,6 @@ def test_precise_orbits_or_clocks_of_another_time_are_named(tmp_path, capsys, ca
     )
 
 
-@pytest.mark.slow
 def _glonass_without_channels(tmp_path):
     """The canyon's rover.obs with its Galileo satellites renamed GLONASS: GLONASS Doppler with
     no GLONASS SLOT / FRQ # entry, and brdc.nav has no GLONASS record."""
