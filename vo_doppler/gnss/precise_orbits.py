@@ -80,7 +80,8 @@ def _interpolate_positions(orbits: PreciseOrbits, column, t, n_points):
     """Quasi-inertial position, velocity and acceleration (NaN where invalid), each satellite
     over the window of its own tabulated (non-missing) epochs."""
     # scipy.interpolate brings scipy.optimize (about 24 MiB resident): loaded by the GNSS stage
-    # that needs it, not by every process that imports the GNSS package (vo_doppler.memory).
+    # that needs it, not by every process that imports the GNSS package (run's parent among
+    # them; tests/architecture/test_lazy_imports.py).
     from scipy.interpolate import KroghInterpolator
 
     out = np.full((3, t.size, 3), np.nan)
