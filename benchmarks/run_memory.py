@@ -10,8 +10,9 @@ of :func:`vo_doppler.run.run_sequence` (GNSS, heading, VO, correction: each stag
 row is that step's own peak; the whole process's peak is the largest of them (the reset clears
 ``ru_maxrss`` too). Prints a table and writes JSON. By default the VO runs in this process, so
 its row is the VO's own peak; ``--in-child`` runs the GNSS and heading stages and the VO in
-forked children as ``vo-doppler run`` does (the rows are then this process's alone, and the
-stages run in a child have none; ``tree_memory.py`` counts the children too).
+forked children and lets the observation rows go after the GNSS stage, as ``vo-doppler run``
+does (the rows are then this process's alone, and the stages run in a child have none;
+``tree_memory.py`` counts the children too).
 """
 
 from __future__ import annotations
@@ -80,10 +81,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--in-child",
         action="store_true",
-        help="run the GNSS and heading stages and the VO in forked child processes, as "
-        "vo-doppler run does; the VO row is then this process's own memory while it waits, "
-        "and the GNSS and heading stages have no row (the children's: "
-        "benchmarks/tree_memory.py)",
+        help="run the GNSS and heading stages and the VO in forked child processes and let "
+        "the observation rows go after the GNSS stage, as vo-doppler run does; the VO row is "
+        "then this process's own memory while it waits, and the GNSS and heading stages have "
+        "no row (the children's: benchmarks/tree_memory.py)",
     )
     args = parser.parse_args(argv)
     meter = StageMeter()
@@ -99,7 +100,9 @@ def main(argv: list[str] | None = None) -> int:
                 meter.wrap(module, name)
     sequence, report = meter.measure("read", read_sequence_with_report, args.sequence)
     config = run_module.RunConfig()
-    result = run_module.run_sequence(sequence, config, in_child=args.in_child)
+    result = run_module.run_sequence(
+        sequence, config, in_child=args.in_child, keep_rows=not args.in_child
+    )
     warnings = input_warnings(sequence, report)
     checks = result_checks(sequence, report, result, warnings)
     with tempfile.TemporaryDirectory(prefix="run_memory_") as out:
