@@ -15,10 +15,11 @@ from tests.helpers.precise_text import clock_text, sp3_text
 from tests.helpers.rinex_text import field, rinex3_epoch, rinex3_header
 from vo_doppler.cli import main
 from vo_doppler.commands import gnss_command
-from vo_doppler.commands.gnss_command import _glonass_dropped
+from vo_doppler.commands.gnss_command import _glonass_dropped, _systems_solved
 from vo_doppler.io.gnss_csv import SPP_COLUMNS, VELOCITY_COLUMNS
 from vo_doppler.io.receiver_file import read_observation_file
 from vo_doppler.io.rinex_nav import read_nav
+from vo_doppler.model.gnss_solutions import SppSolution
 from vo_doppler.model.gpstime import calendar_to_gps_seconds
 
 
@@ -233,9 +234,10 @@ def test_glonass_rows_without_a_frequency_channel_are_said_once_and_left_out_of_
     action, tmp_path, caplog, monkeypatch
 ):
     """GLONASS Doppler without a channel (no GLONASS SLOT / FRQ # entry, no GLONASS record in
-    the navigation file): one warning with the count and the satellites (they were dropped
-    without a word), and the figure's title names the systems used, not R (issue 30: it read
-    "GREJC", the systems asked for)."""
+    the navigation file): ``velocity`` says once, with the count and the satellites, that it
+    drops them (they were dropped without a word); ``spp``, which reads pseudoranges and needs
+    no channel, says nothing of Doppler rows. Each figure's title names the systems used, not R
+    (issue 30: it read "GREJC", the systems asked for): here GLONASS has no ephemeris either."""
     obs = _glonass_without_channels(tmp_path)
     titles = []
 
@@ -247,9 +249,34 @@ def test_glonass_rows_without_a_frequency_channel_are_said_once_and_left_out_of_
     out = tmp_path / "out.csv"
     main(["gnss", action, str(obs), "--nav", str(SAMPLE_GNSS / "brdc.nav"), "-o", str(out)])
     said = [r.getMessage() for r in caplog.records if r.getMessage().startswith("GLONASS:")]
-    assert len(said) == 1
-    assert said[0].startswith("GLONASS: 1606 Doppler rows of R02, R03, R04, R10, R19, R21 dropped")
+    if action == "velocity":
+        assert len(said) == 1
+        start = "GLONASS: 1606 Doppler rows of R02, R03, R04, R10, R19, R21 dropped"
+        assert said[0].startswith(start)
+    else:
+        assert said == []
     assert titles == ["glonass.obs (G)"]
+
+
+def test_the_spp_title_names_the_systems_whose_clock_was_solved():
+    """GLONASS pseudoranges need no frequency channel: where the SPP solved a GLONASS clock
+    (SP3 orbits, which carry no channel), R stays in the title."""
+    n = 3
+    nan = np.full(n, np.nan)
+    clocks = {"G": np.array([1.0, np.nan, 2.0]), "R": np.array([np.nan, 3.0, np.nan]), "E": nan}
+    solution = SppSolution(
+        np.arange(n, dtype=float),
+        np.zeros((n, 3)),
+        clocks,
+        np.full(n, 6),
+        nan,
+        nan,
+        np.ones(n, dtype=bool),
+        0,
+    )
+    assert _systems_solved(solution, "GREJC") == "GR"
+    assert _systems_solved(solution, "RG") == "RG"
+    assert _systems_solved(solution, "EJ") == "no system solved"
 
 
 def test_glonass_with_a_channel_for_some_satellites_stays_in_the_title(tmp_path, caplog):

@@ -39,6 +39,7 @@ from vo_doppler.io.gnss_csv import write_spp_csv, write_velocity_csv
 from vo_doppler.io.output_folder import write_files
 from vo_doppler.io.receiver_file import read_observation_file
 from vo_doppler.io.satellite_states import state_problems
+from vo_doppler.model.gnss_solutions import SppSolution
 from vo_doppler.model.navigation import Navigation
 from vo_doppler.model.observations import Observations
 from vo_doppler.model.precise_orbits import PreciseOrbits
@@ -262,6 +263,15 @@ def _glonass_dropped(obs: Observations, source, systems: str, bands: str | None)
     return present.replace("R", "") if all_glonass else present
 
 
+def _systems_solved(solution: SppSolution, systems: str) -> str:
+    """The systems of ``systems`` whose receiver clock the SPP estimated at some epoch, for the
+    figure's title. Pseudoranges need no GLONASS frequency channel, so ``spp`` keeps GLONASS
+    satellites whose Doppler rows ``velocity`` drops (:func:`_glonass_dropped`)."""
+    clocks = solution.clock_bias_m
+    solved = "".join(s for s in systems if s in clocks and np.isfinite(clocks[s]).any())
+    return solved or "no system solved"
+
+
 def run(args: argparse.Namespace) -> int:
     figure = args.figure or args.output.with_suffix(".png")
     check_output_files(
@@ -287,16 +297,16 @@ def run(args: argparse.Namespace) -> int:
     check_coverage(obs, nav, args.systems, args.nav or [args.obs])
     mask = np.deg2rad(args.elev_mask)
     bands = getattr(args, "bands", None)
-    used = _glonass_dropped(obs, nav, args.systems, bands)
-    title = f"{shown(args.obs.name)} ({used})"
     if args.gnss_command == "spp":
         solution = gnss_position(obs, nav, args.systems, mask)
         valid = solution.valid
+        title = f"{shown(args.obs.name)} ({_systems_solved(solution, args.systems)})"
         outputs = [
             (args.output, lambda path: write_spp_csv(path, solution)),
             (figure, lambda path: spp_figure(path, solution, title)),
         ]
     else:
+        title = f"{shown(args.obs.name)} ({_glonass_dropped(obs, nav, args.systems, bands)})"
         result = gnss_velocity(obs, nav, args.systems, mask, args.bands, range_rate)
         velocity = result.velocity
         valid = velocity.valid
