@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
-from tests.io.fuzz_families import manifest_text
+from tests.conftest import REPO_ROOT
 from vo_doppler.errors import ManifestError
 from vo_doppler.io.sensor_csv import (
     FORWARD_ACCELERATION_COLUMN,
@@ -20,9 +20,28 @@ from vo_doppler.io.sensor_csv import (
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.model.series import SensorSeries
 
+SAMPLE = REPO_ROOT / "sample_sequences" / "urban_canyon_small"
+
+
+def sample_manifest() -> dict:
+    """The sample's manifest with its paths made absolute, to be written anywhere."""
+    manifest = yaml.safe_load((SAMPLE / "sequence.yaml").read_text())
+    for section, key in (
+        ("camera", "images"),
+        ("camera", "times"),
+        ("camera", "calib"),
+        ("gnss", "obs"),
+        ("can", "log"),
+        ("can", "dbc"),
+        ("ground_truth", "trajectory"),
+    ):
+        manifest[section][key] = str(SAMPLE / manifest[section][key])
+    manifest["gnss"]["nav"] = [str(SAMPLE / p) for p in manifest["gnss"]["nav"]]
+    return manifest
+
 
 def write_manifest(tmp_path, change) -> object:
-    manifest = yaml.safe_load(manifest_text())
+    manifest = sample_manifest()
     change(manifest, tmp_path)
     path = tmp_path / "sequence.yaml"
     path.write_text(yaml.safe_dump(manifest, sort_keys=False))
