@@ -8,13 +8,17 @@ from __future__ import annotations
 import dataclasses
 import gc
 import json
+import subprocess
+import sys
 from contextlib import contextmanager, nullcontext
 
 import numpy as np
 import pytest
 
 from vo_doppler.errors import InputError
+from vo_doppler.io.sequence import read_sequence
 from vo_doppler.job import require_tight_heading, run_recording
+from vo_doppler.model.time_span import SpanBound, TimeSpan, trim_sequence
 from vo_doppler.report.run_outputs import SUMMARY_FILE
 from vo_doppler.run import RunConfig
 
@@ -95,3 +99,48 @@ def test_wheels_still_while_gnss_moves_and_a_moving_drive_keep_their_own_message
         require_tight_heading(_without_heading(result, 1.0, 1.0), tmp_path, tmp_path)
     assert "never moved" not in str(raised.value)
     require_tight_heading(result, tmp_path, tmp_path)
+
+
+def _same_poses(got, expected) -> None:
+    np.testing.assert_array_equal(got.t, expected.t)
+    np.testing.assert_array_equal(got.positions, expected.positions)
+    np.testing.assert_array_equal(got.orientations.as_quat(), expected.orientations.as_quat())
+
+
+def test_the_ground_truth_left_out_of_the_run_is_back_for_the_outputs(job, turning_drive_folder):
+    truth = read_sequence(turning_drive_folder).truth
+    assert len(truth) > 1000
+    _same_poses(job.sequence.truth, truth)
+    assert "evaluation" in job.summary
+
+
+def test_a_cut_runs_ground_truth_is_cut_as_the_sequence_read_and_cut_here(
+    turning_drive_folder, tmp_path
+):
+    span = TimeSpan(SpanBound(4.0), SpanBound(12.0))
+    output = run_recording(turning_drive_folder, RunConfig(), lambda: nullcontext(tmp_path), span)
+    expected, _ = trim_sequence(read_sequence(turning_drive_folder), span)
+    _same_poses(output.sequence.truth, expected.truth)
+    assert 0 < len(expected.truth) < len(read_sequence(turning_drive_folder).truth)
+    cut = output.summary["span"]
+    assert (cut["start_from_first_epoch_s"], cut["end_from_first_epoch_s"]) == pytest.approx(
+        (4.0, 12.0), abs=1e-6
+    )
+
+
+def test_the_jobs_process_reads_no_can_log_itself(turning_drive_folder, tmp_path):
+    """The sequence is read in a child process: python-can and cantools (8 MiB) load there,
+    not in the process that runs the job and holds its results."""
+    code = (
+        "import sys\nfrom contextlib import nullcontext\nfrom pathlib import Path\n"
+        "from vo_doppler.job import run_recording\nfrom vo_doppler.run import RunConfig\n"
+        f"output = run_recording(Path({str(turning_drive_folder)!r}), RunConfig(), "
+        f"lambda: nullcontext(Path({str(tmp_path)!r})))\n"
+        "print(output.sequence.vehicle_source.sensor, len(output.sequence.wheel_speed), "
+        "'cantools' in sys.modules, 'can' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    sensor, samples, cantools_loaded, can_loaded = done.stdout.split()
+    assert (sensor, cantools_loaded, can_loaded) == ("CAN", "False", "False")
+    assert int(samples) > 100

@@ -11,17 +11,23 @@ import gc
 import logging
 from collections.abc import Callable
 from contextlib import AbstractContextManager, nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from vo_doppler.child_process import call_in_child
 from vo_doppler.errors import InputError
 from vo_doppler.io.heading_csv import read_heading_csv
-from vo_doppler.io.sequence import read_manifest, read_sequence_with_report
+from vo_doppler.io.sequence import (
+    InputReport,
+    read_ground_truth,
+    read_manifest,
+    read_sequence_with_report,
+)
 from vo_doppler.model.given_heading import GivenHeading
 from vo_doppler.model.sequence import Sequence
-from vo_doppler.model.time_span import TimeSpan, trim_sequence
+from vo_doppler.model.time_span import GpsInterval, TimeSpan, trim, trim_sequence
 from vo_doppler.report.run_outputs import input_warnings, result_checks, write_run_outputs
 from vo_doppler.run import RunResult, run_sequence
 from vo_doppler.run_stages import RunConfig
@@ -63,10 +69,9 @@ def run_recording(
     What is alive before the run (the imported modules, the inputs) and after it (its results)
     is frozen until the job ends: the cycle collector's full passes (automatic, and after
     each figure) skip it."""
-    sequence, report = read_sequence_with_report(folder, allow_outside_paths)
-    interval = None
-    if span is not None and not span.whole:
-        sequence, interval = trim_sequence(sequence, span)
+    sequence, report, interval, has_truth = call_in_child(
+        lambda _: _read_for_the_run(folder, span, allow_outside_paths)
+    )
     given = None
     warnings = input_warnings(sequence, report)
     if heading_file is not None:
@@ -80,6 +85,9 @@ def run_recording(
             result = run_sequence(
                 sequence, config, on_frame, given=given, in_child=True, keep_rows=False
             )
+        if has_truth:
+            truth = read_ground_truth(folder, allow_outside_paths)
+            sequence.truth = truth if interval is None else trim(truth, interval)
         gc.freeze()
         checks = result_checks(sequence, report, result, warnings)
         with write_into() as out:
@@ -95,6 +103,22 @@ def run_recording(
     finally:
         gc.unfreeze()
     return JobOutput(sequence, result, summary)
+
+
+def _read_for_the_run(
+    folder: Path, span: TimeSpan | None, allow_outside_paths: bool
+) -> tuple[Sequence, InputReport, GpsInterval | None, bool]:
+    """The sequence of ``folder`` read and cut to ``span`` (with the GPS interval of the cut, or
+    None), what reading found, and whether it has ground truth, which is left out of the
+    sequence: the run does not use it, and :func:`run_recording` reads it again for the outputs
+    (a 30-min drive's at 100 Hz is 11 MiB not held through the VO). Run in a child process
+    (:func:`~vo_doppler.child_process.call_in_child`), so that the readers' libraries (python-can
+    and cantools, 8 MiB) and their transients leave with it."""
+    sequence, report = read_sequence_with_report(folder, allow_outside_paths)
+    interval = None
+    if span is not None and not span.whole:
+        sequence, interval = trim_sequence(sequence, span)
+    return replace(sequence, truth=None), report, interval, sequence.truth is not None
 
 
 def _heading_time_base(sequence: Sequence, given: GivenHeading, path: Path) -> list[str]:

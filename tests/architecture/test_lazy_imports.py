@@ -4,8 +4,9 @@ camera) nor matplotlib (about 28 MiB, needed only when a figure is drawn), nor s
 filterpy (about 0.4 s of CPU per process; filterpy only serves the Kalman calibration, which is not
 the default), nor scipy.optimize and scipy.interpolate (about 24 MiB, needed only by the GNSS and
 heading stages, which ``run`` gives a child process of their own: without them the parent holds
-24 MiB less through the VO and the outputs). Checked in a fresh interpreter, since this one has
-them all loaded by other tests."""
+24 MiB less through the VO and the outputs), nor python-can and cantools (8 MiB, needed only while
+the CAN log is read, which ``run`` does in a child process: ``tests/test_job.py``). Checked in a
+fresh interpreter, since this one has them all loaded by other tests."""
 
 from __future__ import annotations
 
@@ -25,6 +26,8 @@ HEAVY = (
     "filterpy",
     "scipy.optimize",
     "scipy.interpolate",
+    "cantools",
+    "can",
 )
 MAIN_JOB = (
     "vo_doppler.commands.run_command",
@@ -66,6 +69,7 @@ def test_the_check_sees_a_heavy_import():
     assert loaded_after_import(("vo_doppler.vo.batch",)) == ["cv2", "pycolmap"]
     assert "scipy.stats" in loaded_after_import(("scipy.stats",))
     assert loaded_after_import(("scipy.interpolate",)) == ["scipy.optimize", "scipy.interpolate"]
+    assert loaded_after_import(("vo_doppler.io.can",)) == ["cantools", "can"]
 
 
 def test_new_figure_draws_with_matplotlib():

@@ -15,7 +15,6 @@ from hypothesis import strategies as st
 from tests.conftest import require_shared
 from vo_doppler.errors import InputError
 from vo_doppler.io.can import (
-    CanDecodeReport,
     SignalRef,
     check_dbc,
     decode_motion,
@@ -26,6 +25,7 @@ from vo_doppler.io.can import (
     read_can_log,
     read_can_motion,
 )
+from vo_doppler.io.can_report import CanDecodeReport
 from vo_doppler.io.sensor_csv import read_speed_csv, read_yaw_rate_csv, write_sensor_csv
 from vo_doppler.model.series import SensorSeries
 

@@ -34,7 +34,8 @@ from vo_doppler.gnss.pipeline import gnss_velocity
 from vo_doppler.heading.from_gnss import emulated_canyon, heading_from_gnss
 from vo_doppler.heading.integrity import car_checked_velocity
 from vo_doppler.heading.pipeline import CalibrationMethod
-from vo_doppler.io.can import ShortFrames, read_can_motion
+from vo_doppler.io.can import read_can_motion
+from vo_doppler.io.can_report import ShortFrames
 from vo_doppler.io.gnss_csv import write_velocity_csv
 from vo_doppler.io.heading_csv import write_heading_csv
 from vo_doppler.io.output_folder import write_files

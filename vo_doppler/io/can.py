@@ -32,8 +32,7 @@ import re
 import warnings
 from array import array
 from collections import Counter
-from dataclasses import dataclass, field
-from enum import StrEnum
+from dataclasses import dataclass
 from pathlib import Path
 
 import can
@@ -49,6 +48,7 @@ from vo_doppler.bounds import (
 )
 from vo_doppler.choices import checked
 from vo_doppler.errors import InputError
+from vo_doppler.io.can_report import CanDecodeReport, ShortFrames
 from vo_doppler.io.textfile import (
     MAX_LINE_CHARS,
     SMALL_MAX_BYTES,
@@ -56,7 +56,7 @@ from vo_doppler.io.textfile import (
     read_text,
     regular_file,
 )
-from vo_doppler.io.time_order import TimeOrderReport, order_samples
+from vo_doppler.io.time_order import order_samples
 from vo_doppler.model.series import SensorSeries
 
 log = logging.getLogger(__name__)
@@ -96,39 +96,6 @@ class CanFrames:
 
     def __len__(self) -> int:
         return len(self.t)
-
-
-@dataclass
-class CanDecodeReport:
-    """What happened to the frames: used, short (skipped or zero-padded), undecodable (by id),
-    ignored."""
-
-    n_frames: int = 0
-    n_decoded: int = 0
-    n_short_skipped: int = 0
-    n_padded: int = 0
-    n_undecodable: int = 0
-    n_unreadable_lines: int = 0
-    undecodable_by_id: dict[int, int] = field(default_factory=dict)
-    time_order: dict[str, TimeOrderReport] = field(default_factory=dict)
-    """Per decoded message, what its time order needed."""
-    dbc_units: dict[str, str] = field(default_factory=dict)
-    """Unit string the DBC declares for each decoded ``MESSAGE.SIGNAL``."""
-    out_of_range: dict[str, str] = field(default_factory=dict)
-    """Per ``MESSAGE.SIGNAL``, what was skipped as beyond a vehicle's range (a sentence)."""
-
-    def summary(self) -> str:
-        ids = ", ".join(f"0x{k:X}×{v}" for k, v in sorted(self.undecodable_by_id.items()))
-        return (
-            f"{self.n_frames} frames, {self.n_decoded} decoded, "
-            f"{self.n_short_skipped} short skipped, {self.n_padded} short zero-padded, "
-            f"{self.n_undecodable} undecodable{f' ({ids})' if ids else ''}, "
-            f"{self.n_unreadable_lines} unreadable log lines"
-        )
-
-    def problems(self) -> list[str]:
-        """Sentences for the warnings of a run: the samples skipped as out of range."""
-        return list(self.out_of_range.values())
 
 
 @dataclass
@@ -444,14 +411,6 @@ def check_dbc(dbc_path: str | Path, yaw_rate: str, wheel_speed: str) -> None:
             raise SignalError("; ".join(wrong))
     except InputError as exc:
         raise SignalError(str(exc), dbc_path) from exc
-
-
-class ShortFrames(StrEnum):
-    """What is done with frames shorter than their DBC length (module docstring)."""
-
-    SKIP = "skip"
-    PAD = "pad"
-    """Zero-padded, for logs known to drop trailing zero bytes."""
 
 
 class _StreamDecoder:

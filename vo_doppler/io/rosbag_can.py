@@ -30,7 +30,6 @@ import numpy as np
 from vo_doppler.errors import InputError
 from vo_doppler.io.can import (
     MAX_ARBITRATION_ID,
-    CanDecodeReport,
     SignalError,
     SignalRef,
     decode_motion,
@@ -38,6 +37,7 @@ from vo_doppler.io.can import (
     load_dbc,
     parse_signal_list,
 )
+from vo_doppler.io.can_report import CanDecodeReport
 from vo_doppler.io.rosbag_bag import Bag
 from vo_doppler.io.rosbag_types import field as get
 from vo_doppler.model.series import SensorSeries

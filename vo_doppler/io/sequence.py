@@ -23,7 +23,7 @@ from vo_doppler.choices import allowed, values
 from vo_doppler.errors import InputError, ManifestError, shown
 from vo_doppler.geo import EnuFrame
 from vo_doppler.io.calibration import read_camera
-from vo_doppler.io.can import CanDecodeReport, ShortFrames, SignalError, read_can_motion
+from vo_doppler.io.can_report import CanDecodeReport, ShortFrames
 from vo_doppler.io.doppler_sigma import read_doppler_sigma
 from vo_doppler.io.images import check_image_size, list_images, read_times
 from vo_doppler.io.rinex_obs import read_obs
@@ -42,6 +42,7 @@ from vo_doppler.memory import release_free_heap
 from vo_doppler.model.image_files import ImageFiles
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.series import SensorSeries
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.model.vehicle_source import VehicleSignalSource
 
 log = logging.getLogger(__name__)
@@ -277,9 +278,7 @@ def read_sequence_with_report(
         np.radians(m.number("origin", "lon_deg", low=-180.0, high=180.0)),
         m.number("origin", "height_m", 0.0, low=-1.0e3, high=1.0e4),
     )
-    truth = None
-    if "ground_truth" in m.data:  # optional, but a named file must be there, as every input
-        truth = read_tum(m.file("ground_truth", "trajectory"))
+    truth = _ground_truth(m)
     forward_acceleration = motion.forward_acceleration
     imu = m.data.get("imu")
     if isinstance(imu, dict) and "forward_acceleration" in imu:
@@ -308,6 +307,17 @@ def read_sequence_with_report(
     )
     release_free_heap()  # the readers' temporaries: 50 MiB resident on a 30-min drive else
     return sequence, report
+
+
+def read_ground_truth(folder: str | Path, allow_outside: bool = False) -> Trajectory | None:
+    """The sequence's ground truth as :func:`read_sequence` reads it; None when it has none."""
+    return _ground_truth(Manifest(read_manifest(folder), allow_outside))
+
+
+def _ground_truth(m: Manifest) -> Trajectory | None:
+    if "ground_truth" not in m.data:  # optional, but a named file must be there, as every input
+        return None
+    return read_tum(m.file("ground_truth", "trajectory"))
 
 
 def _gnss(m: Manifest):
@@ -384,6 +394,10 @@ def _sensor_csv(
 
 def _can_motion(m: Manifest, report: InputReport) -> _VehicleMotion:
     """The ``can`` section: the log decoded with its DBC."""
+    # python-can and cantools load here, not with the module: a process that receives a
+    # sequence read elsewhere (vo_doppler.job) need not hold them.
+    from vo_doppler.io.can import SignalError, read_can_motion
+
     can_offset = m.time_offset("can")
     short_frames = m.string("can", "short_frames", ShortFrames.SKIP.value)
     if short_frames not in values(ShortFrames):
