@@ -39,7 +39,7 @@ from vo_doppler.fusion.correction import HeadingSource, absolute_heading
 from vo_doppler.fusion.pipelines import Pipeline, dead_reckoning
 from vo_doppler.fusion.placement import level_with_yaw
 from vo_doppler.gnss.pipeline import GnssVelocityResult
-from vo_doppler.memory import release_free_heap
+from vo_doppler.memory import Parked, release_free_heap
 from vo_doppler.model.given_heading import GivenHeading
 from vo_doppler.model.heading import HeadingTable
 from vo_doppler.model.sequence import Sequence
@@ -63,9 +63,8 @@ log = logging.getLogger(__name__)
 @dataclass
 class RunResult:
     gnss: GnssVelocityResult | None
-    """None for a recording without GNSS (so is ``heading``). Its Doppler rows are emptied
-    once the heading stage has used them (:func:`without_rows`; ``sequence_gnss`` gives
-    them)."""
+    """None for a recording without GNSS (so is ``heading``). Without the Doppler rows the
+    heading stage used (:func:`without_rows`; ``sequence_gnss`` gives them)."""
     heading: HeadingTable | None
     vo: VoOutput | None
     """None for a recording without a camera."""
@@ -77,12 +76,10 @@ class RunResult:
     tc_usable: np.ndarray
     """Epochs whose tightly coupled heading was allowed to correct."""
     warnings: list[str] = field(default_factory=list)
-    """What the checks found doubtful in the inputs and the calibration (each also logged):
-    the origin against the RINEX approximate position, then the heading stage's
-    (``heading.warnings``)."""
+    """What the checks found doubtful in the inputs and the calibration (each also logged): the
+    origin against the RINEX approximate position, then ``heading.warnings``."""
     heading_source: str = ""
-    """Where ``heading`` came from, in words, when it was given (:class:`GivenHeading`);
-    empty when the heading stage computed it from GNSS."""
+    """Where a given ``heading`` came from, in words (:class:`GivenHeading`); else empty."""
 
 
 def run_sequence(
@@ -97,21 +94,18 @@ def run_sequence(
     """Run every stage on a recording. ``images`` replaces reading ``sequence.image_paths``
     (e.g. frames already in memory); ``on_frame`` is called after each VO frame; ``given``,
     an absolute heading from elsewhere, replaces the heading stage
-    (:func:`run_with_given_heading`). With ``in_child`` the GNSS and heading stages run in
-    one forked child process and the VO in another, with the same result: OpenCV and pycolmap
-    (about 70 MiB) leave with the VO's child instead of staying loaded through the correction
-    and the outputs, where the job peaks, and the heap the GNSS and heading stages fragment
-    leaves with theirs (with ``given``, only the VO runs in a child; ``vo-doppler run`` and
-    ``batch`` pass ``in_child``; :mod:`vo_doppler.child_process`). With ``keep_rows`` False
-    (``run`` and ``batch``), ``sequence.observations`` becomes its ``epochs_only()`` once the
-    GNSS stage has used its rows, so that they are not held through the VO.
+    (:func:`run_with_given_heading`). With ``in_child`` (``vo-doppler run`` and ``batch``) the
+    GNSS and heading stages run in one forked child process and the VO in another, with the
+    same result: OpenCV and pycolmap (about 70 MiB) and the heap the stages fragment leave with
+    them instead of staying through the correction and the outputs, where the job peaks
+    (:mod:`vo_doppler.child_process`; with ``given``, only the VO's). With ``keep_rows`` False,
+    ``sequence.observations`` becomes its ``epochs_only()`` once the GNSS stage has used its
+    rows. The GNSS result and the heading table wait on disk through the VO (:class:`Parked`).
 
-    The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`, in the
-    heading stage: :func:`~vo_doppler.heading.from_gnss.heading_from_gnss`): vehicle signals
-    whose times miss the GNSS epochs, a yaw rate too large for a car (before the stage's work)
-    or turning against the GNSS Doppler course (after it, before the VO) raises
-    :class:`InputError`; the rest are warnings, logged and returned in
-    ``RunResult.warnings``."""
+    The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`, in
+    :func:`~vo_doppler.heading.from_gnss.heading_from_gnss`): vehicle signals whose times miss
+    the GNSS epochs, a yaw rate too large for a car or turning against the GNSS Doppler course
+    raises :class:`InputError`; the rest are warnings, logged and in ``RunResult.warnings``."""
     config = (config or RunConfig()).for_sequence(sequence)
     if given is not None:
         return run_with_given_heading(
@@ -124,11 +118,14 @@ def run_sequence(
     if origin:
         log.warning("%s", origin)
     gnss, table = gnss_and_heading(sequence, config, in_child)
+    speed = table.calibrated_speed(sequence.wheel_speed)
+    parked = Parked((gnss, table), to_disk=sequence.has_camera)
+    del gnss, table
     if not keep_rows:
         sequence.observations = obs = obs.epochs_only()
-        release_free_heap()
-    speed = table.calibrated_speed(sequence.wheel_speed)
+    release_free_heap()
     vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
+    gnss, table = parked.take()
     if vo is None:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
     antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
@@ -230,7 +227,6 @@ def run_with_given_heading(
         if not keep_rows:
             sequence.observations = obs = obs.epochs_only()
         antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
-        release_free_heap()
     else:
         warnings.append(NO_GNSS_GIVEN.format(name=sequence.name))
     for text in warnings:
@@ -238,7 +234,11 @@ def run_with_given_heading(
     speed, yaw_rate = sequence.wheel_speed, sequence.yaw_rate
     if given.has_calibration:
         speed, yaw_rate = table.calibrated_speed(speed), table.calibrated_yaw_rate(yaw_rate)
+    parked = Parked(gnss, to_disk=sequence.has_camera)
+    del gnss
+    release_free_heap()
     vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
+    gnss = parked.take()
     trajectories, usable = sequence_trajectories(
         sequence, table, vo_vehicle, speed, antenna, config, yaw_rate, tight_source
     )
