@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import base64
+import gc
 import html
 import io
 import json
 import re
 import subprocess
 import sys
+import tempfile
+import weakref
 from dataclasses import replace
 
 import numpy as np
@@ -17,6 +20,8 @@ from matplotlib.image import imread
 
 from tests.conftest import REPO_ROOT
 from tests.helpers.images import distinct_colours
+from vo_doppler import memory
+from vo_doppler import run as run_module
 from vo_doppler.cli import main
 from vo_doppler.errors import InputError
 from vo_doppler.eval.pipelines import absolute_position_errors
@@ -30,7 +35,7 @@ from vo_doppler.model.series import SensorSeries
 from vo_doppler.report.provenance import config_rows
 from vo_doppler.report.trajectory_map import lon_lat
 from vo_doppler.run import RunConfig, run_sequence
-from vo_doppler.run_stages import sequence_gnss, sequence_heading
+from vo_doppler.run_stages import gnss_and_heading, sequence_gnss, sequence_heading, vehicle_vo
 from vo_doppler.sim.urban_canyon import UrbanCanyonConfig, simulate_urban_canyon
 
 
@@ -348,3 +353,33 @@ def test_the_vo_in_a_child_process_gives_the_same_run_and_leaves_no_opencv_here(
     for name, track in here.trajectories.items():
         poses = np.column_stack([track.t, track.positions, track.orientations.as_quat()])
         np.testing.assert_array_equal(child[name.value], poses)
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("short_drive")
+def test_the_gnss_result_and_the_heading_table_wait_on_disk_through_the_vo(
+    short_drive_folder, tmp_path, monkeypatch
+):
+    """Issue 30: nothing holds the GNSS stage's result or the heading table while the VO runs
+    (19 MiB on a 30-min drive): they wait in a temporary file, and come back whole."""
+    if memory._file_system_of(str(tmp_path)) in memory.RAM_FILE_SYSTEMS:
+        pytest.skip(f"{tmp_path} is on a RAM file system: nothing is parked there")
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    made, during_vo = [], []
+
+    def stages(*args, **kwargs):
+        gnss, table = gnss_and_heading(*args, **kwargs)
+        made.extend([weakref.ref(gnss), weakref.ref(table)])
+        return gnss, table
+
+    def vo(*args, **kwargs):
+        gc.collect()
+        during_vo.append([ref() is None for ref in made])
+        return vehicle_vo(*args, **kwargs)
+
+    monkeypatch.setattr(run_module, "gnss_and_heading", stages)
+    monkeypatch.setattr(run_module, "vehicle_vo", vo)
+    result = run_sequence(read_sequence(short_drive_folder))
+    assert during_vo == [[True, True]]
+    assert len(result.gnss.velocity.t) > 100 and np.isfinite(result.heading.yaw_tc).any()
+    assert result.vo is not None and list(tmp_path.iterdir()) == []
