@@ -15,6 +15,7 @@ from contextlib import contextmanager, nullcontext
 import numpy as np
 import pytest
 
+from vo_doppler import job as job_module
 from vo_doppler.errors import InputError
 from vo_doppler.io.sequence import read_sequence
 from vo_doppler.job import require_tight_heading, run_recording
@@ -144,3 +145,23 @@ def test_the_jobs_process_reads_no_can_log_itself(turning_drive_folder, tmp_path
     sensor, samples, cantools_loaded, can_loaded = done.stdout.split()
     assert (sensor, cantools_loaded, can_loaded) == ("CAN", "False", "False")
     assert int(samples) > 100
+
+
+def test_a_ground_truth_gone_by_the_outputs_costs_the_evaluation_not_the_run(
+    turning_drive_folder, tmp_path, monkeypatch
+):
+    """The truth is read again after the run: a file changed or gone since is a warning, and
+    every other output is written."""
+
+    def gone(folder, allow_outside=False):
+        raise InputError("no such file", turning_drive_folder / "ground_truth.tum")
+
+    monkeypatch.setattr(job_module, "read_ground_truth", gone)
+    output = run_recording(turning_drive_folder, RunConfig(), lambda: nullcontext(tmp_path))
+    assert output.sequence.truth is None and "evaluation" not in output.summary
+    said = [text for text in output.summary["warnings"] if "ground truth" in text]
+    assert said == [
+        f"the ground truth could not be read again for the outputs "
+        f"({turning_drive_folder / 'ground_truth.tum'}: no such file): no evaluation"
+    ]
+    assert (tmp_path / "trajectory_dr_gps_tc.tum").stat().st_size > 0

@@ -28,6 +28,7 @@ from vo_doppler.io.sequence import (
 from vo_doppler.model.given_heading import GivenHeading
 from vo_doppler.model.sequence import Sequence
 from vo_doppler.model.time_span import GpsInterval, TimeSpan, trim, trim_sequence
+from vo_doppler.model.trajectory import Trajectory
 from vo_doppler.report.run_outputs import input_warnings, result_checks, write_run_outputs
 from vo_doppler.run import RunResult, run_sequence
 from vo_doppler.run_stages import RunConfig
@@ -86,8 +87,7 @@ def run_recording(
                 sequence, config, on_frame, given=given, in_child=True, keep_rows=False
             )
         if has_truth:
-            truth = read_ground_truth(folder, allow_outside_paths)
-            sequence.truth = truth if interval is None else trim(truth, interval)
+            sequence.truth = _ground_truth_again(folder, allow_outside_paths, interval, warnings)
         gc.freeze()
         checks = result_checks(sequence, report, result, warnings)
         with write_into() as out:
@@ -119,6 +119,22 @@ def _read_for_the_run(
     if span is not None and not span.whole:
         sequence, interval = trim_sequence(sequence, span)
     return replace(sequence, truth=None), report, interval, sequence.truth is not None
+
+
+def _ground_truth_again(
+    folder: Path, allow_outside_paths: bool, interval: GpsInterval | None, warnings: list[str]
+) -> Trajectory | None:
+    """The ground truth read again for the outputs and cut as the sequence was
+    (:func:`_read_for_the_run` checked it before the run): a file changed or gone since costs
+    the evaluation, said in ``warnings`` and the log, not the run's results."""
+    try:
+        truth = read_ground_truth(folder, allow_outside_paths)
+    except (InputError, OSError) as exc:
+        text = f"the ground truth could not be read again for the outputs ({exc}): no evaluation"
+        log.warning("%s", text)
+        warnings.append(text)
+        return None
+    return truth if truth is None or interval is None else trim(truth, interval)
 
 
 def _heading_time_base(sequence: Sequence, given: GivenHeading, path: Path) -> list[str]:
