@@ -123,7 +123,6 @@ def run_sequence(
     del gnss, table
     if not keep_rows:
         sequence.observations = obs = obs.epochs_only()
-    release_free_heap()
     vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
     gnss, table = parked.take()
     if vo is None:
@@ -236,7 +235,6 @@ def run_with_given_heading(
         speed, yaw_rate = table.calibrated_speed(speed), table.calibrated_yaw_rate(yaw_rate)
     parked = Parked(gnss, to_disk=sequence.has_camera)
     del gnss
-    release_free_heap()
     vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
     gnss = parked.take()
     trajectories, usable = sequence_trajectories(

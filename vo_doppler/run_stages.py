@@ -133,10 +133,12 @@ def vehicle_vo(
     """:func:`sequence_vo` and its camera poses as vehicle poses, (None, None) for a recording
     without a camera. With ``in_child`` the VO runs in a forked child process
     (:func:`~vo_doppler.child_process.call_in_child`: the same result, and OpenCV and pycolmap
-    leave with the child instead of staying loaded through the correction and the outputs)."""
+    leave with the child instead of staying loaded through the correction and the outputs),
+    the heap trimmed first."""
     if not sequence.has_camera:
         return None, None
     if in_child:
+        release_free_heap()  # what the caller let go is not held resident through the VO
         vo = call_in_child(
             lambda report: sequence_vo(sequence, config, speed, report, images), on_frame
         )
