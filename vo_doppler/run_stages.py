@@ -183,7 +183,7 @@ def gnss_and_heading(
 
     def stages(_: object) -> tuple[GnssVelocityResult, HeadingTable]:
         gnss = sequence_gnss(sequence, config)
-        rows, gnss = gnss.rows.in_enu(), without_rows(gnss)
+        rows, gnss = gnss.rows.in_enu().required_only(), without_rows(gnss)
         release_free_heap()
         return gnss, sequence_heading(sequence, rows, gnss.velocity, config.heading)
 
@@ -196,5 +196,7 @@ def without_rows(gnss: GnssVelocityResult) -> GnssVelocityResult:
     """``gnss`` with no Doppler row (their counts of rows not formed kept): nothing after the
     heading stage reads them, and the rows of a 30-min drive at 20 Hz are 28 MiB held through
     the VO and the outputs. :func:`gnss_and_heading` lets them go as soon as it has them in the
-    ENU frame the heading stage takes, which share every array but the vectors with them."""
+    ENU frame the heading stage takes, with the columns it reads alone
+    (:meth:`~vo_doppler.model.doppler.DopplerRows.required_only`), which share every array but
+    the vectors with them."""
     return replace(gnss, rows=gnss.rows.select(np.zeros(0, dtype=int)))

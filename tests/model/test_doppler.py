@@ -76,6 +76,25 @@ def test_rows_turned_into_enu_share_everything_but_the_vectors():
     assert not np.shares_memory(enu.los, rows.los)
 
 
+def test_rows_with_the_required_columns_only_share_them_and_keep_the_counts():
+    rows = dataclasses.replace(
+        rows_of(np.array([1.0, 2.0]), np.array([4.0, -3.0]), np.array([2.0, 1.0])),
+        epoch=np.array([0, 1]),
+        code=np.array(["D1C", "D1C"]),
+        cn0=np.array([40.0, 35.0]),
+        receiver_ecef=np.zeros((2, 3)),
+        n_no_ephemeris=3,
+        missing=("G07@1.000",),
+    )
+    core = rows.required_only()
+    for name in ROW_ARRAYS:
+        assert getattr(core, name) is getattr(rows, name)
+    assert core.epoch is None and core.code is None and core.cn0 is None
+    assert core.receiver_ecef is None
+    assert (core.n_no_ephemeris, core.missing, core.frame) == (3, ("G07@1.000",), rows.frame)
+    assert rows.cn0 is not None
+
+
 def test_the_frame_is_a_member_and_an_unknown_one_is_refused():
     rows = rows_of(np.array([0.0, 1.0]), np.zeros(2), np.ones(2))
     ecef = dataclasses.replace(rows, frame="ecef")

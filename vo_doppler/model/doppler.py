@@ -51,6 +51,12 @@ class VectorFrame(StrEnum):
     ENU = "enu"
 
 
+REQUIRED_ROW_COLUMNS = frozenset(
+    {"t", "los", "sat_velocity", "sat_clock_drift", "range_rate", "weight", "sat_id"}
+)
+"""The columns every :class:`DopplerRows` has (its docstring says what each is)."""
+
+
 @dataclass
 class DopplerRows:
     """Doppler rows sorted by time. Required per row: ``t`` (GPS s), ``los``, ``sat_velocity``
@@ -130,6 +136,14 @@ class DopplerRows:
         return replace(
             self, **{name: read_only(value[keep]) for name, value in self._row_arrays().items()}
         )
+
+    def required_only(self) -> DopplerRows:
+        """The rows with their required columns alone (class docstring), the measurement's
+        origin dropped and the counts kept: what the velocity and heading solvers read. The
+        heading stage takes these, 12 MiB less than all columns in ENU on a 30-min drive at
+        20 Hz."""
+        optional = [f.name for f in fields(self) if f.name not in REQUIRED_ROW_COLUMNS]
+        return replace(self, **{name: None for name in optional if name in self._row_arrays()})
 
     def reduced(self) -> np.ndarray:
         """y = ṙ − G·v_s + ρ_s = −G·v + ρ (m/s)."""
