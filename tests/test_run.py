@@ -323,6 +323,27 @@ def test_the_heading_stage_of_the_run_gets_the_rows_required_columns_only(
     assert kept == REQUIRED_ROW_COLUMNS
 
 
+def test_the_observations_rows_go_before_the_heading_stage_when_not_kept(
+    turning_drive, monkeypatch
+):
+    """Issue 30: the observations' rows (11 MiB on a 30-min drive at 20 Hz), which only the
+    GNSS stage reads, were held through the heading stage too; kept they stay."""
+    seen = []
+
+    def heading(sequence, rows, velocity, config):
+        seen.append(len(sequence.observations))
+        return sequence_heading(sequence, rows, velocity, config)
+
+    monkeypatch.setattr(run_stages, "sequence_heading", heading)
+    for keep_rows in (True, False):
+        drive = replace(turning_drive, camera=None)
+        n_rows, epochs = len(drive.observations), drive.observations.epoch_time
+        gnss_and_heading(drive, RunConfig().for_sequence(drive), keep_rows=keep_rows)
+        assert seen.pop() == (n_rows if keep_rows else 0)
+        assert drive.observations.epoch_time is epochs
+    assert n_rows > 1000
+
+
 CHILD_RUN = """
 import sys
 import numpy as np

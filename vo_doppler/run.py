@@ -95,7 +95,7 @@ def run_sequence(
     (e.g. frames already in memory); ``on_frame`` is called after each VO frame; ``given``,
     an absolute heading from elsewhere, replaces the heading stage
     (:func:`run_with_given_heading`). With ``in_child`` (``vo-doppler run`` and ``batch``) the
-    GNSS and heading stages run in one forked child process and the VO in another, with the
+    GNSS stage, the heading stage and the VO each run in a forked child process, with the
     same result: OpenCV and pycolmap (about 70 MiB) and the heap the stages fragment leave with
     them instead of staying through the correction and the outputs, where the job peaks
     (:mod:`vo_doppler.child_process`; with ``given``, only the VO's). With ``keep_rows`` False,
