@@ -139,9 +139,9 @@ class DopplerRows:
 
     def required_only(self) -> DopplerRows:
         """The rows with their required columns alone (class docstring), the measurement's
-        origin dropped and the counts kept: what the velocity and heading solvers read. The
-        heading stage takes these, 12 MiB less than all columns in ENU on a 30-min drive at
-        20 Hz."""
+        origin dropped and the counts kept: all that the heading stage reads. A run's heading
+        stage takes these, 12 MiB less than all columns in ENU on a 30-min drive at 20 Hz
+        (the velocity solver needs the origin too: each row's epoch, satellite, receiver)."""
         optional = [f.name for f in fields(self) if f.name not in REQUIRED_ROW_COLUMNS]
         return replace(self, **{name: None for name in optional if name in self._row_arrays()})
 
