@@ -342,6 +342,9 @@ def test_the_observations_rows_go_before_the_heading_stage_when_not_kept(
         assert seen.pop() == (n_rows if keep_rows else 0)
         assert drive.observations.epoch_time is epochs
     assert n_rows > 1000
+    drive = replace(turning_drive, camera=None)
+    run_sequence(drive, keep_rows=False)
+    assert seen.pop() == 0 and len(drive.observations) == 0
 
 
 CHILD_RUN = """

@@ -100,7 +100,8 @@ def run_sequence(
     them instead of staying through the correction and the outputs, where the job peaks
     (:mod:`vo_doppler.child_process`; with ``given``, only the VO's). With ``keep_rows`` False,
     ``sequence.observations`` becomes its ``epochs_only()`` once the GNSS stage has used its
-    rows. The GNSS result and the heading table wait on disk through the VO (:class:`Parked`).
+    rows, before the heading stage. The GNSS result and the heading table wait on disk through
+    the VO (:class:`Parked`).
 
     The inputs are checked as ``vo-doppler run`` checks them (:mod:`vo_doppler.checks`, in
     :func:`~vo_doppler.heading.from_gnss.heading_from_gnss`): vehicle signals whose times miss
@@ -113,21 +114,19 @@ def run_sequence(
         )
     if not sequence.has_gnss:
         return run_without_gnss(sequence, config, on_frame, images, in_child)
-    obs = sequence.observations
-    origin = origin_warning(sequence.enu, obs.header.approx_position)
+    header = sequence.observations.header
+    origin = origin_warning(sequence.enu, header.approx_position)
     if origin:
         log.warning("%s", origin)
-    gnss, table = gnss_and_heading(sequence, config, in_child)
+    gnss, table = gnss_and_heading(sequence, config, in_child, keep_rows)
     speed = table.calibrated_speed(sequence.wheel_speed)
     parked = Parked((gnss, table), to_disk=sequence.has_camera)
     del gnss, table
-    if not keep_rows:
-        sequence.observations = obs = obs.epochs_only()
     vo, vo_vehicle = vehicle_vo(sequence, config.vo, speed, on_frame, images, in_child)
     gnss, table = parked.take()
     if vo is None:
         log.warning("%s has no camera: only the non-visual pipelines run", sequence.name)
-    antenna = antenna_track(gnss.spp, gnss.velocity, obs.header.approx_position, sequence.enu)
+    antenna = antenna_track(gnss.spp, gnss.velocity, header.approx_position, sequence.enu)
     trajectories, usable = sequence_trajectories(
         sequence, table, vo_vehicle, speed, antenna, config
     )
