@@ -191,7 +191,10 @@ def gnss_and_heading(
 
     def gnss_stage(_: object) -> tuple[DopplerRows, GnssVelocityResult]:
         gnss = sequence_gnss(sequence, config)
-        return gnss.rows.in_enu().required_only(), without_rows(gnss)
+        result = gnss.rows.in_enu().required_only(), without_rows(gnss)
+        del gnss
+        release_free_heap()  # the child's heap is not held beside the parent's copy
+        return result
 
     rows, gnss = run(gnss_stage)
     if not keep_rows:
